@@ -1,0 +1,94 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "flexkin/chain.h"
+#include "flexkin/propagate.h"
+
+namespace flexkin {
+
+// Options of a whole run: a chain whose leading end visits a list of targets (the leader steps).
+struct RunOptions {
+  // Link rule: tractrix (the paper's sequential optimization) or follow-the-leader.
+  Method method = Method::kTractrix;
+  // Equal sub-steps each leader step is split into; computed but not recorded. >= 1.
+  // With `tolerance` > 0 this is the starting value of the automatic choice. Typical: 1 to 64.
+  int substeps = 1;
+  // Keep the initial frame, every `record_every`-th leader step and the last one. >= 1.
+  int record_every = 1;
+  // Accuracy control. If > 0, `substeps` is doubled until the estimated largest distance of any
+  // point, at any leader step, from the continuous motion (every point's velocity along its
+  // link) is at most `tolerance`, in the chain's length unit. 0 turns it off. Typical: 1e-6.
+  double tolerance = 0.0;
+  // Upper bound for the automatic choice of `substeps`. Typical: 65536.
+  int max_substeps = 1 << 16;
+  // Called with (leader steps done, total) about every 0.1 s of work; may be empty.
+  std::function<void(int64_t done, int64_t total)> progress;
+
+  // Empty if the options are valid, otherwise the reason, naming the field.
+  std::string Validate() const;
+};
+
+// One recorded configuration.
+struct Frame {
+  int64_t step = 0;  // leader steps done; 0 is the initial configuration
+  Points points;     // (n+1) by dim
+  // Angle in radians, in [0, pi], between each link (from its trailing to its leading end) and
+  // the leading end's current direction of motion (that of the last leader step that moved it;
+  // for frame 0, that of the first). 0 means aligned with the pull. Empty if the leader never
+  // moves.
+  Eigen::VectorXd link_angles;
+};
+
+// Metrics of a run (paper eq. 6 and Sec. 3.2).
+struct Metrics {
+  // Per leader step: sum over all points j = 0..n of |x_j(after) - x_j(before)|.
+  Eigen::VectorXd l2_per_step;
+  // The same weighted by arc length (trapezoid weights L_1/2, (L_i + L_{i+1})/2, ..., L_n/2),
+  // the discrete form of eq. (6).
+  Eigen::VectorXd l2_weighted_per_step;
+  double l2_total = 0.0;
+  double l2_weighted_total = 0.0;
+  // Largest |(|x_i - x_{i-1}| - L_i)| / L_i over every link and every leader step.
+  double max_relative_length_error = 0.0;
+  // Distance travelled by each point over the run, sub-steps included: n+1 values.
+  // The profile shows the motion dying out along the chain.
+  Eigen::VectorXd path_length;
+};
+
+// What the accuracy control did.
+struct AccuracyReport {
+  bool enabled = false;          // tolerance > 0 was asked for
+  int substeps = 1;              // sub-steps per leader step actually used
+  int order = 2;                 // convergence order assumed in the estimate (2 tractrix, 1 ftl)
+  double estimated_error = 0.0;  // Richardson estimate of the largest distance to the continuous
+                                 // motion; only meaningful if enabled
+  bool met = true;               // estimated_error <= tolerance (always true if not enabled)
+};
+
+struct RunResult {
+  Method method = Method::kTractrix;
+  Eigen::VectorXd lengths;  // the link lengths, fixed at the start
+  int64_t num_steps = 0;    // leader steps
+  std::vector<Frame> frames;
+  Metrics metrics;
+  AccuracyReport accuracy;
+  double seconds = 0.0;  // wall time of the computation
+
+  // One line: method, steps, length error, L2 total, accuracy.
+  std::string BriefReport() const;
+  // Several lines, including the path-length profile.
+  std::string FullReport() const;
+};
+
+// Runs `chain` with its leading end moved in straight lines through the rows of `leader_steps`
+// (m by dim, the successive targets, not including the start). Throws InputError on invalid
+// input (chain, targets, options).
+RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& options);
+
+}  // namespace flexkin

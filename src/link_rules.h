@@ -1,0 +1,178 @@
+#pragma once
+// Per-link update rules used by every sweep, written once for a scalar `double` and for an
+// xsimd batch (several lanes at once). Each rule updates `tail` in place and returns the mask of
+// lanes that must be redone with the scalar reference form (rare: degenerate or extreme inputs).
+// Everything here has internal linkage so that translation units compiled for different
+// instruction sets never share a copy.
+
+#include <cmath>
+#include <limits>
+
+namespace flexkin::internal {
+namespace {
+
+inline double select(bool mask, double a, double b) { return mask ? a : b; }
+using std::sqrt;
+
+// exp of a non-positive argument; the wavefront engine substitutes a vector version.
+struct StdExp {
+  double operator()(double x) const { return std::exp(x); }
+};
+
+template <int Dim, class T>
+inline T Dot(const T* a, const T* b) {
+  T s = a[0] * b[0];
+  for (int k = 1; k < Dim; ++k) s += a[k] * b[k];
+  return s;
+}
+
+// Reference form of the tractrix step (scalar), used where the fast form could under- or
+// overflow. Frame: u = unit direction of the head's move, r = tail - head_old = X0 u + v with
+// v _|_ u, Y0 = |v|. The tail's velocity along the link gives dX/dp = -(1 - X^2/L^2), so
+// phi = atanh(X/L) decreases linearly: phi(p) = phi0 - p/L with phi0 = asinh(X0/Y0), and
+//   r_new = L (tanh(phi) u + sech(phi) v/Y0).
+// asinh(X0/Y0) is exact as Y0 -> 0 (it goes to +-inf): no 1 + t*tau cancellation.
+template <int Dim>
+inline void TractrixStepReference(const double* head_old, const double* head_new, double* tail,
+                                  double length) {
+  double d[Dim], r[Dim];
+  for (int k = 0; k < Dim; ++k) {
+    d[k] = head_new[k] - head_old[k];
+    r[k] = tail[k] - head_old[k];
+  }
+  // Lengths are scaled by their largest component before squaring so nothing over/underflows.
+  auto norm = [](const double* x) {
+    double m = 0.0;
+    for (int k = 0; k < Dim; ++k) m = std::fmax(m, std::fabs(x[k]));
+    if (m == 0.0) return 0.0;
+    double s = 0.0;
+    for (int k = 0; k < Dim; ++k) s += (x[k] / m) * (x[k] / m);
+    return m * std::sqrt(s);
+  };
+  const double p = norm(d);
+  if (p == 0.0) return;  // the head did not move
+  const double inv_length = 1.0 / length;
+  double u[Dim], v[Dim];
+  for (int k = 0; k < Dim; ++k) u[k] = d[k] / p;
+  double x0 = 0.0;
+  for (int k = 0; k < Dim; ++k) x0 += (r[k] * inv_length) * u[k];
+  for (int k = 0; k < Dim; ++k) v[k] = r[k] * inv_length - x0 * u[k];
+  const double y0 = norm(v);
+  if (y0 == 0.0 && x0 > 0.0) {
+    // Exactly on the unstable equilibrium: the head moves straight at the tail, which is pushed
+    // ahead of it; the link translates.
+    for (int k = 0; k < Dim; ++k) tail[k] += d[k];
+    return;
+  }
+  const double phi0 = (y0 == 0.0) ? -std::numeric_limits<double>::infinity() : std::asinh(x0 / y0);
+  const double phi = phi0 - p * inv_length;  // may be -inf for huge moves of tiny links
+  const double th = std::tanh(phi);
+  const double sech = 1.0 / std::cosh(phi);  // cosh overflows to inf for |phi| > 710: sech = 0
+  for (int k = 0; k < Dim; ++k) {
+    const double across = (y0 > 0.0) ? sech * (v[k] / y0) : 0.0;
+    tail[k] = head_new[k] + length * (th * u[k] + across);
+  }
+}
+
+// Tractrix step in a rational form: one sqrt, one exp and one division.
+// With E = exp(-p/L) and sigma = exp(phi), the reference form gives
+//   pulling (X0 <= 0): sigma = Y0 E / (L - X0),   pushing (X0 > 0): sigma = (L + X0) E / Y0,
+// and tanh, sech are rational in sigma. Scaling numerator and denominator by powers of p removes
+// u = d/p and Y0 = |v|: with rd = r.d, dd = d.d, V = dd r - rd d (= p^2 v):
+//   pulling: s1 = |V|^2 E^2,          s2 = (L p - rd)^2 dd,  c = 2 E (L p - rd) dd
+//   pushing: s1 = (L p + rd)^2 E^2 dd, s2 = |V|^2,            c = 2 E (L p + rd) dd
+//   r_new = L ((s1 - s2) d + c V) / (p (s1 + s2)).
+// Each branch's denominator is a sum of non-negative terms: no cancellation. |r_new| = L holds
+// algebraically (c^2 |V|^2 = 4 s1 s2 dd), so the length is kept to rounding and rounding never
+// accumulates from step to step. Lanes whose denominator leaves the safe range (moves or offsets
+// beyond ~1e+-50 link lengths) are flagged for the reference form.
+template <int Dim, class Exp = StdExp>
+struct TractrixRule {
+  template <class T>
+  static auto Apply(const T* head_old, const T* head_new, T* tail, T length, T inv_length) {
+    T d[Dim], r[Dim], v[Dim];
+    for (int k = 0; k < Dim; ++k) {
+      d[k] = head_new[k] - head_old[k];
+      r[k] = tail[k] - head_old[k];
+    }
+    const T dd = Dot<Dim>(d, d);
+    const T rd = Dot<Dim>(r, d);
+    for (int k = 0; k < Dim; ++k) v[k] = dd * r[k] - rd * d[k];
+    const T vv = Dot<Dim>(v, v);
+    const T p = sqrt(dd);
+    const T e = Exp()(-p * inv_length);
+    const T lp = length * p;
+    const auto pulling = rd <= T(0.0);
+    const T b = lp - rd;
+    const T a = (lp + rd) * e;
+    const T s1 = select(pulling, vv * (e * e), (a * a) * dd);
+    const T s2 = select(pulling, (b * b) * dd, vv);
+    const T c = select(pulling, e * b, a) * (T(2.0) * dd);
+    const T den = p * (s1 + s2);
+    const T f = length / den;
+    const T g = f * (s1 - s2);
+    const T h = f * c;
+    const auto moved = dd > T(0.0);
+    for (int k = 0; k < Dim; ++k) tail[k] = select(moved, g * d[k] + (h * v[k] + head_new[k]), tail[k]);
+    const auto unsafe = (den <= T(1e-250)) | (den >= T(1e250)) | (den != den);
+    return moved & unsafe;
+  }
+  static void Reference(const double* head_old, const double* head_new, double* tail,
+                        double length) {
+    TractrixStepReference<Dim>(head_old, head_new, tail, length);
+  }
+};
+
+// Follow-the-leader: the tail goes to the point of the sphere |x - head_new| = L nearest to it.
+// If the head landed exactly on the tail the reference keeps the link's old direction.
+template <int Dim>
+struct FollowTheLeaderRule {
+  template <class T>
+  static auto Apply(const T* /*head_old*/, const T* head_new, T* tail, T length, T /*inv_length*/) {
+    T r[Dim];
+    for (int k = 0; k < Dim; ++k) r[k] = tail[k] - head_new[k];
+    const T rr = Dot<Dim>(r, r);
+    const T f = length / sqrt(rr);
+    for (int k = 0; k < Dim; ++k) tail[k] = head_new[k] + f * r[k];
+    return (rr <= T(0.0)) | (rr != rr);
+  }
+  static void Reference(const double* head_old, const double* head_new, double* tail,
+                        double length) {
+    double r[Dim];
+    for (int k = 0; k < Dim; ++k) r[k] = tail[k] - head_new[k];
+    double rr = Dot<Dim>(r, r);
+    if (!(rr > 0.0)) {
+      for (int k = 0; k < Dim; ++k) r[k] = tail[k] - head_old[k];
+      rr = Dot<Dim>(r, r);
+    }
+    const double f = length / std::sqrt(rr);
+    for (int k = 0; k < Dim; ++k) tail[k] = head_new[k] + f * r[k];
+  }
+};
+
+// Scalar application of a rule with its fallback.
+template <class Rule, int Dim>
+inline void ApplyScalar(const double* head_old, const double* head_new, double* tail, double length,
+                        double inv_length) {
+  double saved[Dim];
+  for (int k = 0; k < Dim; ++k) saved[k] = tail[k];
+  if (Rule::Apply(head_old, head_new, tail, length, inv_length)) {
+    for (int k = 0; k < Dim; ++k) tail[k] = saved[k];
+    Rule::Reference(head_old, head_new, tail, length);
+  }
+}
+
+// Scalar steps of one link (the public TractrixStep and FollowTheLeaderStep call these).
+template <int Dim>
+inline void TractrixStep(const double* head_old, const double* head_new, double* tail,
+                         double length, double inv_length) {
+  ApplyScalar<TractrixRule<Dim>, Dim>(head_old, head_new, tail, length, inv_length);
+}
+template <int Dim>
+inline void FollowTheLeaderStep(const double* head_old, const double* head_new, double* tail,
+                                double length, double inv_length) {
+  ApplyScalar<FollowTheLeaderRule<Dim>, Dim>(head_old, head_new, tail, length, inv_length);
+}
+
+}  // namespace
+}  // namespace flexkin::internal

@@ -1,0 +1,182 @@
+#include "flexkin/propagate.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "flexkin/error.h"
+#include "link_rules.h"
+#include "sweep.h"
+
+namespace flexkin {
+namespace {
+
+template <class Rule, int Dim>
+void Sweeps(const double* heads, int64_t num_sweeps, const double* lengths,
+            const double* inv_lengths, int n, double* pts) {
+  for (int64_t s = 0; s < num_sweeps; ++s) {
+    double lead_old[Dim], lead_new[Dim];
+    for (int k = 0; k < Dim; ++k) {
+      lead_old[k] = pts[k];
+      pts[k] = lead_new[k] = heads[s * Dim + k];
+    }
+    // Link i's leading end (point i-1) has just moved from lead_old to lead_new.
+    for (int i = 1; i <= n; ++i) {
+      double* tail = pts + i * Dim;
+      double tail_old[Dim];
+      for (int k = 0; k < Dim; ++k) tail_old[k] = tail[k];
+      internal::ApplyScalar<Rule, Dim>(lead_old, lead_new, tail, lengths[i - 1],
+                                       inv_lengths[i - 1]);
+      for (int k = 0; k < Dim; ++k) lead_old[k] = tail_old[k], lead_new[k] = tail[k];
+    }
+  }
+}
+
+}  // namespace
+
+namespace internal {
+
+#if FLEXKIN_HAVE_WAVEFRONT
+using SweepsFn = void (*)(Method, int, const double*, int64_t, const double*, const double*, int,
+                          double*);
+void SweepsWavefrontSse2(Method, int, const double*, int64_t, const double*, const double*, int,
+                         double*);
+void SweepsWavefrontAvx2(Method, int, const double*, int64_t, const double*, const double*, int,
+                         double*);
+void SweepsWavefrontAvx512(Method, int, const double*, int64_t, const double*, const double*, int,
+                           double*);
+
+namespace {
+struct WavefrontChoice {
+  SweepsFn fn;
+  int lanes;
+};
+// FLEXKIN_SIMD=sse2|avx2|avx512 in the environment caps the instruction set (to compare them,
+// or to test every engine on one machine); the CPU's support is still checked.
+WavefrontChoice ChooseWavefront() {
+  __builtin_cpu_init();
+  const char* cap_env = std::getenv("FLEXKIN_SIMD");
+  const std::string cap = cap_env ? cap_env : "avx512";
+  if (cap == "sse2") return {SweepsWavefrontSse2, 2};
+  if (cap == "avx512" && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+      __builtin_cpu_supports("avx512cd")) {
+    return {SweepsWavefrontAvx512, 8};
+  }
+  if (cap != "sse2" && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+    return {SweepsWavefrontAvx2, 4};
+  }
+  return {SweepsWavefrontSse2, 2};
+}
+const WavefrontChoice& Wavefront() {
+  static const WavefrontChoice choice = ChooseWavefront();
+  return choice;
+}
+}  // namespace
+#endif
+
+void SweepsScalar(Method method, int dim, const double* heads, int64_t num_sweeps,
+                  const double* lengths, const double* inv_lengths, int n, double* pts) {
+  const bool tractrix = method == Method::kTractrix;
+  if (dim == 2) {
+    tractrix ? Sweeps<TractrixRule<2>, 2>(heads, num_sweeps, lengths, inv_lengths, n, pts)
+             : Sweeps<FollowTheLeaderRule<2>, 2>(heads, num_sweeps, lengths, inv_lengths, n, pts);
+  } else {
+    tractrix ? Sweeps<TractrixRule<3>, 3>(heads, num_sweeps, lengths, inv_lengths, n, pts)
+             : Sweeps<FollowTheLeaderRule<3>, 3>(heads, num_sweeps, lengths, inv_lengths, n, pts);
+  }
+}
+
+void SweepsWavefront(Method method, int dim, const double* heads, int64_t num_sweeps,
+                     const double* lengths, const double* inv_lengths, int n, double* pts) {
+#if FLEXKIN_HAVE_WAVEFRONT
+  Wavefront().fn(method, dim, heads, num_sweeps, lengths, inv_lengths, n, pts);
+#else
+  SweepsScalar(method, dim, heads, num_sweeps, lengths, inv_lengths, n, pts);
+#endif
+}
+
+int WavefrontLanes() {
+#if FLEXKIN_HAVE_WAVEFRONT
+  return Wavefront().lanes;
+#else
+  return 1;
+#endif
+}
+
+}  // namespace internal
+
+const char* MethodName(Method method) {
+  switch (method) {
+    case Method::kTractrix:
+      return "tractrix";
+    case Method::kFollowTheLeader:
+      return "ftl";
+  }
+  return "unknown";
+}
+
+Method ParseMethod(std::string_view name, const std::string& field) {
+  if (name == "tractrix") return Method::kTractrix;
+  if (name == "ftl") return Method::kFollowTheLeader;
+  throw InputError(field, "unknown method \"" + std::string(name) +
+                              "\"; valid methods are \"tractrix\" and \"ftl\"");
+}
+
+int MethodOrder(Method method) { return method == Method::kTractrix ? 2 : 1; }
+
+Stepper MakeStepper(Method method, const Chain& chain) {
+  ValidateChain(chain);
+  Stepper s;
+  s.method = method;
+  s.dim = chain.dim();
+  s.lengths = chain.lengths;
+  s.inv_lengths = chain.lengths.cwiseInverse();
+  return s;
+}
+
+void MoveLeader(const Stepper& stepper, const Eigen::Ref<const Eigen::VectorXd>& target,
+                int substeps, Points* points) {
+  if (target.size() != stepper.dim) {
+    throw InputError("target", "has " + std::to_string(target.size()) +
+                                   " coordinates; the chain is " + std::to_string(stepper.dim) +
+                                   "D");
+  }
+  for (int k = 0; k < stepper.dim; ++k) {
+    if (!std::isfinite(target[k])) {
+      throw InputError("target[" + std::to_string(k) + "]", "is not a finite number");
+    }
+  }
+  if (substeps < 1) {
+    throw InputError("substeps", "is " + std::to_string(substeps) + "; must be at least 1");
+  }
+  if (points->rows() != stepper.lengths.size() + 1 || points->cols() != stepper.dim) {
+    throw InputError("points", "shape " + std::to_string(points->rows()) + "x" +
+                                   std::to_string(points->cols()) +
+                                   " does not match the stepper's chain");
+  }
+  // Head positions of the sub-steps, interpolated from the start of the move so that the last
+  // one is exactly the target.
+  const int dim = stepper.dim;
+  std::vector<double> heads(static_cast<size_t>(substeps) * dim);
+  for (int j = 1; j <= substeps; ++j) {
+    const double t = static_cast<double>(j) / substeps;
+    for (int k = 0; k < dim; ++k) {
+      const double start = (*points)(0, k);
+      heads[(j - 1) * dim + k] = (j == substeps) ? target[k] : start + t * (target[k] - start);
+    }
+  }
+  const int n = static_cast<int>(stepper.lengths.size());
+  // The wavefront pays for a copy of the chain; it wins once several sweeps share it.
+  const bool wavefront = substeps >= 2 * internal::WavefrontLanes() && n >= 8;
+  (wavefront ? internal::SweepsWavefront : internal::SweepsScalar)(
+      stepper.method, dim, heads.data(), substeps, stepper.lengths.data(),
+      stepper.inv_lengths.data(), n, points->data());
+}
+
+void MoveLeader(Method method, const Eigen::Ref<const Eigen::VectorXd>& target, int substeps,
+                Chain* chain) {
+  MoveLeader(MakeStepper(method, *chain), target, substeps, &chain->points);
+}
+
+}  // namespace flexkin

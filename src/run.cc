@@ -1,0 +1,221 @@
+#include "flexkin/run.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "flexkin/error.h"
+
+namespace flexkin {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+void ValidateLeaderSteps(const Points& steps, int dim) {
+  if (steps.rows() < 1) throw InputError("leader_steps", "is empty; give at least one target");
+  if (steps.cols() != dim) {
+    throw InputError("leader_steps", "targets have " + std::to_string(steps.cols()) +
+                                         " coordinates; the chain is " + std::to_string(dim) +
+                                         "D");
+  }
+  for (Eigen::Index i = 0; i < steps.rows(); ++i) {
+    for (Eigen::Index k = 0; k < steps.cols(); ++k) {
+      if (!std::isfinite(steps(i, k))) {
+        throw InputError("leader_steps[" + std::to_string(i) + "][" + std::to_string(k) + "]",
+                         "is not a finite number");
+      }
+    }
+  }
+}
+
+// Arc-length weights of the trapezoid rule for eq. (6): half of each adjacent link.
+Eigen::VectorXd ArcLengthWeights(const Eigen::VectorXd& lengths) {
+  const Eigen::Index n = lengths.size();
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(n + 1);
+  w.head(n) += 0.5 * lengths;
+  w.tail(n) += 0.5 * lengths;
+  return w;
+}
+
+// Angle in [0, pi] between each link (trailing -> leading end) and the unit vector `direction`.
+Eigen::VectorXd LinkAngles(const Points& points, const Eigen::VectorXd& direction) {
+  if (direction.size() == 0) return {};
+  const Eigen::Index n = points.rows() - 1;
+  Eigen::VectorXd angles(n);
+  for (Eigen::Index i = 1; i <= n; ++i) {
+    const Eigen::VectorXd link = (points.row(i - 1) - points.row(i)).transpose();
+    const double along = link.dot(direction);
+    const double across = (link - along * direction).norm();
+    angles[i - 1] = std::atan2(across, along);  // accurate near 0 and pi, unlike acos
+  }
+  return angles;
+}
+
+double MaxPointDistance(const Points& a, const Points& b) {
+  return (a - b).rowwise().norm().maxCoeff();
+}
+
+// Step doubling: runs the whole path with k and 2k sub-steps side by side and takes the largest
+// difference over all leader steps; for a method of order q the error of the 2k run is about
+// that difference / (2^q - 1) (Richardson). Doubles k until the estimate meets the tolerance.
+AccuracyReport ChooseSubsteps(const Chain& chain, const Points& leader_steps,
+                              const RunOptions& options) {
+  AccuracyReport report;
+  report.enabled = true;
+  report.order = MethodOrder(options.method);
+  const Stepper stepper = MakeStepper(options.method, chain);
+  const double factor = 1.0 / (std::pow(2.0, report.order) - 1.0);
+  for (int k = options.substeps;; k *= 2) {
+    Points coarse = chain.points, fine = chain.points;
+    double diff = 0.0;
+    for (Eigen::Index s = 0; s < leader_steps.rows(); ++s) {
+      const Eigen::VectorXd target = leader_steps.row(s).transpose();
+      MoveLeader(stepper, target, k, &coarse);
+      MoveLeader(stepper, target, 2 * k, &fine);
+      diff = std::fmax(diff, MaxPointDistance(coarse, fine));
+    }
+    report.substeps = 2 * k;
+    report.estimated_error = diff * factor;
+    report.met = report.estimated_error <= options.tolerance;
+    if (report.met || 4 * static_cast<int64_t>(k) > options.max_substeps) return report;
+  }
+}
+
+std::string Format(const char* fmt, double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, x);
+  return buf;
+}
+
+}  // namespace
+
+std::string RunOptions::Validate() const {
+  if (substeps < 1) return "substeps: " + std::to_string(substeps) + " is not valid; must be >= 1";
+  if (record_every < 1) {
+    return "record_every: " + std::to_string(record_every) + " is not valid; must be >= 1";
+  }
+  if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) {
+    return "tolerance: " + Format("%.17g", tolerance) +
+           " is not valid; must be a finite number >= 0 (0 turns accuracy control off)";
+  }
+  if (max_substeps < substeps) {
+    return "max_substeps: " + std::to_string(max_substeps) + " is not valid; must be >= substeps (" +
+           std::to_string(substeps) + ")";
+  }
+  return "";
+}
+
+RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& options) {
+  ValidateChain(chain);
+  ValidateLeaderSteps(leader_steps, chain.dim());
+  if (const std::string why = options.Validate(); !why.empty()) {
+    const auto colon = why.find(':');
+    throw InputError(why.substr(0, colon), why.substr(colon + 2));
+  }
+  const auto start_time = Clock::now();
+
+  RunResult result;
+  result.method = options.method;
+  result.lengths = chain.lengths;
+  result.num_steps = leader_steps.rows();
+  result.accuracy.order = MethodOrder(options.method);
+  result.accuracy.substeps = options.substeps;
+  if (options.tolerance > 0.0) result.accuracy = ChooseSubsteps(chain, leader_steps, options);
+  const int substeps = result.accuracy.substeps;
+
+  const Stepper stepper = MakeStepper(options.method, chain);
+  const Eigen::Index n = chain.num_links();
+  const Eigen::VectorXd weights = ArcLengthWeights(chain.lengths);
+  Metrics& m = result.metrics;
+  m.l2_per_step.resize(result.num_steps);
+  m.l2_weighted_per_step.resize(result.num_steps);
+  m.path_length = Eigen::VectorXd::Zero(n + 1);
+
+  // The direction for frame 0 is that of the first leader step that moves.
+  Eigen::VectorXd direction;
+  {
+    Eigen::VectorXd from = chain.points.row(0).transpose();
+    for (Eigen::Index s = 0; s < leader_steps.rows() && direction.size() == 0; ++s) {
+      const Eigen::VectorXd d = leader_steps.row(s).transpose() - from;
+      if (d.norm() > 0.0) direction = d.normalized();
+      from = leader_steps.row(s).transpose();
+    }
+  }
+  Points points = chain.points;
+  result.frames.push_back({0, points, LinkAngles(points, direction)});
+
+  auto last_report = Clock::now();
+  Points before;
+  for (int64_t s = 0; s < result.num_steps; ++s) {
+    before = points;
+    const Eigen::VectorXd target = leader_steps.row(s).transpose();
+    const Eigen::VectorXd d = target - before.row(0).transpose();
+    if (d.norm() > 0.0) direction = d.normalized();
+    MoveLeader(stepper, target, substeps, &points);
+
+    const Eigen::VectorXd moved = (points - before).rowwise().norm();
+    m.path_length += moved;
+    m.l2_per_step[s] = moved.sum();
+    m.l2_weighted_per_step[s] = moved.dot(weights);
+    for (Eigen::Index i = 1; i <= n; ++i) {
+      const double length = (points.row(i) - points.row(i - 1)).norm();
+      m.max_relative_length_error =
+          std::fmax(m.max_relative_length_error,
+                    std::fabs(length - chain.lengths[i - 1]) / chain.lengths[i - 1]);
+    }
+    const int64_t done = s + 1;
+    if (done % options.record_every == 0 || done == result.num_steps) {
+      result.frames.push_back({done, points, LinkAngles(points, direction)});
+    }
+    if (options.progress && Clock::now() - last_report > std::chrono::milliseconds(100)) {
+      options.progress(done, result.num_steps);
+      last_report = Clock::now();
+    }
+  }
+  if (options.progress) options.progress(result.num_steps, result.num_steps);
+  m.l2_total = m.l2_per_step.sum();
+  m.l2_weighted_total = m.l2_weighted_per_step.sum();
+  result.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
+  return result;
+}
+
+std::string RunResult::BriefReport() const {
+  std::ostringstream out;
+  out << MethodName(method) << ": " << lengths.size() << " links, " << num_steps
+      << " leader steps x " << accuracy.substeps << " sub-steps, max relative length error "
+      << Format("%.3g", metrics.max_relative_length_error) << ", L2 total "
+      << Format("%.10g", metrics.l2_total) << " (arc-length weighted "
+      << Format("%.10g", metrics.l2_weighted_total) << ")";
+  if (accuracy.enabled) {
+    out << ", estimated error " << Format("%.3g", accuracy.estimated_error)
+        << (accuracy.met ? " (tolerance met)" : " (TOLERANCE NOT MET)");
+  }
+  out << ", " << Format("%.3g", seconds) << " s";
+  return out.str();
+}
+
+std::string RunResult::FullReport() const {
+  std::ostringstream out;
+  out << BriefReport() << "\n";
+  out << "  recorded frames: " << frames.size() << "\n";
+  out << "  path length per point (leading end first):";
+  const Eigen::Index n = metrics.path_length.size();
+  // Long chains: print about 20 evenly spaced points so the profile fits on a screen.
+  const Eigen::Index stride = std::max<Eigen::Index>(1, n / 20);
+  for (Eigen::Index j = 0; j < n; j += stride) {
+    out << (j % (8 * stride) == 0 ? "\n    " : " ") << "[" << j << "] "
+        << Format("%.6g", metrics.path_length[j]);
+  }
+  if ((n - 1) % stride != 0) out << " [" << n - 1 << "] " << Format("%.6g", metrics.path_length[n - 1]);
+  out << "\n";
+  if (!frames.empty() && frames.back().link_angles.size() > 0) {
+    const Eigen::VectorXd& a = frames.back().link_angles;
+    out << "  final link angles to the pull, degrees: first " << Format("%.4g", a[0] * 180 / M_PI)
+        << ", largest " << Format("%.4g", a.maxCoeff() * 180 / M_PI) << ", last "
+        << Format("%.4g", a[a.size() - 1] * 180 / M_PI) << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace flexkin

@@ -1,0 +1,188 @@
+#pragma once
+// The wavefront sweep engine, templated on the xsimd instruction set. Included only by the
+// per-instruction-set translation units wavefront_<isa>.cc, each compiled with its own flags.
+
+#include <immintrin.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+#include <xsimd/xsimd.hpp>
+
+#include "../link_rules.h"
+#include "flexkin/propagate.h"
+
+namespace flexkin::internal {
+namespace {
+
+// exp(x) for a batch with every x <= 0, without a division (xsimd's exp ends with one, and the
+// divider is the unit the sweeps are bound by). x is clamped to -708 (exp(-708) = 3.3e-308, the
+// smallest normal double): the link rules only use exp(-p/L), for which anything that small is 0
+// to rounding. Cody-Waite reduction x = k ln2 + r with |r| <= ln2/2, then the Taylor polynomial
+// of degree 13 (truncation error < 5e-18 relative) and 2^k assembled in the exponent bits.
+struct BatchExp {
+  double operator()(double x) const { return std::exp(x); }
+  template <class A>
+  xsimd::batch<double, A> operator()(const xsimd::batch<double, A>& x_in) const {
+    using B = xsimd::batch<double, A>;
+    using I = xsimd::batch<int64_t, A>;
+    const B x = xsimd::max(x_in, B(-708.0));
+    // Adding 1.5 * 2^52 rounds to an integer held in the low mantissa bits.
+    constexpr double kShift = 6755399441055744.0;
+    const B shifted = xsimd::fma(x, B(1.4426950408889634074), B(kShift));  // x / ln2
+    const B k = shifted - B(kShift);
+    const B r = xsimd::fnma(k, B(1.9082149292705877000e-10),
+                            xsimd::fnma(k, B(6.9314718036912381649e-01), x));  // ln2 = hi + lo
+    B poly = B(1.0 / 6227020800.0);                                            // 1/13!
+    constexpr double kInvFactorial[13] = {1.0 / 479001600.0,
+                                          1.0 / 39916800.0,
+                                          1.0 / 3628800.0,
+                                          1.0 / 362880.0,
+                                          1.0 / 40320.0,
+                                          1.0 / 5040.0,
+                                          1.0 / 720.0,
+                                          1.0 / 120.0,
+                                          1.0 / 24.0,
+                                          1.0 / 6.0,
+                                          0.5,
+                                          1.0,
+                                          1.0};
+    for (double c : kInvFactorial) poly = xsimd::fma(poly, r, B(c));
+    // k is in [-1022, 0]: (k << 52) + bits(1.0) are the bits of 2^k.
+    const I bits = (xsimd::bitwise_cast<I>(shifted) << 52) + I(int64_t{0x3FF0000000000000});
+    return poly * xsimd::bitwise_cast<B>(bits);
+  }
+};
+
+// [v1, v2, ..., v_{W-1}, x]: the window moves one point down the chain and takes in point t.
+inline __m128d SlideIn(__m128d v, double x) { return _mm_shuffle_pd(v, _mm_set1_pd(x), 0b01); }
+#if defined(__AVX2__)
+inline __m256d SlideIn(__m256d v, double x) {
+  return _mm256_blend_pd(_mm256_permute4x64_pd(v, _MM_SHUFFLE(0, 3, 2, 1)), _mm256_set1_pd(x),
+                         0b1000);
+}
+#endif
+#if defined(__AVX512F__)
+inline __m512d SlideIn(__m512d v, double x) {
+  return _mm512_permutex2var_pd(v, _mm512_setr_epi64(1, 2, 3, 4, 5, 6, 7, 8), _mm512_set1_pd(x));
+}
+#endif
+inline double First(__m128d v) { return _mm_cvtsd_f64(v); }
+#if defined(__AVX2__)
+inline double First(__m256d v) { return _mm_cvtsd_f64(_mm256_castpd256_pd128(v)); }
+#endif
+#if defined(__AVX512F__)
+inline double First(__m512d v) { return _mm_cvtsd_f64(_mm512_castpd512_pd128(v)); }
+#endif
+
+// Lanes: with W lanes, a group of W consecutive sweeps g..g+W-1 advances together; at iteration
+// t, lane j works on point t-W+1+j for sweep g+W-1-j. The point a lane reads is the one its
+// neighbour lane (the previous sweep) wrote one iteration earlier, so the window stays in
+// registers: each iteration reads one new point (t, for lane W-1, untouched by this group yet)
+// and writes one finished point (t-W+1, from lane 0, the group's last sweep). Nothing goes
+// through memory between lanes, so no store-to-load forwarding stalls.
+template <class Arch, class Rule, int Dim>
+void WavefrontSweeps(const double* heads, int64_t num_sweeps, const double* lengths,
+                     const double* inv_lengths, int n, double* points) {
+  using B = xsimd::batch<double, Arch>;
+  constexpr int W = B::size;
+  // Link lengths of point i at len[pad + i]; the padding lanes compute garbage that is never
+  // stored.
+  const int pad = W - 1;
+  std::vector<double> len(n + 1 + 2 * pad, 1.0), inv_len(n + 1 + 2 * pad, 1.0);
+  std::copy(lengths, lengths + n, len.begin() + pad + 1);
+  std::copy(inv_lengths, inv_lengths + n, inv_len.begin() + pad + 1);
+  alignas(64) double lane_index[W];
+  for (int j = 0; j < W; ++j) lane_index[j] = j;
+  const B lane = B::load_aligned(lane_index);
+  const B last = B(static_cast<double>(n));
+
+  int64_t g = 0;
+  for (; g + W <= num_sweeps; g += W) {
+    B head[Dim], lead_old[Dim], lead_new[Dim], window[Dim];
+    for (int k = 0; k < Dim; ++k) {
+      alignas(64) double h[W];
+      for (int j = 0; j < W; ++j) h[j] = heads[(g + W - 1 - j) * Dim + k];
+      head[k] = B::load_aligned(h);
+      lead_old[k] = lead_new[k] = window[k] = B(0.0);
+    }
+    for (int t = 0; t < n + W; ++t) {
+      const int base = t - W + 1;  // point of lane 0
+      const B index = B(static_cast<double>(base)) + lane;
+      B tail[Dim];
+      for (int k = 0; k < Dim; ++k) {
+        window[k] = B(SlideIn(window[k], t <= n ? points[t * Dim + k] : 0.0));
+        tail[k] = window[k];
+      }
+      const B length = B::load_unaligned(&len[pad + base]);
+      const B inv_length = B::load_unaligned(&inv_len[pad + base]);
+      const auto fix = Rule::Apply(lead_old, lead_new, tail, length, inv_length) &
+                       (index >= B(1.0)) & (index <= last);
+      if (xsimd::any(fix)) {
+        // Rare lanes (degenerate or extreme moves): redo them with the scalar reference.
+        alignas(64) double lo[Dim][W], ln[Dim][W], old[Dim][W], out[Dim][W], mask[W], len_j[W];
+        for (int k = 0; k < Dim; ++k) {
+          lead_old[k].store_aligned(lo[k]);
+          lead_new[k].store_aligned(ln[k]);
+          window[k].store_aligned(old[k]);
+          tail[k].store_aligned(out[k]);
+        }
+        xsimd::select(fix, B(1.0), B(0.0)).store_aligned(mask);
+        length.store_aligned(len_j);
+        for (int j = 0; j < W; ++j) {
+          if (mask[j] == 0.0) continue;
+          double a[Dim], b[Dim], c[Dim];
+          for (int k = 0; k < Dim; ++k) a[k] = lo[k][j], b[k] = ln[k][j], c[k] = old[k][j];
+          Rule::Reference(a, b, c, len_j[j]);
+          for (int k = 0; k < Dim; ++k) out[k][j] = c[k];
+        }
+        for (int k = 0; k < Dim; ++k) tail[k] = B::load_aligned(out[k]);
+      }
+      const auto is_head = index == B(0.0);
+      for (int k = 0; k < Dim; ++k) {
+        tail[k] = xsimd::select(is_head, head[k], tail[k]);
+        lead_old[k] = window[k];
+        lead_new[k] = window[k] = tail[k];
+      }
+      if (base >= 0) {
+        for (int k = 0; k < Dim; ++k) points[base * Dim + k] = First(tail[k]);
+      }
+    }
+  }
+  // Fewer than W sweeps left: finish them one after another.
+  for (; g < num_sweeps; ++g) {
+    double lead_old[Dim], lead_new[Dim];
+    for (int k = 0; k < Dim; ++k) {
+      lead_old[k] = points[k];
+      points[k] = lead_new[k] = heads[g * Dim + k];
+    }
+    for (int i = 1; i <= n; ++i) {
+      double* tail = points + i * Dim;
+      double saved[Dim];
+      for (int k = 0; k < Dim; ++k) saved[k] = tail[k];
+      ApplyScalar<Rule, Dim>(lead_old, lead_new, tail, lengths[i - 1], inv_lengths[i - 1]);
+      for (int k = 0; k < Dim; ++k) lead_old[k] = saved[k], lead_new[k] = tail[k];
+    }
+  }
+}
+
+// Entry point of one instruction set: picks the rule and the dimension.
+template <class Arch>
+void WavefrontDispatch(Method method, int dim, const double* heads, int64_t num_sweeps,
+                       const double* lengths, const double* inv_lengths, int n, double* points) {
+  const bool tractrix = method == Method::kTractrix;
+  if (dim == 2) {
+    tractrix ? WavefrontSweeps<Arch, TractrixRule<2, BatchExp>, 2>(heads, num_sweeps, lengths,
+                                                                   inv_lengths, n, points)
+             : WavefrontSweeps<Arch, FollowTheLeaderRule<2>, 2>(heads, num_sweeps, lengths,
+                                                                inv_lengths, n, points);
+  } else {
+    tractrix ? WavefrontSweeps<Arch, TractrixRule<3, BatchExp>, 3>(heads, num_sweeps, lengths,
+                                                                   inv_lengths, n, points)
+             : WavefrontSweeps<Arch, FollowTheLeaderRule<3>, 3>(heads, num_sweeps, lengths,
+                                                                inv_lengths, n, points);
+  }
+}
+
+}  // namespace
+}  // namespace flexkin::internal
