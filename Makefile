@@ -1,0 +1,45 @@
+# flexkin: two commands on a fresh Debian machine (they install what is missing themselves).
+#   make demo   build, then run the paper's scenarios (figures' numbers printed, results in out/)
+#   make test   build and run every test, then again under AddressSanitizer + UBSan
+# Also: make bench (Google Benchmark, see docs/BENCHMARKS.md), make install PREFIX=...
+
+BUILD      ?= build
+BUILD_SAN  ?= build-sanitize
+JOBS       ?= $(shell nproc)
+PREFIX     ?= /usr/local
+
+.PHONY: all deps build demo test test-release test-sanitize bench install clean
+
+all: build
+
+deps:
+	@bash scripts/install-deps.sh
+
+build: deps
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo > /dev/null
+	@cmake --build $(BUILD) -j$(JOBS)
+
+demo: build
+	@bash scripts/demo.sh $(BUILD)
+
+test: test-release test-sanitize
+
+test-release: build
+	@ctest --test-dir $(BUILD) --output-on-failure -j$(JOBS)
+
+test-sanitize: deps
+	@cmake -S . -B $(BUILD_SAN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLEXKIN_SANITIZE=ON \
+	  -DFLEXKIN_BUILD_BENCHMARKS=OFF > /dev/null
+	@cmake --build $(BUILD_SAN) -j$(JOBS)
+	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+	  ctest --test-dir $(BUILD_SAN) --output-on-failure -j$(JOBS)
+
+bench: build
+	@$(BUILD)/bench/propagation_benchmark --benchmark_repetitions=5 \
+	  --benchmark_report_aggregates_only=true
+
+install: build
+	@cmake --install $(BUILD) --prefix $(PREFIX)
+
+clean:
+	@rm -rf $(BUILD) $(BUILD_SAN) out
