@@ -36,18 +36,28 @@ void SetRate(benchmark::State& state, double link_steps_per_iteration) {
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
-// Question 1: one move of the leader split into `kSubsteps` sweeps.
+// A straight chain along -x pulled along +x: every link keeps moving, however long the chain.
+Chain StraightLine(int n) {
+  Points p(n + 1, 3);
+  for (int i = 0; i <= n; ++i) p.row(i) << -0.3 * i, 0.0, 0.0;
+  return MakeChain(p);
+}
+
+// Question 1: one move of the leader split into `kSubsteps` sweeps. Two scenes: `wander` (the
+// helix, leader on a wandering path: the motion dies out along long chains, and both methods
+// skip links whose leading end did not move) and `pull` (every link moves).
 constexpr int kSubsteps = 64;
 
-void BM_MultiStep(benchmark::State& state, Method method, bool wavefront) {
+void BM_MultiStep(benchmark::State& state, Method method, bool wavefront, bool wander) {
   const int n = static_cast<int>(state.range(0));
-  Chain chain = Helix(n);
+  Chain chain = wander ? Helix(n) : StraightLine(n);
   const Stepper stepper = MakeStepper(method, chain);
   std::vector<double> heads(3 * kSubsteps);
   int j = 0;
   for (auto _ : state) {
     const Eigen::Vector3d start = chain.points.row(0).transpose();
-    const Eigen::Vector3d target = LeaderTarget(start, j++);
+    const Eigen::Vector3d target =
+        wander ? LeaderTarget(start, j++) : Eigen::Vector3d(start + Eigen::Vector3d(0.2, 0, 0));
     for (int s = 1; s <= kSubsteps; ++s) {
       const Eigen::Vector3d h = start + (target - start) * (static_cast<double>(s) / kSubsteps);
       for (int k = 0; k < 3; ++k) heads[3 * (s - 1) + k] = h[k];
@@ -60,13 +70,17 @@ void BM_MultiStep(benchmark::State& state, Method method, bool wavefront) {
   SetRate(state, static_cast<double>(n) * kSubsteps);
   state.counters["lanes"] = wavefront ? internal::WavefrontLanes() : 1;
 }
-BENCHMARK_CAPTURE(BM_MultiStep, tractrix_wavefront, Method::kTractrix, true)
+BENCHMARK_CAPTURE(BM_MultiStep, pull_tractrix_wavefront, Method::kTractrix, true, false)
     ->RangeMultiplier(10)->Range(10, 100000);
-BENCHMARK_CAPTURE(BM_MultiStep, ftl_wavefront, Method::kFollowTheLeader, true)
+BENCHMARK_CAPTURE(BM_MultiStep, pull_ftl_wavefront, Method::kFollowTheLeader, true, false)
     ->RangeMultiplier(10)->Range(10, 100000);
-BENCHMARK_CAPTURE(BM_MultiStep, tractrix_one_pass, Method::kTractrix, false)
+BENCHMARK_CAPTURE(BM_MultiStep, pull_tractrix_one_pass, Method::kTractrix, false, false)
     ->RangeMultiplier(10)->Range(10, 100000);
-BENCHMARK_CAPTURE(BM_MultiStep, ftl_one_pass, Method::kFollowTheLeader, false)
+BENCHMARK_CAPTURE(BM_MultiStep, pull_ftl_one_pass, Method::kFollowTheLeader, false, false)
+    ->RangeMultiplier(10)->Range(10, 100000);
+BENCHMARK_CAPTURE(BM_MultiStep, wander_tractrix_wavefront, Method::kTractrix, true, true)
+    ->RangeMultiplier(10)->Range(10, 100000);
+BENCHMARK_CAPTURE(BM_MultiStep, wander_ftl_wavefront, Method::kFollowTheLeader, true, true)
     ->RangeMultiplier(10)->Range(10, 100000);
 
 // Question 2: single-step moves, one MoveLeader call (one sweep) each.

@@ -12,12 +12,48 @@ namespace flexkin::internal {
 namespace {
 
 inline double select(bool mask, double a, double b) { return mask ? a : b; }
+inline bool none(bool mask) { return !mask; }
+inline bool all(bool mask) { return mask; }
+inline double fma(double a, double b, double c) { return std::fma(a, b, c); }
+// Lane mask of T: bool for a double, batch_bool for a batch.
+template <class T>
+using Mask = decltype(T() < T());
+
+using std::abs;
 using std::sqrt;
 
 // exp of a non-positive argument; the wavefront engine substitutes a vector version.
 struct StdExp {
   double operator()(double x) const { return std::exp(x); }
 };
+
+// a b - c d to within about one ulp even when the products nearly cancel (Kahan's algorithm; it
+// needs a fused multiply-add).
+template <class T>
+inline T DiffOfProducts(T a, T b, T c, T d) {
+  const T cd = c * d;
+  return fma(a, b, -cd) + fma(-c, d, cd);
+}
+
+// v = dd r - (r.d) d = d x (r x d), the part of r across d scaled by dd, with r x d from
+// DiffOfProducts: accurate relative to |v| even when r is nearly along d (exactly 0 if it is
+// exactly along d), and so orthogonal to d to rounding. Returns |v|^2.
+template <int Dim, class T>
+inline T RejectAccurately(const T* r, const T* d, T dd, T* v) {
+  if constexpr (Dim == 2) {
+    const T c = DiffOfProducts(r[0], d[1], r[1], d[0]);
+    v[0] = c * d[1];
+    v[1] = -(c * d[0]);
+    return (c * c) * dd;
+  } else {
+    const T w[3] = {DiffOfProducts(r[1], d[2], r[2], d[1]), DiffOfProducts(r[2], d[0], r[0], d[2]),
+                    DiffOfProducts(r[0], d[1], r[1], d[0])};
+    v[0] = d[1] * w[2] - d[2] * w[1];
+    v[1] = d[2] * w[0] - d[0] * w[2];
+    v[2] = d[0] * w[1] - d[1] * w[0];
+    return dd * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+  }
+}
 
 template <int Dim, class T>
 inline T Dot(const T* a, const T* b) {
@@ -52,11 +88,14 @@ inline void TractrixStepReference(const double* head_old, const double* head_new
   const double p = norm(d);
   if (p == 0.0) return;  // the head did not move
   const double inv_length = 1.0 / length;
-  double u[Dim], v[Dim];
-  for (int k = 0; k < Dim; ++k) u[k] = d[k] / p;
-  double x0 = 0.0;
-  for (int k = 0; k < Dim; ++k) x0 += (r[k] * inv_length) * u[k];
-  for (int k = 0; k < Dim; ++k) v[k] = r[k] * inv_length - x0 * u[k];
+  // In units of the link length: r_hat = r / L = x0 u + v, v from RejectAccurately (u.u = 1).
+  double u[Dim], r_hat[Dim], v[Dim];
+  for (int k = 0; k < Dim; ++k) {
+    u[k] = d[k] / p;
+    r_hat[k] = r[k] * inv_length;
+  }
+  const double x0 = Dot<Dim>(r_hat, u);
+  RejectAccurately<Dim>(r_hat, u, 1.0, v);
   const double y0 = norm(v);
   if (y0 == 0.0 && x0 > 0.0) {
     // Exactly on the unstable equilibrium: the head moves straight at the tail, which is pushed
@@ -89,33 +128,43 @@ inline void TractrixStepReference(const double* head_old, const double* head_new
 template <int Dim, class Exp = StdExp>
 struct TractrixRule {
   template <class T>
-  static auto Apply(const T* head_old, const T* head_new, T* tail, T length, T inv_length) {
+  static auto Apply(const T* head_old, const T* head_new, T* tail, T length, T neg_inv_length) {
     T d[Dim], r[Dim], v[Dim];
     for (int k = 0; k < Dim; ++k) {
       d[k] = head_new[k] - head_old[k];
       r[k] = tail[k] - head_old[k];
     }
     const T dd = Dot<Dim>(d, d);
+    // Where the motion has died out the head does not move and neither does the tail. Lanes
+    // that did not move among lanes that did get den = 0 below and go to the reference form.
+    if (none(dd > T(0.0))) return Mask<T>(dd != dd);
     const T rd = Dot<Dim>(r, d);
-    for (int k = 0; k < Dim; ++k) v[k] = dd * r[k] - rd * d[k];
-    const T vv = Dot<Dim>(v, v);
-    const T p = sqrt(dd);
-    const T e = Exp()(-p * inv_length);
-    const T lp = length * p;
     const auto pulling = rd <= T(0.0);
-    const T b = lp - rd;
-    const T a = (lp + rd) * e;
-    const T s1 = select(pulling, vv * (e * e), (a * a) * dd);
-    const T s2 = select(pulling, (b * b) * dd, vv);
-    const T c = select(pulling, e * b, a) * (T(2.0) * dd);
+    T vv;
+    if (all(pulling)) {
+      // Pulling: v enters only beside the dominant (L p - rd)^2 dd term, so the plain form
+      // (whose error is eps L p^2 absolute) moves the tail by rounding only.
+      for (int k = 0; k < Dim; ++k) v[k] = dd * r[k] - rd * d[k];
+      vv = Dot<Dim>(v, v);
+    } else {
+      // Pushing: with the tail nearly ahead of the head, v is small and decides which way the
+      // link swings; it needs full relative accuracy (and v.d = 0 keeps the length).
+      vv = RejectAccurately<Dim>(r, d, dd, v);
+    }
+    const T p = sqrt(dd);
+    const T e = Exp()(p * neg_inv_length);
+    // m = L p - rd when pulling, L p + rd when pushing: L p + |rd| either way, no cancellation.
+    const T m = length * p + abs(rd);
+    const T mmdd = (m * m) * dd;
+    const T s1 = (e * e) * select(pulling, vv, mmdd);
+    const T s2 = select(pulling, mmdd, vv);
+    const T c = (e * m) * (dd + dd);
     const T den = p * (s1 + s2);
     const T f = length / den;
     const T g = f * (s1 - s2);
     const T h = f * c;
-    const auto moved = dd > T(0.0);
-    for (int k = 0; k < Dim; ++k) tail[k] = select(moved, g * d[k] + (h * v[k] + head_new[k]), tail[k]);
-    const auto unsafe = (den <= T(1e-250)) | (den >= T(1e250)) | (den != den);
-    return moved & unsafe;
+    for (int k = 0; k < Dim; ++k) tail[k] = g * d[k] + (h * v[k] + head_new[k]);
+    return Mask<T>((den <= T(1e-250)) | (den >= T(1e250)) | (den != den));
   }
   static void Reference(const double* head_old, const double* head_new, double* tail,
                         double length) {
@@ -128,13 +177,18 @@ struct TractrixRule {
 template <int Dim>
 struct FollowTheLeaderRule {
   template <class T>
-  static auto Apply(const T* /*head_old*/, const T* head_new, T* tail, T length, T /*inv_length*/) {
+  static auto Apply(const T* head_old, const T* head_new, T* tail, T length, T /*neg_inv_length*/) {
+    // Where the motion has died out the head does not move; projecting the tail again would
+    // only change it by rounding, so leave it (the same shortcut as the tractrix rule's).
+    T d[Dim];
+    for (int k = 0; k < Dim; ++k) d[k] = head_new[k] - head_old[k];
+    if (none(Dot<Dim>(d, d) > T(0.0))) return Mask<T>(length != length);
     T r[Dim];
     for (int k = 0; k < Dim; ++k) r[k] = tail[k] - head_new[k];
     const T rr = Dot<Dim>(r, r);
     const T f = length / sqrt(rr);
     for (int k = 0; k < Dim; ++k) tail[k] = head_new[k] + f * r[k];
-    return (rr <= T(0.0)) | (rr != rr);
+    return Mask<T>((rr <= T(0.0)) | (rr != rr));
   }
   static void Reference(const double* head_old, const double* head_new, double* tail,
                         double length) {
@@ -154,9 +208,10 @@ struct FollowTheLeaderRule {
 template <class Rule, int Dim>
 inline void ApplyScalar(const double* head_old, const double* head_new, double* tail, double length,
                         double inv_length) {
+  const double neg_inv_length = -inv_length;
   double saved[Dim];
   for (int k = 0; k < Dim; ++k) saved[k] = tail[k];
-  if (Rule::Apply(head_old, head_new, tail, length, inv_length)) {
+  if (Rule::Apply(head_old, head_new, tail, length, neg_inv_length)) {
     for (int k = 0; k < Dim; ++k) tail[k] = saved[k];
     Rule::Reference(head_old, head_new, tail, length);
   }

@@ -40,8 +40,6 @@ namespace internal {
 #if FLEXKIN_HAVE_WAVEFRONT
 using SweepsFn = void (*)(Method, int, const double*, int64_t, const double*, const double*, int,
                           double*);
-void SweepsWavefrontSse2(Method, int, const double*, int64_t, const double*, const double*, int,
-                         double*);
 void SweepsWavefrontAvx2(Method, int, const double*, int64_t, const double*, const double*, int,
                          double*);
 void SweepsWavefrontAvx512(Method, int, const double*, int64_t, const double*, const double*, int,
@@ -52,21 +50,22 @@ struct WavefrontChoice {
   SweepsFn fn;
   int lanes;
 };
-// FLEXKIN_SIMD=sse2|avx2|avx512 in the environment caps the instruction set (to compare them,
-// or to test every engine on one machine); the CPU's support is still checked.
+// FLEXKIN_SIMD=scalar|avx2|avx512 in the environment caps the instruction set (to compare them,
+// or to test every engine on one machine); the CPU's support is still checked. Without AVX2 and
+// FMA there is no wavefront (lanes = 1) and every move takes the one-pass loop.
 WavefrontChoice ChooseWavefront() {
   __builtin_cpu_init();
   const char* cap_env = std::getenv("FLEXKIN_SIMD");
   const std::string cap = cap_env ? cap_env : "avx512";
-  if (cap == "sse2") return {SweepsWavefrontSse2, 2};
+  if (cap == "scalar") return {nullptr, 1};
   if (cap == "avx512" && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
       __builtin_cpu_supports("avx512cd")) {
     return {SweepsWavefrontAvx512, 8};
   }
-  if (cap != "sse2" && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
     return {SweepsWavefrontAvx2, 4};
   }
-  return {SweepsWavefrontSse2, 2};
+  return {nullptr, 1};
 }
 const WavefrontChoice& Wavefront() {
   static const WavefrontChoice choice = ChooseWavefront();
@@ -90,10 +89,12 @@ void SweepsScalar(Method method, int dim, const double* heads, int64_t num_sweep
 void SweepsWavefront(Method method, int dim, const double* heads, int64_t num_sweeps,
                      const double* lengths, const double* inv_lengths, int n, double* pts) {
 #if FLEXKIN_HAVE_WAVEFRONT
-  Wavefront().fn(method, dim, heads, num_sweeps, lengths, inv_lengths, n, pts);
-#else
-  SweepsScalar(method, dim, heads, num_sweeps, lengths, inv_lengths, n, pts);
+  if (Wavefront().fn != nullptr) {
+    Wavefront().fn(method, dim, heads, num_sweeps, lengths, inv_lengths, n, pts);
+    return;
+  }
 #endif
+  SweepsScalar(method, dim, heads, num_sweeps, lengths, inv_lengths, n, pts);
 }
 
 int WavefrontLanes() {
@@ -168,7 +169,8 @@ void MoveLeader(const Stepper& stepper, const Eigen::Ref<const Eigen::VectorXd>&
   }
   const int n = static_cast<int>(stepper.lengths.size());
   // The wavefront pays for a copy of the chain; it wins once several sweeps share it.
-  const bool wavefront = substeps >= 2 * internal::WavefrontLanes() && n >= 8;
+  const int lanes = internal::WavefrontLanes();
+  const bool wavefront = lanes > 1 && substeps >= 2 * lanes && n >= 8;
   (wavefront ? internal::SweepsWavefront : internal::SweepsScalar)(
       stepper.method, dim, heads.data(), substeps, stepper.lengths.data(),
       stepper.inv_lengths.data(), n, points->data());

@@ -1,5 +1,6 @@
 #include "flexkin/run.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -16,8 +17,7 @@ void ValidateLeaderSteps(const Points& steps, int dim) {
   if (steps.rows() < 1) throw InputError("leader_steps", "is empty; give at least one target");
   if (steps.cols() != dim) {
     throw InputError("leader_steps", "targets have " + std::to_string(steps.cols()) +
-                                         " coordinates; the chain is " + std::to_string(dim) +
-                                         "D");
+                                         " coordinates; the chain is " + std::to_string(dim) + "D");
   }
   for (Eigen::Index i = 0; i < steps.rows(); ++i) {
     for (Eigen::Index k = 0; k < steps.cols(); ++k) {
@@ -57,28 +57,31 @@ double MaxPointDistance(const Points& a, const Points& b) {
 }
 
 // Step doubling: runs the whole path with k and 2k sub-steps side by side and takes the largest
-// difference over all leader steps; for a method of order q the error of the 2k run is about
-// that difference / (2^q - 1) (Richardson). Doubles k until the estimate meets the tolerance.
+// difference over all leader steps; for a method of order q the error of the finer run is about
+// that difference / (2^q - 1) (Richardson). Doubles until the estimate meets the tolerance or the
+// finer run would exceed max_substeps (the last round then uses max_substeps and max/2).
 AccuracyReport ChooseSubsteps(const Chain& chain, const Points& leader_steps,
                               const RunOptions& options) {
   AccuracyReport report;
   report.enabled = true;
   report.order = MethodOrder(options.method);
   const Stepper stepper = MakeStepper(options.method, chain);
-  const double factor = 1.0 / (std::pow(2.0, report.order) - 1.0);
-  for (int k = options.substeps;; k *= 2) {
-    Points coarse = chain.points, fine = chain.points;
+  for (int fine = std::min(2 * options.substeps, options.max_substeps);;
+       fine = std::min(2 * fine, options.max_substeps)) {
+    const int coarse = std::max(1, fine / 2);
+    Points coarse_points = chain.points, fine_points = chain.points;
     double diff = 0.0;
     for (Eigen::Index s = 0; s < leader_steps.rows(); ++s) {
       const Eigen::VectorXd target = leader_steps.row(s).transpose();
-      MoveLeader(stepper, target, k, &coarse);
-      MoveLeader(stepper, target, 2 * k, &fine);
-      diff = std::fmax(diff, MaxPointDistance(coarse, fine));
+      MoveLeader(stepper, target, coarse, &coarse_points);
+      MoveLeader(stepper, target, fine, &fine_points);
+      diff = std::fmax(diff, MaxPointDistance(coarse_points, fine_points));
     }
-    report.substeps = 2 * k;
-    report.estimated_error = diff * factor;
+    const double ratio = static_cast<double>(fine) / coarse;
+    report.substeps = fine;
+    report.estimated_error = diff / (std::pow(ratio, report.order) - 1.0);
     report.met = report.estimated_error <= options.tolerance;
-    if (report.met || 4 * static_cast<int64_t>(k) > options.max_substeps) return report;
+    if (report.met || fine == options.max_substeps) return report;
   }
 }
 
@@ -99,9 +102,13 @@ std::string RunOptions::Validate() const {
     return "tolerance: " + Format("%.17g", tolerance) +
            " is not valid; must be a finite number >= 0 (0 turns accuracy control off)";
   }
+  if (tolerance > 0.0 && max_substeps < 2) {
+    return "max_substeps: " + std::to_string(max_substeps) +
+           " is not valid; accuracy control compares two runs and needs max_substeps >= 2";
+  }
   if (max_substeps < substeps) {
-    return "max_substeps: " + std::to_string(max_substeps) + " is not valid; must be >= substeps (" +
-           std::to_string(substeps) + ")";
+    return "max_substeps: " + std::to_string(max_substeps) +
+           " is not valid; must be >= substeps (" + std::to_string(substeps) + ")";
   }
   return "";
 }
@@ -147,14 +154,21 @@ RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& 
 
   auto last_report = Clock::now();
   Points before;
+  Eigen::VectorXd moved(n + 1), head(chain.dim());
   for (int64_t s = 0; s < result.num_steps; ++s) {
-    before = points;
+    const Eigen::VectorXd start = points.row(0).transpose();
     const Eigen::VectorXd target = leader_steps.row(s).transpose();
-    const Eigen::VectorXd d = target - before.row(0).transpose();
-    if (d.norm() > 0.0) direction = d.normalized();
-    MoveLeader(stepper, target, substeps, &points);
-
-    const Eigen::VectorXd moved = (points - before).rowwise().norm();
+    if ((target - start).norm() > 0.0) direction = (target - start).normalized();
+    // One sub-step at a time (the heads MoveLeader would use), so that the metrics see the
+    // motion at the resolution it is computed.
+    moved.setZero();
+    for (int j = 1; j <= substeps; ++j) {
+      head = (j == substeps) ? target
+                             : Eigen::VectorXd(start + (double(j) / substeps) * (target - start));
+      before = points;
+      MoveLeader(stepper, head, 1, &points);
+      moved += (points - before).rowwise().norm();
+    }
     m.path_length += moved;
     m.l2_per_step[s] = moved.sum();
     m.l2_weighted_per_step[s] = moved.dot(weights);
@@ -207,7 +221,8 @@ std::string RunResult::FullReport() const {
     out << (j % (8 * stride) == 0 ? "\n    " : " ") << "[" << j << "] "
         << Format("%.6g", metrics.path_length[j]);
   }
-  if ((n - 1) % stride != 0) out << " [" << n - 1 << "] " << Format("%.6g", metrics.path_length[n - 1]);
+  if ((n - 1) % stride != 0)
+    out << " [" << n - 1 << "] " << Format("%.6g", metrics.path_length[n - 1]);
   out << "\n";
   if (!frames.empty() && frames.back().link_angles.size() > 0) {
     const Eigen::VectorXd& a = frames.back().link_angles;

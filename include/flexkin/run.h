@@ -24,8 +24,9 @@ struct RunOptions {
   // Accuracy control. If > 0, `substeps` is doubled until the estimated largest distance of any
   // point, at any leader step, from the continuous motion (every point's velocity along its
   // link) is at most `tolerance`, in the chain's length unit. 0 turns it off. Typical: 1e-6.
+  // The runs that pick `substeps` cost about as much as the final run again.
   double tolerance = 0.0;
-  // Upper bound for the automatic choice of `substeps`. Typical: 65536.
+  // Upper bound for the automatic choice of `substeps`; >= 2 when `tolerance` > 0. Typical: 65536.
   int max_substeps = 1 << 16;
   // Called with (leader steps done, total) about every 0.1 s of work; may be empty.
   std::function<void(int64_t done, int64_t total)> progress;
@@ -47,14 +48,15 @@ struct Frame {
 
 // Metrics of a run (paper eq. 6 and Sec. 3.2).
 struct Metrics {
-  // Per leader step: sum over all points j = 0..n of |x_j(after) - x_j(before)|.
+  // Per leader step: sum over all points j = 0..n of the distance x_j travels during the step,
+  // sub-step by sub-step (with one sub-step: |x_j(after) - x_j(before)|).
   Eigen::VectorXd l2_per_step;
   // The same weighted by arc length (trapezoid weights L_1/2, (L_i + L_{i+1})/2, ..., L_n/2),
   // the discrete form of eq. (6).
   Eigen::VectorXd l2_weighted_per_step;
   double l2_total = 0.0;
   double l2_weighted_total = 0.0;
-  // Largest |(|x_i - x_{i-1}| - L_i)| / L_i over every link and every leader step.
+  // Largest |(|x_i - x_{i-1}| - L_i)| / L_i over every link, after every leader step.
   double max_relative_length_error = 0.0;
   // Distance travelled by each point over the run, sub-steps included: n+1 values.
   // The profile shows the motion dying out along the chain.
