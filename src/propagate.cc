@@ -38,8 +38,6 @@ void Sweeps(const double* heads, int64_t num_sweeps, const double* lengths,
 namespace internal {
 
 #if FLEXKIN_HAVE_WAVEFRONT
-using SweepsFn = void (*)(Method, int, const double*, int64_t, const double*, const double*, int,
-                          double*);
 void SweepsWavefrontAvx2(Method, int, const double*, int64_t, const double*, const double*, int,
                          double*);
 void SweepsWavefrontAvx512(Method, int, const double*, int64_t, const double*, const double*, int,
@@ -95,6 +93,21 @@ void SweepsWavefront(Method method, int dim, const double* heads, int64_t num_sw
   }
 #endif
   SweepsScalar(method, dim, heads, num_sweeps, lengths, inv_lengths, n, pts);
+}
+
+std::vector<WavefrontEngine> AvailableWavefronts() {
+  std::vector<WavefrontEngine> engines;
+#if FLEXKIN_HAVE_WAVEFRONT
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+    engines.push_back({"avx2", SweepsWavefrontAvx2, 4});
+  }
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+      __builtin_cpu_supports("avx512cd")) {
+    engines.push_back({"avx512", SweepsWavefrontAvx512, 8});
+  }
+#endif
+  return engines;
 }
 
 int WavefrontLanes() {

@@ -4,6 +4,7 @@
 // method's rule. `points` is the (n+1) by dim row-major chain, updated in place.
 
 #include <cstdint>
+#include <vector>
 
 #include "flexkin/propagate.h"
 
@@ -22,5 +23,16 @@ void SweepsWavefront(Method method, int dim, const double* heads, int64_t num_sw
 
 // Number of sweeps in flight in SweepsWavefront on this CPU (the SIMD width in doubles).
 int WavefrontLanes();
+
+// Every wavefront engine this CPU can run, by name ("avx2", "avx512"), so tests can check each
+// against SweepsScalar whatever FLEXKIN_SIMD says.
+using SweepsFn = void (*)(Method, int, const double*, int64_t, const double*, const double*, int,
+                          double*);
+struct WavefrontEngine {
+  const char* name;
+  SweepsFn fn;
+  int lanes;
+};
+std::vector<WavefrontEngine> AvailableWavefronts();
 
 }  // namespace flexkin::internal
