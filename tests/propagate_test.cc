@@ -211,11 +211,13 @@ TEST(MoveLeaderTest, SweepAppliesTheLinkRuleDownTheChain) {
   }
 }
 
-// Long chains with many sub-steps may take the vectorized (wavefront) sweep, whose exp may
-// differ from std::exp by about an ulp: the same motion to rounding.
+// Long chains with many sub-steps may take the vectorized (wavefront) sweep, whose exp (a
+// vector exp, or a short Taylor series for sub-steps below L/32, as with 1024 sub-steps here)
+// may differ from std::exp by about an ulp: the same motion to rounding.
 TEST(MoveLeaderTest, ManySubstepsOnALongChainAgreeWithTheLinkRules) {
+  double worst = 0.0;
   for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {
-    for (const int substeps : {16, 64, 67}) {
+    for (const int substeps : {16, 64, 67, 1024}) {
       const Chain chain = MakeChain(CurvedPoints(3, 40, 1.0, 0.2));
       const Eigen::Vector3d target(-0.4, 2.2, 0.5);
       Chain moved = chain;
@@ -223,9 +225,12 @@ TEST(MoveLeaderTest, ManySubstepsOnALongChainAgreeWithTheLinkRules) {
       const double diff =
           MaxDistance(moved.points, LinkRuleSweeps(method, chain, target, substeps));
       EXPECT_LT(diff, 1e-13) << MethodName(method) << ", " << substeps << " sub-steps";
+      worst = std::fmax(worst, diff);
       EXPECT_LT(MaxRelativeLengthError(moved), 1e-14);
     }
   }
+  std::cout << "[ measured ] vectorized vs scalar link-rule sweeps: max point distance " << worst
+            << "\n";
 }
 
 // ----- Invariants ---------------------------------------------------------------------------
