@@ -1,0 +1,231 @@
+// The flexkin command line: runs and checks scenario files.
+//
+//   flexkin run SCENARIO.json -o RESULT.json [--csv FRAMES.csv] [--method tractrix|ftl]
+//       [--substeps N] [--tolerance T] [--max-substeps N] [--record-every N]
+//       [--report brief|full] [--quiet]
+//   flexkin validate SCENARIO.json
+//   flexkin --version
+//
+// Exit codes are listed in kExitCodesHelp and in docs/scenario-format.md.
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <exception>
+#include <iostream>
+#include <new>
+#include <string>
+#include <system_error>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "flexkin/error.h"
+#include "flexkin/propagate.h"
+#include "flexkin/result_io.h"
+#include "flexkin/run.h"
+#include "flexkin/scenario.h"
+
+namespace {
+
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitInvalidInput = 1,    // scenario or option values invalid, or any other failure
+  kExitUsage = 2,           // command-line syntax (unknown option, missing argument, ...)
+  kExitAccuracyNotMet = 3,  // run done and result written, but the tolerance was not met
+  kExitIoError = 4,         // a file could not be read or written
+};
+
+constexpr const char* kExitCodesHelp =
+    "Exit codes:\n"
+    "  0  success\n"
+    "  1  invalid input: the scenario or an option value (the message names the file, the\n"
+    "     field, the value and what is valid), or another failure\n"
+    "  2  usage error: unknown option, missing argument, malformed number\n"
+    "  3  the run completed and the result was written, but the accuracy target\n"
+    "     (--tolerance) was not met within --max-substeps\n"
+    "  4  I/O error: a file could not be read or written (an existing output file is\n"
+    "     never left half-written)";
+
+void PrintError(const std::string& message) { std::cerr << "flexkin: error: " << message << "\n"; }
+
+struct RunArgs {
+  std::string scenario, output, csv, method, report = "brief";
+  int substeps = 0, record_every = 0, max_substeps = 0;
+  double tolerance = 0.0;
+  bool quiet = false;
+  // Which overrides were given.
+  CLI::Option *substeps_opt = nullptr, *record_every_opt = nullptr, *max_substeps_opt = nullptr,
+              *tolerance_opt = nullptr, *method_opt = nullptr;
+};
+
+// Fails early, before a possibly long run, if an output's directory does not exist.
+void CheckOutputDirectory(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  const std::string dir = slash == std::string::npos ? "." : path.substr(0, slash + 1);
+  struct stat st;
+  if (::stat(dir.c_str(), &st) != 0) {
+    throw std::system_error(errno, std::generic_category(), "cannot write '" + path + "'");
+  }
+  if (!S_ISDIR(st.st_mode)) {
+    throw std::system_error(ENOTDIR, std::generic_category(), "cannot write '" + path + "'");
+  }
+}
+
+// Progress on stderr, rewritten in place; only used when stderr is a terminal.
+void ShowProgress(int64_t done, int64_t total) {
+  std::fprintf(stderr, "\rflexkin: leader step %lld of %lld (%.0f%%)", static_cast<long long>(done),
+               static_cast<long long>(total), total > 0 ? 100.0 * done / total : 100.0);
+  if (done >= total) std::fputc('\n', stderr);
+  std::fflush(stderr);
+}
+
+// Applies the command-line overrides to the scenario's options; throws InputError naming the
+// option (or the scenario field it conflicts with).
+void ApplyOverrides(const RunArgs& args, flexkin::RunOptions* options) {
+  if (*args.method_opt) options->method = flexkin::ParseMethod(args.method, "--method");
+  if (*args.substeps_opt) options->substeps = args.substeps;
+  if (*args.record_every_opt) options->record_every = args.record_every;
+  if (*args.tolerance_opt) options->tolerance = args.tolerance;
+  if (*args.max_substeps_opt) {
+    options->max_substeps = args.max_substeps;
+  } else if (*args.substeps_opt && options->max_substeps < options->substeps) {
+    options->max_substeps = options->substeps;  // a large --substeps raises the default cap
+  }
+  const std::string why = options->Validate();
+  if (why.empty()) return;
+  const std::string field = why.substr(0, why.find(':'));
+  const std::string reason = why.substr(why.find(':') + 2);
+  const bool from_cli = (field == "substeps" && *args.substeps_opt) ||
+                        (field == "record_every" && *args.record_every_opt) ||
+                        (field == "tolerance" && *args.tolerance_opt) ||
+                        (field == "max_substeps" && *args.max_substeps_opt);
+  std::string flag = field;
+  for (char& c : flag) c = c == '_' ? '-' : c;
+  const std::string pointer = field == "substeps"       ? "/leader/substeps"
+                              : field == "record_every" ? "/record/every"
+                              : field == "tolerance"    ? "/accuracy/tolerance"
+                                                        : "/accuracy/max_substeps";
+  throw flexkin::InputError(from_cli ? "--" + flag : args.scenario + ": " + pointer, reason);
+}
+
+int RunCommand(const RunArgs& args) {
+  flexkin::Scenario scenario;
+  try {
+    scenario = flexkin::LoadScenarioFile(args.scenario);
+  } catch (const flexkin::InputError& e) {
+    PrintError(args.scenario + ": " + e.what());
+    return kExitInvalidInput;
+  }
+  ApplyOverrides(args, &scenario.options);
+  CheckOutputDirectory(args.output);
+  if (!args.csv.empty()) CheckOutputDirectory(args.csv);
+  if (!args.quiet && ::isatty(STDERR_FILENO)) scenario.options.progress = ShowProgress;
+
+  const flexkin::RunResult result =
+      flexkin::Run(scenario.chain, scenario.leader_steps, scenario.options);
+  flexkin::WriteResultJson(result, args.output, scenario.name);
+  if (!args.csv.empty()) flexkin::WriteFramesCsv(result, args.csv);
+
+  if (!args.quiet) {
+    std::cout << (args.report == "full" ? result.FullReport() : result.BriefReport() + "\n");
+  }
+  if (result.accuracy.enabled && !result.accuracy.met) {
+    std::fprintf(stderr,
+                 "flexkin: warning: accuracy target not met: estimated error %.3g > tolerance "
+                 "%.3g with %d sub-steps (raise --max-substeps or --tolerance); the result was "
+                 "written to %s\n",
+                 result.accuracy.estimated_error, scenario.options.tolerance,
+                 result.accuracy.substeps, args.output.c_str());
+    return kExitAccuracyNotMet;
+  }
+  return kExitOk;
+}
+
+int ValidateCommand(const std::string& path) {
+  nlohmann::json json;
+  try {
+    json = flexkin::ReadJsonFile(path);
+  } catch (const flexkin::InputError& e) {
+    std::cout << path << ": " << e.what() << "\n";
+    return kExitInvalidInput;
+  }
+  const std::vector<flexkin::ScenarioProblem> problems = flexkin::ValidateScenario(json);
+  if (!problems.empty()) {
+    for (const auto& p : problems) {
+      std::cout << path << ": " << (p.pointer.empty() ? "" : p.pointer + ": ") << p.message << "\n";
+    }
+    return kExitInvalidInput;
+  }
+  std::cout << "ok: " << flexkin::ScenarioSummary(flexkin::ParseScenario(json)) << "\n";
+  return kExitOk;
+}
+
+int Main(int argc, char** argv) {
+  CLI::App app{
+      "flexkin: natural, length-preserving motion of a chain of rigid links whose\n"
+      "leading end is moved along a path (tractrix method).",
+      "flexkin"};
+  app.set_version_flag("--version", std::string("flexkin ") + FLEXKIN_VERSION);
+  app.require_subcommand(1);
+  app.footer(kExitCodesHelp);
+
+  RunArgs args;
+  CLI::App* run = app.add_subcommand("run", "Run a scenario file and write the result.");
+  run->add_option("scenario", args.scenario, "Scenario file (JSON, docs/scenario-format.md)")
+      ->required();
+  run->add_option("-o,--output", args.output, "Result file to write (JSON)")->required();
+  run->add_option("--csv", args.csv, "Also write the recorded frames as CSV");
+  args.method_opt = run->add_option("--method", args.method, "Link rule: tractrix or ftl");
+  args.substeps_opt =
+      run->add_option("--substeps", args.substeps, "Sub-steps per leader step (>= 1)");
+  args.tolerance_opt = run->add_option(
+      "--tolerance", args.tolerance,
+      "Automatic sub-steps: largest distance to the continuous motion (length unit); 0 = off");
+  args.max_substeps_opt = run->add_option("--max-substeps", args.max_substeps,
+                                          "Upper bound of the automatic sub-steps");
+  args.record_every_opt = run->add_option("--record-every", args.record_every,
+                                          "Record every N-th leader step (and the last)");
+  run->add_option("--report", args.report, "Report printed after the run")
+      ->check(CLI::IsMember({"brief", "full"}));
+  run->add_flag("-q,--quiet", args.quiet, "Print no report and no progress");
+  run->footer(kExitCodesHelp);
+
+  std::string validate_path;
+  CLI::App* validate = app.add_subcommand("validate", "Check a scenario file; list every problem.");
+  validate->add_option("scenario", validate_path, "Scenario file (JSON)")->required();
+  validate->footer(kExitCodesHelp);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+  }
+  try {
+    if (*run) return RunCommand(args);
+    return ValidateCommand(validate_path);
+  } catch (const flexkin::InputError& e) {
+    PrintError(e.what());
+    return kExitInvalidInput;
+  } catch (const std::system_error& e) {  // files; std::ios_base::failure is one too
+    PrintError(e.what());
+    return kExitIoError;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return Main(argc, argv);
+  } catch (const std::bad_alloc&) {
+    PrintError("out of memory");
+  } catch (const std::exception& e) {
+    PrintError(std::string("unexpected failure: ") + e.what());
+  } catch (...) {
+    PrintError("unexpected failure");
+  }
+  return kExitInvalidInput;
+}

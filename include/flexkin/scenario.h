@@ -1,0 +1,49 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "flexkin/chain.h"
+#include "flexkin/run.h"
+
+namespace flexkin {
+
+// A scenario file (JSON, docs/scenario-format.md, docs/schema/scenario.schema.json): an initial
+// curve, a motion of its leading end, and the options of the run.
+struct Scenario {
+  std::string name;         // "name", "" if absent
+  std::string description;  // "description", "" if absent
+  // From "curve". For a generated shape every link length is exactly "link_length"; for a point
+  // list they are the distances between the points (MakeChain).
+  Chain chain;
+  Points leader_steps;  // m by dim, m >= 1: the targets from "leader", not including the start
+  RunOptions options;   // "method", "leader/substeps", "record/every", "accuracy/..."
+};
+
+// One problem in a scenario document.
+struct ScenarioProblem {
+  std::string pointer;  // JSON pointer to the offending value ("/leader/steps"); "" = whole file
+  std::string message;  // the value and what would be valid, without the pointer
+};
+
+// Checks `json` and builds the scenario. Throws InputError whose field() is the JSON pointer of
+// the first problem and whose what() is "pointer: message", e.g.
+//   "/leader/steps: value 0 is not valid; expected an integer >= 1".
+Scenario ParseScenario(const nlohmann::json& json);
+
+// Every problem found in `json` (unknown keys, wrong types, values out of range, inconsistent
+// dimensions, curves that cannot be generated, ...), in the order checked (the keys of an
+// object alphabetically); empty if and only if ParseScenario would succeed.
+std::vector<ScenarioProblem> ValidateScenario(const nlohmann::json& json);
+
+// ReadJsonFile (result_io.h) + ParseScenario. Messages do not repeat the path; callers add it.
+// Throws std::system_error if the file cannot be read, InputError if it is not valid JSON (the
+// message gives line and column) or not a valid scenario.
+Scenario LoadScenarioFile(const std::string& path);
+
+// One line: "2D, 20 links (total length 5), 5 leader steps, method tractrix, 1 sub-step".
+std::string ScenarioSummary(const Scenario& scenario);
+
+}  // namespace flexkin

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# make demo: runs the paper's scenarios (examples/*.json) with the flexkin command line, writes
+# the results to out/, and prints for each the link-length error, the L2 metric and the
+# path-length profile; then the closed-form check of Fig. 7 and the Fig. 6 comparison.
+set -euo pipefail
+build=${1:-build}
+cd "$(dirname "$0")/.."
+flexkin="$build/apps/flexkin"
+mkdir -p out
+for scenario in examples/fig*.json; do
+  name=$(basename "$scenario" .json)
+  echo "== $name"
+  "$flexkin" run "$scenario" -o "out/$name.json" --report full
+done
+echo "== closed form and comparisons"
+"$build/examples/fig07_closed_form" examples/fig07_straight_link.json
+"$build/examples/fig06_compare" examples/fig06_parabola_single_step.json \
+  examples/fig06_parabola_multi_step.json
+echo "results: out/*.json (format: docs/result-format.md)"

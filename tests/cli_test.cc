@@ -1,0 +1,245 @@
+// Tests of the flexkin command line (the FLEXKIN_CLI executable), run in a temporary directory:
+// documented exit codes, files written, messages naming file and field, and an existing output
+// left byte-identical whenever a run fails.
+#include <dirent.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "flexkin/result_io.h"
+
+namespace flexkin {
+namespace {
+
+const std::string kCli = FLEXKIN_CLI;
+
+std::string Example(const std::string& name) {
+  return std::string(FLEXKIN_SOURCE_DIR) + "/examples/" + name;
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+bool Exists(const std::string& path) {
+  struct stat st;
+  return ::stat(path.c_str(), &st) == 0;
+}
+
+struct CliResult {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+class CliTest : public testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_FALSE(kCli.empty()) << "FLEXKIN_CLI is empty: the flexkin_cli target was not built "
+                                  "(configure with FLEXKIN_BUILD_APPS=ON)";
+    ASSERT_TRUE(Exists(kCli)) << "FLEXKIN_CLI does not exist: " << kCli;
+    char name[] = "/tmp/flexkin_cli_test_XXXXXX";
+    ASSERT_NE(::mkdtemp(name), nullptr);
+    dir_ = name;
+  }
+  void TearDown() override {
+    if (dir_.empty()) return;
+    if (DIR* d = ::opendir(dir_.c_str())) {
+      while (const dirent* e = ::readdir(d)) {
+        const std::string n = e->d_name;
+        if (n != "." && n != "..") ::unlink((dir_ + "/" + n).c_str());
+      }
+      ::closedir(d);
+    }
+    ::rmdir(dir_.c_str());
+  }
+
+  std::string Path(const std::string& name) const { return dir_ + "/" + name; }
+  void Write(const std::string& name, const std::string& text) const {
+    std::ofstream(Path(name), std::ios::binary) << text;
+  }
+
+  // Runs `flexkin ARGS` in the temporary directory, stdout and stderr captured to files (so
+  // stderr is not a terminal and no progress is shown).
+  CliResult Cli(const std::string& args) const {
+    const std::string command = "cd '" + dir_ + "' && '" + kCli + "' " + args + " > '" +
+                                Path("stdout.txt") + "' 2> '" + Path("stderr.txt") + "'";
+    const int status = std::system(command.c_str());
+    CliResult r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.out = ReadFile(Path("stdout.txt"));
+    r.err = ReadFile(Path("stderr.txt"));
+    ::unlink(Path("stdout.txt").c_str());
+    ::unlink(Path("stderr.txt").c_str());
+    return r;
+  }
+
+  std::string dir_;
+};
+
+#define EXPECT_CONTAINS(text, part) \
+  EXPECT_NE(std::string(text).find(part), std::string::npos) << "in: " << (text)
+
+TEST_F(CliTest, RunWritesResultAndCsvAndPrintsTheReport) {
+  const CliResult r = Cli("run '" + Example("fig06_parabola_multi_step.json") +
+                          "' -o result.json --csv frames.csv");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_CONTAINS(r.out, "tractrix: 20 links, 5 leader steps");
+  EXPECT_EQ(r.err, "");  // no progress when stderr is not a terminal
+  const ResultFile result = ReadResultJson(Path("result.json"));
+  EXPECT_EQ(result.scenario_name, "fig06_parabola_multi_step");
+  EXPECT_EQ(result.result.frames.size(), 6u);
+  const std::string csv = ReadFile(Path("frames.csv"));
+  EXPECT_EQ(csv.rfind("step,point,x,y\n", 0), 0u);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 6 * 21);
+}
+
+TEST_F(CliTest, EveryExampleRuns) {
+  for (const char* file :
+       {"fig07_straight_link.json", "fig06_parabola_single_step.json",
+        "fig06_parabola_multi_step.json", "fig10_planar_curve.json", "fig12_spatial_curve.json"}) {
+    const CliResult r = Cli("run '" + Example(file) + "' -o out.json --quiet");
+    EXPECT_EQ(r.exit_code, 0) << file << ": " << r.err;
+    EXPECT_EQ(r.out, "") << "--quiet printed something";
+    EXPECT_GT(ReadResultJson(Path("out.json")).result.num_steps, 0) << file;
+  }
+}
+
+TEST_F(CliTest, OptionsOverrideTheScenario) {
+  const CliResult r = Cli("run '" + Example("fig07_straight_link.json") +
+                          "' -o out.json --method ftl --record-every 100 --substeps 3 "
+                          "--report full");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_CONTAINS(r.out, "path length per point");
+  const ResultFile f = ReadResultJson(Path("out.json"));
+  EXPECT_EQ(f.result.method, Method::kFollowTheLeader);
+  EXPECT_EQ(f.result.accuracy.substeps, 3);
+  EXPECT_EQ(f.result.frames.size(), 6u);  // steps 0, 100, ..., 500
+}
+
+TEST_F(CliTest, ValidateSaysOkWithASummary) {
+  const CliResult r = Cli("validate '" + Example("fig12_spatial_curve.json") + "'");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out,
+            "ok: 3D, 20 links (total length 30), 2650 leader steps, method tractrix, "
+            "1 sub-step\n");
+}
+
+TEST_F(CliTest, ValidateListsEveryProblem) {
+  Write("bad.json", R"({"curve": {"shape": "arc", "radius": 1, "links": 0, "link_length": 0.1},
+                        "leader": {"pull": [1, 0], "steps": 0}, "method": "fast"})");
+  const CliResult r = Cli("validate bad.json");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.out, "bad.json: /curve/links: value 0 is not valid");
+  EXPECT_CONTAINS(r.out, "bad.json: /method: value \"fast\" is not valid");
+  EXPECT_CONTAINS(r.out, "bad.json: /leader/steps: value 0 is not valid");
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 3);
+}
+
+TEST_F(CliTest, MalformedScenarioExitsOneAndKeepsTheOldOutput) {
+  Write("bad.json", R"({"curve": {"points": [[0, 0], [1, 0]]},
+                        "leader": {"pull": [1, 0], "steps": 0}})");
+  Write("out.json", "precious");
+  const CliResult r = Cli("run bad.json -o out.json");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "bad.json: /leader/steps: value 0 is not valid; expected an integer >= 1");
+  EXPECT_EQ(ReadFile(Path("out.json")), "precious");
+}
+
+TEST_F(CliTest, JsonSyntaxErrorGivesLineAndColumn) {
+  Write("broken.json", "{\n  \"curve\": {\"points\": [[0, 0], [1, 0]]},\n  \"leader\": }\n");
+  Write("out.json", "precious");
+  const CliResult r = Cli("run broken.json -o out.json");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "broken.json: line 3, column 13: invalid JSON");
+  EXPECT_EQ(ReadFile(Path("out.json")), "precious");
+}
+
+TEST_F(CliTest, InvalidOptionValueExitsOneNamingTheOption) {
+  Write("out.json", "precious");
+  const std::string run = "run '" + Example("fig07_straight_link.json") + "' -o out.json ";
+  CliResult r = Cli(run + "--substeps 0");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "--substeps: 0 is not valid");
+  r = Cli(run + "--method fast");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "--method: unknown method \"fast\"");
+  r = Cli(run + "--tolerance -1");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "--tolerance");
+  EXPECT_EQ(ReadFile(Path("out.json")), "precious");
+}
+
+TEST_F(CliTest, UsageErrorsExitTwo) {
+  const std::string scenario = "'" + Example("fig07_straight_link.json") + "'";
+  EXPECT_EQ(Cli("").exit_code, 2);
+  EXPECT_EQ(Cli("frobnicate").exit_code, 2);
+  EXPECT_EQ(Cli("run " + scenario).exit_code, 2);  // no -o
+  EXPECT_EQ(Cli("run " + scenario + " -o x.json --no-such-option").exit_code, 2);
+  EXPECT_EQ(Cli("run " + scenario + " -o x.json --substeps many").exit_code, 2);
+  EXPECT_EQ(Cli("run " + scenario + " -o x.json --report long").exit_code, 2);
+  EXPECT_FALSE(Exists(Path("x.json")));
+}
+
+TEST_F(CliTest, HelpAndVersionExitZero) {
+  CliResult r = Cli("--version");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_EQ(r.out.rfind("flexkin ", 0), 0u) << r.out;
+  r = Cli("run --help");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_CONTAINS(r.out, "Exit codes:");
+  EXPECT_CONTAINS(r.out, "--tolerance");
+}
+
+TEST_F(CliTest, MissingScenarioExitsFour) {
+  const CliResult r = Cli("run missing.json -o out.json");
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_CONTAINS(r.err, "cannot read 'missing.json': No such file or directory");
+  EXPECT_FALSE(Exists(Path("out.json")));
+  EXPECT_EQ(Cli("validate missing.json").exit_code, 4);
+}
+
+TEST_F(CliTest, UnwritableOutputExitsFour) {
+  const CliResult r =
+      Cli("run '" + Example("fig07_straight_link.json") + "' -o no/such/dir/out.json");
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_CONTAINS(r.err, "cannot write 'no/such/dir/out.json'");
+  // An output that is a directory is refused after the run and stays a directory.
+  ASSERT_EQ(::mkdir(Path("taken").c_str(), 0755), 0);
+  EXPECT_EQ(Cli("run '" + Example("fig07_straight_link.json") + "' -o taken").exit_code, 4);
+  struct stat st;
+  EXPECT_TRUE(::stat(Path("taken").c_str(), &st) == 0 && S_ISDIR(st.st_mode));
+  ::rmdir(Path("taken").c_str());
+}
+
+TEST_F(CliTest, AccuracyNotMetExitsThreeButWritesTheResult) {
+  Write("out.json", "old");
+  const CliResult r = Cli("run '" + Example("fig06_parabola_single_step.json") +
+                          "' -o out.json --tolerance 1e-300 --max-substeps 4");
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_CONTAINS(r.err, "warning: accuracy target not met");
+  const ResultFile f = ReadResultJson(Path("out.json"));
+  EXPECT_TRUE(f.result.accuracy.enabled);
+  EXPECT_FALSE(f.result.accuracy.met);
+}
+
+TEST_F(CliTest, AccuracyMetExitsZero) {
+  const CliResult r =
+      Cli("run '" + Example("fig06_parabola_single_step.json") + "' -o out.json --tolerance 1e-4");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(ReadResultJson(Path("out.json")).result.accuracy.met);
+}
+
+}  // namespace
+}  // namespace flexkin
