@@ -156,6 +156,11 @@ void WavefrontSweeps(const double* heads, int64_t num_sweeps, const double* leng
         lead_old[k] = window[k];
         lead_new[k] = window[k] = tail[k];
       }
+      if (t >= n) {
+        // Lanes that have finished the chain stay still too: their leading end stops moving.
+        const auto done = index >= last;
+        for (int k = 0; k < Dim; ++k) lead_new[k] = xsimd::select(done, lead_old[k], lead_new[k]);
+      }
       if (base >= 0) {
         for (int k = 0; k < Dim; ++k) points[base * Dim + k] = First(tail[k]);
       }
