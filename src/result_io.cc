@@ -463,6 +463,9 @@ void WriteResultJson(const RunResult& result, std::ostream& out, const std::stri
   t += "\"seconds\": ";
   AppendDouble(std::isfinite(result.seconds) ? result.seconds : 0.0, &t);
   t += ",\n\"accuracy\": {\"enabled\": " + std::string(a.enabled ? "true" : "false") +
+       ", \"tolerance\": ";
+  AppendDouble(a.tolerance, &t);
+  t += ", \"max_substeps\": " + std::to_string(a.max_substeps) +
        ", \"substeps\": " + std::to_string(a.substeps) + ", \"order\": " + std::to_string(a.order) +
        ", \"estimated_error\": ";
   AppendDouble(a.estimated_error, &t);
@@ -562,6 +565,10 @@ ResultFile ResultFromJson(const json& j) {
 
   const json& accuracy = Member(j, "", "accuracy");
   r.accuracy.enabled = ReadBool(Member(accuracy, "/accuracy", "enabled"), "/accuracy/enabled");
+  r.accuracy.tolerance =
+      ReadNumber(Member(accuracy, "/accuracy", "tolerance"), "/accuracy/tolerance");
+  r.accuracy.max_substeps = static_cast<int>(
+      ReadInteger(Member(accuracy, "/accuracy", "max_substeps"), "/accuracy/max_substeps", 0));
   r.accuracy.substeps = static_cast<int>(
       ReadInteger(Member(accuracy, "/accuracy", "substeps"), "/accuracy/substeps", 1));
   r.accuracy.order =

@@ -64,6 +64,8 @@ AccuracyReport ChooseSubsteps(const Chain& chain, const Points& leader_steps,
                               const RunOptions& options) {
   AccuracyReport report;
   report.enabled = true;
+  report.tolerance = options.tolerance;
+  report.max_substeps = options.max_substeps;
   report.order = MethodOrder(options.method);
   const Stepper stepper = MakeStepper(options.method, chain);
   for (int fine = std::min(2 * options.substeps, options.max_substeps);;

@@ -121,6 +121,8 @@ RunResult AwkwardResult(int dim, uint64_t seed) {
   }
   awkward(&r.metrics.l2_total);
   awkward(&r.accuracy.estimated_error);
+  awkward(&r.accuracy.tolerance);
+  r.accuracy.max_substeps = 4096;
   return r;
 }
 
@@ -155,6 +157,8 @@ TEST(ResultJsonTest, RoundTripIsBitExact) {
     EXPECT_TRUE(SameBits(back.result.accuracy.estimated_error, r.accuracy.estimated_error));
     EXPECT_EQ(back.result.accuracy.enabled, r.accuracy.enabled);
     EXPECT_EQ(back.result.accuracy.substeps, r.accuracy.substeps);
+    EXPECT_TRUE(SameBits(back.result.accuracy.tolerance, r.accuracy.tolerance));
+    EXPECT_EQ(back.result.accuracy.max_substeps, r.accuracy.max_substeps);
     EXPECT_EQ(back.result.accuracy.met, r.accuracy.met);
   }
 }
@@ -179,7 +183,8 @@ TEST(ResultJsonTest, HasTheDocumentedKeys) {
                           "max_relative_length_error", "path_length"}) {
     EXPECT_TRUE(j["metrics"].contains(key)) << key;
   }
-  for (const char* key : {"enabled", "substeps", "order", "estimated_error", "met"}) {
+  for (const char* key :
+       {"enabled", "tolerance", "max_substeps", "substeps", "order", "estimated_error", "met"}) {
     EXPECT_TRUE(j["accuracy"].contains(key)) << key;
   }
   ASSERT_EQ(j["frames"].size(), 6u);

@@ -66,6 +66,8 @@ struct Metrics {
 // What the accuracy control did.
 struct AccuracyReport {
   bool enabled = false;          // tolerance > 0 was asked for
+  double tolerance = 0.0;        // the tolerance asked for (RunOptions::tolerance)
+  int max_substeps = 0;          // the bound on the sub-steps (RunOptions::max_substeps)
   int substeps = 1;              // sub-steps per leader step actually used
   int order = 2;                 // convergence order assumed in the estimate (2 tractrix, 1 ftl)
   double estimated_error = 0.0;  // Richardson estimate of the largest distance to the continuous
