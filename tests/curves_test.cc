@@ -1,6 +1,7 @@
 // Tests of the generated initial curves: every link has exactly the requested chord length, the
 // points lie on the intended shape, and bad parameters are refused with the field named.
 #include "flexkin/curves.h"
+#include "test_util.h"
 
 #include <cmath>
 #include <string>
@@ -15,6 +16,8 @@
 namespace flexkin {
 namespace {
 
+using test_util::ExpectInputError;
+
 constexpr double kPi = 3.14159265358979323846;
 
 // Every distance between consecutive points equals `length` to `tolerance` relative.
@@ -27,17 +30,6 @@ void ExpectChords(const Points& p, double length, double tolerance = 1e-12) {
 
 // Calls `make` and checks that it throws an InputError for `field` whose message contains
 // `text`.
-template <typename Make>
-void ExpectInputError(Make make, const std::string& field, const std::string& text) {
-  try {
-    make();
-    ADD_FAILURE() << "no InputError, expected one for " << field;
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.field(), field) << e.what();
-    EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
-  }
-}
-
 TEST(CurveLineTest, PointsAreEquallySpacedAlongTheUnitDirection) {
   LineDef def;
   def.start = Eigen::Vector3d(1.0, -2.0, 0.5);

@@ -2,6 +2,7 @@
 // path has no step longer than max_step, visits every vertex exactly, and takes the fewest steps
 // that allow that.
 #include "flexkin/leader.h"
+#include "test_util.h"
 
 #include <cmath>
 #include <random>
@@ -14,16 +15,7 @@
 namespace flexkin {
 namespace {
 
-template <typename Make>
-void ExpectInputError(Make make, const std::string& field, const std::string& text) {
-  try {
-    make();
-    ADD_FAILURE() << "no InputError, expected one for " << field;
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.field(), field) << e.what();
-    EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
-  }
-}
+using test_util::ExpectInputError;
 
 Points Rows(std::initializer_list<std::initializer_list<double>> rows) {
   Points p(rows.size(), rows.begin()->size());

@@ -2,6 +2,7 @@
 // against an independent ODE solution (Boost.Odeint), its fast form against its reference form,
 // edge cases and invariants; the follow-the-leader step's invariants; input checking.
 #include "flexkin/link_step.h"
+#include "test_util.h"
 
 #include <gtest/gtest.h>
 
@@ -20,6 +21,8 @@
 
 namespace flexkin {
 namespace {
+
+using test_util::Str;
 
 template <int Dim>
 using Vec = Eigen::Matrix<double, Dim, 1>;
@@ -122,12 +125,6 @@ LinkMove<Dim> AlmostTowardMove(Random& random, double length, double offset, dou
   m.tail = m.head_old + length * (std::sqrt(1.0 - offset * offset) * u + offset * w);
   m.head_new = m.head_old + p * u;
   return m;
-}
-
-std::string Str(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", x);
-  return buf;
 }
 
 const char* KindName(MoveKind kind) {

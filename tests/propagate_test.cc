@@ -3,6 +3,7 @@
 // dying out, alignment with a long pull) and convergence of the multi-step methods to the
 // continuous motion computed by an independent ODE solver (reference_ode.h).
 #include "flexkin/propagate.h"
+#include "test_util.h"
 
 #include <gtest/gtest.h>
 
@@ -23,27 +24,11 @@
 namespace flexkin {
 namespace {
 
+using test_util::Str;
+using test_util::ExpectInputError;
+using test_util::CurvedPoints;
+
 constexpr double kEps = std::numeric_limits<double>::epsilon();
-
-std::string Str(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", x);
-  return buf;
-}
-
-// A curved chain of `n` links: points on a helix (a circle of radius `radius` in 2D), point 0
-// first. Link lengths are about radius * turn (slightly different per link in 3D: the pitch
-// varies) so that the lengths are not all equal.
-Points CurvedPoints(int dim, int n, double radius, double turn) {
-  Points p(n + 1, dim);
-  for (int i = 0; i <= n; ++i) {
-    const double a = turn * i;
-    p(i, 0) = radius * std::cos(a);
-    p(i, 1) = radius * std::sin(a);
-    if (dim == 3) p(i, 2) = 0.02 * radius * i + 0.01 * radius * std::sin(3.0 * a);
-  }
-  return p;
-}
 
 // Largest distance between corresponding points.
 double MaxDistance(const Points& a, const Points& b) { return (a - b).rowwise().norm().maxCoeff(); }
@@ -72,18 +57,6 @@ TEST(MakeChainTest, LengthsAreTheDistancesBetweenConsecutivePoints) {
   EXPECT_EQ(chain.points, p);
   EXPECT_EQ(chain.lengths, Eigen::Vector3d(5, 12, 1));
   EXPECT_EQ(MaxRelativeLengthError(chain), 0.0);
-}
-
-// Expects `f` to throw InputError whose field is `field` and whose message names it.
-template <class F>
-void ExpectInputError(F f, const std::string& field) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError; expected one naming " << field;
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.field(), field) << e.what();
-    EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
-  }
 }
 
 TEST(MakeChainTest, RejectsDegenerateInputNamingTheField) {

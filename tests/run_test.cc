@@ -2,6 +2,7 @@
 // independent computation from the frames, and the accuracy control against the continuous
 // motion computed by an independent ODE solver (reference_ode.h).
 #include "flexkin/run.h"
+#include "test_util.h"
 
 #include <gtest/gtest.h>
 
@@ -21,22 +22,12 @@
 namespace flexkin {
 namespace {
 
-std::string Str(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", x);
-  return buf;
-}
+using test_util::Str;
+using test_util::ExpectInputError;
 
-// A curved chain of `n` links on a circle (2D) or helix (3D) of radius `radius`, point 0 first.
+// A curved chain of `n` links on a circle (2D) or helix (3D), point 0 first.
 Chain CurvedChain(int dim, int n, double radius, double turn) {
-  Points p(n + 1, dim);
-  for (int i = 0; i <= n; ++i) {
-    const double a = turn * i;
-    p(i, 0) = radius * std::cos(a);
-    p(i, 1) = radius * std::sin(a);
-    if (dim == 3) p(i, 2) = 0.05 * radius * i;
-  }
-  return MakeChain(p);
+  return MakeChain(test_util::CurvedPoints(dim, n, radius, turn));
 }
 
 // `count` leader targets along a smooth curve starting at the chain's leading end, about
@@ -66,17 +57,6 @@ std::vector<Points> DirectRun(const Chain& chain, const Points& targets, Method 
     states.push_back(points);
   }
   return states;
-}
-
-template <class F>
-void ExpectInputError(F f, const std::string& field) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError; expected one naming " << field;
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.field(), field) << e.what();
-    EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
-  }
 }
 
 // ----- Input checking -----------------------------------------------------------------------

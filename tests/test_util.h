@@ -1,0 +1,54 @@
+#pragma once
+// Helpers shared by the test programs.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "flexkin/chain.h"
+#include "flexkin/error.h"
+
+namespace flexkin::test_util {
+
+// A number for a test message, 3 significant digits.
+inline std::string Str(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  return buf;
+}
+
+// Expects `make()` to throw InputError with the given field and a message containing `text`.
+template <typename Make>
+void ExpectInputError(Make make, const std::string& field, const std::string& text) {
+  try {
+    make();
+    ADD_FAILURE() << "no InputError, expected one for " << field;
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), field) << e.what();
+    EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+  }
+}
+
+// Expects `make()` to throw InputError whose field is `field` and whose message names it.
+template <typename Make>
+void ExpectInputError(Make make, const std::string& field) {
+  ExpectInputError(make, field, field);
+}
+
+// A curved chain of `n` links: points on a helix (a circle of radius `radius` in 2D), point 0
+// first. Link lengths are about radius * turn (slightly different per link in 3D: the pitch
+// varies) so that the lengths are not all equal.
+inline Points CurvedPoints(int dim, int n, double radius, double turn) {
+  Points p(n + 1, dim);
+  for (int i = 0; i <= n; ++i) {
+    const double a = turn * i;
+    p(i, 0) = radius * std::cos(a);
+    p(i, 1) = radius * std::sin(a);
+    if (dim == 3) p(i, 2) = 0.02 * radius * i + 0.01 * radius * std::sin(3.0 * a);
+  }
+  return p;
+}
+
+}  // namespace flexkin::test_util
