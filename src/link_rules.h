@@ -140,24 +140,27 @@ struct TractrixRule {
     if (none(dd > T(0.0))) return Mask<T>(dd != dd);
     const T rd = Dot<Dim>(r, d);
     const auto pulling = rd <= T(0.0);
-    T vv;
+    const T p = sqrt(dd);
+    T e, m, s1, s2;
     if (all(pulling)) {
       // Pulling: v enters only beside the dominant (L p - rd)^2 dd term, so the plain form
       // (whose error is eps L p^2 absolute) moves the tail by rounding only.
       for (int k = 0; k < Dim; ++k) v[k] = dd * r[k] - rd * d[k];
-      vv = Dot<Dim>(v, v);
+      e = Exp()(p * neg_inv_length);
+      m = length * p - rd;
+      s1 = (e * e) * Dot<Dim>(v, v);
+      s2 = (m * m) * dd;
     } else {
       // Pushing: with the tail nearly ahead of the head, v is small and decides which way the
       // link swings; it needs full relative accuracy (and v.d = 0 keeps the length).
-      vv = RejectAccurately<Dim>(r, d, dd, v);
+      const T vv = RejectAccurately<Dim>(r, d, dd, v);
+      e = Exp()(p * neg_inv_length);
+      // m = L p - rd when pulling, L p + rd when pushing: L p + |rd|, no cancellation.
+      m = length * p + abs(rd);
+      const T mmdd = (m * m) * dd;
+      s1 = (e * e) * select(pulling, vv, mmdd);
+      s2 = select(pulling, mmdd, vv);
     }
-    const T p = sqrt(dd);
-    const T e = Exp()(p * neg_inv_length);
-    // m = L p - rd when pulling, L p + rd when pushing: L p + |rd| either way, no cancellation.
-    const T m = length * p + abs(rd);
-    const T mmdd = (m * m) * dd;
-    const T s1 = (e * e) * select(pulling, vv, mmdd);
-    const T s2 = select(pulling, mmdd, vv);
     const T c = (e * m) * (dd + dd);
     const T den = p * (s1 + s2);
     const T f = length / den;

@@ -62,39 +62,39 @@ struct BatchExp {
   }
 };
 
-// [v1, v2, ..., v_{W-1}, x]: the window moves one point down the chain and takes in point t.
+// [a1, a2, ..., a_{W-1}, b0]: a window register moves one point down the chain and takes in the
+// first lane of the register after it.
 #if defined(__AVX2__)
-inline __m256d SlideIn(__m256d v, double x) {
-  return _mm256_blend_pd(_mm256_permute4x64_pd(v, _MM_SHUFFLE(0, 3, 2, 1)), _mm256_set1_pd(x),
-                         0b1000);
+inline __m256d SlideIn(__m256d a, __m256d b) {
+  return _mm256_blend_pd(_mm256_permute4x64_pd(a, _MM_SHUFFLE(0, 3, 2, 1)),
+                         _mm256_permute4x64_pd(b, _MM_SHUFFLE(0, 0, 0, 0)), 0b1000);
 }
-#endif
-#if defined(__AVX512F__)
-inline __m512d SlideIn(__m512d v, double x) {
-  return _mm512_permutex2var_pd(v, _mm512_setr_epi64(1, 2, 3, 4, 5, 6, 7, 8), _mm512_set1_pd(x));
-}
-#endif
-#if defined(__AVX2__)
 inline double First(__m256d v) { return _mm_cvtsd_f64(_mm256_castpd256_pd128(v)); }
 #endif
 #if defined(__AVX512F__)
+inline __m512d SlideIn(__m512d a, __m512d b) {
+  return _mm512_permutex2var_pd(a, _mm512_setr_epi64(1, 2, 3, 4, 5, 6, 7, 8), b);
+}
 inline double First(__m512d v) { return _mm_cvtsd_f64(_mm512_castpd512_pd128(v)); }
 #endif
 
-// Lanes: with W lanes, a group of W consecutive sweeps g..g+W-1 advances together; at iteration
-// t, lane j works on point t-W+1+j for sweep g+W-1-j. The point a lane reads is the one its
-// neighbour lane (the previous sweep) wrote one iteration earlier, so the window stays in
-// registers: each iteration reads one new point (t, for lane W-1, untouched by this group yet)
-// and writes one finished point (t-W+1, from lane 0, the group's last sweep). Nothing goes
-// through memory between lanes, so no store-to-load forwarding stalls.
-template <class Arch, class Rule, int Dim>
-void WavefrontSweeps(const double* heads, int64_t num_sweeps, const double* lengths,
-                     const double* inv_lengths, int n, double* points) {
+// Lanes: with U registers of W lanes (G = U W lanes), a group of G consecutive sweeps
+// g..g+G-1 advances together; at iteration t, lane j (register j / W) works on point t-G+1+j for
+// sweep g+G-1-j. The point a lane reads is the one its neighbour lane (the previous sweep) wrote
+// one iteration earlier, so the window stays in registers: each iteration reads one new point
+// (t, for the last lane, untouched by this group yet) and writes one finished point (t-G+1, from
+// lane 0, the group's last sweep). Nothing goes through memory between lanes (no store-to-load
+// forwarding stalls), and the U registers' rule evaluations are independent, so their latencies
+// overlap. Returns the number of sweeps done (a multiple of G).
+template <class Arch, class Rule, int Dim, int U>
+int64_t WavefrontGroups(const double* heads, int64_t num_sweeps, const double* lengths,
+                        const double* inv_lengths, int n, double* points) {
   using B = xsimd::batch<double, Arch>;
   constexpr int W = B::size;
-  // Link lengths of point i at len[pad + i]; the padding lanes compute garbage that is never
-  // stored.
-  const int pad = W - 1;
+  constexpr int G = U * W;
+  if (num_sweeps < G) return 0;
+  // Link lengths of point i at len[pad + i]; the padding lanes compute garbage never stored.
+  const int pad = G - 1;
   std::vector<double> len(n + 1 + 2 * pad, 1.0), neg_inv_len(n + 1 + 2 * pad, -1.0);
   std::copy(lengths, lengths + n, len.begin() + pad + 1);
   for (int i = 0; i < n; ++i) neg_inv_len[pad + 1 + i] = -inv_lengths[i];
@@ -104,70 +104,91 @@ void WavefrontSweeps(const double* heads, int64_t num_sweeps, const double* leng
   const B last = B(static_cast<double>(n));
 
   int64_t g = 0;
-  for (; g + W <= num_sweeps; g += W) {
-    B head[Dim], lead_old[Dim], lead_new[Dim], window[Dim];
-    for (int k = 0; k < Dim; ++k) {
-      alignas(64) double h[W];
-      for (int j = 0; j < W; ++j) h[j] = heads[(g + W - 1 - j) * Dim + k];
-      head[k] = B::load_aligned(h);
-      lead_old[k] = lead_new[k] = window[k] = B(0.0);
+  for (; g + G <= num_sweeps; g += G) {
+    B head[U][Dim], lead_old[U][Dim], lead_new[U][Dim], window[U][Dim];
+    for (int u = 0; u < U; ++u) {
+      for (int k = 0; k < Dim; ++k) {
+        alignas(64) double h[W];
+        for (int j = 0; j < W; ++j) h[j] = heads[(g + G - 1 - (u * W + j)) * Dim + k];
+        head[u][k] = B::load_aligned(h);
+        lead_old[u][k] = lead_new[u][k] = window[u][k] = B(0.0);
+      }
     }
-    for (int t = 0; t < n + W; ++t) {
-      const int base = t - W + 1;  // point of lane 0
-      const B index = B(static_cast<double>(base)) + lane;
-      B tail[Dim];
+    for (int t = 0; t < n + G; ++t) {
+      const int base = t - G + 1;  // point of lane 0
       for (int k = 0; k < Dim; ++k) {
-        window[k] = B(SlideIn(window[k], t <= n ? points[t * Dim + k] : 0.0));
-        tail[k] = window[k];
+        for (int u = 0; u + 1 < U; ++u) window[u][k] = B(SlideIn(window[u][k], window[u + 1][k]));
+        window[U - 1][k] = B(SlideIn(window[U - 1][k], B(t <= n ? points[t * Dim + k] : 0.0)));
       }
-      const B length = B::load_unaligned(&len[pad + base]);
-      const B neg_inv_length = B::load_unaligned(&neg_inv_len[pad + base]);
-      const auto fix = Rule::Apply(lead_old, lead_new, tail, length, neg_inv_length) &
-                       (index >= B(1.0)) & (index <= last);
-      if (xsimd::any(fix)) {
-        // Rare lanes (degenerate or extreme moves): redo them with the scalar reference.
-        alignas(64) double lo[Dim][W], ln[Dim][W], old[Dim][W], out[Dim][W], mask[W], len_j[W];
+      B tail[U][Dim];
+      for (int u = 0; u < U; ++u) {
+        const int first = base + u * W;  // point of this register's lane 0
+        const B index = B(static_cast<double>(first)) + lane;
+        for (int k = 0; k < Dim; ++k) tail[u][k] = window[u][k];
+        const B length = B::load_unaligned(&len[pad + first]);
+        const B neg_inv_length = B::load_unaligned(&neg_inv_len[pad + first]);
+        const auto fix = Rule::Apply(lead_old[u], lead_new[u], tail[u], length, neg_inv_length) &
+                         (index >= B(1.0)) & (index <= last);
+        if (xsimd::any(fix)) {
+          // Rare lanes (degenerate or extreme moves): redo them with the scalar reference.
+          alignas(64) double lo[Dim][W], ln[Dim][W], old[Dim][W], out[Dim][W], mask[W], len_j[W];
+          for (int k = 0; k < Dim; ++k) {
+            lead_old[u][k].store_aligned(lo[k]);
+            lead_new[u][k].store_aligned(ln[k]);
+            window[u][k].store_aligned(old[k]);
+            tail[u][k].store_aligned(out[k]);
+          }
+          xsimd::select(fix, B(1.0), B(0.0)).store_aligned(mask);
+          length.store_aligned(len_j);
+          for (int j = 0; j < W; ++j) {
+            if (mask[j] == 0.0) continue;
+            double a[Dim], b[Dim], c[Dim];
+            for (int k = 0; k < Dim; ++k) a[k] = lo[k][j], b[k] = ln[k][j], c[k] = old[k][j];
+            Rule::Reference(a, b, c, len_j[j]);
+            for (int k = 0; k < Dim; ++k) out[k][j] = c[k];
+          }
+          for (int k = 0; k < Dim; ++k) tail[u][k] = B::load_aligned(out[k]);
+        }
+        if (t < G) {
+          // Lanes that have not reached the chain yet stay still, so that they carry no
+          // garbage (which would, for one, push the whole batch off the exp fast path).
+          const auto started = index >= B(1.0);
+          for (int k = 0; k < Dim; ++k) {
+            tail[u][k] = xsimd::select(started, tail[u][k], window[u][k]);
+          }
+        }
+        const auto is_head = index == B(0.0);
         for (int k = 0; k < Dim; ++k) {
-          lead_old[k].store_aligned(lo[k]);
-          lead_new[k].store_aligned(ln[k]);
-          window[k].store_aligned(old[k]);
-          tail[k].store_aligned(out[k]);
+          tail[u][k] = xsimd::select(is_head, head[u][k], tail[u][k]);
+          lead_old[u][k] = window[u][k];
+          lead_new[u][k] = window[u][k] = tail[u][k];
         }
-        xsimd::select(fix, B(1.0), B(0.0)).store_aligned(mask);
-        length.store_aligned(len_j);
-        for (int j = 0; j < W; ++j) {
-          if (mask[j] == 0.0) continue;
-          double a[Dim], b[Dim], c[Dim];
-          for (int k = 0; k < Dim; ++k) a[k] = lo[k][j], b[k] = ln[k][j], c[k] = old[k][j];
-          Rule::Reference(a, b, c, len_j[j]);
-          for (int k = 0; k < Dim; ++k) out[k][j] = c[k];
+        if (t >= n) {
+          // Lanes that have finished the chain stay still too: their leading end stops moving.
+          const auto done = index >= last;
+          for (int k = 0; k < Dim; ++k) {
+            lead_new[u][k] = xsimd::select(done, lead_old[u][k], lead_new[u][k]);
+          }
         }
-        for (int k = 0; k < Dim; ++k) tail[k] = B::load_aligned(out[k]);
-      }
-      if (t < W) {
-        // Lanes that have not reached the chain yet stay still, so that they carry no garbage
-        // (which would, for one, push the whole batch off the exp fast path).
-        const auto started = index >= B(1.0);
-        for (int k = 0; k < Dim; ++k) tail[k] = xsimd::select(started, tail[k], window[k]);
-      }
-      const auto is_head = index == B(0.0);
-      for (int k = 0; k < Dim; ++k) {
-        tail[k] = xsimd::select(is_head, head[k], tail[k]);
-        lead_old[k] = window[k];
-        lead_new[k] = window[k] = tail[k];
-      }
-      if (t >= n) {
-        // Lanes that have finished the chain stay still too: their leading end stops moving.
-        const auto done = index >= last;
-        for (int k = 0; k < Dim; ++k) lead_new[k] = xsimd::select(done, lead_old[k], lead_new[k]);
       }
       if (base >= 0) {
-        for (int k = 0; k < Dim; ++k) points[base * Dim + k] = First(tail[k]);
+        for (int k = 0; k < Dim; ++k) points[base * Dim + k] = First(tail[0][k]);
       }
     }
   }
+  return g;
+}
+
+template <class Arch, class Rule, int Dim>
+void WavefrontSweeps(const double* heads, int64_t num_sweeps, const double* lengths,
+                     const double* inv_lengths, int n, double* points) {
+  // Two registers per coordinate while at least 2 W sweeps are left, then one.
+  int64_t done =
+      WavefrontGroups<Arch, Rule, Dim, 2>(heads, num_sweeps, lengths, inv_lengths, n, points);
+  done += WavefrontGroups<Arch, Rule, Dim, 1>(heads + done * Dim, num_sweeps - done, lengths,
+                                              inv_lengths, n, points);
   // Fewer than W sweeps left: finish them one after another.
-  for (; g < num_sweeps; ++g) {
+  for (int64_t g = done; g < num_sweeps; ++g) {
     double lead_old[Dim], lead_new[Dim];
     for (int k = 0; k < Dim; ++k) {
       lead_old[k] = points[k];
