@@ -68,7 +68,7 @@ TEST(WavefrontTest, EveryEngineMatchesTheOnePassLoop) {
     for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {
       for (const int dim : {2, 3}) {
         for (const int links : {1, 2, 3, 7, 8, 9, 16, 17, 100}) {
-          for (const int sweeps : {1, 3, 4, 8, 9, 16, 33}) {
+          for (const int sweeps : {1, 3, 4, 8, 9, 12, 16, 24, 33}) {
             // Small steps (the exp fast path), steps of about a link, and huge ones (the
             // reference form's range).
             for (const double step : {1e-3, 0.7, 1e55}) {
