@@ -6,6 +6,7 @@
 #include <dirent.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -322,18 +323,40 @@ TEST(ResultAtomicWriteTest, FailureInTheMiddleKeepsTheOldFile) {
 }
 
 TEST(ResultAtomicWriteTest, ReadOnlyDirectoryKeepsTheOldFile) {
-  if (::geteuid() == 0) {
-    GTEST_SKIP()
-        << "running as root, which writes into read-only directories; "
-           "ResultAtomicWriteTest.FailureInTheMiddleKeepsTheOldFile covers the failure path";
-  }
   TempDir dir;
   const std::string path = dir / "result.json";
   WriteText(path, "old");
-  ASSERT_EQ(::chmod(dir.path().c_str(), 0500), 0);
-  EXPECT_THROW(WriteResultJson(AwkwardResult(2, 8), path), std::system_error);
+  ASSERT_EQ(::chmod(dir.path().c_str(), 0555), 0);
+  if (::geteuid() != 0) {
+    EXPECT_THROW(WriteResultJson(AwkwardResult(2, 8), path), std::system_error);
+  } else {
+    // Root writes into read-only directories, so the write is tried by a child process that
+    // has given up root for the unprivileged user "nobody" (uid and gid 65534).
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      int code = 2;  // could not drop privileges
+      if (::setgid(65534) == 0 && ::setuid(65534) == 0) {
+        try {
+          WriteResultJson(AwkwardResult(2, 8), path);
+          code = 1;  // wrote into a read-only directory
+        } catch (const std::system_error&) {
+          code = 0;  // refused, as it must be
+        } catch (...) {
+          code = 3;
+        }
+      }
+      ::_exit(code);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 0) << "1: the write succeeded, 2: could not drop root, 3: "
+                                         "another exception than std::system_error";
+  }
   ::chmod(dir.path().c_str(), 0700);
   EXPECT_EQ(ReadFile(path), "old");
+  EXPECT_EQ(dir.Files(), std::vector<std::string>{"result.json"});
 }
 
 TEST(ResultAtomicWriteTest, ReplacingKeepsTheFileMode) {
