@@ -1,0 +1,92 @@
+#pragma once
+// Whole-curve ("overall") optimization of one step (paper Sec. 3 and 4): the leading end is moved
+// to a prescribed position and all other points move at once, to the configuration that
+// minimizes a metric of the motion subject to every link keeping its length.
+
+#include <Eigen/Core>
+#include <string>
+
+#include "flexkin/chain.h"
+
+namespace flexkin {
+
+// The metric of one step, from the old configuration a_0..a_n to the new one x_0..x_n, as a
+// weighted sum of these terms. Link vectors: D_i = x_i - x_{i-1}, D_i^old = a_i - a_{i-1}.
+struct ObjectiveWeights {
+  // Sum over points j = 1..n of |x_j - a_j|^2: the smooth form of the paper's L2 metric.
+  // Typical: 1 (a "rope").
+  double squared = 1.0;
+  // Sum over points of (arc-length weight w_j) |x_j - a_j|^2, w_j = (L_j + L_{j+1}) / 2 and
+  // L_n / 2 at the trailing end: the squared form of eq. (6).
+  double squared_weighted = 0.0;
+  // Body rotation (Sec. 4.1): sum over links of |D_i - D_i^old|^2 / L_i = sum of
+  // L_i |e_i - e_i^old|^2 = sum of 2 L_i (1 - cos theta_i), theta_i the rotation of link i.
+  // Alone, its minimizer is a pure translation (Fig. 8).
+  double rotation = 0.0;
+  // Joint-angle change (Sec. 4.2, planar chains only): sum over the inner joints i = 1..n-1 of
+  // L_mean (psi_i - psi_i^old)^2, psi_i the signed angle from link i to link i+1 and
+  // L_mean = (L_i + L_{i+1}) / 2. Alone it leaves the chain rigid (Fig. 9); it does not fix
+  // the chain's overall rotation, so combine it with another term.
+  double joint_angle = 0.0;
+
+  // Empty if valid (every weight finite and >= 0, at least one > 0), else the reason.
+  std::string Validate() const;
+};
+
+// Options of the overall solver (an SQP/Newton method on the KKT system, whose linear algebra is
+// banded: the cost per iteration is linear in the number of points).
+struct OverallOptions {
+  ObjectiveWeights weights;
+  // Stop when every |(|x_i - x_{i-1}|^2 - L_i^2)| / (2 L_i^2) is below this. Typical: 1e-12
+  // (points far from the origin cannot be stored closer than about 1e-16 |x| / L).
+  double constraint_tolerance = 1e-12;
+  // ... and the first-order optimality (largest component of the Lagrangian's gradient divided by
+  // the largest component of the objective's gradient, or 1) is below this. Typical: 1e-10.
+  double optimality_tolerance = 1e-10;
+  // Newton iterations at most. Typical: 50.
+  int max_iterations = 50;
+
+  // Empty if valid, else the reason naming the field.
+  std::string Validate() const;
+};
+
+enum class OverallStatus {
+  kConverged,      // both tolerances met
+  kMaxIterations,  // max_iterations reached first
+  kStalled,        // the line search could not make progress
+  kFailed,         // a linear system was singular or a value not finite
+};
+const char* OverallStatusName(OverallStatus status);  // "converged", "max_iterations", ...
+
+// What the solver did. Never a silent failure: anything but kConverged is reported as such.
+struct OverallReport {
+  OverallStatus status = OverallStatus::kFailed;
+  int iterations = 0;
+  double objective = 0.0;             // metric of the step at the returned configuration
+  double constraint_violation = 0.0;  // largest |(|D_i|^2 - L_i^2)| / (2 L_i^2)
+  double optimality = 0.0;            // as in OverallOptions::optimality_tolerance
+  // The returned configuration is the local minimizer reached by Newton's method from the
+  // sequential (tractrix) solution of the same step, which is feasible and close to it.
+  std::string start = "sequential tractrix step";
+
+  bool converged() const { return status == OverallStatus::kConverged; }
+  std::string BriefReport() const;
+};
+
+// One step: moves point 0 of `points` (the old configuration, (n+1) by dim) to `head` and the
+// other points to the minimizer of `options.weights` subject to |x_i - x_{i-1}| = lengths[i-1].
+// `points` is updated in place (to the best configuration found, even when not converged: check
+// the report). Throws InputError on invalid input (shapes, non-finite values, options; the
+// joint-angle term in 3D).
+OverallReport OverallStep(const Eigen::VectorXd& lengths,
+                          const Eigen::Ref<const Eigen::VectorXd>& head,
+                          const OverallOptions& options, Points* points);
+
+// The value, gradient (n dim) and, if `hessian` is not null, the Hessian (n dim square, dense:
+// for tests and small problems) of the step metric as a function of x_1..x_n (point 0 fixed at
+// `new_points.row(0)`). Exposed so that tests and other solvers evaluate the very same function.
+double OverallObjective(const ObjectiveWeights& weights, const Eigen::VectorXd& lengths,
+                        const Points& old_points, const Points& new_points,
+                        Eigen::VectorXd* gradient = nullptr, Eigen::MatrixXd* hessian = nullptr);
+
+}  // namespace flexkin

@@ -1,0 +1,493 @@
+#include "flexkin/overall.h"
+
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "flexkin/error.h"
+#include "flexkin/propagate.h"
+
+namespace flexkin {
+namespace {
+
+using Triplets = std::vector<Eigen::Triplet<double>>;
+
+std::string Num(double x) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
+// Where the objective's derivatives go. Points are numbered 0..n; point 0 is fixed, so its
+// entries are dropped. `offset(j)` is the first row of point j's coordinates in the unknowns.
+struct Sink {
+  int dim = 0;
+  Eigen::VectorXd* gradient = nullptr;  // may be null
+  Triplets* hessian = nullptr;          // may be null
+  std::vector<int> offset;              // offset[j] for j = 1..n; offset[0] unused
+
+  void Gradient(int j, const double* g, double scale) const {
+    if (gradient == nullptr || j == 0) return;
+    for (int k = 0; k < dim; ++k) (*gradient)[offset[j] + k] += scale * g[k];
+  }
+  // Adds scale * block (dim by dim, row-major in `b`) at (point p, point q).
+  void Block(int p, int q, const double* b, double scale) const {
+    if (hessian == nullptr || p == 0 || q == 0) return;
+    for (int r = 0; r < dim; ++r) {
+      for (int c = 0; c < dim; ++c) {
+        // Zeros too: the pattern must not change between iterations.
+        hessian->emplace_back(offset[p] + r, offset[q] + c, scale * b[r * dim + c]);
+      }
+    }
+  }
+  void Identity(int p, int q, double scale) const {
+    if (hessian == nullptr || p == 0 || q == 0) return;
+    for (int r = 0; r < dim; ++r) hessian->emplace_back(offset[p] + r, offset[q] + r, scale);
+  }
+};
+
+// Arc-length weight of each point: (L_j + L_{j+1}) / 2, half a link at the ends.
+Eigen::VectorXd PointWeights(const Eigen::VectorXd& lengths) {
+  const Eigen::Index n = lengths.size();
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(n + 1);
+  w.head(n) += 0.5 * lengths;
+  w.tail(n) += 0.5 * lengths;
+  return w;
+}
+
+// Signed angle from link vector u to link vector v (2D), in (-pi, pi].
+double TurnAngle(const double* u, const double* v) {
+  return std::atan2(u[0] * v[1] - u[1] * v[0], u[0] * v[0] + u[1] * v[1]);
+}
+
+// Wraps an angle difference into (-pi, pi].
+double Wrap(double a) { return std::remainder(a, 2.0 * M_PI); }
+
+// The metric of one step and its derivatives, term by term. x(j) and a(j): new and old point j.
+double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const Points& old_points,
+                const Points& x, const Sink& sink) {
+  const int n = static_cast<int>(lengths.size());
+  const int dim = static_cast<int>(x.cols());
+  double value = 0.0;
+
+  // Squared displacement, plain and arc-length weighted.
+  if (w.squared > 0.0 || w.squared_weighted > 0.0) {
+    const Eigen::VectorXd point_weights = PointWeights(lengths);
+    for (int j = 1; j <= n; ++j) {
+      const double s = w.squared + w.squared_weighted * point_weights[j];
+      const Eigen::VectorXd d = (x.row(j) - old_points.row(j)).transpose();
+      value += s * d.squaredNorm();
+      const Eigen::VectorXd g = 2.0 * s * d;
+      sink.Gradient(j, g.data(), 1.0);
+      sink.Identity(j, j, 2.0 * s);
+    }
+  }
+
+  // Body rotation: sum of |D_i - D_i_old|^2 / L_i over the links.
+  if (w.rotation > 0.0) {
+    for (int i = 1; i <= n; ++i) {
+      const double s = w.rotation / lengths[i - 1];
+      const Eigen::VectorXd e =
+          ((x.row(i) - x.row(i - 1)) - (old_points.row(i) - old_points.row(i - 1))).transpose();
+      value += s * e.squaredNorm();
+      const Eigen::VectorXd g = 2.0 * s * e;
+      sink.Gradient(i, g.data(), 1.0);
+      sink.Gradient(i - 1, g.data(), -1.0);
+      sink.Identity(i, i, 2.0 * s);
+      sink.Identity(i - 1, i - 1, 2.0 * s);
+      sink.Identity(i, i - 1, -2.0 * s);
+      sink.Identity(i - 1, i, -2.0 * s);
+    }
+  }
+
+  // Joint-angle change (2D): sum over inner joints of L_mean (psi_i - psi_i_old)^2, psi_i the
+  // turn from link i to link i+1. With theta(u) = atan2(u_y, u_x): grad theta = perp(u)/|u|^2,
+  // hess theta = [[2 u_x u_y, u_y^2 - u_x^2], [u_y^2 - u_x^2, -2 u_x u_y]] / |u|^4, and
+  // psi_i = theta(D_{i+1}) - theta(D_i), D_i = x_i - x_{i-1}.
+  if (w.joint_angle > 0.0 && dim == 2) {
+    for (int i = 1; i < n; ++i) {
+      auto link = [](const Points& p, int k) {
+        return Eigen::Vector2d(p(k, 0) - p(k - 1, 0), p(k, 1) - p(k - 1, 1));
+      };
+      const Eigen::Vector2d u = link(x, i), v = link(x, i + 1);
+      const Eigen::Vector2d u0 = link(old_points, i), v0 = link(old_points, i + 1);
+      const double c = w.joint_angle * 0.5 * (lengths[i - 1] + lengths[i]);
+      const double delta = Wrap(TurnAngle(u.data(), v.data()) - TurnAngle(u0.data(), v0.data()));
+      value += c * delta * delta;
+      if (sink.gradient == nullptr && sink.hessian == nullptr) continue;
+      // Explicit return types: an Eigen expression returned by `auto` would dangle.
+      auto grad_theta = [](const Eigen::Vector2d& q) -> Eigen::Vector2d {
+        return Eigen::Vector2d(-q.y(), q.x()) / q.squaredNorm();
+      };
+      auto hess_theta = [](const Eigen::Vector2d& q) -> Eigen::Matrix2d {
+        const double r4 = q.squaredNorm() * q.squaredNorm();
+        Eigen::Matrix2d h;
+        h << 2.0 * q.x() * q.y(), q.y() * q.y() - q.x() * q.x(), q.y() * q.y() - q.x() * q.x(),
+            -2.0 * q.x() * q.y();
+        return Eigen::Matrix2d(h / r4);
+      };
+      // Derivatives with respect to (D_i, D_{i+1}) = (u, v): dpsi = (-grad theta(u), grad
+      // theta(v)).
+      Eigen::Matrix<double, 4, 1> dpsi;
+      dpsi << -grad_theta(u), grad_theta(v);
+      Eigen::Matrix4d h = 2.0 * c * dpsi * dpsi.transpose();
+      h.topLeftCorner<2, 2>() += 2.0 * c * delta * -hess_theta(u);
+      h.bottomRightCorner<2, 2>() += 2.0 * c * delta * hess_theta(v);
+      const Eigen::Matrix<double, 4, 1> gd = 2.0 * c * delta * dpsi;
+      // Back to points: D_i = x_i - x_{i-1}, D_{i+1} = x_{i+1} - x_i, so
+      // d/dx_{i-1} = -d/dD_i, d/dx_i = d/dD_i - d/dD_{i+1}, d/dx_{i+1} = d/dD_{i+1}.
+      const int points[3] = {i - 1, i, i + 1};
+      Eigen::Matrix<double, 6, 4> m = Eigen::Matrix<double, 6, 4>::Zero();
+      m.block<2, 2>(0, 0) = -Eigen::Matrix2d::Identity();
+      m.block<2, 2>(2, 0) = Eigen::Matrix2d::Identity();
+      m.block<2, 2>(2, 2) = -Eigen::Matrix2d::Identity();
+      m.block<2, 2>(4, 2) = Eigen::Matrix2d::Identity();
+      const Eigen::Matrix<double, 6, 1> gx = m * gd;
+      const Eigen::Matrix<double, 6, 6> hx = m * h * m.transpose();
+      for (int a = 0; a < 3; ++a) {
+        sink.Gradient(points[a], gx.data() + 2 * a, 1.0);
+        for (int b = 0; b < 3; ++b) {
+          const Eigen::Matrix<double, 2, 2, Eigen::RowMajor> block = hx.block<2, 2>(2 * a, 2 * b);
+          sink.Block(points[a], points[b], block.data(), 1.0);
+        }
+      }
+    }
+  }
+  return value;
+}
+
+// Largest |(|D_i|^2 - L_i^2)| / (2 L_i^2).
+double ConstraintViolation(const Eigen::VectorXd& lengths, const Points& x) {
+  double worst = 0.0;
+  for (Eigen::Index i = 1; i < x.rows(); ++i) {
+    const double l = lengths[i - 1];
+    const double c = ((x.row(i) - x.row(i - 1)).squaredNorm() - l * l) / (2.0 * l * l);
+    worst = std::fmax(worst, std::fabs(c));
+  }
+  return worst;
+}
+
+void ValidateInput(const Eigen::VectorXd& lengths, const Eigen::Ref<const Eigen::VectorXd>& head,
+                   const OverallOptions& options, const Points& points) {
+  Chain chain{points, lengths};
+  ValidateChain(chain, "points");
+  if (head.size() != points.cols()) {
+    throw InputError("head", "has " + std::to_string(head.size()) + " coordinates; the chain is " +
+                                 std::to_string(points.cols()) + "D");
+  }
+  for (Eigen::Index k = 0; k < head.size(); ++k) {
+    if (!std::isfinite(head[k])) {
+      throw InputError("head[" + std::to_string(k) + "]",
+                       "value " + Num(head[k]) + " is not a finite number");
+    }
+  }
+  if (const std::string why = options.Validate(); !why.empty()) {
+    const auto colon = why.find(':');
+    throw InputError(why.substr(0, colon), why.substr(colon + 2));
+  }
+  if (options.weights.joint_angle > 0.0 && points.cols() != 2) {
+    throw InputError("weights.joint_angle",
+                     "the joint-angle term is defined for planar (2D) chains only; this chain is "
+                     "3D: set it to 0");
+  }
+}
+
+}  // namespace
+
+std::string ObjectiveWeights::Validate() const {
+  const std::pair<const char*, double> terms[] = {{"squared", squared},
+                                                  {"squared_weighted", squared_weighted},
+                                                  {"rotation", rotation},
+                                                  {"joint_angle", joint_angle}};
+  double total = 0.0;
+  for (const auto& [name, value] : terms) {
+    if (!(value >= 0.0) || !std::isfinite(value)) {
+      return std::string("weights.") + name + ": " + Num(value) +
+             " is not valid; each weight must be a finite number >= 0";
+    }
+    total += value;
+  }
+  if (!(total > 0.0)) {
+    return "weights: all weights are 0; give at least one term (squared, squared_weighted, "
+           "rotation, joint_angle) a positive weight";
+  }
+  return "";
+}
+
+std::string OverallOptions::Validate() const {
+  if (const std::string why = weights.Validate(); !why.empty()) return why;
+  if (!(constraint_tolerance > 0.0) || !std::isfinite(constraint_tolerance)) {
+    return "constraint_tolerance: " + Num(constraint_tolerance) +
+           " is not valid; must be a finite number > 0 (typical 1e-14)";
+  }
+  if (!(optimality_tolerance > 0.0) || !std::isfinite(optimality_tolerance)) {
+    return "optimality_tolerance: " + Num(optimality_tolerance) +
+           " is not valid; must be a finite number > 0 (typical 1e-10)";
+  }
+  if (max_iterations < 1) {
+    return "max_iterations: " + std::to_string(max_iterations) + " is not valid; must be >= 1";
+  }
+  return "";
+}
+
+const char* OverallStatusName(OverallStatus status) {
+  switch (status) {
+    case OverallStatus::kConverged:
+      return "converged";
+    case OverallStatus::kMaxIterations:
+      return "max_iterations";
+    case OverallStatus::kStalled:
+      return "stalled";
+    case OverallStatus::kFailed:
+      return "failed";
+  }
+  return "unknown";
+}
+
+std::string OverallReport::BriefReport() const {
+  char buf[256];
+  std::snprintf(buf, sizeof buf,
+                "%s after %d iterations: objective %.12g, constraint violation %.2g, optimality "
+                "%.2g (start: %s)",
+                OverallStatusName(status), iterations, objective, constraint_violation, optimality,
+                start.c_str());
+  return buf;
+}
+
+double OverallObjective(const ObjectiveWeights& weights, const Eigen::VectorXd& lengths,
+                        const Points& old_points, const Points& new_points,
+                        Eigen::VectorXd* gradient, Eigen::MatrixXd* hessian) {
+  const int n = static_cast<int>(lengths.size());
+  const int dim = static_cast<int>(new_points.cols());
+  Sink sink;
+  sink.dim = dim;
+  sink.offset.resize(n + 1);
+  for (int j = 1; j <= n; ++j) sink.offset[j] = (j - 1) * dim;
+  if (gradient != nullptr) {
+    gradient->setZero(n * dim);
+    sink.gradient = gradient;
+  }
+  Triplets triplets;
+  if (hessian != nullptr) sink.hessian = &triplets;
+  const double value = Evaluate(weights, lengths, old_points, new_points, sink);
+  if (hessian != nullptr) {
+    Eigen::SparseMatrix<double> h(n * dim, n * dim);
+    h.setFromTriplets(triplets.begin(), triplets.end());
+    *hessian = Eigen::MatrixXd(h);
+  }
+  return value;
+}
+
+OverallReport OverallStep(const Eigen::VectorXd& lengths,
+                          const Eigen::Ref<const Eigen::VectorXd>& head,
+                          const OverallOptions& options, Points* points) {
+  ValidateInput(lengths, head, options, *points);
+  const int n = static_cast<int>(lengths.size());
+  const int dim = static_cast<int>(points->cols());
+  const Points old_points = *points;
+  OverallReport report;
+
+  // Start: the sequential tractrix step, feasible and close to the overall minimizer.
+  Chain chain{old_points, lengths};
+  MoveLeader(Method::kTractrix, head, 1, &chain);
+  Points x = chain.points;
+
+  // Unknowns interleaved point by point, [x_1, lambda_1, x_2, lambda_2, ...], so that the KKT
+  // matrix is banded (constraint i couples x_{i-1} and x_i; the objective couples neighbours).
+  const int block = dim + 1;
+  const int size = n * block;
+  Sink sink;
+  sink.dim = dim;
+  sink.offset.resize(n + 1);
+  for (int j = 1; j <= n; ++j) sink.offset[j] = (j - 1) * block;
+  auto multiplier_row = [&](int i) { return (i - 1) * block + dim; };
+
+  // Objective gradient g (in the interleaved layout, multiplier rows 0), constraints
+  // c_i = (|D_i|^2 - L_i^2) / (2 L_i), and the KKT matrix.
+  Eigen::VectorXd g(size), lambda = Eigen::VectorXd::Zero(n), rhs(size);
+  auto evaluate = [&](const Points& p, Triplets* hessian, Eigen::VectorXd* grad) {
+    sink.gradient = grad;
+    sink.hessian = hessian;
+    if (grad != nullptr) grad->setZero(size);
+    return Evaluate(options.weights, lengths, old_points, p, sink);
+  };
+  auto constraints = [&](const Points& p) {
+    Eigen::VectorXd c(n);
+    for (int i = 1; i <= n; ++i) {
+      c[i - 1] = ((p.row(i) - p.row(i - 1)).squaredNorm() - lengths[i - 1] * lengths[i - 1]) /
+                 (2.0 * lengths[i - 1]);
+    }
+    return c;
+  };
+  // Gradient of the Lagrangian g + J^T lambda (x rows only).
+  auto lagrangian_gradient = [&](const Points& p, const Eigen::VectorXd& grad,
+                                 const Eigen::VectorXd& lam) {
+    Eigen::VectorXd r = grad;
+    for (int i = 1; i <= n; ++i) {
+      const Eigen::VectorXd e = (p.row(i) - p.row(i - 1)).transpose() / lengths[i - 1];
+      for (int k = 0; k < dim; ++k) {
+        r[sink.offset[i] + k] += lam[i - 1] * e[k];
+        if (i > 1) r[sink.offset[i - 1] + k] -= lam[i - 1] * e[k];
+      }
+    }
+    for (int i = 1; i <= n; ++i) r[multiplier_row(i)] = 0.0;
+    return r;
+  };
+  auto optimality = [&](const Eigen::VectorXd& grad, const Eigen::VectorXd& lag) {
+    const double scale = std::fmax(grad.cwiseAbs().maxCoeff(), std::numeric_limits<double>::min());
+    return lag.cwiseAbs().maxCoeff() / scale;
+  };
+
+  Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu;
+  bool analyzed = false;
+  double regularization = 0.0;
+  double value = evaluate(x, nullptr, &g);
+  Eigen::VectorXd c = constraints(x);
+  double merit_weight = 0.0;
+
+  for (report.iterations = 0;; ++report.iterations) {
+    const Eigen::VectorXd lag = lagrangian_gradient(x, g, lambda);
+    report.objective = value;
+    report.constraint_violation = ConstraintViolation(lengths, x);
+    report.optimality = optimality(g, lag);
+    if (!std::isfinite(report.objective) || !std::isfinite(report.optimality)) {
+      report.status = OverallStatus::kFailed;
+      break;
+    }
+    if (report.iterations > 0 && report.constraint_violation <= options.constraint_tolerance &&
+        report.optimality <= options.optimality_tolerance) {
+      report.status = OverallStatus::kConverged;
+      break;
+    }
+    if (report.iterations >= options.max_iterations) {
+      report.status = OverallStatus::kMaxIterations;
+      break;
+    }
+
+    // KKT matrix: [H + delta I, J^T; J, 0] with H = hess f + sum lambda_i hess c_i.
+    Triplets t;
+    evaluate(x, &t, nullptr);
+    for (int i = 1; i <= n; ++i) {
+      const double s = lambda[i - 1] / lengths[i - 1];
+      sink.Identity(i, i, s);
+      if (i > 1) {
+        sink.Identity(i - 1, i - 1, s);
+        sink.Identity(i, i - 1, -s);
+        sink.Identity(i - 1, i, -s);
+      }
+      const Eigen::VectorXd e = (x.row(i) - x.row(i - 1)).transpose() / lengths[i - 1];
+      for (int k = 0; k < dim; ++k) {
+        t.emplace_back(multiplier_row(i), sink.offset[i] + k, e[k]);
+        t.emplace_back(sink.offset[i] + k, multiplier_row(i), e[k]);
+        if (i > 1) {
+          t.emplace_back(multiplier_row(i), sink.offset[i - 1] + k, -e[k]);
+          t.emplace_back(sink.offset[i - 1] + k, multiplier_row(i), -e[k]);
+        }
+      }
+    }
+    // Keep every diagonal entry in the pattern so the symbolic analysis can be reused.
+    for (int j = 1; j <= n; ++j) {
+      for (int k = 0; k < dim; ++k)
+        t.emplace_back(sink.offset[j] + k, sink.offset[j] + k, regularization);
+      t.emplace_back(multiplier_row(j), multiplier_row(j), 0.0);
+    }
+
+    // Newton step for (x, lambda_new): [H J^T; J 0] [dx; lambda_new] = -[g; c].
+    bool stepped = false;
+    for (int attempt = 0; attempt < 8 && !stepped; ++attempt) {
+      Eigen::SparseMatrix<double> kkt(size, size);
+      kkt.setFromTriplets(t.begin(), t.end());
+      if (!analyzed) {
+        lu.analyzePattern(kkt);
+        analyzed = true;
+      }
+      lu.factorize(kkt);
+      if (lu.info() != Eigen::Success) {
+        // Singular: regularize the Hessian block and retry.
+        const double bump = regularization == 0.0 ? 1e-10 * std::fmax(1.0, g.cwiseAbs().maxCoeff())
+                                                  : 9.0 * regularization;
+        for (int j = 1; j <= n; ++j) {
+          for (int k = 0; k < dim; ++k)
+            t.emplace_back(sink.offset[j] + k, sink.offset[j] + k, bump);
+        }
+        regularization += bump;
+        continue;
+      }
+      for (int j = 1; j <= n; ++j) {
+        for (int k = 0; k < dim; ++k) rhs[sink.offset[j] + k] = -g[sink.offset[j] + k];
+        rhs[multiplier_row(j)] = -c[j - 1];
+      }
+      const Eigen::VectorXd sol = lu.solve(rhs);
+      if (!sol.allFinite()) break;
+      Eigen::VectorXd lambda_new(n);
+      Points dx(n + 1, dim);
+      dx.row(0).setZero();
+      for (int j = 1; j <= n; ++j) {
+        for (int k = 0; k < dim; ++k) dx(j, k) = sol[sink.offset[j] + k];
+        lambda_new[j - 1] = sol[multiplier_row(j)];
+      }
+
+      // Line search on the l1 merit f + mu sum |c_i|, mu above the multipliers' size.
+      merit_weight = std::fmax(merit_weight, 2.0 * lambda_new.cwiseAbs().maxCoeff());
+      const double merit = value + merit_weight * c.cwiseAbs().sum();
+      double slope = 0.0;
+      for (int j = 1; j <= n; ++j)
+        slope += g.segment(sink.offset[j], dim).dot(dx.row(j).transpose());
+      slope -= merit_weight * c.cwiseAbs().sum();
+      for (double alpha = 1.0; alpha > 1e-10; alpha *= 0.5) {
+        Points trial = x + alpha * dx;
+        Eigen::VectorXd g_trial(size);
+        const double v_trial = evaluate(trial, nullptr, &g_trial);
+        const Eigen::VectorXd c_trial = constraints(trial);
+        const double m_trial = v_trial + merit_weight * c_trial.cwiseAbs().sum();
+        // Full Newton steps near the solution are taken when they shrink the KKT residual
+        // (the l1 merit can reject them there: the Maratos effect).
+        const bool full_step_ok =
+            alpha == 1.0 &&
+            std::fmax(lagrangian_gradient(trial, g_trial, lambda_new).cwiseAbs().maxCoeff(),
+                      c_trial.cwiseAbs().maxCoeff()) <
+                0.9 * std::fmax(lagrangian_gradient(x, g, lambda_new).cwiseAbs().maxCoeff(),
+                                c.cwiseAbs().maxCoeff());
+        if (std::isfinite(m_trial) &&
+            (m_trial <= merit + 1e-4 * alpha * std::fmin(slope, 0.0) || full_step_ok)) {
+          x = trial;
+          value = v_trial;
+          g = g_trial;
+          c = c_trial;
+          lambda = lambda + alpha * (lambda_new - lambda);
+          stepped = true;
+          break;
+        }
+      }
+      if (!stepped) {
+        // Not a descent direction: more regularization, then try again.
+        const double bump = regularization == 0.0 ? 1e-8 * std::fmax(1.0, g.cwiseAbs().maxCoeff())
+                                                  : 9.0 * regularization;
+        for (int j = 1; j <= n; ++j) {
+          for (int k = 0; k < dim; ++k)
+            t.emplace_back(sink.offset[j] + k, sink.offset[j] + k, bump);
+        }
+        regularization += bump;
+      }
+    }
+    if (!stepped) {
+      report.status =
+          lu.info() == Eigen::Success ? OverallStatus::kStalled : OverallStatus::kFailed;
+      report.objective = value;
+      report.constraint_violation = ConstraintViolation(lengths, x);
+      report.optimality = optimality(g, lagrangian_gradient(x, g, lambda));
+      break;
+    }
+    regularization *= 0.1;
+    if (regularization < 1e-14) regularization = 0.0;
+  }
+  *points = x;
+  return report;
+}
+
+}  // namespace flexkin
