@@ -161,6 +161,16 @@ double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const
   return value;
 }
 
+// Puts every point back at its link's length from the point before it, from the (fixed) head
+// down: the follow-the-leader projection, a retraction onto the set of feasible configurations.
+void Retract(const Eigen::VectorXd& lengths, Points* x) {
+  for (Eigen::Index i = 1; i < x->rows(); ++i) {
+    const Eigen::VectorXd d = (x->row(i) - x->row(i - 1)).transpose();
+    const double norm = d.norm();
+    if (norm > 0.0) x->row(i) = x->row(i - 1) + (lengths[i - 1] / norm) * d.transpose();
+  }
+}
+
 // Largest |(|D_i|^2 - L_i^2)| / (2 L_i^2).
 double ConstraintViolation(const Eigen::VectorXd& lengths, const Points& x) {
   double worst = 0.0;
@@ -283,19 +293,16 @@ double OverallObjective(const ObjectiveWeights& weights, const Eigen::VectorXd& 
   return value;
 }
 
-OverallReport OverallStep(const Eigen::VectorXd& lengths,
-                          const Eigen::Ref<const Eigen::VectorXd>& head,
-                          const OverallOptions& options, Points* points) {
-  ValidateInput(lengths, head, options, *points);
-  const int n = static_cast<int>(lengths.size());
-  const int dim = static_cast<int>(points->cols());
-  const Points old_points = *points;
-  OverallReport report;
+namespace {
 
-  // Start: the sequential tractrix step, feasible and close to the overall minimizer.
-  Chain chain{old_points, lengths};
-  MoveLeader(Method::kTractrix, head, 1, &chain);
-  Points x = chain.points;
+// Newton's method on the KKT conditions from the feasible configuration `*start` (whose point 0
+// is the prescribed head), for the metric measured from `old_points`. `*start` becomes the result.
+OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_points,
+                          const OverallOptions& options, Points* start) {
+  const int n = static_cast<int>(lengths.size());
+  const int dim = static_cast<int>(start->cols());
+  OverallReport report;
+  Points x = *start;
 
   // Unknowns interleaved point by point, [x_1, lambda_1, x_2, lambda_2, ...], so that the KKT
   // matrix is banded (constraint i couples x_{i-1} and x_i; the objective couples neighbours).
@@ -338,23 +345,37 @@ OverallReport OverallStep(const Eigen::VectorXd& lengths,
     for (int i = 1; i <= n; ++i) r[multiplier_row(i)] = 0.0;
     return r;
   };
-  auto optimality = [&](const Eigen::VectorXd& grad, const Eigen::VectorXd& lag) {
-    const double scale = std::fmax(grad.cwiseAbs().maxCoeff(), std::numeric_limits<double>::min());
-    return lag.cwiseAbs().maxCoeff() / scale;
+  // First-order optimality: the Lagrangian's gradient relative to the objective's gradient (now
+  // or at the start, whichever is larger). Where the metric is 0 at the solution (a still head,
+  // or a pure translation under the rotation metric) that ratio means nothing; a gradient at the
+  // rounding level of the positions, 64 eps (sum of weights) max(|x|, L), counts as 0 instead.
+  const ObjectiveWeights& w = options.weights;
+  const double weight_sum = w.squared + w.squared_weighted * lengths.maxCoeff() +
+                            w.rotation / lengths.minCoeff() + w.joint_angle;
+  double start_gradient = 0.0;
+  auto optimality = [&](const Points& p, const Eigen::VectorXd& grad, const Eigen::VectorXd& lag) {
+    const double residual = lag.cwiseAbs().maxCoeff();
+    const double extent = std::fmax(p.cwiseAbs().maxCoeff(), lengths.maxCoeff());
+    if (residual <= 64.0 * std::numeric_limits<double>::epsilon() * weight_sum * extent) {
+      return 0.0;
+    }
+    const double scale = std::fmax(std::fmax(grad.cwiseAbs().maxCoeff(), start_gradient),
+                                   std::numeric_limits<double>::min());
+    return residual / scale;
   };
 
   Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu;
   bool analyzed = false;
   double regularization = 0.0;
   double value = evaluate(x, nullptr, &g);
+  start_gradient = g.cwiseAbs().maxCoeff();
   Eigen::VectorXd c = constraints(x);
-  double merit_weight = 0.0;
 
   for (report.iterations = 0;; ++report.iterations) {
     const Eigen::VectorXd lag = lagrangian_gradient(x, g, lambda);
     report.objective = value;
     report.constraint_violation = ConstraintViolation(lengths, x);
-    report.optimality = optimality(g, lag);
+    report.optimality = optimality(x, g, lag);
     if (!std::isfinite(report.objective) || !std::isfinite(report.optimality)) {
       report.status = OverallStatus::kFailed;
       break;
@@ -399,7 +420,7 @@ OverallReport OverallStep(const Eigen::VectorXd& lengths,
 
     // Newton step for (x, lambda_new): [H J^T; J 0] [dx; lambda_new] = -[g; c].
     bool stepped = false;
-    for (int attempt = 0; attempt < 8 && !stepped; ++attempt) {
+    for (int attempt = 0; attempt < 12 && !stepped; ++attempt) {
       Eigen::SparseMatrix<double> kkt(size, size);
       kkt.setFromTriplets(t.begin(), t.end());
       if (!analyzed) {
@@ -410,7 +431,7 @@ OverallReport OverallStep(const Eigen::VectorXd& lengths,
       if (lu.info() != Eigen::Success) {
         // Singular: regularize the Hessian block and retry.
         const double bump = regularization == 0.0 ? 1e-10 * std::fmax(1.0, g.cwiseAbs().maxCoeff())
-                                                  : 9.0 * regularization;
+                                                  : 10.0 * regularization;
         for (int j = 1; j <= n; ++j) {
           for (int k = 0; k < dim; ++k)
             t.emplace_back(sink.offset[j] + k, sink.offset[j] + k, bump);
@@ -431,43 +452,81 @@ OverallReport OverallStep(const Eigen::VectorXd& lengths,
         for (int k = 0; k < dim; ++k) dx(j, k) = sol[sink.offset[j] + k];
         lambda_new[j - 1] = sol[multiplier_row(j)];
       }
+      // Curvature test (no inertia from a sparse LU): the step must see positive curvature of
+      // the regularized Lagrangian, dx' (H + delta I) dx >= 1e-8 |dx|^2 (scaled); else more
+      // regularization. Otherwise Newton heads for a saddle or maximum on non-convex terms.
+      {
+        Eigen::VectorXd dx_only = Eigen::VectorXd::Zero(size);
+        for (int j = 1; j <= n; ++j) {
+          for (int k = 0; k < dim; ++k) dx_only[sink.offset[j] + k] = dx(j, k);
+        }
+        const Eigen::VectorXd k_dx = kkt * dx_only;
+        double curvature = 0.0;
+        for (int j = 1; j <= n; ++j) {
+          for (int k = 0; k < dim; ++k) curvature += dx(j, k) * k_dx[sink.offset[j] + k];
+        }
+        const double floor = 1e-8 * std::fmax(1.0, weight_sum) * dx.squaredNorm();
+        if (curvature < floor && dx.squaredNorm() > 0.0) {
+          const double bump =
+              regularization == 0.0 ? 1e-4 * std::fmax(1.0, weight_sum) : 10.0 * regularization;
+          for (int j = 1; j <= n; ++j) {
+            for (int k = 0; k < dim; ++k)
+              t.emplace_back(sink.offset[j] + k, sink.offset[j] + k, bump);
+          }
+          regularization += bump;
+          continue;
+        }
+      }
 
-      // Line search on the l1 merit f + mu sum |c_i|, mu above the multipliers' size.
-      merit_weight = std::fmax(merit_weight, 2.0 * lambda_new.cwiseAbs().maxCoeff());
-      const double merit = value + merit_weight * c.cwiseAbs().sum();
-      double slope = 0.0;
-      for (int j = 1; j <= n; ++j)
-        slope += g.segment(sink.offset[j], dim).dot(dx.row(j).transpose());
-      slope -= merit_weight * c.cwiseAbs().sum();
-      for (double alpha = 1.0; alpha > 1e-10; alpha *= 0.5) {
-        Points trial = x + alpha * dx;
+      // Line search on the metric itself, every trial put back on the constraint manifold by
+      // a follow-the-leader sweep from the fixed head (a retraction: exact lengths in O(n)).
+      // Iterates stay feasible, so no merit function is needed and full Newton steps are never
+      // rejected near the solution for leaving the manifold (no Maratos effect).
+      auto accept = [&](Points&& trial, double v_trial, Eigen::VectorXd&& g_trial) {
+        x = std::move(trial);
+        value = v_trial;
+        g = std::move(g_trial);
+        c = constraints(x);
+        lambda = lambda_new;
+        stepped = true;
+      };
+      // First the full Newton step: near the solution the metric changes by less than rounding,
+      // so it is judged by the Lagrangian's gradient, which it must halve, without raising the
+      // metric beyond rounding (Newton's method is drawn to saddles and maxima as well; the
+      // iterates are feasible, so this cannot lead away from the constraints).
+      const double allowance = 64.0 * std::numeric_limits<double>::epsilon() * std::fabs(value);
+      {
+        Points trial = x + dx;
+        Retract(lengths, &trial);
         Eigen::VectorXd g_trial(size);
         const double v_trial = evaluate(trial, nullptr, &g_trial);
-        const Eigen::VectorXd c_trial = constraints(trial);
-        const double m_trial = v_trial + merit_weight * c_trial.cwiseAbs().sum();
-        // Full Newton steps near the solution are taken when they shrink the KKT residual
-        // (the l1 merit can reject them there: the Maratos effect).
-        const bool full_step_ok =
-            alpha == 1.0 &&
-            std::fmax(lagrangian_gradient(trial, g_trial, lambda_new).cwiseAbs().maxCoeff(),
-                      c_trial.cwiseAbs().maxCoeff()) <
-                0.9 * std::fmax(lagrangian_gradient(x, g, lambda_new).cwiseAbs().maxCoeff(),
-                                c.cwiseAbs().maxCoeff());
-        if (std::isfinite(m_trial) &&
-            (m_trial <= merit + 1e-4 * alpha * std::fmin(slope, 0.0) || full_step_ok)) {
-          x = trial;
-          value = v_trial;
-          g = g_trial;
-          c = c_trial;
-          lambda = lambda + alpha * (lambda_new - lambda);
-          stepped = true;
+        if (std::isfinite(v_trial) && v_trial <= value + allowance &&
+            lagrangian_gradient(trial, g_trial, lambda_new).cwiseAbs().maxCoeff() <
+                0.5 * lagrangian_gradient(x, g, lambda_new).cwiseAbs().maxCoeff()) {
+          accept(std::move(trial), v_trial, std::move(g_trial));
           break;
+        }
+      }
+      // Otherwise Armijo backtracking on the metric, from a descent direction only.
+      double slope = 0.0;
+      for (int j = 1; j <= n; ++j) {
+        slope += g.segment(sink.offset[j], dim).dot(dx.row(j).transpose());
+      }
+      if (slope < 0.0) {
+        for (double alpha = 1.0; alpha > 1e-12 && !stepped; alpha *= 0.5) {
+          Points trial = x + alpha * dx;
+          Retract(lengths, &trial);
+          Eigen::VectorXd g_trial(size);
+          const double v_trial = evaluate(trial, nullptr, &g_trial);
+          if (std::isfinite(v_trial) && v_trial <= value + 1e-4 * alpha * slope + allowance) {
+            accept(std::move(trial), v_trial, std::move(g_trial));
+          }
         }
       }
       if (!stepped) {
         // Not a descent direction: more regularization, then try again.
         const double bump = regularization == 0.0 ? 1e-8 * std::fmax(1.0, g.cwiseAbs().maxCoeff())
-                                                  : 9.0 * regularization;
+                                                  : 10.0 * regularization;
         for (int j = 1; j <= n; ++j) {
           for (int k = 0; k < dim; ++k)
             t.emplace_back(sink.offset[j] + k, sink.offset[j] + k, bump);
@@ -476,17 +535,58 @@ OverallReport OverallStep(const Eigen::VectorXd& lengths,
       }
     }
     if (!stepped) {
-      report.status =
-          lu.info() == Eigen::Success ? OverallStatus::kStalled : OverallStatus::kFailed;
       report.objective = value;
       report.constraint_violation = ConstraintViolation(lengths, x);
-      report.optimality = optimality(g, lagrangian_gradient(x, g, lambda));
+      report.optimality = optimality(x, g, lagrangian_gradient(x, g, lambda));
+      const bool done = report.constraint_violation <= options.constraint_tolerance &&
+                        report.optimality <= options.optimality_tolerance;
+      report.status = done                          ? OverallStatus::kConverged
+                      : lu.info() == Eigen::Success ? OverallStatus::kStalled
+                                                    : OverallStatus::kFailed;
       break;
     }
     regularization *= 0.1;
     if (regularization < 1e-14) regularization = 0.0;
   }
-  *points = x;
+  *start = x;
+  return report;
+}
+
+}  // namespace
+
+OverallReport OverallStep(const Eigen::VectorXd& lengths,
+                          const Eigen::Ref<const Eigen::VectorXd>& head,
+                          const OverallOptions& options, Points* points) {
+  ValidateInput(lengths, head, options, *points);
+  const Points old_points = *points;
+  // Continuation: the head advances to its target in sub-steps no longer than half the shortest
+  // link; each sub-problem (the same metric, measured from the old configuration, with the head
+  // part of the way) starts from the tractrix step of the previous solution and is solved by
+  // Newton's method. At the old head position the old configuration is the global minimizer, so
+  // this follows the minimizer continuously connected to it, rather than whichever stationary
+  // point (possibly a saddle) a single Newton run from far away would reach.
+  const Eigen::VectorXd from = old_points.row(0).transpose();
+  const double distance = (head - from).norm();
+  const int sub_steps =
+      std::max(1, static_cast<int>(std::ceil(distance / (0.5 * lengths.minCoeff()))));
+  OverallReport report;
+  int iterations = 0;
+  Chain chain{old_points, lengths};
+  for (int s = 1; s <= sub_steps; ++s) {
+    const Eigen::VectorXd target =
+        s == sub_steps
+            ? Eigen::VectorXd(head)
+            : Eigen::VectorXd(from + (static_cast<double>(s) / sub_steps) * (head - from));
+    MoveLeader(Method::kTractrix, target, 1, &chain);
+    report = NewtonSolve(lengths, old_points, options, &chain.points);
+    iterations += report.iterations;
+    if (!report.converged()) break;
+  }
+  report.iterations = iterations;
+  report.start = sub_steps == 1 ? "sequential tractrix step"
+                                : "continuation in " + std::to_string(sub_steps) +
+                                      " head sub-steps from the old configuration";
+  *points = chain.points;
   return report;
 }
 

@@ -40,9 +40,11 @@ struct OverallOptions {
   // Stop when every |(|x_i - x_{i-1}|^2 - L_i^2)| / (2 L_i^2) is below this. Typical: 1e-12
   // (points far from the origin cannot be stored closer than about 1e-16 |x| / L).
   double constraint_tolerance = 1e-12;
-  // ... and the first-order optimality (largest component of the Lagrangian's gradient divided by
-  // the largest component of the objective's gradient, or 1) is below this. Typical: 1e-10.
-  double optimality_tolerance = 1e-10;
+  // ... and the first-order optimality is below this: the largest component of the Lagrangian's
+  // gradient divided by the largest component of the objective's gradient (at the solution or
+  // at the start, whichever is larger); 0 when the Lagrangian's gradient is at the rounding
+  // level of the positions. Typical: 1e-12.
+  double optimality_tolerance = 1e-12;
   // Newton iterations at most. Typical: 50.
   int max_iterations = 50;
 
