@@ -1,6 +1,6 @@
 // The flexkin command line: runs and checks scenario files.
 //
-//   flexkin run SCENARIO.json -o RESULT.json [--csv FRAMES.csv] [--method tractrix|ftl]
+//   flexkin run SCENARIO.json -o RESULT.json [--csv FRAMES.csv] [--method tractrix|ftl|overall]
 //       [--substeps N] [--tolerance T] [--max-substeps N] [--record-every N]
 //       [--report brief|full] [--quiet]
 //   flexkin validate SCENARIO.json
@@ -36,6 +36,7 @@ enum ExitCode : int {
   kExitUsage = 2,           // command-line syntax (unknown option, missing argument, ...)
   kExitAccuracyNotMet = 3,  // run done and result written, but the tolerance was not met
   kExitIoError = 4,         // a file could not be read or written
+  kExitNotConverged = 5,    // run done and result written, but an overall solve did not converge
 };
 
 constexpr const char* kExitCodesHelp =
@@ -47,7 +48,9 @@ constexpr const char* kExitCodesHelp =
     "  3  the run completed and the result was written, but the accuracy target\n"
     "     (--tolerance) was not met within --max-substeps\n"
     "  4  I/O error: a file could not be read or written (an existing output file is\n"
-    "     never left half-written)";
+    "     never left half-written)\n"
+    "  5  method overall: the run completed and the result was written, but the solver\n"
+    "     did not converge at some step (the result and the message say where)";
 
 void PrintError(const std::string& message) { std::cerr << "flexkin: error: " << message << "\n"; }
 
@@ -132,6 +135,15 @@ int RunCommand(const RunArgs& args) {
   if (!args.quiet) {
     std::cout << (args.report == "full" ? result.FullReport() : result.BriefReport() + "\n");
   }
+  if (result.overall.failures > 0) {
+    std::fprintf(stderr,
+                 "flexkin: warning: the overall solver did not converge at %lld of %lld "
+                 "sub-steps; first: %s; the result was written to %s\n",
+                 static_cast<long long>(result.overall.failures),
+                 static_cast<long long>(result.overall.solves),
+                 result.overall.first_failure.c_str(), args.output.c_str());
+    return kExitNotConverged;
+  }
   if (result.accuracy.enabled && !result.accuracy.met) {
     std::fprintf(stderr,
                  "flexkin: warning: accuracy target not met: estimated error %.3g > tolerance "
@@ -178,7 +190,7 @@ int Main(int argc, char** argv) {
       ->required();
   run->add_option("-o,--output", args.output, "Result file to write (JSON)")->required();
   run->add_option("--csv", args.csv, "Also write the recorded frames as CSV");
-  args.method_opt = run->add_option("--method", args.method, "Link rule: tractrix or ftl");
+  args.method_opt = run->add_option("--method", args.method, "tractrix, ftl or overall");
   args.substeps_opt =
       run->add_option("--substeps", args.substeps, "Sub-steps per leader step (>= 1)");
   args.tolerance_opt = run->add_option(

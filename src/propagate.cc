@@ -126,6 +126,8 @@ const char* MethodName(Method method) {
       return "tractrix";
     case Method::kFollowTheLeader:
       return "ftl";
+    case Method::kOverall:
+      return "overall";
   }
   return "unknown";
 }
@@ -133,14 +135,29 @@ const char* MethodName(Method method) {
 Method ParseMethod(std::string_view name, const std::string& field) {
   if (name == "tractrix") return Method::kTractrix;
   if (name == "ftl") return Method::kFollowTheLeader;
+  if (name == "overall") return Method::kOverall;
   throw InputError(field, "unknown method \"" + std::string(name) +
-                              "\"; valid methods are \"tractrix\" and \"ftl\"");
+                              "\"; valid methods are \"tractrix\", \"ftl\" and \"overall\"");
 }
 
-int MethodOrder(Method method) { return method == Method::kTractrix ? 2 : 1; }
+int MethodOrder(Method method) {
+  switch (method) {
+    case Method::kTractrix:
+      return 2;
+    case Method::kFollowTheLeader:
+      return 1;
+    case Method::kOverall:
+      return 0;
+  }
+  return 0;
+}
 
 Stepper MakeStepper(Method method, const Chain& chain) {
   ValidateChain(chain);
+  if (method == Method::kOverall) {
+    throw InputError("method", "\"overall\" is not a link rule; move the chain with Run or "
+                               "OverallStep (overall.h), or use \"tractrix\" or \"ftl\"");
+  }
   Stepper s;
   s.method = method;
   s.dim = chain.dim();

@@ -8,13 +8,12 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <ostream>
 #include <streambuf>
 #include <string>
 #include <system_error>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "flexkin/error.h"
 
@@ -470,6 +469,28 @@ void WriteResultJson(const RunResult& result, std::ostream& out, const std::stri
        ", \"estimated_error\": ";
   AppendDouble(a.estimated_error, &t);
   t += ", \"met\": " + std::string(a.met ? "true" : "false") + "},\n";
+  if (result.method == Method::kOverall) {
+    const OverallSummary& o = result.overall;
+    const ObjectiveWeights& w = result.weights;
+    t += "\"overall\": {\"objective\": {\"squared\": ";
+    AppendDouble(w.squared, &t);
+    t += ", \"squared_weighted\": ";
+    AppendDouble(w.squared_weighted, &t);
+    t += ", \"rotation\": ";
+    AppendDouble(w.rotation, &t);
+    t += ", \"joint_angle\": ";
+    AppendDouble(w.joint_angle, &t);
+    t += "}, \"solves\": " + std::to_string(o.solves) +
+         ", \"failures\": " + std::to_string(o.failures) +
+         ", \"iterations\": " + std::to_string(o.iterations) +
+         ", \"max_iterations\": " + std::to_string(o.max_iterations) +
+         ", \"constraint_violation\": ";
+    AppendDouble(o.constraint_violation, &t);
+    t += ", \"optimality\": ";
+    AppendDouble(o.optimality, &t);
+    t += ", \"first_failure\": " +
+         json(o.first_failure).dump(-1, ' ', false, json::error_handler_t::replace) + "},\n";
+  }
   t += "\"metrics\": {\n\"l2_total\": ";
   AppendDouble(m.l2_total, &t);
   t += ",\n\"l2_weighted_total\": ";
@@ -572,10 +593,31 @@ ResultFile ResultFromJson(const json& j) {
   r.accuracy.substeps = static_cast<int>(
       ReadInteger(Member(accuracy, "/accuracy", "substeps"), "/accuracy/substeps", 1));
   r.accuracy.order =
-      static_cast<int>(ReadInteger(Member(accuracy, "/accuracy", "order"), "/accuracy/order", 1));
+      static_cast<int>(ReadInteger(Member(accuracy, "/accuracy", "order"), "/accuracy/order", 0));
   r.accuracy.estimated_error =
       ReadNumber(Member(accuracy, "/accuracy", "estimated_error"), "/accuracy/estimated_error");
   r.accuracy.met = ReadBool(Member(accuracy, "/accuracy", "met"), "/accuracy/met");
+  if (const auto it = j.find("overall"); it != j.end()) {
+    const json& o = *it;
+    const json& w = Member(o, "/overall", "objective");
+    r.weights.squared =
+        ReadNumber(Member(w, "/overall/objective", "squared"), "/overall/objective/squared");
+    r.weights.squared_weighted = ReadNumber(Member(w, "/overall/objective", "squared_weighted"),
+                                            "/overall/objective/squared_weighted");
+    r.weights.rotation =
+        ReadNumber(Member(w, "/overall/objective", "rotation"), "/overall/objective/rotation");
+    r.weights.joint_angle = ReadNumber(Member(w, "/overall/objective", "joint_angle"),
+                                       "/overall/objective/joint_angle");
+    r.overall.solves = ReadInteger(Member(o, "/overall", "solves"), "/overall/solves", 0);
+    r.overall.failures = ReadInteger(Member(o, "/overall", "failures"), "/overall/failures", 0);
+    r.overall.iterations =
+        ReadInteger(Member(o, "/overall", "iterations"), "/overall/iterations", 0);
+    r.overall.max_iterations = static_cast<int>(
+        ReadInteger(Member(o, "/overall", "max_iterations"), "/overall/max_iterations", 0));
+    r.overall.constraint_violation =
+        ReadNumber(Member(o, "/overall", "constraint_violation"), "/overall/constraint_violation");
+    r.overall.optimality = ReadNumber(Member(o, "/overall", "optimality"), "/overall/optimality");
+  }
 
   const json& metrics = Member(j, "", "metrics");
   Metrics& m = r.metrics;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 
 #include "flexkin/error.h"
@@ -87,6 +88,23 @@ AccuracyReport ChooseSubsteps(const Chain& chain, const Points& leader_steps,
   }
 }
 
+// Adds one overall solve to the run's summary.
+void Record(const OverallReport& report, int64_t step, int substep, OverallSummary* summary) {
+  ++summary->solves;
+  summary->iterations += report.iterations;
+  summary->max_iterations = std::max(summary->max_iterations, report.iterations);
+  summary->constraint_violation =
+      std::fmax(summary->constraint_violation, report.constraint_violation);
+  summary->optimality = std::fmax(summary->optimality, report.optimality);
+  if (!report.converged()) {
+    if (summary->failures == 0) {
+      summary->first_failure = "leader step " + std::to_string(step) + ", sub-step " +
+                               std::to_string(substep) + ": " + report.BriefReport();
+    }
+    ++summary->failures;
+  }
+}
+
 std::string Format(const char* fmt, double x) {
   char buf[64];
   std::snprintf(buf, sizeof buf, fmt, x);
@@ -107,6 +125,13 @@ std::string RunOptions::Validate() const {
   if (tolerance > 0.0 && max_substeps < 2) {
     return "max_substeps: " + std::to_string(max_substeps) +
            " is not valid; accuracy control compares two runs and needs max_substeps >= 2";
+  }
+  if (method == Method::kOverall) {
+    if (tolerance > 0.0) {
+      return "tolerance: accuracy control is available for the tractrix and ftl methods; with "
+             "\"overall\" set it to 0 and choose the sub-steps";
+    }
+    if (const std::string why = overall.Validate(); !why.empty()) return "overall." + why;
   }
   if (max_substeps < substeps) {
     return "max_substeps: " + std::to_string(max_substeps) +
@@ -133,7 +158,18 @@ RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& 
   if (options.tolerance > 0.0) result.accuracy = ChooseSubsteps(chain, leader_steps, options);
   const int substeps = result.accuracy.substeps;
 
-  const Stepper stepper = MakeStepper(options.method, chain);
+  const bool overall = options.method == Method::kOverall;
+  std::optional<Stepper> stepper;
+  if (overall) {
+    result.weights = options.overall.weights;
+    if (options.overall.weights.joint_angle > 0.0 && chain.dim() != 2) {
+      throw InputError("overall.weights.joint_angle",
+                       "the joint-angle term is defined for planar (2D) chains only; this chain is "
+                       "3D: set it to 0");
+    }
+  } else {
+    stepper = MakeStepper(options.method, chain);
+  }
   const Eigen::Index n = chain.num_links();
   const Eigen::VectorXd weights = ArcLengthWeights(chain.lengths);
   Metrics& m = result.metrics;
@@ -168,7 +204,12 @@ RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& 
       head = (j == substeps) ? target
                              : Eigen::VectorXd(start + (double(j) / substeps) * (target - start));
       before = points;
-      MoveLeader(stepper, head, 1, &points);
+      if (overall) {
+        const OverallReport report = OverallStep(chain.lengths, head, options.overall, &points);
+        Record(report, s + 1, j, &result.overall);
+      } else {
+        MoveLeader(*stepper, head, 1, &points);
+      }
       moved += (points - before).rowwise().norm();
     }
     m.path_length += moved;
@@ -203,6 +244,12 @@ std::string RunResult::BriefReport() const {
       << Format("%.3g", metrics.max_relative_length_error) << ", L2 total "
       << Format("%.10g", metrics.l2_total) << " (arc-length weighted "
       << Format("%.10g", metrics.l2_weighted_total) << ")";
+  if (method == Method::kOverall) {
+    out << ", overall solver: " << overall.solves - overall.failures << "/" << overall.solves
+        << " steps converged, " << overall.iterations << " iterations (at most "
+        << overall.max_iterations << " per step)";
+    if (overall.failures > 0) out << ", FIRST FAILURE " << overall.first_failure;
+  }
   if (accuracy.enabled) {
     out << ", estimated error " << Format("%.3g", accuracy.estimated_error)
         << (accuracy.met ? " (tolerance met)" : " (TOLERANCE NOT MET)");

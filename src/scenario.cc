@@ -3,12 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "flexkin/curves.h"
 #include "flexkin/error.h"
@@ -516,8 +515,62 @@ void Parser::ParseOptions(const json& root, RunOptions* options) {
         options->method = ParseMethod(*name, "/method");
       } catch (const InputError& e) {
         Add(e.field(), "value " + ShowJson(*m) + " is not valid; expected \"" +
-                           MethodName(Method::kTractrix) + "\" or \"" +
-                           MethodName(Method::kFollowTheLeader) + "\"");
+                           MethodName(Method::kTractrix) + "\", \"" +
+                           MethodName(Method::kFollowTheLeader) + "\" or \"" +
+                           MethodName(Method::kOverall) + "\"");
+      }
+    }
+  }
+  // The overall method's metric and solver.
+  for (const char* key : {"objective", "solver"}) {
+    if (Find(root, key) != nullptr && options->method != Method::kOverall) {
+      Add(std::string("/") + key, std::string("is used only with \"method\": \"overall\"; ") +
+                                      "remove it or set the method to \"overall\"");
+    }
+  }
+  if (const json* o = Find(root, "objective")) {
+    if (ExpectObject(*o, "/objective",
+                     "an object of term weights, e.g. {\"squared\": 1, \"rotation\": 0.5}")) {
+      CheckKeys(*o, "/objective", {"squared", "squared_weighted", "rotation", "joint_angle"});
+      // Only the terms listed count: {"rotation": 1} is the rotation metric alone.
+      ObjectiveWeights& w = options->overall.weights;
+      w = {0.0, 0.0, 0.0, 0.0};
+      Optional(
+          *o, "/objective", "squared",
+          [&](const json& v, const std::string& p) { return Number(v, p, Range::kNonNegative); },
+          &w.squared);
+      Optional(
+          *o, "/objective", "squared_weighted",
+          [&](const json& v, const std::string& p) { return Number(v, p, Range::kNonNegative); },
+          &w.squared_weighted);
+      Optional(
+          *o, "/objective", "rotation",
+          [&](const json& v, const std::string& p) { return Number(v, p, Range::kNonNegative); },
+          &w.rotation);
+      Optional(
+          *o, "/objective", "joint_angle",
+          [&](const json& v, const std::string& p) { return Number(v, p, Range::kNonNegative); },
+          &w.joint_angle);
+    }
+  }
+  if (const json* v = Find(root, "solver")) {
+    if (ExpectObject(*v, "/solver",
+                     "an object {\"max_iterations\": n, \"constraint_tolerance\": t, "
+                     "\"optimality_tolerance\": t}")) {
+      CheckKeys(*v, "/solver", {"max_iterations", "constraint_tolerance", "optimality_tolerance"});
+      OverallOptions& o = options->overall;
+      Optional(
+          *v, "/solver", "constraint_tolerance",
+          [&](const json& x, const std::string& p) { return Number(x, p, Range::kPositive); },
+          &o.constraint_tolerance);
+      Optional(
+          *v, "/solver", "optimality_tolerance",
+          [&](const json& x, const std::string& p) { return Number(x, p, Range::kPositive); },
+          &o.optimality_tolerance);
+      if (const json* m = Find(*v, "max_iterations")) {
+        if (const auto n = Integer(*m, "/solver/max_iterations", 1, 1000000)) {
+          o.max_iterations = static_cast<int>(*n);
+        }
       }
     }
   }
@@ -552,7 +605,8 @@ Scenario Parser::Parse(const json& root) {
   Scenario s;
   if (!ExpectObject(root, "", "an object with \"curve\" and \"leader\"")) return s;
   CheckKeys(root, "",
-            {"$schema", "name", "description", "curve", "leader", "method", "record", "accuracy"});
+            {"$schema", "name", "description", "curve", "leader", "method", "objective", "solver",
+             "record", "accuracy"});
   for (const char* key : {"$schema", "name", "description"}) {
     if (const json* v = Find(root, key)) {
       if (const auto text = String(*v, std::string("/") + key)) {
@@ -580,10 +634,12 @@ Scenario Parser::Parse(const json& root) {
   if (!problems.empty()) return s;
   if (const std::string why = s.options.Validate(); !why.empty()) {
     const std::string field = why.substr(0, why.find(':'));
-    const std::string pointer = field == "substeps"       ? "/leader/substeps"
-                                : field == "record_every" ? "/record/every"
-                                : field == "tolerance"    ? "/accuracy/tolerance"
-                                                          : "/accuracy/max_substeps";
+    const std::string pointer = field == "substeps"                      ? "/leader/substeps"
+                                : field == "record_every"                ? "/record/every"
+                                : field == "tolerance"                   ? "/accuracy/tolerance"
+                                : field.rfind("overall.weights", 0) == 0 ? "/objective"
+                                : field.rfind("overall.", 0) == 0        ? "/solver"
+                                                                         : "/accuracy/max_substeps";
     Add(pointer, why.substr(why.find(':') + 2));
     return s;
   }

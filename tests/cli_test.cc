@@ -241,5 +241,33 @@ TEST_F(CliTest, AccuracyMetExitsZero) {
   EXPECT_TRUE(ReadResultJson(Path("out.json")).result.accuracy.met);
 }
 
+// Method "overall": the result carries the solver's summary; a solve that does not converge is
+// reported (exit 5, result written, the failure named), never passed off as a solution.
+TEST_F(CliTest, OverallRunWritesTheSolverSummary) {
+  Write("overall.json", R"({"curve": {"shape": "parabola", "a": 1, "links": 20, "link_length": 0.25},
+    "leader": {"pull": [0.49497474683058318, 0.49497474683058318], "steps": 5},
+    "method": "overall", "objective": {"squared": 1, "rotation": 0.5}})");
+  const CliResult r = Cli("run overall.json -o out.json");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_CONTAINS(r.out, "overall solver: 5/5 steps converged");
+  const ResultFile f = ReadResultJson(Path("out.json"));
+  EXPECT_EQ(f.result.method, Method::kOverall);
+  EXPECT_EQ(f.result.overall.solves, 5);
+  EXPECT_EQ(f.result.overall.failures, 0);
+  EXPECT_EQ(f.result.weights.rotation, 0.5);
+  EXPECT_LE(f.result.overall.constraint_violation, 1e-12);
+  EXPECT_LE(f.result.metrics.max_relative_length_error, 1e-12);
+
+  Write("capped.json", R"({"curve": {"shape": "parabola", "a": 1, "links": 20, "link_length": 0.25},
+    "leader": {"pull": [0.49497474683058318, 0.49497474683058318], "steps": 1},
+    "method": "overall", "solver": {"max_iterations": 1}})");
+  const CliResult capped = Cli("run capped.json -o capped_out.json");
+  EXPECT_EQ(capped.exit_code, 5);
+  EXPECT_CONTAINS(capped.err, "did not converge");
+  EXPECT_CONTAINS(capped.err, "max_iterations");
+  const ResultFile g = ReadResultJson(Path("capped_out.json"));
+  EXPECT_GT(g.result.overall.failures, 0);
+}
+
 }  // namespace
 }  // namespace flexkin

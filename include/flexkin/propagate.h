@@ -13,13 +13,17 @@ namespace flexkin {
 enum class Method {
   kTractrix,         // "tractrix": closed-form tractrix step, velocity along the link (paper Sec. 2-3)
   kFollowTheLeader,  // "ftl": nearest point on the sphere around the new leading end (FABRIK, hair)
+  // "overall": all points at once, each step minimizing a metric under the length constraints
+  // (paper Sec. 3 and 4; overall.h). Not a link rule: used by Run and OverallStep, not Stepper.
+  kOverall,
 };
 
 // The one vocabulary for method names, shared by the CLI, files and messages.
 const char* MethodName(Method method);
-// Parses "tractrix" or "ftl"; throws InputError naming `field` and listing the valid names.
+// Parses "tractrix", "ftl" or "overall"; throws InputError naming `field` and listing them.
 Method ParseMethod(std::string_view name, const std::string& field = "method");
-// Convergence order of the multi-step method to the continuous motion (2 for tractrix, 1 for ftl).
+// Convergence order of the multi-step method to the continuous motion (2 for tractrix, 1 for ftl;
+// 0 for overall, whose order is not established).
 int MethodOrder(Method method);
 
 // Data precomputed once per chain and reused by every move (the reciprocal link lengths).
@@ -30,7 +34,7 @@ struct Stepper {
   Eigen::VectorXd inv_lengths;  // n, 1 / lengths
 };
 
-// Throws InputError if `chain` is not valid (see ValidateChain).
+// Throws InputError if `chain` is not valid (see ValidateChain) or `method` is not a link rule.
 Stepper MakeStepper(Method method, const Chain& chain);
 
 // Sequential propagation. The leading end moves in a straight line from its current position to

@@ -1,21 +1,24 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-
 #include "flexkin/chain.h"
+#include "flexkin/overall.h"
 #include "flexkin/propagate.h"
 
 namespace flexkin {
 
 // Options of a whole run: a chain whose leading end visits a list of targets (the leader steps).
 struct RunOptions {
-  // Link rule: tractrix (the paper's sequential optimization) or follow-the-leader.
+  // Tractrix (the paper's sequential optimization), follow-the-leader, or overall (all points
+  // at once, each sub-step solved by OverallStep with `overall`).
   Method method = Method::kTractrix;
+  // The metric and solver options of the overall method; unused by the others.
+  OverallOptions overall;
   // Equal sub-steps each leader step is split into; computed but not recorded. >= 1.
   // With `tolerance` > 0 this is the starting value of the automatic choice. Typical: 1 to 64.
   int substeps = 1;
@@ -24,6 +27,7 @@ struct RunOptions {
   // Accuracy control. If > 0, `substeps` is doubled until the estimated largest distance of any
   // point, at any leader step, from the continuous motion (every point's velocity along its
   // link) is at most `tolerance`, in the chain's length unit. 0 turns it off. Typical: 1e-6.
+  // Tractrix and ftl only (the overall method's order of convergence is not established).
   // The runs that pick `substeps` cost about as much as the final run again.
   double tolerance = 0.0;
   // Upper bound for the automatic choice of `substeps`; >= 2 when `tolerance` > 0. Typical: 65536.
@@ -75,6 +79,17 @@ struct AccuracyReport {
   bool met = true;               // estimated_error <= tolerance (always true if not enabled)
 };
 
+// What the overall solver did over a run (method "overall" only).
+struct OverallSummary {
+  int64_t solves = 0;                 // sub-steps solved
+  int64_t failures = 0;               // sub-steps whose solve did not converge
+  int64_t iterations = 0;             // Newton iterations in all
+  int max_iterations = 0;             // most iterations of one sub-step
+  double constraint_violation = 0.0;  // worst over the run
+  double optimality = 0.0;            // worst over the run
+  std::string first_failure;          // "leader step s, sub-step j: <report>" of the first failure
+};
+
 struct RunResult {
   Method method = Method::kTractrix;
   Eigen::VectorXd lengths;  // the link lengths, fixed at the start
@@ -82,7 +97,9 @@ struct RunResult {
   std::vector<Frame> frames;
   Metrics metrics;
   AccuracyReport accuracy;
-  double seconds = 0.0;  // wall time of the computation
+  OverallSummary overall;    // method "overall" only
+  ObjectiveWeights weights;  // the overall method's metric (method "overall" only)
+  double seconds = 0.0;      // wall time of the computation
 
   // One line: method, steps, length error, L2 total, accuracy.
   std::string BriefReport() const;
