@@ -14,6 +14,7 @@ for scenario in examples/fig*.json; do
 done
 echo "== closed form and comparisons"
 "$build/examples/fig07_closed_form" examples/fig07_straight_link.json
-"$build/examples/fig06_compare" examples/fig06_parabola_single_step.json \
-  examples/fig06_parabola_multi_step.json
+"$build/examples/fig06_compare" examples/fig06_parabola_multi_step.json \
+  examples/fig06_parabola_single_step.json examples/fig06_parabola_overall_multi_step.json \
+  examples/fig06_parabola_overall_single_step.json
 echo "results: out/*.json (format: docs/result-format.md)"
