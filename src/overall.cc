@@ -1,8 +1,8 @@
 #include "flexkin/overall.h"
 
 #include <Eigen/SparseCore>
-#include <Eigen/SparseLU>
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -16,6 +16,64 @@ namespace flexkin {
 namespace {
 
 using Triplets = std::vector<Eigen::Triplet<double>>;
+
+}  // namespace
+}  // namespace flexkin
+
+// LAPACK's banded LU with partial pivoting (Fortran interface; the trailing size_t is the hidden
+// length of the character argument).
+extern "C" {
+void dgbtrf_(const int* m, const int* n, const int* kl, const int* ku, double* ab, const int* ldab,
+             int* ipiv, int* info);
+void dgbtrs_(const char* trans, const int* n, const int* kl, const int* ku, const int* nrhs,
+             const double* ab, const int* ldab, const int* ipiv, double* b, const int* ldb,
+             int* info, size_t trans_length);
+}
+
+namespace flexkin {
+namespace {
+
+// LU factorization of a square banded matrix (half-bandwidth `band` above and below), built from
+// triplets (duplicates summed). Cost linear in the size for a fixed band.
+class BandedLu {
+ public:
+  BandedLu(int size, int band)
+      : size_(size),
+        band_(band),
+        ldab_(3 * band + 1),
+        ab_(static_cast<size_t>(ldab_) * size),
+        ipiv_(size) {}
+
+  // False if the matrix is singular (or a triplet lies outside the band: a bug).
+  bool Factorize(const Triplets& triplets) {
+    std::fill(ab_.begin(), ab_.end(), 0.0);
+    for (const auto& t : triplets) {
+      const int i = t.row(), j = t.col();
+      assert(std::abs(i - j) <= band_);
+      ab_[static_cast<size_t>(j) * ldab_ + (2 * band_ + i - j)] += t.value();
+    }
+    int info = 0;
+    dgbtrf_(&size_, &size_, &band_, &band_, ab_.data(), &ldab_, ipiv_.data(), &info);
+    factorized_ = info == 0;
+    return factorized_;
+  }
+  Eigen::VectorXd Solve(const Eigen::VectorXd& rhs) const {
+    Eigen::VectorXd x = rhs;
+    const char trans = 'N';
+    const int one = 1;
+    int info = 0;
+    dgbtrs_(&trans, &size_, &band_, &band_, &one, ab_.data(), &ldab_, ipiv_.data(), x.data(),
+            &size_, &info, 1);
+    return x;
+  }
+  bool factorized() const { return factorized_; }
+
+ private:
+  int size_, band_, ldab_;
+  std::vector<double> ab_;
+  std::vector<int> ipiv_;
+  bool factorized_ = false;
+};
 
 std::string Num(double x) {
   char buf[40];
@@ -364,8 +422,10 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
     return residual / scale;
   };
 
-  Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu;
-  bool analyzed = false;
+  // Half-bandwidth of the KKT matrix in the interleaved order: x_j reaches x_{j+1} (2 dim) and
+  // lambda_j reaches x_{j-1} (2 dim + 1); the joint-angle term reaches x_{j+2} (3 dim + 1).
+  const int band = options.weights.joint_angle > 0.0 ? 3 * dim + 1 : 2 * dim + 1;
+  BandedLu lu(size, std::min(band, size - 1));
   double regularization = 0.0;
   double value = evaluate(x, nullptr, &g);
   start_gradient = g.cwiseAbs().maxCoeff();
@@ -421,14 +481,8 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
     // Newton step for (x, lambda_new): [H J^T; J 0] [dx; lambda_new] = -[g; c].
     bool stepped = false;
     for (int attempt = 0; attempt < 12 && !stepped; ++attempt) {
-      Eigen::SparseMatrix<double> kkt(size, size);
-      kkt.setFromTriplets(t.begin(), t.end());
-      if (!analyzed) {
-        lu.analyzePattern(kkt);
-        analyzed = true;
-      }
-      lu.factorize(kkt);
-      if (lu.info() != Eigen::Success) {
+      lu.Factorize(t);
+      if (!lu.factorized()) {
         // Singular: regularize the Hessian block and retry.
         const double bump = regularization == 0.0 ? 1e-10 * std::fmax(1.0, g.cwiseAbs().maxCoeff())
                                                   : 10.0 * regularization;
@@ -443,7 +497,7 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
         for (int k = 0; k < dim; ++k) rhs[sink.offset[j] + k] = -g[sink.offset[j] + k];
         rhs[multiplier_row(j)] = -c[j - 1];
       }
-      const Eigen::VectorXd sol = lu.solve(rhs);
+      const Eigen::VectorXd sol = lu.Solve(rhs);
       if (!sol.allFinite()) break;
       Eigen::VectorXd lambda_new(n);
       Points dx(n + 1, dim);
@@ -460,7 +514,13 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
         for (int j = 1; j <= n; ++j) {
           for (int k = 0; k < dim; ++k) dx_only[sink.offset[j] + k] = dx(j, k);
         }
-        const Eigen::VectorXd k_dx = kkt * dx_only;
+        // (H + delta I) dx, from the triplets of the Hessian block.
+        Eigen::VectorXd k_dx = Eigen::VectorXd::Zero(size);
+        for (const auto& e : t) {
+          if (e.row() % block != dim && e.col() % block != dim) {
+            k_dx[e.row()] += e.value() * dx_only[e.col()];
+          }
+        }
         double curvature = 0.0;
         for (int j = 1; j <= n; ++j) {
           for (int k = 0; k < dim; ++k) curvature += dx(j, k) * k_dx[sink.offset[j] + k];
@@ -540,9 +600,9 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
       report.optimality = optimality(x, g, lagrangian_gradient(x, g, lambda));
       const bool done = report.constraint_violation <= options.constraint_tolerance &&
                         report.optimality <= options.optimality_tolerance;
-      report.status = done                          ? OverallStatus::kConverged
-                      : lu.info() == Eigen::Success ? OverallStatus::kStalled
-                                                    : OverallStatus::kFailed;
+      report.status = done              ? OverallStatus::kConverged
+                      : lu.factorized() ? OverallStatus::kStalled
+                                        : OverallStatus::kFailed;
       break;
     }
     regularization *= 0.1;
