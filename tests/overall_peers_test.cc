@@ -1,0 +1,229 @@
+// OverallStep against general-purpose solvers on the same problems: NLopt's SLSQP and IPOPT
+// (testing/peer_solvers.h), from the same starting point, with the same objective function.
+// Where a peer reports convergence, OverallStep must reach the same minimum (objective to 1e-8
+// relative, configuration to 1e-6). A peer that does not converge is recorded as a test property
+// (--gtest_output=xml shows it), not a failure: the peers are the reference, not the subject.
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <string>
+#include <vector>
+
+#include "flexkin/curves.h"
+#include "flexkin/overall.h"
+#include "peer_solvers.h"
+
+namespace flexkin {
+namespace {
+
+using peers::PeerOptions;
+using peers::PeerReport;
+
+struct Case {
+  std::string name;
+  Chain chain;
+  Eigen::VectorXd head;
+  ObjectiveWeights weights;
+};
+
+ObjectiveWeights Weights(double squared, double squared_weighted, double rotation,
+                         double joint_angle) {
+  ObjectiveWeights w;
+  w.squared = squared;
+  w.squared_weighted = squared_weighted;
+  w.rotation = rotation;
+  w.joint_angle = joint_angle;
+  return w;
+}
+
+// The objectives tried on every chain: each term alone, and mixes (the joint angle is planar).
+std::vector<std::pair<std::string, ObjectiveWeights>> Objectives(int dim) {
+  std::vector<std::pair<std::string, ObjectiveWeights>> list = {
+      {"squared", Weights(1, 0, 0, 0)},
+      {"squared_weighted", Weights(0, 1, 0, 0)},
+      {"rotation", Weights(0, 0, 1, 0)},
+      {"squared_rotation", Weights(1, 0, 0.5, 0)},
+  };
+  if (dim == 2) list.push_back({"squared_rotation_joint", Weights(1, 0, 0.5, 0.3)});
+  return list;
+}
+
+// A random chain: link lengths in [0.5, 1.5], each link turned from the previous one by up to
+// 60 degrees, so that the chain is curved but never folds back on itself.
+Chain RandomChain(int dim, int links, std::mt19937* rng) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  Points p(links + 1, dim);
+  p.row(0).setZero();
+  Eigen::VectorXd direction = Eigen::VectorXd::Zero(dim);
+  direction[0] = 1.0;
+  Chain chain;
+  chain.lengths.resize(links);
+  for (int i = 1; i <= links; ++i) {
+    Eigen::VectorXd turn(dim);
+    for (int k = 0; k < dim; ++k) turn[k] = unit(*rng);
+    turn -= turn.dot(direction) * direction;
+    direction = (direction + 0.6 * turn).normalized();
+    chain.lengths[i - 1] = 1.0 + 0.5 * unit(*rng);
+    p.row(i) = p.row(i - 1) + chain.lengths[i - 1] * direction.transpose();
+  }
+  chain.points = p;
+  return chain;
+}
+
+std::vector<Case> Cases() {
+  std::vector<Case> cases;
+  // Paper Sec. 5.1: y = x^2 in 20 links of 0.25, vertex leading, pulled 0.7 at 45 degrees.
+  ParabolaDef parabola;
+  const Chain paper = MakeEqualLinkChain(MakeParabola(parabola), parabola.link_length);
+  const Eigen::Vector2d pull(0.7 / std::sqrt(2.0), 0.7 / std::sqrt(2.0));
+  for (const auto& [objective, weights] : Objectives(2)) {
+    cases.push_back(
+        {"parabola_" + objective, paper, paper.points.row(0).transpose() + pull, weights});
+  }
+  // Random chains of 5 to 50 links, moved by 0.1 to 1 mean link length in a random direction.
+  std::mt19937 rng(20240611);
+  std::uniform_int_distribution<int> links(5, 50);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), size(0.1, 1.0);
+  for (int dim : {2, 3}) {
+    for (int seed = 0; seed < 5; ++seed) {
+      const Chain chain = RandomChain(dim, links(rng), &rng);
+      Eigen::VectorXd move(dim);
+      for (int k = 0; k < dim; ++k) move[k] = unit(rng);
+      move *= size(rng) * chain.lengths.mean() / move.norm();
+      const Eigen::VectorXd head = chain.points.row(0).transpose() + move;
+      for (const auto& [objective, weights] : Objectives(dim)) {
+        cases.push_back({"random" + std::to_string(dim) + "d_" + std::to_string(seed) + "_" +
+                             std::to_string(chain.num_links()) + "links_" + objective,
+                         chain, head, weights});
+      }
+    }
+  }
+  return cases;
+}
+
+// |a - b| within 1e-8 relative; minima of exactly 0 (the rotation term alone: a translation)
+// compare to 1e-14 absolute.
+void ExpectSameObjective(double overall, double peer, const std::string& who) {
+  EXPECT_LE(std::fabs(overall - peer),
+            1e-8 * std::fmax(std::fabs(overall), std::fabs(peer)) + 1e-14)
+      << who << ": OverallStep " << overall << " vs " << peer;
+}
+
+// For gtest's messages: the case's name rather than its bytes.
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+
+class OverallPeersTest : public testing::TestWithParam<Case> {};
+
+TEST_P(OverallPeersTest, SameMinimumAsSlsqpAndIpopt) {
+  const Case& c = GetParam();
+  // The peers first, so that their outcome is recorded (and shown below) whatever OverallStep does.
+  PeerOptions peer_options;
+  peer_options.weights = c.weights;
+  std::vector<PeerReport> peers;
+  std::string peer_results;
+  for (auto solve : {peers::SolveWithSlsqp, peers::SolveWithIpopt}) {
+    peers.push_back(solve(c.chain.lengths, c.head, peer_options, c.chain.points));
+    RecordProperty(peers.back().solver, peers.back().BriefReport());
+    peer_results += "\n  " + peers.back().BriefReport();
+  }
+
+  OverallOptions options;
+  options.weights = c.weights;
+  Points overall = c.chain.points;
+  const OverallReport report = OverallStep(c.chain.lengths, c.head, options, &overall);
+  ASSERT_TRUE(report.converged()) << report.BriefReport() << peer_results;
+  EXPECT_LT(report.constraint_violation, 1e-12) << report.BriefReport();
+  EXPECT_NEAR(report.objective,
+              OverallObjective(c.weights, c.chain.lengths, c.chain.points, overall),
+              1e-12 * (1.0 + std::fabs(report.objective)));
+
+  for (const PeerReport& peer : peers) {
+    if (!peer.converged) continue;  // recorded above; the peer's failure is not OverallStep's
+    ExpectSameObjective(report.objective, peer.objective, peer.BriefReport());
+    EXPECT_LT(peer.constraint_violation, 1e-10) << peer.BriefReport();
+    EXPECT_LT((overall - peer.points).cwiseAbs().maxCoeff(), 1e-6) << peer.BriefReport();
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Problems, OverallPeersTest, testing::ValuesIn(Cases()),
+                         [](const testing::TestParamInfo<Case>& info) { return info.param.name; });
+
+// IPOPT with its quasi-Newton Hessian instead of the exact one reaches the same minimum.
+TEST(OverallPeers, IpoptLimitedMemoryAgrees) {
+  ParabolaDef parabola;
+  const Chain chain = MakeEqualLinkChain(MakeParabola(parabola), parabola.link_length);
+  const Eigen::Vector2d head = chain.points.row(0).transpose() + Eigen::Vector2d(0.49, 0.49);
+  PeerOptions options;
+  options.exact_hessian = false;
+  const PeerReport exact = peers::SolveWithIpopt(chain.lengths, head, PeerOptions(), chain.points);
+  const PeerReport quasi = peers::SolveWithIpopt(chain.lengths, head, options, chain.points);
+  ASSERT_TRUE(exact.converged) << exact.BriefReport();
+  RecordProperty("ipopt_limited_memory", quasi.BriefReport());
+  if (quasi.converged) EXPECT_NEAR(quasi.objective, exact.objective, 1e-8 * exact.objective);
+}
+
+// The peers start where OverallStep starts (the tractrix step) and stop where their own test says
+// so; the report carries the solver's verdict and the same measures as OverallReport.
+TEST(OverallPeers, ReportsAreComplete) {
+  std::mt19937 rng(7);
+  const Chain chain = RandomChain(3, 12, &rng);
+  const Eigen::Vector3d head = chain.points.row(0).transpose() + Eigen::Vector3d(0.3, -0.2, 0.1);
+  PeerOptions options;
+  options.max_evaluations = 2;  // SLSQP stops long before convergence
+  options.max_iterations = 1;
+  const PeerReport slsqp = peers::SolveWithSlsqp(chain.lengths, head, options, chain.points);
+  EXPECT_FALSE(slsqp.converged);
+  EXPECT_EQ(slsqp.status, "MAXEVAL_REACHED") << slsqp.BriefReport();
+  const PeerReport ipopt = peers::SolveWithIpopt(chain.lengths, head, options, chain.points);
+  EXPECT_FALSE(ipopt.converged);
+  EXPECT_EQ(ipopt.status, "Maximum_Iterations_Exceeded") << ipopt.BriefReport();
+  for (const PeerReport* r : {&slsqp, &ipopt}) {
+    ASSERT_EQ(r->points.rows(), chain.points.rows());
+    EXPECT_EQ(r->points.row(0), head.transpose());
+    EXPECT_GT(r->evaluations, 0);
+    EXPECT_GT(r->seconds, 0.0);
+    EXPECT_NEAR(r->objective,
+                OverallObjective(ObjectiveWeights(), chain.lengths, chain.points, r->points),
+                1e-15);
+  }
+  EXPECT_THROW(peers::SolveWithIpopt(chain.lengths, head, PeerOptions(), chain.points.leftCols(2)),
+               InputError);
+  options.weights.joint_angle = 1.0;  // planar only
+  EXPECT_THROW(peers::SolveWithSlsqp(chain.lengths, head, options, chain.points), InputError);
+}
+
+// IPOPT stays silent: no banner, no iteration log.
+TEST(OverallPeers, IpoptPrintsNothing) {
+  std::mt19937 rng(3);
+  const Chain chain = RandomChain(2, 8, &rng);
+  const Eigen::Vector2d head = chain.points.row(0).transpose() + Eigen::Vector2d(0.2, 0.3);
+  testing::internal::CaptureStdout();
+  const PeerReport report = peers::SolveWithIpopt(chain.lengths, head, PeerOptions(), chain.points);
+  EXPECT_EQ(testing::internal::GetCapturedStdout(), "");
+  EXPECT_TRUE(report.converged) << report.BriefReport();
+}
+
+// The banded Hessian handed to IPOPT, assembled from OverallObjective's Hessian on windows, equals
+// OverallObjective's Hessian of the whole chain: one window (short chains) and many (long ones).
+TEST(OverallPeers, BandedHessianEqualsDense) {
+  std::mt19937 rng(11);
+  for (int dim : {2, 3}) {
+    for (int links : {1, 3, 23, 24, 25, 90}) {
+      const Chain chain = RandomChain(dim, links, &rng);
+      const Chain moved = RandomChain(dim, links, &rng);  // any configuration will do
+      for (const auto& [objective, weights] : Objectives(dim)) {
+        SCOPED_TRACE(std::to_string(dim) + "D, " + std::to_string(links) + " links, " + objective);
+        Eigen::MatrixXd dense;
+        OverallObjective(weights, chain.lengths, chain.points, moved.points, nullptr, &dense);
+        peers::BandedHessian banded;
+        peers::ObjectiveHessianBands(weights, chain.lengths, chain.points, moved.points, &banded);
+        EXPECT_EQ(banded.band, peers::HessianBand(weights, dim));
+        EXPECT_LE((banded.ToDense() - dense).cwiseAbs().maxCoeff(), 1e-12 * (1.0 + dense.norm()));
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace flexkin
