@@ -109,15 +109,6 @@ struct Sink {
   }
 };
 
-// Arc-length weight of each point: (L_j + L_{j+1}) / 2, half a link at the ends.
-Eigen::VectorXd PointWeights(const Eigen::VectorXd& lengths) {
-  const Eigen::Index n = lengths.size();
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(n + 1);
-  w.head(n) += 0.5 * lengths;
-  w.tail(n) += 0.5 * lengths;
-  return w;
-}
-
 // Signed angle from link vector u to link vector v (2D), in (-pi, pi].
 double TurnAngle(const double* u, const double* v) {
   return std::atan2(u[0] * v[1] - u[1] * v[0], u[0] * v[0] + u[1] * v[1]);
@@ -133,15 +124,20 @@ double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const
   const int dim = static_cast<int>(x.cols());
   double value = 0.0;
 
-  // Squared displacement, plain and arc-length weighted.
+  // Squared displacement, plain and arc-length weighted. (Plain loops: no temporaries per point.)
+  double d[3], grad[3];
   if (w.squared > 0.0 || w.squared_weighted > 0.0) {
-    const Eigen::VectorXd point_weights = PointWeights(lengths);
     for (int j = 1; j <= n; ++j) {
-      const double s = w.squared + w.squared_weighted * point_weights[j];
-      const Eigen::VectorXd d = (x.row(j) - old_points.row(j)).transpose();
-      value += s * d.squaredNorm();
-      const Eigen::VectorXd g = 2.0 * s * d;
-      sink.Gradient(j, g.data(), 1.0);
+      const double arc = 0.5 * (lengths[j - 1] + (j < n ? lengths[j] : 0.0));
+      const double s = w.squared + w.squared_weighted * arc;
+      double sq = 0.0;
+      for (int k = 0; k < dim; ++k) {
+        d[k] = x(j, k) - old_points(j, k);
+        sq += d[k] * d[k];
+        grad[k] = 2.0 * s * d[k];
+      }
+      value += s * sq;
+      sink.Gradient(j, grad, 1.0);
       sink.Identity(j, j, 2.0 * s);
     }
   }
@@ -150,12 +146,15 @@ double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const
   if (w.rotation > 0.0) {
     for (int i = 1; i <= n; ++i) {
       const double s = w.rotation / lengths[i - 1];
-      const Eigen::VectorXd e =
-          ((x.row(i) - x.row(i - 1)) - (old_points.row(i) - old_points.row(i - 1))).transpose();
-      value += s * e.squaredNorm();
-      const Eigen::VectorXd g = 2.0 * s * e;
-      sink.Gradient(i, g.data(), 1.0);
-      sink.Gradient(i - 1, g.data(), -1.0);
+      double sq = 0.0;
+      for (int k = 0; k < dim; ++k) {
+        d[k] = (x(i, k) - x(i - 1, k)) - (old_points(i, k) - old_points(i - 1, k));
+        sq += d[k] * d[k];
+        grad[k] = 2.0 * s * d[k];
+      }
+      value += s * sq;
+      sink.Gradient(i, grad, 1.0);
+      sink.Gradient(i - 1, grad, -1.0);
       sink.Identity(i, i, 2.0 * s);
       sink.Identity(i - 1, i - 1, 2.0 * s);
       sink.Identity(i, i - 1, -2.0 * s);

@@ -67,9 +67,12 @@ struct OverallReport {
   double objective = 0.0;             // metric of the step at the returned configuration
   double constraint_violation = 0.0;  // largest |(|D_i|^2 - L_i^2)| / (2 L_i^2)
   double optimality = 0.0;            // as in OverallOptions::optimality_tolerance
-  // The returned configuration is the local minimizer reached by Newton's method from the
-  // sequential (tractrix) solution of the same step, which is feasible and close to it.
-  std::string start = "sequential tractrix step";
+  // How the returned local minimizer was reached: the head advances in sub-steps of at most half
+  // the shortest link, each solved by Newton's method from the tractrix step of the previous
+  // solution ("continuation in k head sub-steps from the old configuration"), or, for a short
+  // move, directly from the tractrix step ("sequential tractrix step"). It is the minimizer
+  // continuously connected to the old configuration.
+  std::string start;
 
   bool converged() const { return status == OverallStatus::kConverged; }
   std::string BriefReport() const;
@@ -87,6 +90,8 @@ OverallReport OverallStep(const Eigen::VectorXd& lengths,
 // The value, gradient (n dim) and, if `hessian` is not null, the Hessian (n dim square, dense:
 // for tests and small problems) of the step metric as a function of x_1..x_n (point 0 fixed at
 // `new_points.row(0)`). Exposed so that tests and other solvers evaluate the very same function.
+// It does not validate its input (OverallStep does): the shapes must match, and the joint-angle
+// term is ignored for 3D chains.
 double OverallObjective(const ObjectiveWeights& weights, const Eigen::VectorXd& lengths,
                         const Points& old_points, const Points& new_points,
                         Eigen::VectorXd* gradient = nullptr, Eigen::MatrixXd* hessian = nullptr);
