@@ -126,6 +126,10 @@ const char* MethodName(Method method) {
       return "tractrix";
     case Method::kFollowTheLeader:
       return "ftl";
+    case Method::kMinRotation:
+      return "min_rotation";
+    case Method::kMinJointAngle:
+      return "min_joint_angle";
     case Method::kOverall:
       return "overall";
   }
@@ -133,11 +137,16 @@ const char* MethodName(Method method) {
 }
 
 Method ParseMethod(std::string_view name, const std::string& field) {
-  if (name == "tractrix") return Method::kTractrix;
-  if (name == "ftl") return Method::kFollowTheLeader;
-  if (name == "overall") return Method::kOverall;
-  throw InputError(field, "unknown method \"" + std::string(name) +
-                              "\"; valid methods are \"tractrix\", \"ftl\" and \"overall\"");
+  for (const Method m : {Method::kTractrix, Method::kFollowTheLeader, Method::kMinRotation,
+                         Method::kMinJointAngle, Method::kOverall}) {
+    if (name == MethodName(m)) return m;
+  }
+  throw InputError(
+      field, "unknown method \"" + std::string(name) + "\"; valid methods are " + MethodNames());
+}
+
+std::string MethodNames() {
+  return "\"tractrix\", \"ftl\", \"min_rotation\", \"min_joint_angle\" or \"overall\"";
 }
 
 int MethodOrder(Method method) {
@@ -146,6 +155,8 @@ int MethodOrder(Method method) {
       return 2;
     case Method::kFollowTheLeader:
       return 1;
+    case Method::kMinRotation:
+    case Method::kMinJointAngle:
     case Method::kOverall:
       return 0;
   }
@@ -155,8 +166,9 @@ int MethodOrder(Method method) {
 Stepper MakeStepper(Method method, const Chain& chain) {
   ValidateChain(chain);
   if (method == Method::kOverall) {
-    throw InputError("method", "\"overall\" is not a link rule; move the chain with Run or "
-                               "OverallStep (overall.h), or use \"tractrix\" or \"ftl\"");
+    throw InputError("method",
+                     "\"overall\" is not a link rule; move the chain with Run or "
+                     "OverallStep (overall.h), or use \"tractrix\" or \"ftl\"");
   }
   Stepper s;
   s.method = method;
@@ -199,6 +211,15 @@ void MoveLeader(const Stepper& stepper, const Eigen::Ref<const Eigen::VectorXd>&
   }
   const int n = static_cast<int>(stepper.lengths.size());
   // The wavefront pays for a copy of the chain; it wins once several sweeps share it.
+  if (stepper.method == Method::kMinRotation) {
+    internal::SweepsMinRotation(dim, heads.data(), substeps, n, points->data());
+    return;
+  }
+  if (stepper.method == Method::kMinJointAngle) {
+    internal::SweepsMinJointAngle(dim, heads.data(), substeps, stepper.lengths.data(),
+                                  stepper.inv_lengths.data(), n, points->data());
+    return;
+  }
   const int lanes = internal::WavefrontLanes();
   const bool wavefront = lanes > 1 && substeps >= 2 * lanes && n >= 8;
   (wavefront ? internal::SweepsWavefront : internal::SweepsScalar)(

@@ -126,11 +126,13 @@ std::string RunOptions::Validate() const {
     return "max_substeps: " + std::to_string(max_substeps) +
            " is not valid; accuracy control compares two runs and needs max_substeps >= 2";
   }
+  if (tolerance > 0.0 && MethodOrder(method) == 0) {
+    return std::string(
+               "tolerance: accuracy control is available for the tractrix and ftl methods; "
+               "with \"") +
+           MethodName(method) + "\" set it to 0 and choose the sub-steps";
+  }
   if (method == Method::kOverall) {
-    if (tolerance > 0.0) {
-      return "tolerance: accuracy control is available for the tractrix and ftl methods; with "
-             "\"overall\" set it to 0 and choose the sub-steps";
-    }
     if (const std::string why = overall.Validate(); !why.empty()) return "overall." + why;
   }
   if (max_substeps < substeps) {

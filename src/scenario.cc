@@ -514,10 +514,7 @@ void Parser::ParseOptions(const json& root, RunOptions* options) {
       try {
         options->method = ParseMethod(*name, "/method");
       } catch (const InputError& e) {
-        Add(e.field(), "value " + ShowJson(*m) + " is not valid; expected \"" +
-                           MethodName(Method::kTractrix) + "\", \"" +
-                           MethodName(Method::kFollowTheLeader) + "\" or \"" +
-                           MethodName(Method::kOverall) + "\"");
+        Add(e.field(), "value " + ShowJson(*m) + " is not valid; expected " + MethodNames());
       }
     }
   }

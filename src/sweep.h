@@ -21,6 +21,12 @@ void SweepsWavefront(Method method, int dim, const double* heads, int64_t num_sw
                      const double* lengths, const double* inv_lengths, int num_links,
                      double* points);
 
+// The sequential rules of the rotation and joint-angle metrics (metric_rules.cc).
+void SweepsMinRotation(int dim, const double* heads, int64_t num_sweeps, int num_links,
+                       double* points);
+void SweepsMinJointAngle(int dim, const double* heads, int64_t num_sweeps, const double* lengths,
+                         const double* inv_lengths, int num_links, double* points);
+
 // Number of sweeps in flight in SweepsWavefront on this CPU (the SIMD width in doubles).
 int WavefrontLanes();
 

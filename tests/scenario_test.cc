@@ -260,7 +260,7 @@ const BadCase kBadCases[] = {
     {"substeps 0", "{" CURVE R"(, "leader": {"pull": [1, 0], "substeps": 0}})", "/leader/substeps",
      "value 0 is not valid"},
     {"unknown method", "{" CURVE "," LEADER R"(, "method": "fabrik"})", "/method",
-     R"(value "fabrik" is not valid; expected "tractrix", "ftl" or "overall")"},
+     R"(value "fabrik" is not valid; expected "tractrix", "ftl", "min_rotation", "min_joint_angle" or "overall")"},
     {"objective without the overall method",
      "{" CURVE "," LEADER R"(, "objective": {"squared": 1}})", "/objective",
      R"(is used only with "method": "overall")"},

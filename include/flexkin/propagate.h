@@ -13,6 +13,13 @@ namespace flexkin {
 enum class Method {
   kTractrix,         // "tractrix": closed-form tractrix step, velocity along the link (paper Sec. 2-3)
   kFollowTheLeader,  // "ftl": nearest point on the sphere around the new leading end (FABRIK, hair)
+  // "min_rotation": sequential minimum body rotation (Sec. 4.1): each link translates, so the
+  // whole chain does.
+  kMinRotation,
+  // "min_joint_angle": sequential minimum joint-angle change (Sec. 4.2): the first link moves by
+  // the tractrix step, every later link keeps its angle to the one before: the chain behind the
+  // first link moves rigidly with it.
+  kMinJointAngle,
   // "overall": all points at once, each step minimizing a metric under the length constraints
   // (paper Sec. 3 and 4; overall.h). Not a link rule: used by Run and OverallStep, not Stepper.
   kOverall,
@@ -20,11 +27,14 @@ enum class Method {
 
 // The one vocabulary for method names, shared by the CLI, files and messages.
 const char* MethodName(Method method);
-// Parses "tractrix", "ftl" or "overall"; throws InputError naming `field` and listing them.
+// Parses a method name ("tractrix", "ftl", "min_rotation", "min_joint_angle", "overall"); throws
+// InputError naming `field` and listing them.
 Method ParseMethod(std::string_view name, const std::string& field = "method");
 // Convergence order of the multi-step method to the continuous motion (2 for tractrix, 1 for ftl;
-// 0 for overall, whose order is not established).
+// 0 where it is not established: accuracy control is then not offered).
 int MethodOrder(Method method);
+// All method names, quoted and listed for messages: "tractrix", "ftl", ... or "overall".
+std::string MethodNames();
 
 // Data precomputed once per chain and reused by every move (the reciprocal link lengths).
 struct Stepper {
