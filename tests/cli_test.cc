@@ -2,18 +2,18 @@
 // documented exit codes, files written, messages naming file and field, and an existing output
 // left byte-identical whenever a run fails.
 #include <dirent.h>
+#include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "flexkin/result_io.h"
 
@@ -49,8 +49,9 @@ class CliTest : public testing::Test {
     ASSERT_FALSE(kCli.empty()) << "FLEXKIN_CLI is empty: the flexkin_cli target was not built "
                                   "(configure with FLEXKIN_BUILD_APPS=ON)";
     ASSERT_TRUE(Exists(kCli)) << "FLEXKIN_CLI does not exist: " << kCli;
-    char name[] = "/tmp/flexkin_cli_test_XXXXXX";
-    ASSERT_NE(::mkdtemp(name), nullptr);
+    std::string name =
+        (std::filesystem::temp_directory_path() / "flexkin_cli_test_XXXXXX").string();
+    ASSERT_NE(::mkdtemp(name.data()), nullptr);
     dir_ = name;
   }
   void TearDown() override {
@@ -244,7 +245,8 @@ TEST_F(CliTest, AccuracyMetExitsZero) {
 // Method "overall": the result carries the solver's summary; a solve that does not converge is
 // reported (exit 5, result written, the failure named), never passed off as a solution.
 TEST_F(CliTest, OverallRunWritesTheSolverSummary) {
-  Write("overall.json", R"({"curve": {"shape": "parabola", "a": 1, "links": 20, "link_length": 0.25},
+  Write("overall.json",
+        R"({"curve": {"shape": "parabola", "a": 1, "links": 20, "link_length": 0.25},
     "leader": {"pull": [0.49497474683058318, 0.49497474683058318], "steps": 5},
     "method": "overall", "objective": {"squared": 1, "rotation": 0.5}})");
   const CliResult r = Cli("run overall.json -o out.json");

@@ -4,6 +4,7 @@
 #include "flexkin/result_io.h"
 
 #include <dirent.h>
+#include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -12,16 +13,15 @@
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
 #include <string>
 #include <system_error>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include "flexkin/chain.h"
 #include "flexkin/error.h"
@@ -35,8 +35,9 @@ namespace {
 class TempDir {
  public:
   TempDir() {
-    char name[] = "/tmp/flexkin_result_io_XXXXXX";
-    path_ = ::mkdtemp(name);
+    std::string name =
+        (std::filesystem::temp_directory_path() / "flexkin_result_io_XXXXXX").string();
+    path_ = ::mkdtemp(name.data());
   }
   ~TempDir() {
     ::chmod(path_.c_str(), 0700);
