@@ -6,19 +6,12 @@
 #include <limits>
 #include <string>
 
+#include "flexkin/error.h"
+
 namespace flexkin {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-// Shortest of %.15g / %.17g that reads back as `x`, so messages show 0.1 rather than
-// 0.10000000000000001 but never a rounded value.
-std::string Num(double x) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.15g", x);
-  if (std::strtod(buf, nullptr) != x) std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
-}
 
 void CheckLinks(int links, std::vector<InputError>* problems) {
   if (links < 1 || links > kMaxGeneratedLinks) {
@@ -30,14 +23,14 @@ void CheckLinks(int links, std::vector<InputError>* problems) {
 
 void CheckLinkLength(double link_length, std::vector<InputError>* problems) {
   if (!(link_length > 0.0) || !std::isfinite(link_length)) {
-    problems->emplace_back(
-        "link_length", "value " + Num(link_length) + " is not valid; expected a finite number > 0");
+    problems->emplace_back("link_length", "value " + FormatNumber(link_length) +
+                                              " is not valid; expected a finite number > 0");
   }
 }
 
 void CheckFinite(const char* field, double value, std::vector<InputError>* problems) {
   if (!std::isfinite(value)) {
-    problems->emplace_back(field, "value " + Num(value) + " is not a finite number");
+    problems->emplace_back(field, "value " + FormatNumber(value) + " is not a finite number");
   }
 }
 
@@ -46,15 +39,15 @@ void CheckFiniteVector(const char* field, const Eigen::Ref<const Eigen::VectorXd
   for (Eigen::Index k = 0; k < v.size(); ++k) {
     if (!std::isfinite(v[k])) {
       problems->emplace_back(std::string(field) + "[" + std::to_string(k) + "]",
-                             "value " + Num(v[k]) + " is not a finite number");
+                             "value " + FormatNumber(v[k]) + " is not a finite number");
     }
   }
 }
 
 void CheckRadius(double radius, std::vector<InputError>* problems) {
   if (!(radius > 0.0) || !std::isfinite(radius)) {
-    problems->emplace_back("radius",
-                           "value " + Num(radius) + " is not valid; expected a finite number > 0");
+    problems->emplace_back(
+        "radius", "value " + FormatNumber(radius) + " is not valid; expected a finite number > 0");
   }
 }
 
@@ -120,8 +113,8 @@ std::vector<InputError> CurveProblems(const LineDef& def) {
     CheckFiniteVector("direction", def.direction, &problems);
     const double norm = def.direction.norm();
     if (def.direction.allFinite() && !(norm > 0.0 && std::isfinite(norm))) {
-      problems.emplace_back(
-          "direction", "has length " + Num(norm) + "; expected a nonzero, finite direction vector");
+      problems.emplace_back("direction", "has length " + FormatNumber(norm) +
+                                             "; expected a nonzero, finite direction vector");
     }
   }
   CheckLinks(def.links, &problems);
@@ -150,10 +143,10 @@ std::vector<InputError> CurveProblems(const ArcDef& def) {
   CheckLinkLength(def.link_length, &problems);
   if (problems.empty() && 2.0 * def.radius < def.link_length) {
     problems.emplace_back("radius",
-                          "value " + Num(def.radius) + " is too small for link_length " +
-                              Num(def.link_length) +
+                          "value " + FormatNumber(def.radius) + " is too small for link_length " +
+                              FormatNumber(def.link_length) +
                               " (a chord cannot exceed the diameter); expected radius >= " +
-                              Num(0.5 * def.link_length));
+                              FormatNumber(0.5 * def.link_length));
   }
   return problems;
 }
@@ -173,11 +166,12 @@ std::vector<InputError> CurveProblems(const HelixDef& def) {
       const double min_radius = 0.5 * std::sqrt(std::fmax(0.0, def.link_length * def.link_length -
                                                                    0.25 * def.pitch * def.pitch));
       problems.emplace_back(
-          "radius", "value " + Num(def.radius) + " is too small for link_length " +
-                        Num(def.link_length) + " and pitch " + Num(def.pitch) +
+          "radius", "value " + FormatNumber(def.radius) + " is too small for link_length " +
+                        FormatNumber(def.link_length) + " and pitch " + FormatNumber(def.pitch) +
                         " (a link may span at most half a turn, whose chord is sqrt(4 radius^2 + "
                         "(pitch/2)^2) = " +
-                        Num(half_turn_chord) + "); expected radius >= " + Num(min_radius));
+                        FormatNumber(half_turn_chord) +
+                        "); expected radius >= " + FormatNumber(min_radius));
     }
   }
   return problems;
@@ -249,8 +243,8 @@ Chain MakeEqualLinkChain(const Points& points, double link_length) {
   for (Eigen::Index i = 0; i < chain.lengths.size(); ++i) {
     if (std::fabs(chain.lengths[i] - link_length) > 1e-9 * link_length) {
       throw InputError("points", "link " + std::to_string(i + 1) + " has length " +
-                                     Num(chain.lengths[i]) + "; expected link_length " +
-                                     Num(link_length) + " to 1e-9 relative");
+                                     FormatNumber(chain.lengths[i]) + "; expected link_length " +
+                                     FormatNumber(link_length) + " to 1e-9 relative");
     }
   }
   chain.lengths.setConstant(link_length);

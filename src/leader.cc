@@ -10,14 +10,6 @@
 namespace flexkin {
 namespace {
 
-// Shortest of %.15g / %.17g that reads back as `x`.
-std::string Num(double x) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.15g", x);
-  if (std::strtod(buf, nullptr) != x) std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
-}
-
 void CheckVector(const Eigen::VectorXd& v, int dim, const std::string& field) {
   if (v.size() != dim) {
     throw InputError(field, "has " + std::to_string(v.size()) + " coordinates; expected " +
@@ -26,7 +18,7 @@ void CheckVector(const Eigen::VectorXd& v, int dim, const std::string& field) {
   for (Eigen::Index k = 0; k < v.size(); ++k) {
     if (!std::isfinite(v[k])) {
       throw InputError(field + "[" + std::to_string(k) + "]",
-                       "value " + Num(v[k]) + " is not a finite number");
+                       "value " + FormatNumber(v[k]) + " is not a finite number");
     }
   }
 }
@@ -89,8 +81,8 @@ Points ResamplePath(const Eigen::VectorXd& start, const Points& path, double max
   CheckVector(start, dim, "start");
   ExplicitPath(path, dim, "path");
   if (!(max_step > 0.0) || !std::isfinite(max_step)) {
-    throw InputError("max_step",
-                     "value " + Num(max_step) + " is not valid; expected a finite number > 0");
+    throw InputError("max_step", "value " + FormatNumber(max_step) +
+                                     " is not valid; expected a finite number > 0");
   }
   // First pass: count, so that the result is allocated once and huge counts are refused early.
   double total = 0.0;
@@ -101,9 +93,9 @@ Points ResamplePath(const Eigen::VectorXd& start, const Points& path, double max
     from = to;
   }
   if (!(total <= static_cast<double>(kMaxLeaderSteps))) {
-    throw InputError("max_step", "value " + Num(max_step) + " splits the path into " + Num(total) +
-                                     " steps; expected at most " + std::to_string(kMaxLeaderSteps) +
-                                     " (use a larger max_step)");
+    throw InputError("max_step", "value " + FormatNumber(max_step) + " splits the path into " +
+                                     FormatNumber(total) + " steps; expected at most " +
+                                     std::to_string(kMaxLeaderSteps) + " (use a larger max_step)");
   }
   Points targets(static_cast<Eigen::Index>(total), dim);
   Eigen::Index row = 0;

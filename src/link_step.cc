@@ -15,7 +15,7 @@ void CheckFinite(const Vec& x, const char* field) {
   for (int k = 0; k < x.size(); ++k) {
     if (!std::isfinite(x[k])) {
       throw InputError(std::string(field) + "[" + std::to_string(k) + "]",
-                       "value " + std::to_string(x[k]) + " is not a finite number");
+                       "value " + FormatNumber(x[k]) + " is not a finite number");
     }
   }
 }
@@ -27,10 +27,8 @@ Vec Apply(void (*rule)(const double*, const double*, double*, double, double), c
   CheckFinite(head_new, "head_new");
   CheckFinite(tail, "tail");
   if (!(length > 0.0) || !std::isfinite(length)) {
-    char buf[40];
-    std::snprintf(buf, sizeof buf, "%.17g", length);
-    throw InputError("length", std::string("link length ") + buf +
-                                   " is not a positive finite number");
+    throw InputError("length",
+                     "link length " + FormatNumber(length) + " is not a positive finite number");
   }
   Vec out = tail;
   rule(head_old.data(), head_new.data(), out.data(), length, 1.0 / length);
@@ -48,13 +46,13 @@ Eigen::Vector3d TractrixStep(const Eigen::Vector3d& head_old, const Eigen::Vecto
   return Apply<3>(internal::TractrixStep<3>, head_old, head_new, tail, length);
 }
 Eigen::Vector2d FollowTheLeaderStep(const Eigen::Vector2d& head_old,
-                                    const Eigen::Vector2d& head_new,
-                                    const Eigen::Vector2d& tail, double length) {
+                                    const Eigen::Vector2d& head_new, const Eigen::Vector2d& tail,
+                                    double length) {
   return Apply<2>(internal::FollowTheLeaderStep<2>, head_old, head_new, tail, length);
 }
 Eigen::Vector3d FollowTheLeaderStep(const Eigen::Vector3d& head_old,
-                                    const Eigen::Vector3d& head_new,
-                                    const Eigen::Vector3d& tail, double length) {
+                                    const Eigen::Vector3d& head_new, const Eigen::Vector3d& tail,
+                                    double length) {
   return Apply<3>(internal::FollowTheLeaderStep<3>, head_old, head_new, tail, length);
 }
 

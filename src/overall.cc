@@ -1,6 +1,5 @@
 #include "flexkin/overall.h"
 
-#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -9,214 +8,18 @@
 #include <string>
 #include <vector>
 
+#include "banded_lu.h"
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
+#include "overall_objective.h"
 
 namespace flexkin {
 namespace {
 
-using Triplets = std::vector<Eigen::Triplet<double>>;
-
-}  // namespace
-}  // namespace flexkin
-
-// LAPACK's banded LU with partial pivoting (Fortran interface; the trailing size_t is the hidden
-// length of the character argument).
-extern "C" {
-void dgbtrf_(const int* m, const int* n, const int* kl, const int* ku, double* ab, const int* ldab,
-             int* ipiv, int* info);
-void dgbtrs_(const char* trans, const int* n, const int* kl, const int* ku, const int* nrhs,
-             const double* ab, const int* ldab, const int* ipiv, double* b, const int* ldb,
-             int* info, size_t trans_length);
-}
-
-namespace flexkin {
-namespace {
-
-// LU factorization of a square banded matrix (half-bandwidth `band` above and below), built from
-// triplets (duplicates summed). Cost linear in the size for a fixed band.
-class BandedLu {
- public:
-  BandedLu(int size, int band)
-      : size_(size),
-        band_(band),
-        ldab_(3 * band + 1),
-        ab_(static_cast<size_t>(ldab_) * size),
-        ipiv_(size) {}
-
-  // False if the matrix is singular (or a triplet lies outside the band: a bug).
-  bool Factorize(const Triplets& triplets) {
-    std::fill(ab_.begin(), ab_.end(), 0.0);
-    for (const auto& t : triplets) {
-      const int i = t.row(), j = t.col();
-      assert(std::abs(i - j) <= band_);
-      ab_[static_cast<size_t>(j) * ldab_ + (2 * band_ + i - j)] += t.value();
-    }
-    int info = 0;
-    dgbtrf_(&size_, &size_, &band_, &band_, ab_.data(), &ldab_, ipiv_.data(), &info);
-    factorized_ = info == 0;
-    return factorized_;
-  }
-  Eigen::VectorXd Solve(const Eigen::VectorXd& rhs) const {
-    Eigen::VectorXd x = rhs;
-    const char trans = 'N';
-    const int one = 1;
-    int info = 0;
-    dgbtrs_(&trans, &size_, &band_, &band_, &one, ab_.data(), &ldab_, ipiv_.data(), x.data(),
-            &size_, &info, 1);
-    return x;
-  }
-  bool factorized() const { return factorized_; }
-
- private:
-  int size_, band_, ldab_;
-  std::vector<double> ab_;
-  std::vector<int> ipiv_;
-  bool factorized_ = false;
-};
-
-std::string Num(double x) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
-}
-
-// Where the objective's derivatives go. Points are numbered 0..n; point 0 is fixed, so its
-// entries are dropped. `offset(j)` is the first row of point j's coordinates in the unknowns.
-struct Sink {
-  int dim = 0;
-  Eigen::VectorXd* gradient = nullptr;  // may be null
-  Triplets* hessian = nullptr;          // may be null
-  std::vector<int> offset;              // offset[j] for j = 1..n; offset[0] unused
-
-  void Gradient(int j, const double* g, double scale) const {
-    if (gradient == nullptr || j == 0) return;
-    for (int k = 0; k < dim; ++k) (*gradient)[offset[j] + k] += scale * g[k];
-  }
-  // Adds scale * block (dim by dim, row-major in `b`) at (point p, point q).
-  void Block(int p, int q, const double* b, double scale) const {
-    if (hessian == nullptr || p == 0 || q == 0) return;
-    for (int r = 0; r < dim; ++r) {
-      for (int c = 0; c < dim; ++c) {
-        // Zeros too: the pattern must not change between iterations.
-        hessian->emplace_back(offset[p] + r, offset[q] + c, scale * b[r * dim + c]);
-      }
-    }
-  }
-  void Identity(int p, int q, double scale) const {
-    if (hessian == nullptr || p == 0 || q == 0) return;
-    for (int r = 0; r < dim; ++r) hessian->emplace_back(offset[p] + r, offset[q] + r, scale);
-  }
-};
-
-// Signed angle from link vector u to link vector v (2D), in (-pi, pi].
-double TurnAngle(const double* u, const double* v) {
-  return std::atan2(u[0] * v[1] - u[1] * v[0], u[0] * v[0] + u[1] * v[1]);
-}
-
-// Wraps an angle difference into (-pi, pi].
-double Wrap(double a) { return std::remainder(a, 2.0 * M_PI); }
-
-// The metric of one step and its derivatives, term by term. x(j) and a(j): new and old point j.
-double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const Points& old_points,
-                const Points& x, const Sink& sink) {
-  const int n = static_cast<int>(lengths.size());
-  const int dim = static_cast<int>(x.cols());
-  double value = 0.0;
-
-  // Squared displacement, plain and arc-length weighted. (Plain loops: no temporaries per point.)
-  double d[3], grad[3];
-  if (w.squared > 0.0 || w.squared_weighted > 0.0) {
-    for (int j = 1; j <= n; ++j) {
-      const double arc = 0.5 * (lengths[j - 1] + (j < n ? lengths[j] : 0.0));
-      const double s = w.squared + w.squared_weighted * arc;
-      double sq = 0.0;
-      for (int k = 0; k < dim; ++k) {
-        d[k] = x(j, k) - old_points(j, k);
-        sq += d[k] * d[k];
-        grad[k] = 2.0 * s * d[k];
-      }
-      value += s * sq;
-      sink.Gradient(j, grad, 1.0);
-      sink.Identity(j, j, 2.0 * s);
-    }
-  }
-
-  // Body rotation: sum of |D_i - D_i_old|^2 / L_i over the links.
-  if (w.rotation > 0.0) {
-    for (int i = 1; i <= n; ++i) {
-      const double s = w.rotation / lengths[i - 1];
-      double sq = 0.0;
-      for (int k = 0; k < dim; ++k) {
-        d[k] = (x(i, k) - x(i - 1, k)) - (old_points(i, k) - old_points(i - 1, k));
-        sq += d[k] * d[k];
-        grad[k] = 2.0 * s * d[k];
-      }
-      value += s * sq;
-      sink.Gradient(i, grad, 1.0);
-      sink.Gradient(i - 1, grad, -1.0);
-      sink.Identity(i, i, 2.0 * s);
-      sink.Identity(i - 1, i - 1, 2.0 * s);
-      sink.Identity(i, i - 1, -2.0 * s);
-      sink.Identity(i - 1, i, -2.0 * s);
-    }
-  }
-
-  // Joint-angle change (2D): sum over inner joints of L_mean (psi_i - psi_i_old)^2, psi_i the
-  // turn from link i to link i+1. With theta(u) = atan2(u_y, u_x): grad theta = perp(u)/|u|^2,
-  // hess theta = [[2 u_x u_y, u_y^2 - u_x^2], [u_y^2 - u_x^2, -2 u_x u_y]] / |u|^4, and
-  // psi_i = theta(D_{i+1}) - theta(D_i), D_i = x_i - x_{i-1}.
-  if (w.joint_angle > 0.0 && dim == 2) {
-    for (int i = 1; i < n; ++i) {
-      auto link = [](const Points& p, int k) {
-        return Eigen::Vector2d(p(k, 0) - p(k - 1, 0), p(k, 1) - p(k - 1, 1));
-      };
-      const Eigen::Vector2d u = link(x, i), v = link(x, i + 1);
-      const Eigen::Vector2d u0 = link(old_points, i), v0 = link(old_points, i + 1);
-      const double c = w.joint_angle * 0.5 * (lengths[i - 1] + lengths[i]);
-      const double delta = Wrap(TurnAngle(u.data(), v.data()) - TurnAngle(u0.data(), v0.data()));
-      value += c * delta * delta;
-      if (sink.gradient == nullptr && sink.hessian == nullptr) continue;
-      // Explicit return types: an Eigen expression returned by `auto` would dangle.
-      auto grad_theta = [](const Eigen::Vector2d& q) -> Eigen::Vector2d {
-        return Eigen::Vector2d(-q.y(), q.x()) / q.squaredNorm();
-      };
-      auto hess_theta = [](const Eigen::Vector2d& q) -> Eigen::Matrix2d {
-        const double r4 = q.squaredNorm() * q.squaredNorm();
-        Eigen::Matrix2d h;
-        h << 2.0 * q.x() * q.y(), q.y() * q.y() - q.x() * q.x(), q.y() * q.y() - q.x() * q.x(),
-            -2.0 * q.x() * q.y();
-        return Eigen::Matrix2d(h / r4);
-      };
-      // Derivatives with respect to (D_i, D_{i+1}) = (u, v): dpsi = (-grad theta(u), grad
-      // theta(v)).
-      Eigen::Matrix<double, 4, 1> dpsi;
-      dpsi << -grad_theta(u), grad_theta(v);
-      Eigen::Matrix4d h = 2.0 * c * dpsi * dpsi.transpose();
-      h.topLeftCorner<2, 2>() += 2.0 * c * delta * -hess_theta(u);
-      h.bottomRightCorner<2, 2>() += 2.0 * c * delta * hess_theta(v);
-      const Eigen::Matrix<double, 4, 1> gd = 2.0 * c * delta * dpsi;
-      // Back to points: D_i = x_i - x_{i-1}, D_{i+1} = x_{i+1} - x_i, so
-      // d/dx_{i-1} = -d/dD_i, d/dx_i = d/dD_i - d/dD_{i+1}, d/dx_{i+1} = d/dD_{i+1}.
-      const int points[3] = {i - 1, i, i + 1};
-      Eigen::Matrix<double, 6, 4> m = Eigen::Matrix<double, 6, 4>::Zero();
-      m.block<2, 2>(0, 0) = -Eigen::Matrix2d::Identity();
-      m.block<2, 2>(2, 0) = Eigen::Matrix2d::Identity();
-      m.block<2, 2>(2, 2) = -Eigen::Matrix2d::Identity();
-      m.block<2, 2>(4, 2) = Eigen::Matrix2d::Identity();
-      const Eigen::Matrix<double, 6, 1> gx = m * gd;
-      const Eigen::Matrix<double, 6, 6> hx = m * h * m.transpose();
-      for (int a = 0; a < 3; ++a) {
-        sink.Gradient(points[a], gx.data() + 2 * a, 1.0);
-        for (int b = 0; b < 3; ++b) {
-          const Eigen::Matrix<double, 2, 2, Eigen::RowMajor> block = hx.block<2, 2>(2 * a, 2 * b);
-          sink.Block(points[a], points[b], block.data(), 1.0);
-        }
-      }
-    }
-  }
-  return value;
-}
+using internal::BandedLu;
+using internal::Evaluate;
+using internal::Sink;
+using internal::Triplets;
 
 // Puts every point back at its link's length from the point before it, from the (fixed) head
 // down: the follow-the-leader projection, a retraction onto the set of feasible configurations.
@@ -250,7 +53,7 @@ void ValidateInput(const Eigen::VectorXd& lengths, const Eigen::Ref<const Eigen:
   for (Eigen::Index k = 0; k < head.size(); ++k) {
     if (!std::isfinite(head[k])) {
       throw InputError("head[" + std::to_string(k) + "]",
-                       "value " + Num(head[k]) + " is not a finite number");
+                       "value " + FormatNumber(head[k]) + " is not a finite number");
     }
   }
   if (const std::string why = options.Validate(); !why.empty()) {
@@ -266,34 +69,14 @@ void ValidateInput(const Eigen::VectorXd& lengths, const Eigen::Ref<const Eigen:
 
 }  // namespace
 
-std::string ObjectiveWeights::Validate() const {
-  const std::pair<const char*, double> terms[] = {{"squared", squared},
-                                                  {"squared_weighted", squared_weighted},
-                                                  {"rotation", rotation},
-                                                  {"joint_angle", joint_angle}};
-  double total = 0.0;
-  for (const auto& [name, value] : terms) {
-    if (!(value >= 0.0) || !std::isfinite(value)) {
-      return std::string("weights.") + name + ": " + Num(value) +
-             " is not valid; each weight must be a finite number >= 0";
-    }
-    total += value;
-  }
-  if (!(total > 0.0)) {
-    return "weights: all weights are 0; give at least one term (squared, squared_weighted, "
-           "rotation, joint_angle) a positive weight";
-  }
-  return "";
-}
-
 std::string OverallOptions::Validate() const {
   if (const std::string why = weights.Validate(); !why.empty()) return why;
   if (!(constraint_tolerance > 0.0) || !std::isfinite(constraint_tolerance)) {
-    return "constraint_tolerance: " + Num(constraint_tolerance) +
+    return "constraint_tolerance: " + FormatNumber(constraint_tolerance) +
            " is not valid; must be a finite number > 0 (typical 1e-14)";
   }
   if (!(optimality_tolerance > 0.0) || !std::isfinite(optimality_tolerance)) {
-    return "optimality_tolerance: " + Num(optimality_tolerance) +
+    return "optimality_tolerance: " + FormatNumber(optimality_tolerance) +
            " is not valid; must be a finite number > 0 (typical 1e-10)";
   }
   if (max_iterations < 1) {
@@ -324,30 +107,6 @@ std::string OverallReport::BriefReport() const {
                 OverallStatusName(status), iterations, objective, constraint_violation, optimality,
                 start.c_str());
   return buf;
-}
-
-double OverallObjective(const ObjectiveWeights& weights, const Eigen::VectorXd& lengths,
-                        const Points& old_points, const Points& new_points,
-                        Eigen::VectorXd* gradient, Eigen::MatrixXd* hessian) {
-  const int n = static_cast<int>(lengths.size());
-  const int dim = static_cast<int>(new_points.cols());
-  Sink sink;
-  sink.dim = dim;
-  sink.offset.resize(n + 1);
-  for (int j = 1; j <= n; ++j) sink.offset[j] = (j - 1) * dim;
-  if (gradient != nullptr) {
-    gradient->setZero(n * dim);
-    sink.gradient = gradient;
-  }
-  Triplets triplets;
-  if (hessian != nullptr) sink.hessian = &triplets;
-  const double value = Evaluate(weights, lengths, old_points, new_points, sink);
-  if (hessian != nullptr) {
-    Eigen::SparseMatrix<double> h(n * dim, n * dim);
-    h.setFromTriplets(triplets.begin(), triplets.end());
-    *hessian = Eigen::MatrixXd(h);
-  }
-  return value;
 }
 
 namespace {

@@ -119,7 +119,7 @@ std::string RunOptions::Validate() const {
     return "record_every: " + std::to_string(record_every) + " is not valid; must be >= 1";
   }
   if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) {
-    return "tolerance: " + Format("%.17g", tolerance) +
+    return "tolerance: " + FormatNumber(tolerance) +
            " is not valid; must be a finite number >= 0 (0 turns accuracy control off)";
   }
   if (tolerance > 0.0 && max_substeps < 2) {

@@ -21,4 +21,8 @@ class InputError : public std::invalid_argument {
   std::string field_;
 };
 
+// A number for an error message: the shortest of 15 or 17 significant digits that reads back
+// as exactly `x` ("0.1", not "0.10000000000000001"); "nan", "inf" and "-inf" as such.
+std::string FormatNumber(double x);
+
 }  // namespace flexkin
