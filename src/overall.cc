@@ -229,26 +229,27 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
         }
       }
     }
-    // Keep every diagonal entry in the pattern so the symbolic analysis can be reused.
-    for (int j = 1; j <= n; ++j) {
-      for (int k = 0; k < dim; ++k)
-        t.emplace_back(sink.offset[j] + k, sink.offset[j] + k, regularization);
-      t.emplace_back(multiplier_row(j), multiplier_row(j), 0.0);
-    }
+    // Regularization delta I on the Hessian block, carried over (decayed) from the last
+    // iteration; `regularize` adds more: `first` if there was none, else 10 times as much.
+    auto add_to_diagonal = [&](double amount) {
+      for (int j = 1; j <= n; ++j) {
+        for (int k = 0; k < dim; ++k)
+          t.emplace_back(sink.offset[j] + k, sink.offset[j] + k, amount);
+      }
+    };
+    auto regularize = [&](double first) {
+      const double bump = regularization == 0.0 ? first : 10.0 * regularization;
+      add_to_diagonal(bump);
+      regularization += bump;
+    };
+    add_to_diagonal(regularization);
 
     // Newton step for (x, lambda_new): [H J^T; J 0] [dx; lambda_new] = -[g; c].
     bool stepped = false;
     for (int attempt = 0; attempt < 12 && !stepped; ++attempt) {
       lu.Factorize(t);
       if (!lu.factorized()) {
-        // Singular: regularize the Hessian block and retry.
-        const double bump = regularization == 0.0 ? 1e-10 * std::fmax(1.0, g.cwiseAbs().maxCoeff())
-                                                  : 10.0 * regularization;
-        for (int j = 1; j <= n; ++j) {
-          for (int k = 0; k < dim; ++k)
-            t.emplace_back(sink.offset[j] + k, sink.offset[j] + k, bump);
-        }
-        regularization += bump;
+        regularize(1e-10 * std::fmax(1.0, g.cwiseAbs().maxCoeff()));  // singular
         continue;
       }
       for (int j = 1; j <= n; ++j) {
@@ -264,7 +265,7 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
         for (int k = 0; k < dim; ++k) dx(j, k) = sol[sink.offset[j] + k];
         lambda_new[j - 1] = sol[multiplier_row(j)];
       }
-      // Curvature test (no inertia from a sparse LU): the step must see positive curvature of
+      // Curvature test (an LU gives no inertia): the step must see positive curvature of
       // the regularized Lagrangian, dx' (H + delta I) dx >= 1e-8 |dx|^2 (scaled); else more
       // regularization. Otherwise Newton heads for a saddle or maximum on non-convex terms.
       {
@@ -285,13 +286,7 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
         }
         const double floor = 1e-8 * std::fmax(1.0, weight_sum) * dx.squaredNorm();
         if (curvature < floor && dx.squaredNorm() > 0.0) {
-          const double bump =
-              regularization == 0.0 ? 1e-4 * std::fmax(1.0, weight_sum) : 10.0 * regularization;
-          for (int j = 1; j <= n; ++j) {
-            for (int k = 0; k < dim; ++k)
-              t.emplace_back(sink.offset[j] + k, sink.offset[j] + k, bump);
-          }
-          regularization += bump;
+          regularize(1e-4 * std::fmax(1.0, weight_sum));
           continue;
         }
       }
@@ -341,16 +336,8 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
           }
         }
       }
-      if (!stepped) {
-        // Not a descent direction: more regularization, then try again.
-        const double bump = regularization == 0.0 ? 1e-8 * std::fmax(1.0, g.cwiseAbs().maxCoeff())
-                                                  : 10.0 * regularization;
-        for (int j = 1; j <= n; ++j) {
-          for (int k = 0; k < dim; ++k)
-            t.emplace_back(sink.offset[j] + k, sink.offset[j] + k, bump);
-        }
-        regularization += bump;
-      }
+      // No acceptable step: more regularization, then try again.
+      if (!stepped) regularize(1e-8 * std::fmax(1.0, g.cwiseAbs().maxCoeff()));
     }
     if (!stepped) {
       report.objective = value;

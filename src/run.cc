@@ -163,12 +163,7 @@ RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& 
   const bool overall = options.method == Method::kOverall;
   std::optional<Stepper> stepper;
   if (overall) {
-    result.weights = options.overall.weights;
-    if (options.overall.weights.joint_angle > 0.0 && chain.dim() != 2) {
-      throw InputError("overall.weights.joint_angle",
-                       "the joint-angle term is defined for planar (2D) chains only; this chain is "
-                       "3D: set it to 0");
-    }
+    result.weights = options.overall.weights;  // OverallStep checks them against the chain
   } else {
     stepper = MakeStepper(options.method, chain);
   }

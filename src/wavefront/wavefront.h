@@ -10,6 +10,7 @@
 #include <xsimd/xsimd.hpp>
 
 #include "../link_rules.h"
+#include "../sweep.h"
 #include "flexkin/propagate.h"
 
 namespace flexkin::internal {
@@ -21,7 +22,6 @@ namespace {
 // to rounding. Cody-Waite reduction x = k ln2 + r with |r| <= ln2/2, then the Taylor polynomial
 // of degree 13 (truncation error < 5e-18 relative) and 2^k assembled in the exponent bits.
 struct BatchExp {
-  double operator()(double x) const { return std::exp(x); }
   template <class A>
   xsimd::batch<double, A> operator()(const xsimd::batch<double, A>& x_in) const {
     using B = xsimd::batch<double, A>;
@@ -179,47 +179,35 @@ int64_t WavefrontGroups(const double* heads, int64_t num_sweeps, const double* l
   return g;
 }
 
+// Sweeps done by the engine (two registers per coordinate while at least 2 W sweeps are left,
+// then one); the caller finishes the fewer than W left with the one-pass loop.
 template <class Arch, class Rule, int Dim>
-void WavefrontSweeps(const double* heads, int64_t num_sweeps, const double* lengths,
-                     const double* inv_lengths, int n, double* points) {
-  // Two registers per coordinate while at least 2 W sweeps are left, then one.
-  int64_t done =
+int64_t WavefrontSweeps(const double* heads, int64_t num_sweeps, const double* lengths,
+                        const double* inv_lengths, int n, double* points) {
+  const int64_t done =
       WavefrontGroups<Arch, Rule, Dim, 2>(heads, num_sweeps, lengths, inv_lengths, n, points);
-  done += WavefrontGroups<Arch, Rule, Dim, 1>(heads + done * Dim, num_sweeps - done, lengths,
-                                              inv_lengths, n, points);
-  // Fewer than W sweeps left: finish them one after another.
-  for (int64_t g = done; g < num_sweeps; ++g) {
-    double lead_old[Dim], lead_new[Dim];
-    for (int k = 0; k < Dim; ++k) {
-      lead_old[k] = points[k];
-      points[k] = lead_new[k] = heads[g * Dim + k];
-    }
-    for (int i = 1; i <= n; ++i) {
-      double* tail = points + i * Dim;
-      double saved[Dim];
-      for (int k = 0; k < Dim; ++k) saved[k] = tail[k];
-      ApplyScalar<Rule, Dim>(lead_old, lead_new, tail, lengths[i - 1], inv_lengths[i - 1]);
-      for (int k = 0; k < Dim; ++k) lead_old[k] = saved[k], lead_new[k] = tail[k];
-    }
-  }
+  return done + WavefrontGroups<Arch, Rule, Dim, 1>(heads + done * Dim, num_sweeps - done, lengths,
+                                                    inv_lengths, n, points);
 }
 
-// Entry point of one instruction set: picks the rule and the dimension.
+// Entry point of one instruction set: picks the rule and the dimension; the sweeps left over
+// (fewer than the lanes) go through the one-pass loop.
 template <class Arch>
 void WavefrontDispatch(Method method, int dim, const double* heads, int64_t num_sweeps,
                        const double* lengths, const double* inv_lengths, int n, double* points) {
   const bool tractrix = method == Method::kTractrix;
+  auto run = [&](auto sweeps) {
+    return sweeps(heads, num_sweeps, lengths, inv_lengths, n, points);
+  };
+  int64_t done;
   if (dim == 2) {
-    tractrix ? WavefrontSweeps<Arch, TractrixRule<2, BatchExp>, 2>(heads, num_sweeps, lengths,
-                                                                   inv_lengths, n, points)
-             : WavefrontSweeps<Arch, FollowTheLeaderRule<2>, 2>(heads, num_sweeps, lengths,
-                                                                inv_lengths, n, points);
+    done = tractrix ? run(WavefrontSweeps<Arch, TractrixRule<2, BatchExp>, 2>)
+                    : run(WavefrontSweeps<Arch, FollowTheLeaderRule<2>, 2>);
   } else {
-    tractrix ? WavefrontSweeps<Arch, TractrixRule<3, BatchExp>, 3>(heads, num_sweeps, lengths,
-                                                                   inv_lengths, n, points)
-             : WavefrontSweeps<Arch, FollowTheLeaderRule<3>, 3>(heads, num_sweeps, lengths,
-                                                                inv_lengths, n, points);
+    done = tractrix ? run(WavefrontSweeps<Arch, TractrixRule<3, BatchExp>, 3>)
+                    : run(WavefrontSweeps<Arch, FollowTheLeaderRule<3>, 3>);
   }
+  SweepsScalar(method, dim, heads + done * dim, num_sweeps - done, lengths, inv_lengths, n, points);
 }
 
 }  // namespace
