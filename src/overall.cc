@@ -1,5 +1,6 @@
 #include "flexkin/overall.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -8,39 +9,14 @@
 #include <string>
 #include <vector>
 
-#include "banded_lu.h"
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
+#include "overall_newton.h"
 #include "overall_objective.h"
 
 namespace flexkin {
 namespace {
 
-using internal::BandedLu;
-using internal::Evaluate;
-using internal::Sink;
-using internal::Triplets;
-
-// Puts every point back at its link's length from the point before it, from the (fixed) head
-// down: the follow-the-leader projection, a retraction onto the set of feasible configurations.
-void Retract(const Eigen::VectorXd& lengths, Points* x) {
-  for (Eigen::Index i = 1; i < x->rows(); ++i) {
-    const Eigen::VectorXd d = (x->row(i) - x->row(i - 1)).transpose();
-    const double norm = d.norm();
-    if (norm > 0.0) x->row(i) = x->row(i - 1) + (lengths[i - 1] / norm) * d.transpose();
-  }
-}
-
-// Largest |(|D_i|^2 - L_i^2)| / (2 L_i^2).
-double ConstraintViolation(const Eigen::VectorXd& lengths, const Points& x) {
-  double worst = 0.0;
-  for (Eigen::Index i = 1; i < x.rows(); ++i) {
-    const double l = lengths[i - 1];
-    const double c = ((x.row(i) - x.row(i - 1)).squaredNorm() - l * l) / (2.0 * l * l);
-    worst = std::fmax(worst, std::fabs(c));
-  }
-  return worst;
-}
 
 void ValidateInput(const Eigen::VectorXd& lengths, const Eigen::Ref<const Eigen::VectorXd>& head,
                    const OverallOptions& options, const Points& points) {
@@ -111,249 +87,184 @@ std::string OverallReport::BriefReport() const {
 
 namespace {
 
-// Newton's method on the KKT conditions from the feasible configuration `*start` (whose point 0
-// is the prescribed head), for the metric measured from `old_points`. `*start` becomes the result.
-OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_points,
-                          const OverallOptions& options, Points* start) {
-  const int n = static_cast<int>(lengths.size());
-  const int dim = static_cast<int>(start->cols());
-  OverallReport report;
-  Points x = *start;
+// The L2 metric's still points as Coulomb friction. A point j that has not moved satisfies the
+// optimality condition 0 in s_j + w_j B + lambda_j e_j - lambda_{j+1} e_{j+1} (s_j the smooth
+// terms' gradient, w_j its L2 weight, B the unit ball, e_i the unit link vectors, lambda the
+// multipliers of (|D_i|^2 - L_i^2) / (2 L_i)) when the pull of its links is at most w_j. A still
+// tail k+1..n can hold the pull on point k+1 if multipliers of its links exist that meet this
+// at every still point. The values of lambda_j that points j..n can hold form an interval
+// [lo_j, hi_j], found here from the trailing end up, once per step.
+struct TailFriction {
+  std::vector<double> lo, hi;  // indexed by link j = 2..n, and j = n+1: [0, 0]
+  Points e;                    // unit link vectors of the old configuration; row i-1: link i
+  std::vector<double> w;       // L2 weight of each point, indexed by j = 1..n
+};
 
-  // Unknowns interleaved point by point, [x_1, lambda_1, x_2, lambda_2, ...], so that the KKT
-  // matrix is banded (constraint i couples x_{i-1} and x_i; the objective couples neighbours).
-  const int block = dim + 1;
-  const int size = n * block;
-  Sink sink;
-  sink.dim = dim;
-  sink.offset.resize(n + 1);
-  for (int j = 1; j <= n; ++j) sink.offset[j] = (j - 1) * block;
-  auto multiplier_row = [&](int i) { return (i - 1) * block + dim; };
-
-  // Objective gradient g (in the interleaved layout, multiplier rows 0), constraints
-  // c_i = (|D_i|^2 - L_i^2) / (2 L_i), and the KKT matrix.
-  Eigen::VectorXd g(size), lambda = Eigen::VectorXd::Zero(n), rhs(size);
-  auto evaluate = [&](const Points& p, Triplets* hessian, Eigen::VectorXd* grad) {
-    sink.gradient = grad;
-    sink.hessian = hessian;
-    if (grad != nullptr) grad->setZero(size);
-    return Evaluate(options.weights, lengths, old_points, p, sink);
-  };
-  auto constraints = [&](const Points& p) {
-    Eigen::VectorXd c(n);
-    for (int i = 1; i <= n; ++i) {
-      c[i - 1] = ((p.row(i) - p.row(i - 1)).squaredNorm() - lengths[i - 1] * lengths[i - 1]) /
-                 (2.0 * lengths[i - 1]);
-    }
-    return c;
-  };
-  // Gradient of the Lagrangian g + J^T lambda (x rows only).
-  auto lagrangian_gradient = [&](const Points& p, const Eigen::VectorXd& grad,
-                                 const Eigen::VectorXd& lam) {
-    Eigen::VectorXd r = grad;
-    for (int i = 1; i <= n; ++i) {
-      const Eigen::VectorXd e = (p.row(i) - p.row(i - 1)).transpose() / lengths[i - 1];
-      for (int k = 0; k < dim; ++k) {
-        r[sink.offset[i] + k] += lam[i - 1] * e[k];
-        if (i > 1) r[sink.offset[i - 1] + k] -= lam[i - 1] * e[k];
-      }
-    }
-    for (int i = 1; i <= n; ++i) r[multiplier_row(i)] = 0.0;
-    return r;
-  };
-  // First-order optimality: the Lagrangian's gradient relative to the objective's gradient (now
-  // or at the start, whichever is larger). Where the metric is 0 at the solution (a still head,
-  // or a pure translation under the rotation metric) that ratio means nothing; a gradient at the
-  // rounding level of the positions, 64 eps (sum of weights) max(|x|, L), counts as 0 instead.
-  const ObjectiveWeights& w = options.weights;
-  const double weight_sum = w.squared + w.squared_weighted * lengths.maxCoeff() +
-                            w.rotation / lengths.minCoeff() + w.joint_angle;
-  double start_gradient = 0.0;
-  auto optimality = [&](const Points& p, const Eigen::VectorXd& grad, const Eigen::VectorXd& lag) {
-    const double residual = lag.cwiseAbs().maxCoeff();
-    const double extent = std::fmax(p.cwiseAbs().maxCoeff(), lengths.maxCoeff());
-    if (residual <= 64.0 * std::numeric_limits<double>::epsilon() * weight_sum * extent) {
-      return 0.0;
-    }
-    const double scale = std::fmax(std::fmax(grad.cwiseAbs().maxCoeff(), start_gradient),
-                                   std::numeric_limits<double>::min());
-    return residual / scale;
-  };
-
-  // Half-bandwidth of the KKT matrix in the interleaved order: x_j reaches x_{j+1} (2 dim) and
-  // lambda_j reaches x_{j-1} (2 dim + 1); the joint-angle term reaches x_{j+2} (3 dim + 1).
-  const int band = options.weights.joint_angle > 0.0 ? 3 * dim + 1 : 2 * dim + 1;
-  BandedLu lu(size, std::min(band, size - 1));
-  double regularization = 0.0;
-  double value = evaluate(x, nullptr, &g);
-  start_gradient = g.cwiseAbs().maxCoeff();
-  Eigen::VectorXd c = constraints(x);
-
-  for (report.iterations = 0;; ++report.iterations) {
-    const Eigen::VectorXd lag = lagrangian_gradient(x, g, lambda);
-    report.objective = value;
-    report.constraint_violation = ConstraintViolation(lengths, x);
-    report.optimality = optimality(x, g, lag);
-    if (!std::isfinite(report.objective) || !std::isfinite(report.optimality)) {
-      report.status = OverallStatus::kFailed;
-      break;
-    }
-    if (report.iterations > 0 && report.constraint_violation <= options.constraint_tolerance &&
-        report.optimality <= options.optimality_tolerance) {
-      report.status = OverallStatus::kConverged;
-      break;
-    }
-    if (report.iterations >= options.max_iterations) {
-      report.status = OverallStatus::kMaxIterations;
-      break;
-    }
-
-    // KKT matrix: [H + delta I, J^T; J, 0] with H = hess f + sum lambda_i hess c_i.
-    Triplets t;
-    evaluate(x, &t, nullptr);
-    for (int i = 1; i <= n; ++i) {
-      const double s = lambda[i - 1] / lengths[i - 1];
-      sink.Identity(i, i, s);
-      if (i > 1) {
-        sink.Identity(i - 1, i - 1, s);
-        sink.Identity(i, i - 1, -s);
-        sink.Identity(i - 1, i, -s);
-      }
-      const Eigen::VectorXd e = (x.row(i) - x.row(i - 1)).transpose() / lengths[i - 1];
-      for (int k = 0; k < dim; ++k) {
-        t.emplace_back(multiplier_row(i), sink.offset[i] + k, e[k]);
-        t.emplace_back(sink.offset[i] + k, multiplier_row(i), e[k]);
-        if (i > 1) {
-          t.emplace_back(multiplier_row(i), sink.offset[i - 1] + k, -e[k]);
-          t.emplace_back(sink.offset[i - 1] + k, multiplier_row(i), -e[k]);
-        }
-      }
-    }
-    // Regularization delta I on the Hessian block, carried over (decayed) from the last
-    // iteration; `regularize` adds more: `first` if there was none, else 10 times as much.
-    auto add_to_diagonal = [&](double amount) {
-      for (int j = 1; j <= n; ++j) {
-        for (int k = 0; k < dim; ++k)
-          t.emplace_back(sink.offset[j] + k, sink.offset[j] + k, amount);
-      }
-    };
-    auto regularize = [&](double first) {
-      const double bump = regularization == 0.0 ? first : 10.0 * regularization;
-      add_to_diagonal(bump);
-      regularization += bump;
-    };
-    add_to_diagonal(regularization);
-
-    // Newton step for (x, lambda_new): [H J^T; J 0] [dx; lambda_new] = -[g; c].
-    bool stepped = false;
-    for (int attempt = 0; attempt < 12 && !stepped; ++attempt) {
-      lu.Factorize(t);
-      if (!lu.factorized()) {
-        regularize(1e-10 * std::fmax(1.0, g.cwiseAbs().maxCoeff()));  // singular
-        continue;
-      }
-      for (int j = 1; j <= n; ++j) {
-        for (int k = 0; k < dim; ++k) rhs[sink.offset[j] + k] = -g[sink.offset[j] + k];
-        rhs[multiplier_row(j)] = -c[j - 1];
-      }
-      const Eigen::VectorXd sol = lu.Solve(rhs);
-      if (!sol.allFinite()) break;
-      Eigen::VectorXd lambda_new(n);
-      Points dx(n + 1, dim);
-      dx.row(0).setZero();
-      for (int j = 1; j <= n; ++j) {
-        for (int k = 0; k < dim; ++k) dx(j, k) = sol[sink.offset[j] + k];
-        lambda_new[j - 1] = sol[multiplier_row(j)];
-      }
-      // Curvature test (an LU gives no inertia): the step must see positive curvature of
-      // the regularized Lagrangian, dx' (H + delta I) dx >= 1e-8 |dx|^2 (scaled); else more
-      // regularization. Otherwise Newton heads for a saddle or maximum on non-convex terms.
-      {
-        Eigen::VectorXd dx_only = Eigen::VectorXd::Zero(size);
-        for (int j = 1; j <= n; ++j) {
-          for (int k = 0; k < dim; ++k) dx_only[sink.offset[j] + k] = dx(j, k);
-        }
-        // (H + delta I) dx, from the triplets of the Hessian block.
-        Eigen::VectorXd k_dx = Eigen::VectorXd::Zero(size);
-        for (const auto& e : t) {
-          if (e.row() % block != dim && e.col() % block != dim) {
-            k_dx[e.row()] += e.value() * dx_only[e.col()];
-          }
-        }
-        double curvature = 0.0;
-        for (int j = 1; j <= n; ++j) {
-          for (int k = 0; k < dim; ++k) curvature += dx(j, k) * k_dx[sink.offset[j] + k];
-        }
-        const double floor = 1e-8 * std::fmax(1.0, weight_sum) * dx.squaredNorm();
-        if (curvature < floor && dx.squaredNorm() > 0.0) {
-          regularize(1e-4 * std::fmax(1.0, weight_sum));
-          continue;
-        }
-      }
-
-      // Line search on the metric itself, every trial put back on the constraint manifold by
-      // a follow-the-leader sweep from the fixed head (a retraction: exact lengths in O(n)).
-      // Iterates stay feasible, so no merit function is needed and full Newton steps are never
-      // rejected near the solution for leaving the manifold (no Maratos effect).
-      auto accept = [&](Points&& trial, double v_trial, Eigen::VectorXd&& g_trial) {
-        x = std::move(trial);
-        value = v_trial;
-        g = std::move(g_trial);
-        c = constraints(x);
-        lambda = lambda_new;
-        stepped = true;
-      };
-      // First the full Newton step: near the solution the metric changes by less than rounding,
-      // so it is judged by the Lagrangian's gradient, which it must halve, without raising the
-      // metric beyond rounding (Newton's method is drawn to saddles and maxima as well; the
-      // iterates are feasible, so this cannot lead away from the constraints).
-      const double allowance = 64.0 * std::numeric_limits<double>::epsilon() * std::fabs(value);
-      {
-        Points trial = x + dx;
-        Retract(lengths, &trial);
-        Eigen::VectorXd g_trial(size);
-        const double v_trial = evaluate(trial, nullptr, &g_trial);
-        if (std::isfinite(v_trial) && v_trial <= value + allowance &&
-            lagrangian_gradient(trial, g_trial, lambda_new).cwiseAbs().maxCoeff() <
-                0.5 * lagrangian_gradient(x, g, lambda_new).cwiseAbs().maxCoeff()) {
-          accept(std::move(trial), v_trial, std::move(g_trial));
-          break;
-        }
-      }
-      // Otherwise Armijo backtracking on the metric, from a descent direction only.
-      double slope = 0.0;
-      for (int j = 1; j <= n; ++j) {
-        slope += g.segment(sink.offset[j], dim).dot(dx.row(j).transpose());
-      }
-      if (slope < 0.0) {
-        for (double alpha = 1.0; alpha > 1e-12 && !stepped; alpha *= 0.5) {
-          Points trial = x + alpha * dx;
-          Retract(lengths, &trial);
-          Eigen::VectorXd g_trial(size);
-          const double v_trial = evaluate(trial, nullptr, &g_trial);
-          if (std::isfinite(v_trial) && v_trial <= value + 1e-4 * alpha * slope + allowance) {
-            accept(std::move(trial), v_trial, std::move(g_trial));
-          }
-        }
-      }
-      // No acceptable step: more regularization, then try again.
-      if (!stepped) regularize(1e-8 * std::fmax(1.0, g.cwiseAbs().maxCoeff()));
-    }
-    if (!stepped) {
-      report.objective = value;
-      report.constraint_violation = ConstraintViolation(lengths, x);
-      report.optimality = optimality(x, g, lagrangian_gradient(x, g, lambda));
-      const bool done = report.constraint_violation <= options.constraint_tolerance &&
-                        report.optimality <= options.optimality_tolerance;
-      report.status = done              ? OverallStatus::kConverged
-                      : lu.factorized() ? OverallStatus::kStalled
-                                        : OverallStatus::kFailed;
-      break;
-    }
-    regularization *= 0.1;
-    if (regularization < 1e-14) regularization = 0.0;
+// max over mu in [a, b] with |mu| s <= w of mu c + sqrt(w^2 - mu^2 s^2): the largest multiplier
+// of a link at angle (c = cos, s = sin) to the next one, whose multiplier lies in [a, b], that a
+// point of weight w holds.
+double Reach(double c, double s, double w, double a, double b) {
+  double low = a, high = b;
+  if (s > 0.0) {
+    low = std::fmax(low, -w / s);
+    high = std::fmin(high, w / s);
   }
-  *start = x;
+  // The concave function's maximizer c w / s, clamped (s = 0: the end c points to).
+  const double best = s > 0.0 ? c * w / s : (c > 0.0 ? high : low);
+  const double mu = std::clamp(best, low, high);
+  return mu * c + std::sqrt(std::fmax(0.0, w * w - mu * mu * s * s));
+}
+
+TailFriction MakeTailFriction(const ObjectiveWeights& weights, const Eigen::VectorXd& lengths,
+                              const Points& old_points) {
+  const int n = static_cast<int>(lengths.size());
+  const int dim = static_cast<int>(old_points.cols());
+  TailFriction f;
+  f.lo.assign(n + 2, 0.0);
+  f.hi.assign(n + 2, 0.0);
+  f.w.assign(n + 1, 0.0);
+  f.e.resize(n, dim);
+  for (int i = 1; i <= n; ++i) {
+    f.e.row(i - 1) = (old_points.row(i) - old_points.row(i - 1)).normalized();
+    f.w[i] = internal::L2Weight(weights, lengths, i);
+  }
+  for (int j = n; j >= 2; --j) {
+    if (j == n) {
+      f.lo[j] = -f.w[n];
+      f.hi[j] = f.w[n];
+      continue;
+    }
+    const Eigen::VectorXd u = f.e.row(j - 1).transpose(), v = f.e.row(j).transpose();
+    const double c = u.dot(v);
+    const double s = dim == 2 ? std::fabs(u[0] * v[1] - u[1] * v[0])
+                              : Eigen::Vector3d(u[0], u[1], u[2])
+                                    .cross(Eigen::Vector3d(v[0], v[1], v[2]))
+                                    .norm();
+    f.hi[j] = Reach(c, s, f.w[j], f.lo[j + 1], f.hi[j + 1]);
+    f.lo[j] = -Reach(c, s, f.w[j], -f.hi[j + 1], -f.lo[j + 1]);
+  }
+  return f;
+}
+
+// The part of `force` on the still point j (pulled by link j) that the still tail after it
+// cannot hold: zero if it holds it (to a relative 1e-9 of w_j).
+Eigen::VectorXd UnheldForce(const TailFriction& f, int j, const Eigen::VectorXd& force) {
+  const int n = static_cast<int>(f.w.size()) - 1;
+  Eigen::VectorXd rest = force;
+  if (j < n) {
+    const Eigen::VectorXd e = f.e.row(j).transpose();  // link j+1
+    rest -= std::clamp(force.dot(e), f.lo[j + 1], f.hi[j + 1]) * e;
+  }
+  if (rest.norm() <= f.w[j] * (1.0 + 1e-9)) return Eigen::VectorXd::Zero(force.size());
+  return rest;
+}
+
+// Releases the still points that the pull `force` on point k+1 sets moving: point k+1, and the
+// points after it down to the first whose tail holds the tension passed on along the chain (an
+// estimate: the active-set loop corrects it either way). They start a little way (1e-3 of a
+// link) against the `unheld` part of the pull, the block dragged after point k+1 by follow-the-leader steps, so that
+// Newton's method does not start in the kinks of the L2 term. Returns the new k.
+int Release(const TailFriction& f, const Eigen::VectorXd& lengths, const Points& old_points, int k,
+            const Eigen::VectorXd& force, const Eigen::VectorXd& unheld, Points* x) {
+  const int n = static_cast<int>(lengths.size());
+  int m = k + 1;
+  Eigen::VectorXd pull = force;
+  while (m < n) {
+    const Eigen::VectorXd e = f.e.row(m).transpose();  // link m+1
+    const double tension = pull.dot(e);
+    if (tension >= f.lo[m + 1] && tension <= f.hi[m + 1]) break;  // the tail after m holds it
+    pull = tension * e;
+    ++m;
+  }
+  x->row(k + 1) = old_points.row(k + 1) - (1e-3 * lengths[k] / unheld.norm()) * unheld.transpose();
+  for (int j = k + 2; j <= m; ++j) {
+    const Eigen::RowVectorXd d = old_points.row(j) - x->row(j - 1);
+    x->row(j) = x->row(j - 1) + (lengths[j - 1] / d.norm()) * d;
+  }
+  return m;
+}
+
+// One (sub-)step of a metric with an L2 term: Newton's method on points 1..k, the others held
+// still, with k (`*moving`, carried from the last sub-step) raised while the still points cannot
+// hold the pull, and lowered where a moving point comes to rest. `*x` is the solution of the
+// last sub-step on entry, of this one on return.
+OverallReport SolveActiveSet(const Eigen::VectorXd& lengths, const Points& old_points,
+                             const OverallOptions& options, const TailFriction& friction,
+                             const Eigen::VectorXd& head, int* moving, Points* x) {
+  const int n = static_cast<int>(lengths.size());
+  const int dim = static_cast<int>(old_points.cols());
+  int k = std::max(*moving, 1);
+  Points current = *x;
+  std::vector<char> rested(n + 1, 0);
+  OverallReport report;
+  int iterations = 0;
+  bool released = false;
+  for (int round = 0;; ++round) {
+    if (round > 2 * n + 8) {  // the active set cycles
+      report.status = OverallStatus::kStalled;
+      break;
+    }
+    Points trial = current;
+    trial.row(0) = head.transpose();
+    trial.bottomRows(n - k) = old_points.bottomRows(n - k);
+    if (!internal::Retract(lengths, k, &trial)) {
+      // No chain of points 1..k reaches from the head to the still point k+1.
+      ++k;
+      continue;
+    }
+    Eigen::VectorXd lambda;
+    // After a release the new points sit in the L2 term's kinks: the way out goes through the
+    // smoothed problem (mu = 1e-2, 1e-4, 1e-6 of the shortest link), then the exact one.
+    if (released) {
+      for (const double mu : {1e-2, 1e-4, 1e-6}) {
+        report = internal::NewtonSolve(lengths, old_points, options, k, &trial, &lambda,
+                                       mu * lengths.minCoeff());
+        iterations += report.iterations;
+      }
+    }
+    report = internal::NewtonSolve(lengths, old_points, options, k, &trial, &lambda);
+    iterations += report.iterations;
+    released = false;
+    current = trial;
+    // A moving point (nearly) back where it was: at the minimizer it, and every point after it,
+    // may be still. (Newton's method converges slowly into the L2 metric's kink, so a failed
+    // solve is looked at with a looser threshold.) The friction check below confirms it.
+    const double near = report.converged() ? 1e-12 : 1e-5;
+    int rest = 0;
+    for (int j = 2; j <= k && rest == 0; ++j) {
+      if (!rested[j] && (trial.row(j) - old_points.row(j)).norm() <= near * lengths[j - 1]) rest = j;
+    }
+    if (rest > 0) {
+      rested[rest] = 1;
+      k = rest - 1;
+      continue;
+    }
+    if (!report.converged()) {
+      if (k == n) break;
+      ++k;
+      continue;
+    }
+    if (k == n) break;
+    // The pull on the first still point: its smooth terms' gradient plus link k+1's multiplier.
+    internal::Sink sink;
+    sink.dim = dim;
+    sink.offset.assign(n + 1, -1);
+    for (int j = 1; j <= k + 1; ++j) sink.offset[j] = (j - 1) * dim;
+    Eigen::VectorXd gradient = Eigen::VectorXd::Zero((k + 1) * dim);
+    sink.gradient = &gradient;
+    internal::Evaluate(options.weights, lengths, old_points, trial, sink, std::min(n, k + 2));
+    const Eigen::VectorXd e =
+        (trial.row(k + 1) - trial.row(k)).transpose() / lengths[k];
+    const Eigen::VectorXd force = gradient.tail(dim) + lambda[k] * e;
+    const Eigen::VectorXd unheld = UnheldForce(friction, k + 1, force);
+    if (unheld.squaredNorm() == 0.0) break;
+    k = Release(friction, lengths, old_points, k, force, unheld, &current);
+    released = true;
+  }
+  report.moving_points = k;
+  report.iterations = iterations;
+  *moving = k;
+  *x = current;
   return report;
 }
 
@@ -374,6 +285,19 @@ OverallReport OverallStep(const Eigen::VectorXd& lengths,
   const double distance = (head - from).norm();
   const int sub_steps =
       std::max(1, static_cast<int>(std::ceil(distance / (0.5 * lengths.minCoeff()))));
+  const bool l2 = options.weights.l2 > 0.0 || options.weights.l2_weighted > 0.0;
+  const int n = static_cast<int>(lengths.size());
+  if (l2 && distance == 0.0) {  // nothing moves: the minimizer is the old configuration
+    OverallReport report;
+    report.status = OverallStatus::kConverged;
+    report.start = "the old configuration (the head did not move)";
+    return report;
+  }
+  // With an L2 term, the sub-problems are solved on an active set: the points after the last
+  // moving one held still (their friction bound checked), from the last sub-step's solution.
+  const TailFriction friction =
+      l2 ? MakeTailFriction(options.weights, lengths, old_points) : TailFriction{};
+  int moving = l2 ? 0 : n;
   OverallReport report;
   int iterations = 0;
   Chain chain{old_points, lengths};
@@ -382,15 +306,24 @@ OverallReport OverallStep(const Eigen::VectorXd& lengths,
         s == sub_steps
             ? Eigen::VectorXd(head)
             : Eigen::VectorXd(from + (static_cast<double>(s) / sub_steps) * (head - from));
-    MoveLeader(Method::kTractrix, target, 1, &chain);
-    report = NewtonSolve(lengths, old_points, options, &chain.points);
+    if (l2) {
+      report = SolveActiveSet(lengths, old_points, options, friction, target, &moving,
+                              &chain.points);
+    } else {
+      MoveLeader(Method::kTractrix, target, 1, &chain);
+      Eigen::VectorXd multipliers;
+      report = internal::NewtonSolve(lengths, old_points, options, n, &chain.points, &multipliers);
+    }
     iterations += report.iterations;
     if (!report.converged()) break;
   }
   report.iterations = iterations;
-  report.start = sub_steps == 1 ? "sequential tractrix step"
-                                : "continuation in " + std::to_string(sub_steps) +
-                                      " head sub-steps from the old configuration";
+  const std::string from_where = l2 ? "the last sub-step's solution" : "its tractrix step";
+  report.start = sub_steps == 1
+                     ? (l2 ? "the old configuration, on an active set of moving points"
+                           : "sequential tractrix step")
+                     : "continuation in " + std::to_string(sub_steps) +
+                           " head sub-steps from the old configuration, each from " + from_where;
   *points = chain.points;
   return report;
 }

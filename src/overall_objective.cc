@@ -21,11 +21,41 @@ double Wrap(double a) { return std::remainder(a, 2.0 * M_PI); }
 }  // namespace
 
 // The metric of one step and its derivatives, term by term. x(j) and a(j): new and old point j.
-double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const Points& old_points,
-                const Points& x, const Sink& sink) {
+double L2Weight(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, int j) {
   const int n = static_cast<int>(lengths.size());
+  return w.l2 + w.l2_weighted * 0.5 * (lengths[j - 1] + (j < n ? lengths[j] : 0.0));
+}
+
+double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const Points& old_points,
+                const Points& x, const Sink& sink, int last, double smoothing) {
+  const int n = last < 0 ? static_cast<int>(lengths.size()) : last;
   const int dim = static_cast<int>(x.cols());
   double value = 0.0;
+
+  // The paper's L2 metric, sum of w_j |x_j - a_j|: gradient w u, Hessian w (I - u u^T) / r with
+  // r = |x_j - a_j| and u = (x_j - a_j) / r; at r = 0 the subgradient 0 and no Hessian (the
+  // solver keeps such points out of its unknowns).
+  if (w.l2 > 0.0 || w.l2_weighted > 0.0) {
+    double d[3], block[9];
+    for (int j = 1; j <= n; ++j) {
+      const double s = L2Weight(w, lengths, j);
+      double sq = 0.0;
+      for (int k = 0; k < dim; ++k) {
+        d[k] = x(j, k) - old_points(j, k);
+        sq += d[k] * d[k];
+      }
+      const double r = std::sqrt(sq + smoothing * smoothing);
+      value += s * r;
+      if (r == 0.0) continue;
+      for (int k = 0; k < dim; ++k) d[k] /= r;
+      sink.Gradient(j, d, s);
+      if (sink.hessian == nullptr) continue;
+      for (int a = 0; a < dim; ++a) {
+        for (int b = 0; b < dim; ++b) block[a * dim + b] = ((a == b ? 1.0 : 0.0) - d[a] * d[b]) / r;
+      }
+      sink.Block(j, j, block, s);
+    }
+  }
 
   // Squared displacement, plain and arc-length weighted. (Plain loops: no temporaries per point.)
   double d[3], grad[3];
@@ -124,7 +154,9 @@ double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const
 }  // namespace internal
 
 std::string ObjectiveWeights::Validate() const {
-  const std::pair<const char*, double> terms[] = {{"squared", squared},
+  const std::pair<const char*, double> terms[] = {{"l2", l2},
+                                                  {"l2_weighted", l2_weighted},
+                                                  {"squared", squared},
                                                   {"squared_weighted", squared_weighted},
                                                   {"rotation", rotation},
                                                   {"joint_angle", joint_angle}};
@@ -136,9 +168,14 @@ std::string ObjectiveWeights::Validate() const {
     }
     total += value;
   }
+  if ((l2 > 0.0 || l2_weighted > 0.0) && joint_angle > 0.0) {
+    return "weights.joint_angle: " + FormatNumber(joint_angle) +
+           " cannot be combined with the L2 metric (l2, l2_weighted): that combination is not "
+           "supported; set joint_angle or both L2 weights to 0";
+  }
   if (!(total > 0.0)) {
-    return "weights: all weights are 0; give at least one term (squared, squared_weighted, "
-           "rotation, joint_angle) a positive weight";
+    return "weights: all weights are 0; give at least one term (l2, l2_weighted, squared, "
+           "squared_weighted, rotation, joint_angle) a positive weight";
   }
   return "";
 }
@@ -151,6 +188,7 @@ double OverallObjective(const ObjectiveWeights& weights, const Eigen::VectorXd& 
   internal::Sink sink;
   sink.dim = dim;
   sink.offset.resize(n + 1);
+  sink.offset[0] = -1;
   for (int j = 1; j <= n; ++j) sink.offset[j] = (j - 1) * dim;
   if (gradient != nullptr) {
     gradient->setZero(n * dim);

@@ -12,21 +12,22 @@ namespace flexkin::internal {
 
 using Triplets = std::vector<Eigen::Triplet<double>>;
 
-// Where the objective's derivatives go. Points are numbered 0..n; point 0 is fixed, so its
-// entries are dropped. `offset(j)` is the first row of point j's coordinates in the unknowns.
+// Where the objective's derivatives go. Points are numbered 0..n; point 0 is fixed, and so may be
+// a tail of still points (the L2 metric's active set): their entries are dropped.
+// `offset[j]` is the first row of point j's coordinates in the unknowns, or -1 for a fixed point.
 struct Sink {
   int dim = 0;
   Eigen::VectorXd* gradient = nullptr;  // may be null
   Triplets* hessian = nullptr;          // may be null
-  std::vector<int> offset;              // offset[j] for j = 1..n; offset[0] unused
+  std::vector<int> offset;              // offset[j] for j = 0..n; -1: point j is fixed
 
   void Gradient(int j, const double* g, double scale) const {
-    if (gradient == nullptr || j == 0) return;
+    if (gradient == nullptr || offset[j] < 0) return;
     for (int k = 0; k < dim; ++k) (*gradient)[offset[j] + k] += scale * g[k];
   }
   // Adds scale * block (dim by dim, row-major in `b`) at (point p, point q).
   void Block(int p, int q, const double* b, double scale) const {
-    if (hessian == nullptr || p == 0 || q == 0) return;
+    if (hessian == nullptr || offset[p] < 0 || offset[q] < 0) return;
     for (int r = 0; r < dim; ++r) {
       for (int c = 0; c < dim; ++c) {
         // Zeros too: the pattern must not change between iterations.
@@ -35,13 +36,22 @@ struct Sink {
     }
   }
   void Identity(int p, int q, double scale) const {
-    if (hessian == nullptr || p == 0 || q == 0) return;
+    if (hessian == nullptr || offset[p] < 0 || offset[q] < 0) return;
     for (int r = 0; r < dim; ++r) hessian->emplace_back(offset[p] + r, offset[q] + r, scale);
   }
 };
 
-// The metric of one step, from `old_points` to `x`, and (into `sink`) its derivatives.
+// The metric of one step, from `old_points` to `x`, and (into `sink`) its derivatives. Only the
+// terms of points 1..`last` and of the links and joints among points 0..`last` are evaluated
+// (-1: all); the caller guarantees the others are 0 (points after `last` still).
+// The L2 term contributes the subgradient 0 and no Hessian at a point that has not moved. With
+// `smoothing` mu > 0 (a length), each |x_j - a_j| becomes sqrt(|x_j - a_j|^2 + mu^2): the
+// solver's path into the kinks, never its answer.
 double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const Points& old_points,
-                const Points& x, const Sink& sink);
+                const Points& x, const Sink& sink, int last = -1, double smoothing = 0.0);
+
+// The L2 metric's weight of point j = 1..n: l2 + l2_weighted (L_j + L_{j+1}) / 2 (L_n / 2 at
+// the trailing end).
+double L2Weight(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, int j);
 
 }  // namespace flexkin::internal

@@ -472,7 +472,11 @@ void WriteResultJson(const RunResult& result, std::ostream& out, const std::stri
   if (result.method == Method::kOverall) {
     const OverallSummary& o = result.overall;
     const ObjectiveWeights& w = result.weights;
-    t += "\"overall\": {\"objective\": {\"squared\": ";
+    t += "\"overall\": {\"objective\": {\"l2\": ";
+    AppendDouble(w.l2, &t);
+    t += ", \"l2_weighted\": ";
+    AppendDouble(w.l2_weighted, &t);
+    t += ", \"squared\": ";
     AppendDouble(w.squared, &t);
     t += ", \"squared_weighted\": ";
     AppendDouble(w.squared_weighted, &t);
@@ -600,6 +604,13 @@ ResultFile ResultFromJson(const json& j) {
   if (const auto it = j.find("overall"); it != j.end()) {
     const json& o = *it;
     const json& w = Member(o, "/overall", "objective");
+    // (The L2 terms are optional: files written before they existed lack them.)
+    for (const auto& [name, weight] : {std::pair<const char*, double*>{"l2", &r.weights.l2},
+                                       {"l2_weighted", &r.weights.l2_weighted}}) {
+      if (const auto term = w.find(name); term != w.end()) {
+        *weight = ReadNumber(*term, std::string("/overall/objective/") + name);
+      }
+    }
     r.weights.squared =
         ReadNumber(Member(w, "/overall/objective", "squared"), "/overall/objective/squared");
     r.weights.squared_weighted = ReadNumber(Member(w, "/overall/objective", "squared_weighted"),

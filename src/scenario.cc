@@ -528,26 +528,25 @@ void Parser::ParseOptions(const json& root, RunOptions* options) {
   if (const json* o = Find(root, "objective")) {
     if (ExpectObject(*o, "/objective",
                      "an object of term weights, e.g. {\"squared\": 1, \"rotation\": 0.5}")) {
-      CheckKeys(*o, "/objective", {"squared", "squared_weighted", "rotation", "joint_angle"});
-      // Only the terms listed count: {"rotation": 1} is the rotation metric alone.
       ObjectiveWeights& w = options->overall.weights;
-      w = {0.0, 0.0, 0.0, 0.0};
-      Optional(
-          *o, "/objective", "squared",
-          [&](const json& v, const std::string& p) { return Number(v, p, Range::kNonNegative); },
-          &w.squared);
-      Optional(
-          *o, "/objective", "squared_weighted",
-          [&](const json& v, const std::string& p) { return Number(v, p, Range::kNonNegative); },
-          &w.squared_weighted);
-      Optional(
-          *o, "/objective", "rotation",
-          [&](const json& v, const std::string& p) { return Number(v, p, Range::kNonNegative); },
-          &w.rotation);
-      Optional(
-          *o, "/objective", "joint_angle",
-          [&](const json& v, const std::string& p) { return Number(v, p, Range::kNonNegative); },
-          &w.joint_angle);
+      const std::pair<const char*, double*> terms[] = {
+          {"l2", &w.l2},
+          {"l2_weighted", &w.l2_weighted},
+          {"squared", &w.squared},
+          {"squared_weighted", &w.squared_weighted},
+          {"rotation", &w.rotation},
+          {"joint_angle", &w.joint_angle}};
+      std::vector<std::string> names;
+      for (const auto& [name, weight] : terms) names.push_back(name);
+      CheckKeys(*o, "/objective", names);
+      // Only the terms listed count: {"rotation": 1} is the rotation metric alone.
+      for (const auto& [name, weight] : terms) {
+        *weight = 0.0;
+        Optional(
+            *o, "/objective", name,
+            [&](const json& v, const std::string& p) { return Number(v, p, Range::kNonNegative); },
+            weight);
+      }
     }
   }
   if (const json* v = Find(root, "solver")) {

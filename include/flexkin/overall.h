@@ -29,6 +29,16 @@ struct ObjectiveWeights {
   // the chain's overall rotation, so combine it with another term.
   double joint_angle = 0.0;
 
+  // The paper's L2 metric: sum over points j = 1..n of |x_j - a_j|, the distance each point
+  // moves. Not differentiable where a point stays still, and its minimizer is sparse: points
+  // that need not move stay exactly still (OverallReport::moving_points). Like Coulomb
+  // friction, each point resists with a force of at most its weight, so a pull moves as few
+  // points as it must. Typical: 1. Not combined with joint_angle (an InputError).
+  double l2 = 0.0;
+  // The same, point j weighted by its arc length (L_j + L_{j+1}) / 2 (L_n / 2 at the trailing
+  // end): the discrete form of eq. (6).
+  double l2_weighted = 0.0;
+
   // Empty if valid (every weight finite and >= 0, at least one > 0), else the reason.
   std::string Validate() const;
 };
@@ -73,6 +83,9 @@ struct OverallReport {
   // move, directly from the tractrix step ("sequential tractrix step"). It is the minimizer
   // continuously connected to the old configuration.
   std::string start;
+  // Points 1..moving_points moved; the others stayed exactly where they were. n for the smooth
+  // metrics; usually fewer with an L2 term (its sparse minimizer).
+  int moving_points = 0;
 
   bool converged() const { return status == OverallStatus::kConverged; }
   std::string BriefReport() const;
@@ -91,7 +104,8 @@ OverallReport OverallStep(const Eigen::VectorXd& lengths,
 // for tests and small problems) of the step metric as a function of x_1..x_n (point 0 fixed at
 // `new_points.row(0)`). Exposed so that tests and other solvers evaluate the very same function.
 // It does not validate its input (OverallStep does): the shapes must match, and the joint-angle
-// term is ignored for 3D chains.
+// term is ignored for 3D chains. At a point that has not moved, the L2 term contributes the
+// subgradient 0 and no Hessian.
 double OverallObjective(const ObjectiveWeights& weights, const Eigen::VectorXd& lengths,
                         const Points& old_points, const Points& new_points,
                         Eigen::VectorXd* gradient = nullptr, Eigen::MatrixXd* hessian = nullptr);

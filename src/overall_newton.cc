@@ -1,0 +1,351 @@
+#include "overall_newton.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "banded_lu.h"
+#include "overall_objective.h"
+
+namespace flexkin::internal {
+namespace {
+
+// The follow-the-leader projection from the (fixed) head down: exact lengths in one pass.
+void RetractFollowTheLeader(const Eigen::VectorXd& lengths, Points* x) {
+  for (Eigen::Index i = 1; i < x->rows(); ++i) {
+    const Eigen::VectorXd d = (x->row(i) - x->row(i - 1)).transpose();
+    const double norm = d.norm();
+    if (norm > 0.0) x->row(i) = x->row(i - 1) + (lengths[i - 1] / norm) * d.transpose();
+  }
+}
+
+// Least-change projection of points 1..moving onto the chain of links 1..moving+1 between the
+// head and the fixed point moving+1: Gauss-Newton steps x -= J^T (J J^T)^-1 c(x) with
+// c_i = (|D_i|^2 - L_i^2) / (2 L_i). J J^T is tridiagonal, so each step is linear.
+bool RetractBetweenEnds(const Eigen::VectorXd& lengths, int moving, Points* x) {
+  const int m = moving + 1;  // constraints
+  const int dim = static_cast<int>(x->cols());
+  Eigen::MatrixXd e(m, dim);  // rows: D_i / L_i
+  Eigen::VectorXd c(m), diag(m), off(m), y(m);
+  double last_violation = std::numeric_limits<double>::infinity();
+  for (int iteration = 0; iteration < 30; ++iteration) {
+    double violation = 0.0;
+    for (int i = 1; i <= m; ++i) {
+      const double l = lengths[i - 1];
+      e.row(i - 1) = (x->row(i) - x->row(i - 1)) / l;
+      c[i - 1] = 0.5 * l * (e.row(i - 1).squaredNorm() - 1.0);
+      violation = std::fmax(violation, std::fabs(c[i - 1]) / l);
+    }
+    if (!std::isfinite(violation)) return false;
+    // Done at the rounding level, or when Gauss-Newton stops gaining (rounding reached).
+    if (violation <= 4.0 * std::numeric_limits<double>::epsilon() ||
+        (violation <= 1e-14 && violation >= 0.5 * last_violation)) {
+      return true;
+    }
+    if (iteration > 0 && violation > 0.9 * last_violation && violation > 1e-8) return false;
+    last_violation = violation;
+    // J J^T: row i of J is +e_i at x_i (i <= moving) and -e_i at x_{i-1} (i >= 2).
+    for (int i = 1; i <= m; ++i) {
+      const double ee = e.row(i - 1).squaredNorm();
+      diag[i - 1] = ee * ((i <= moving ? 1.0 : 0.0) + (i >= 2 ? 1.0 : 0.0));
+      off[i - 1] = i < m ? -e.row(i - 1).dot(e.row(i)) : 0.0;  // (i, i+1), shared point x_i
+    }
+    // Tridiagonal solve (J J^T is symmetric positive definite while J has full rank).
+    y = c;
+    for (int i = 1; i < m; ++i) {
+      if (!(diag[i - 1] > 0.0)) return false;
+      const double f = off[i - 1] / diag[i - 1];
+      diag[i] -= f * off[i - 1];
+      y[i] -= f * y[i - 1];
+    }
+    if (!(diag[m - 1] > 1e-14 * diag.head(m).cwiseAbs().maxCoeff())) return false;
+    y[m - 1] /= diag[m - 1];
+    for (int i = m - 2; i >= 0; --i) y[i] = (y[i] - off[i] * y[i + 1]) / diag[i];
+    // x -= J^T y.
+    for (int i = 1; i <= m; ++i) {
+      if (i <= moving) x->row(i) -= y[i - 1] * e.row(i - 1);
+      if (i >= 2) x->row(i - 1) += y[i - 1] * e.row(i - 1);
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+double ConstraintViolation(const Eigen::VectorXd& lengths, const Points& x) {
+  double worst = 0.0;
+  for (Eigen::Index i = 1; i < x.rows(); ++i) {
+    const double l = lengths[i - 1];
+    const double c = ((x.row(i) - x.row(i - 1)).squaredNorm() - l * l) / (2.0 * l * l);
+    worst = std::fmax(worst, std::fabs(c));
+  }
+  return worst;
+}
+
+bool Retract(const Eigen::VectorXd& lengths, int moving, Points* x) {
+  if (moving == lengths.size()) {
+    RetractFollowTheLeader(lengths, x);
+    return true;
+  }
+  return RetractBetweenEnds(lengths, moving, x);
+}
+
+OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_points,
+                          const OverallOptions& options, int moving, Points* start,
+                          Eigen::VectorXd* multipliers, double smoothing) {
+  const int n = static_cast<int>(lengths.size());
+  const int k = moving;
+  const int nc = k < n ? k + 1 : n;  // constraints: links 1..k, and link k+1 to the fixed point
+  const int dim = static_cast<int>(start->cols());
+  OverallReport report;
+  report.moving_points = k;
+  Points x = *start;
+
+  // Unknowns interleaved point by point, [x_1, lambda_1, ..., x_k, lambda_k (, lambda_k+1)], so
+  // that the KKT matrix is banded (constraint i couples x_{i-1} and x_i; the objective couples
+  // neighbours).
+  const int block = dim + 1;
+  const int size = k * block + (nc - k);
+  Sink sink;
+  sink.dim = dim;
+  sink.offset.assign(n + 1, -1);
+  for (int j = 1; j <= k; ++j) sink.offset[j] = (j - 1) * block;
+  auto multiplier_row = [&](int i) { return i <= k ? (i - 1) * block + dim : k * block; };
+  const int last = std::min(n, k + 1);  // the objective's terms beyond are 0
+
+  Eigen::VectorXd g(size), lambda = Eigen::VectorXd::Zero(nc), rhs(size);
+  auto evaluate = [&](const Points& p, Triplets* hessian, Eigen::VectorXd* grad) {
+    sink.gradient = grad;
+    sink.hessian = hessian;
+    if (grad != nullptr) grad->setZero(size);
+    return Evaluate(options.weights, lengths, old_points, p, sink, last, smoothing);
+  };
+  auto constraints = [&](const Points& p) {
+    Eigen::VectorXd c(nc);
+    for (int i = 1; i <= nc; ++i) {
+      c[i - 1] = ((p.row(i) - p.row(i - 1)).squaredNorm() - lengths[i - 1] * lengths[i - 1]) /
+                 (2.0 * lengths[i - 1]);
+    }
+    return c;
+  };
+  // Gradient of the Lagrangian g + J^T lambda (x rows only).
+  auto lagrangian_gradient = [&](const Points& p, const Eigen::VectorXd& grad,
+                                 const Eigen::VectorXd& lam) {
+    Eigen::VectorXd r = grad;
+    for (int i = 1; i <= nc; ++i) {
+      const Eigen::VectorXd e = (p.row(i) - p.row(i - 1)).transpose() / lengths[i - 1];
+      for (int c = 0; c < dim; ++c) {
+        if (i <= k) r[sink.offset[i] + c] += lam[i - 1] * e[c];
+        if (i > 1) r[sink.offset[i - 1] + c] -= lam[i - 1] * e[c];
+      }
+    }
+    for (int i = 1; i <= nc; ++i) r[multiplier_row(i)] = 0.0;
+    return r;
+  };
+  // First-order optimality: the Lagrangian's gradient relative to the objective's gradient (now
+  // or at the start, whichever is larger). Where the metric is 0 at the solution (a still head,
+  // or a pure translation under the rotation metric) that ratio means nothing; a gradient at the
+  // rounding level of the positions, 64 eps (sum of weights) max(|x|, L), counts as 0 instead.
+  const ObjectiveWeights& w = options.weights;
+  const double weight_sum = w.squared + w.squared_weighted * lengths.maxCoeff() +
+                            (w.rotation + w.l2 + w.l2_weighted * lengths.maxCoeff()) /
+                                lengths.minCoeff() +
+                            w.joint_angle;
+  double start_gradient = 0.0;
+  auto optimality = [&](const Points& p, const Eigen::VectorXd& grad, const Eigen::VectorXd& lag) {
+    const double residual = lag.cwiseAbs().maxCoeff();
+    const double extent = std::fmax(p.cwiseAbs().maxCoeff(), lengths.maxCoeff());
+    if (residual <= 64.0 * std::numeric_limits<double>::epsilon() * weight_sum * extent) {
+      return 0.0;
+    }
+    const double scale = std::fmax(std::fmax(grad.cwiseAbs().maxCoeff(), start_gradient),
+                                   std::numeric_limits<double>::min());
+    return residual / scale;
+  };
+
+  // Half-bandwidth of the KKT matrix in the interleaved order: x_j reaches x_{j+1} (2 dim) and
+  // lambda_j reaches x_{j-1} (2 dim + 1); the joint-angle term reaches x_{j+2} (3 dim + 1).
+  const int band = options.weights.joint_angle > 0.0 ? 3 * dim + 1 : 2 * dim + 1;
+  BandedLu lu(size, std::min(band, size - 1));
+  double regularization = 0.0;
+  double value = evaluate(x, nullptr, &g);
+  start_gradient = g.cwiseAbs().maxCoeff();
+  Eigen::VectorXd c = constraints(x);
+
+  for (report.iterations = 0;; ++report.iterations) {
+    const Eigen::VectorXd lag = lagrangian_gradient(x, g, lambda);
+    report.objective = value;
+    report.constraint_violation = ConstraintViolation(lengths, x);
+    report.optimality = optimality(x, g, lag);
+    if (!std::isfinite(report.objective) || !std::isfinite(report.optimality)) {
+      report.status = OverallStatus::kFailed;
+      break;
+    }
+    if (report.iterations > 0 && report.constraint_violation <= options.constraint_tolerance &&
+        report.optimality <= options.optimality_tolerance) {
+      report.status = OverallStatus::kConverged;
+      break;
+    }
+    if (report.iterations >= options.max_iterations) {
+      report.status = OverallStatus::kMaxIterations;
+      break;
+    }
+
+    // KKT matrix: [H + delta I, J^T; J, 0] with H = hess f + sum lambda_i hess c_i.
+    Triplets t;
+    evaluate(x, &t, nullptr);
+    for (int i = 1; i <= nc; ++i) {
+      const double s = lambda[i - 1] / lengths[i - 1];
+      sink.Identity(i, i, s);
+      if (i > 1) {
+        sink.Identity(i - 1, i - 1, s);
+        sink.Identity(i, i - 1, -s);
+        sink.Identity(i - 1, i, -s);
+      }
+      const Eigen::VectorXd e = (x.row(i) - x.row(i - 1)).transpose() / lengths[i - 1];
+      for (int q = 0; q < dim; ++q) {
+        if (i <= k) {
+          t.emplace_back(multiplier_row(i), sink.offset[i] + q, e[q]);
+          t.emplace_back(sink.offset[i] + q, multiplier_row(i), e[q]);
+        }
+        if (i > 1) {
+          t.emplace_back(multiplier_row(i), sink.offset[i - 1] + q, -e[q]);
+          t.emplace_back(sink.offset[i - 1] + q, multiplier_row(i), -e[q]);
+        }
+      }
+    }
+    // Regularization delta I on the Hessian block, carried over (decayed) from the last
+    // iteration; `regularize` adds more: `first` if there was none, else 10 times as much.
+    auto add_to_diagonal = [&](double amount) {
+      for (int j = 1; j <= k; ++j) {
+        for (int q = 0; q < dim; ++q)
+          t.emplace_back(sink.offset[j] + q, sink.offset[j] + q, amount);
+      }
+    };
+    auto regularize = [&](double first) {
+      const double bump = regularization == 0.0 ? first : 10.0 * regularization;
+      add_to_diagonal(bump);
+      regularization += bump;
+    };
+    add_to_diagonal(regularization);
+
+    // Newton step for (x, lambda_new): [H J^T; J 0] [dx; lambda_new] = -[g; c].
+    bool stepped = false;
+    for (int attempt = 0; attempt < 12 && !stepped; ++attempt) {
+      lu.Factorize(t);
+      if (!lu.factorized()) {
+        regularize(1e-10 * std::fmax(1.0, g.cwiseAbs().maxCoeff()));  // singular
+        continue;
+      }
+      for (int j = 1; j <= k; ++j) {
+        for (int q = 0; q < dim; ++q) rhs[sink.offset[j] + q] = -g[sink.offset[j] + q];
+      }
+      for (int i = 1; i <= nc; ++i) rhs[multiplier_row(i)] = -c[i - 1];
+      const Eigen::VectorXd sol = lu.Solve(rhs);
+      if (!sol.allFinite()) break;
+      Eigen::VectorXd lambda_new(nc);
+      Points dx = Points::Zero(n + 1, dim);
+      for (int j = 1; j <= k; ++j) {
+        for (int q = 0; q < dim; ++q) dx(j, q) = sol[sink.offset[j] + q];
+      }
+      for (int i = 1; i <= nc; ++i) lambda_new[i - 1] = sol[multiplier_row(i)];
+      // Curvature test (an LU gives no inertia): the step must see positive curvature of
+      // the regularized Lagrangian, dx' (H + delta I) dx >= 1e-8 |dx|^2 (scaled); else more
+      // regularization. Otherwise Newton heads for a saddle or maximum on non-convex terms.
+      {
+        Eigen::VectorXd dx_only = Eigen::VectorXd::Zero(size);
+        for (int j = 1; j <= k; ++j) {
+          for (int q = 0; q < dim; ++q) dx_only[sink.offset[j] + q] = dx(j, q);
+        }
+        // dx' (H + delta I) dx, from the triplets of the Hessian block (multiplier rows of
+        // dx_only are 0, so the Jacobian's entries add nothing).
+        double curvature = 0.0;
+        for (const auto& e : t) curvature += dx_only[e.row()] * e.value() * dx_only[e.col()];
+        const double floor = 1e-8 * std::fmax(1.0, weight_sum) * dx.squaredNorm();
+        if (curvature < floor && dx.squaredNorm() > 0.0) {
+          regularize(1e-4 * std::fmax(1.0, weight_sum));
+          continue;
+        }
+      }
+
+      // Line search on the metric itself, every trial put back on the constraint manifold by
+      // the retraction. Iterates stay feasible, so no merit function is needed and full Newton
+      // steps are never rejected near the solution for leaving the manifold (no Maratos effect).
+      auto accept = [&](Points&& trial, double v_trial, Eigen::VectorXd&& g_trial) {
+        x = std::move(trial);
+        value = v_trial;
+        g = std::move(g_trial);
+        c = constraints(x);
+        lambda = lambda_new;
+        stepped = true;
+      };
+      auto try_point = [&](double alpha, Points* trial, Eigen::VectorXd* g_trial) {
+        *trial = x + alpha * dx;
+        if (!Retract(lengths, k, trial)) return std::numeric_limits<double>::infinity();
+        g_trial->resize(size);
+        return evaluate(*trial, nullptr, g_trial);
+      };
+      // First the full Newton step: near the solution the metric changes by less than rounding,
+      // so it is judged by the Lagrangian's gradient, which it must halve, without raising the
+      // metric beyond rounding (Newton's method is drawn to saddles and maxima as well; the
+      // iterates are feasible, so this cannot lead away from the constraints).
+      // (Rounding of the metric: of its value, and of the positions, which the retraction
+      // recomputes, times the gradient.)
+      const double allowance =
+          64.0 * std::numeric_limits<double>::epsilon() *
+          (std::fabs(value) +
+           g.cwiseAbs().sum() * std::fmax(x.cwiseAbs().maxCoeff(), lengths.maxCoeff()));
+      {
+        Points trial;
+        Eigen::VectorXd g_trial;
+        const double v_trial = try_point(1.0, &trial, &g_trial);
+        const Eigen::VectorXd lag_trial = lagrangian_gradient(trial, g_trial, lambda_new);
+        // (The second test accepts a step that only corrects the multipliers: with as many
+        // constraints as unknowns the configuration is already determined.)
+        if (std::isfinite(v_trial) && v_trial <= value + allowance &&
+            (lag_trial.cwiseAbs().maxCoeff() <
+                 0.5 * lagrangian_gradient(x, g, lambda_new).cwiseAbs().maxCoeff() ||
+             optimality(trial, g_trial, lag_trial) <= options.optimality_tolerance)) {
+          accept(std::move(trial), v_trial, std::move(g_trial));
+          break;
+        }
+      }
+      // Otherwise Armijo backtracking on the metric, from a descent direction only.
+      double slope = 0.0;
+      for (int j = 1; j <= k; ++j) {
+        slope += g.segment(sink.offset[j], dim).dot(dx.row(j).transpose());
+      }
+      if (slope < 0.0) {
+        for (double alpha = 1.0; alpha > 1e-12 && !stepped; alpha *= 0.5) {
+          Points trial;
+          Eigen::VectorXd g_trial;
+          const double v_trial = try_point(alpha, &trial, &g_trial);
+          if (std::isfinite(v_trial) && v_trial <= value + 1e-4 * alpha * slope + allowance) {
+            accept(std::move(trial), v_trial, std::move(g_trial));
+          }
+        }
+      }
+      // No acceptable step: more regularization, then try again.
+      if (!stepped) regularize(1e-8 * std::fmax(1.0, g.cwiseAbs().maxCoeff()));
+    }
+    if (!stepped) {
+      report.objective = value;
+      report.constraint_violation = ConstraintViolation(lengths, x);
+      report.optimality = optimality(x, g, lagrangian_gradient(x, g, lambda));
+      const bool done = report.constraint_violation <= options.constraint_tolerance &&
+                        report.optimality <= options.optimality_tolerance;
+      report.status = done              ? OverallStatus::kConverged
+                      : lu.factorized() ? OverallStatus::kStalled
+                                        : OverallStatus::kFailed;
+      break;
+    }
+    regularization *= 0.1;
+    if (regularization < 1e-14) regularization = 0.0;
+  }
+  *start = x;
+  *multipliers = lambda;
+  return report;
+}
+
+}  // namespace flexkin::internal
