@@ -633,7 +633,9 @@ Scenario Parser::Parse(const json& root) {
     const std::string pointer = field == "substeps"                      ? "/leader/substeps"
                                 : field == "record_every"                ? "/record/every"
                                 : field == "tolerance"                   ? "/accuracy/tolerance"
-                                : field.rfind("overall.weights", 0) == 0 ? "/objective"
+                                : field.rfind("overall.weights.", 0) == 0
+                                    ? "/objective/" + field.substr(16)
+                                : field == "overall.weights"             ? "/objective"
                                 : field.rfind("overall.", 0) == 0        ? "/solver"
                                                                          : "/accuracy/max_substeps";
     Add(pointer, why.substr(why.find(':') + 2));
