@@ -1,68 +1,169 @@
 #pragma once
-// LU factorization of a banded matrix built from triplets, on LAPACK's dgbtrf/dgbtrs (used by
-// the overall solver: its KKT matrix is banded in the interleaved order).
+// Banded matrices for the overall solver, whose KKT matrix is banded in the interleaved order:
+// storage that the solver assembles into directly, an LU factorization with partial pivoting,
+// and the inertia of a symmetric banded matrix.
+//
+// The LU is LAPACK's dgbtf2/dgbtrs algorithm (same storage, same pivoting, so the same factors),
+// written out here because the systems are small and solved thousands of times: the reference
+// LAPACK spends most of its time in per-column BLAS calls at these sizes. tests/banded_lu_test.cc
+// checks it against LAPACK's dgbtrf/dgbtrs.
 
 #include <Eigen/Core>
-#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cassert>
-#include <cstdlib>
+#include <cmath>
 #include <vector>
-
-// LAPACK's banded LU with partial pivoting (Fortran interface; the trailing size_t is the hidden
-// length of the character argument).
-extern "C" {
-void dgbtrf_(const int* m, const int* n, const int* kl, const int* ku, double* ab, const int* ldab,
-             int* ipiv, int* info);
-void dgbtrs_(const char* trans, const int* n, const int* kl, const int* ku, const int* nrhs,
-             const double* ab, const int* ldab, const int* ipiv, double* b, const int* ldb,
-             int* info, size_t trans_length);
-}
 
 namespace flexkin::internal {
 
-using Triplets = std::vector<Eigen::Triplet<double>>;
+// A square matrix of half-bandwidth `band` (entries with |i - j| > band are 0), stored by
+// columns in LAPACK's band layout with room for the fill-in of partial pivoting:
+// A(i, j) = ab[j * ldab + 2 band + i - j], ldab = 3 band + 1.
+class BandMatrix {
+ public:
+  BandMatrix(int size, int band)
+      : size_(size), band_(band), ldab_(3 * band + 1), ab_(static_cast<size_t>(ldab_) * size) {}
 
-// LU factorization of a square banded matrix (half-bandwidth `band` above and below), built from
-// triplets (duplicates summed). Cost linear in the size for a fixed band.
+  int size() const { return size_; }
+  int band() const { return band_; }
+  void SetZero() { std::fill(ab_.begin(), ab_.end(), 0.0); }
+  // Adds v to A(i, j); (i, j) must lie in the band.
+  void Add(int i, int j, double v) {
+    assert(i >= 0 && j >= 0 && i < size_ && j < size_ && std::abs(i - j) <= band_);
+    ab_[Index(i, j)] += v;
+  }
+  double operator()(int i, int j) const {
+    return std::abs(i - j) <= band_ ? ab_[Index(i, j)] : 0.0;
+  }
+  // y = A x.
+  Eigen::VectorXd Multiply(const Eigen::VectorXd& x) const {
+    Eigen::VectorXd y = Eigen::VectorXd::Zero(size_);
+    double* out = y.data();
+    for (int j = 0; j < size_; ++j) {
+      const double xj = x[j];
+      if (xj == 0.0) continue;
+      const int first = std::max(0, j - band_), last = std::min(size_ - 1, j + band_);
+      const double* column = &ab_[Index(0, j)];
+      for (int i = first; i <= last; ++i) out[i] += column[i] * xj;
+    }
+    return y;
+  }
+
+ private:
+  friend class BandedLu;
+  friend int NegativePivots(const BandMatrix& a);
+  size_t Index(int i, int j) const {
+    return static_cast<size_t>(j) * ldab_ + (2 * band_ + i - j);
+  }
+
+  int size_, band_, ldab_;
+  std::vector<double> ab_;
+};
+
+// LU factorization with partial pivoting of a BandMatrix. Cost O(size band^2).
 class BandedLu {
  public:
-  BandedLu(int size, int band)
-      : size_(size),
-        band_(band),
-        ldab_(3 * band + 1),
-        ab_(static_cast<size_t>(ldab_) * size),
-        ipiv_(size) {}
+  explicit BandedLu(const BandMatrix& shape)
+      : lu_(shape.size(), shape.band()), ipiv_(shape.size()) {}
 
-  // False if the matrix is singular (or a triplet lies outside the band: a bug).
-  bool Factorize(const Triplets& triplets) {
-    std::fill(ab_.begin(), ab_.end(), 0.0);
-    for (const auto& t : triplets) {
-      const int i = t.row(), j = t.col();
-      assert(std::abs(i - j) <= band_);
-      ab_[static_cast<size_t>(j) * ldab_ + (2 * band_ + i - j)] += t.value();
+  // Factors a copy of `a` (of the shape given at construction). False if it is singular.
+  bool Factorize(const BandMatrix& a) {
+    assert(a.size() == lu_.size_ && a.band() == lu_.band_);
+    lu_.ab_ = a.ab_;
+    const int n = lu_.size_, kl = lu_.band_, ku = lu_.band_;
+    factorized_ = false;
+    int ju = 0;  // the last column that the pivot rows so far reach
+    for (int j = 0; j < n; ++j) {
+      const int km = std::min(kl, n - 1 - j);
+      double* column = &lu_.ab_[lu_.Index(j, j)];  // column[r] = A(j + r, j)
+      int jp = 0;
+      double largest = std::fabs(column[0]);
+      for (int r = 1; r <= km; ++r) {
+        const double v = std::fabs(column[r]);
+        if (v > largest) {
+          largest = v;
+          jp = r;
+        }
+      }
+      ipiv_[j] = j + jp;
+      if (column[jp] == 0.0 || !std::isfinite(column[jp])) return false;
+      ju = std::max(ju, std::min(j + ku + jp, n - 1));
+      if (jp != 0) {
+        for (int c = j; c <= ju; ++c) std::swap(lu_.ab_[lu_.Index(j, c)], lu_.ab_[lu_.Index(j + jp, c)]);
+      }
+      const double inverse = 1.0 / column[0];
+      for (int r = 1; r <= km; ++r) column[r] *= inverse;
+      for (int c = j + 1; c <= ju; ++c) {
+        const double u = lu_.ab_[lu_.Index(j, c)];
+        if (u == 0.0) continue;
+        double* target = &lu_.ab_[lu_.Index(j, c)];  // target[r] = A(j + r, c)
+        for (int r = 1; r <= km; ++r) target[r] -= column[r] * u;
+      }
     }
-    int info = 0;
-    dgbtrf_(&size_, &size_, &band_, &band_, ab_.data(), &ldab_, ipiv_.data(), &info);
-    factorized_ = info == 0;
-    return factorized_;
+    factorized_ = true;
+    return true;
   }
+
+  // Solves A x = rhs with the last factorization.
   Eigen::VectorXd Solve(const Eigen::VectorXd& rhs) const {
-    Eigen::VectorXd x = rhs;
-    const char trans = 'N';
-    const int one = 1;
-    int info = 0;
-    dgbtrs_(&trans, &size_, &band_, &band_, &one, ab_.data(), &ldab_, ipiv_.data(), x.data(),
-            &size_, &info, 1);
-    return x;
+    assert(factorized_);
+    const int n = lu_.size_, kl = lu_.band_, kv = 2 * lu_.band_;
+    Eigen::VectorXd solution = rhs;
+    double* b = solution.data();
+    for (int j = 0; j < n; ++j) {  // L, with the row interchanges in order
+      if (ipiv_[j] != j) std::swap(b[j], b[ipiv_[j]]);
+      const int km = std::min(kl, n - 1 - j);
+      const double* column = &lu_.ab_[lu_.Index(j, j)];
+      const double bj = b[j];
+      for (int r = 1; r <= km; ++r) b[j + r] -= column[r] * bj;
+    }
+    for (int j = n - 1; j >= 0; --j) {  // U, of half-bandwidth 2 band above the diagonal
+      const double* column = &lu_.ab_[lu_.Index(j, j)];
+      const double bj = b[j] / column[0];
+      b[j] = bj;
+      for (int i = std::max(0, j - kv); i < j; ++i) b[i] -= column[i - j] * bj;
+    }
+    return solution;
   }
   bool factorized() const { return factorized_; }
 
  private:
-  int size_, band_, ldab_;
-  std::vector<double> ab_;
+  BandMatrix lu_;
   std::vector<int> ipiv_;
   bool factorized_ = false;
 };
+
+// The inertia of a symmetric BandMatrix: by Sylvester's law, the signs of the pivots of its
+// LDL^T factorization without pivoting. Returns the number of negative pivots, or -1 when a pivot
+// is tiny (below 1e-12 times the largest entry: the factorization without pivoting is then not
+// to be trusted, and the caller must decide another way). Cost O(size band^2).
+inline int NegativePivots(const BandMatrix& a) {
+  const int n = a.size_, band = a.band_, width = band + 1;
+  // The lower triangle, column by column: l[j * width + (i - j)] for j <= i <= j + band.
+  std::vector<double> l(static_cast<size_t>(n) * width, 0.0);
+  double scale = 0.0;
+  for (int j = 0; j < n; ++j) {
+    for (int i = j; i <= std::min(n - 1, j + band); ++i) {
+      l[static_cast<size_t>(j) * width + (i - j)] = a(i, j);
+      scale = std::max(scale, std::fabs(a(i, j)));
+    }
+  }
+  int negative = 0;
+  for (int j = 0; j < n; ++j) {
+    const double* column = &l[static_cast<size_t>(j) * width];
+    const double pivot = column[0];
+    if (!(std::fabs(pivot) > 1e-12 * scale)) return -1;
+    if (pivot < 0.0) ++negative;
+    // A(i, k) -= A(i, j) A(k, j) / pivot for j < k <= i <= j + band.
+    const int last = std::min(n - 1, j + band);
+    for (int k = j + 1; k <= last; ++k) {
+      const double f = column[k - j] / pivot;
+      if (f == 0.0) continue;
+      double* target = &l[static_cast<size_t>(k) * width];
+      for (int i = k; i <= last; ++i) target[i - k] -= f * column[i - j];
+    }
+  }
+  return negative;
+}
 
 }  // namespace flexkin::internal

@@ -301,6 +301,23 @@ OverallReport OverallStep(const Eigen::VectorXd& lengths,
   OverallReport report;
   int iterations = 0;
   Chain chain{old_points, lengths};
+  // Without an L2 term, first one Newton run from the sequential tractrix step of the whole move:
+  // kept if it converges to a strict local minimizer (the inertia of the KKT matrix says so),
+  // which is the usual case and several times cheaper than the continuation below.
+  if (!l2 && sub_steps > 1) {
+    Chain direct{old_points, lengths};
+    MoveLeader(Method::kTractrix, head, 1, &direct);
+    Eigen::VectorXd multipliers;
+    bool strict = false;
+    report = internal::NewtonSolve(lengths, old_points, options, n, &direct.points, &multipliers,
+                                   0.0, &strict);
+    iterations = report.iterations;
+    if (report.converged() && strict) {
+      report.start = "sequential tractrix step (a strict local minimizer: KKT inertia checked)";
+      *points = direct.points;
+      return report;
+    }
+  }
   for (int s = 1; s <= sub_steps; ++s) {
     const Eigen::VectorXd target =
         s == sub_steps

@@ -11,12 +11,24 @@
 namespace flexkin::internal {
 namespace {
 
+// A vector of a point's coordinates (2 or 3) without heap allocation: the loops over links below
+// run in every Newton iteration.
+using PointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 3, 1>;
+
 // The follow-the-leader projection from the (fixed) head down: exact lengths in one pass.
+// (Plain loops on the row-major storage: this runs for every trial point of the line search.)
 void RetractFollowTheLeader(const Eigen::VectorXd& lengths, Points* x) {
+  const int dim = static_cast<int>(x->cols());
+  double* p = x->data();
   for (Eigen::Index i = 1; i < x->rows(); ++i) {
-    const Eigen::VectorXd d = (x->row(i) - x->row(i - 1)).transpose();
-    const double norm = d.norm();
-    if (norm > 0.0) x->row(i) = x->row(i - 1) + (lengths[i - 1] / norm) * d.transpose();
+    double* point = p + i * dim;
+    const double* previous = point - dim;
+    double sq = 0.0;
+    for (int k = 0; k < dim; ++k) sq += (point[k] - previous[k]) * (point[k] - previous[k]);
+    const double norm = std::sqrt(sq);
+    if (!(norm > 0.0)) continue;
+    const double f = lengths[i - 1] / norm;
+    for (int k = 0; k < dim; ++k) point[k] = previous[k] + f * (point[k] - previous[k]);
   }
 }
 
@@ -93,7 +105,8 @@ bool Retract(const Eigen::VectorXd& lengths, int moving, Points* x) {
 
 OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_points,
                           const OverallOptions& options, int moving, Points* start,
-                          Eigen::VectorXd* multipliers, double smoothing) {
+                          Eigen::VectorXd* multipliers, double smoothing,
+                          bool* strict_minimizer) {
   const int n = static_cast<int>(lengths.size());
   const int k = moving;
   const int nc = k < n ? k + 1 : n;  // constraints: links 1..k, and link k+1 to the fixed point
@@ -115,9 +128,9 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
   const int last = std::min(n, k + 1);  // the objective's terms beyond are 0
 
   Eigen::VectorXd g(size), lambda = Eigen::VectorXd::Zero(nc), rhs(size);
-  auto evaluate = [&](const Points& p, Triplets* hessian, Eigen::VectorXd* grad) {
+  auto evaluate = [&](const Points& p, BandMatrix* hessian, Eigen::VectorXd* grad) {
     sink.gradient = grad;
-    sink.hessian = hessian;
+    sink.band = hessian;
     if (grad != nullptr) grad->setZero(size);
     return Evaluate(options.weights, lengths, old_points, p, sink, last, smoothing);
   };
@@ -132,16 +145,20 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
   // Gradient of the Lagrangian g + J^T lambda (x rows only).
   auto lagrangian_gradient = [&](const Points& p, const Eigen::VectorXd& grad,
                                  const Eigen::VectorXd& lam) {
-    Eigen::VectorXd r = grad;
+    Eigen::VectorXd result = grad;
+    double* r = result.data();
+    const double* points = p.data();
     for (int i = 1; i <= nc; ++i) {
-      const Eigen::VectorXd e = (p.row(i) - p.row(i - 1)).transpose() / lengths[i - 1];
+      const double f = lam[i - 1] / lengths[i - 1];
+      const double* a = points + (i - 1) * dim;
       for (int c = 0; c < dim; ++c) {
-        if (i <= k) r[sink.offset[i] + c] += lam[i - 1] * e[c];
-        if (i > 1) r[sink.offset[i - 1] + c] -= lam[i - 1] * e[c];
+        const double force = f * (a[dim + c] - a[c]);  // lambda_i e_i
+        if (i <= k) r[sink.offset[i] + c] += force;
+        if (i > 1) r[sink.offset[i - 1] + c] -= force;
       }
     }
     for (int i = 1; i <= nc; ++i) r[multiplier_row(i)] = 0.0;
-    return r;
+    return result;
   };
   // First-order optimality: the Lagrangian's gradient relative to the objective's gradient (now
   // or at the start, whichever is larger). Where the metric is 0 at the solution (a still head,
@@ -167,12 +184,38 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
   // Half-bandwidth of the KKT matrix in the interleaved order: x_j reaches x_{j+1} (2 dim) and
   // lambda_j reaches x_{j-1} (2 dim + 1); the joint-angle term reaches x_{j+2} (3 dim + 1).
   const int band = options.weights.joint_angle > 0.0 ? 3 * dim + 1 : 2 * dim + 1;
-  BandedLu lu(size, std::min(band, size - 1));
+  BandMatrix kkt(size, std::min(band, size - 1));  // the KKT matrix, assembled in place
+  BandedLu lu(kkt);
   double regularization = 0.0;
   double value = evaluate(x, nullptr, &g);
   start_gradient = g.cwiseAbs().maxCoeff();
   Eigen::VectorXd c = constraints(x);
 
+  // The KKT matrix [H, J^T; J, 0] at (p, lam), H = hess f + sum lam_i hess c_i, into `kkt`.
+  auto assemble = [&](const Points& p, const Eigen::VectorXd& lam) {
+    kkt.SetZero();
+    evaluate(p, &kkt, nullptr);
+    for (int i = 1; i <= nc; ++i) {
+      const double s = lam[i - 1] / lengths[i - 1];
+      sink.Identity(i, i, s);
+      if (i > 1) {
+        sink.Identity(i - 1, i - 1, s);
+        sink.Identity(i, i - 1, -s);
+        sink.Identity(i - 1, i, -s);
+      }
+      const PointVector e = (p.row(i) - p.row(i - 1)).transpose() / lengths[i - 1];
+      for (int q = 0; q < dim; ++q) {
+        if (i <= k) {
+          kkt.Add(multiplier_row(i), sink.offset[i] + q, e[q]);
+          kkt.Add(sink.offset[i] + q, multiplier_row(i), e[q]);
+        }
+        if (i > 1) {
+          kkt.Add(multiplier_row(i), sink.offset[i - 1] + q, -e[q]);
+          kkt.Add(sink.offset[i - 1] + q, multiplier_row(i), -e[q]);
+        }
+      }
+    }
+  };
   for (report.iterations = 0;; ++report.iterations) {
     const Eigen::VectorXd lag = lagrangian_gradient(x, g, lambda);
     report.objective = value;
@@ -192,35 +235,13 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
       break;
     }
 
-    // KKT matrix: [H + delta I, J^T; J, 0] with H = hess f + sum lambda_i hess c_i.
-    Triplets t;
-    evaluate(x, &t, nullptr);
-    for (int i = 1; i <= nc; ++i) {
-      const double s = lambda[i - 1] / lengths[i - 1];
-      sink.Identity(i, i, s);
-      if (i > 1) {
-        sink.Identity(i - 1, i - 1, s);
-        sink.Identity(i, i - 1, -s);
-        sink.Identity(i - 1, i, -s);
-      }
-      const Eigen::VectorXd e = (x.row(i) - x.row(i - 1)).transpose() / lengths[i - 1];
-      for (int q = 0; q < dim; ++q) {
-        if (i <= k) {
-          t.emplace_back(multiplier_row(i), sink.offset[i] + q, e[q]);
-          t.emplace_back(sink.offset[i] + q, multiplier_row(i), e[q]);
-        }
-        if (i > 1) {
-          t.emplace_back(multiplier_row(i), sink.offset[i - 1] + q, -e[q]);
-          t.emplace_back(sink.offset[i - 1] + q, multiplier_row(i), -e[q]);
-        }
-      }
-    }
+    assemble(x, lambda);
     // Regularization delta I on the Hessian block, carried over (decayed) from the last
     // iteration; `regularize` adds more: `first` if there was none, else 10 times as much.
     auto add_to_diagonal = [&](double amount) {
       for (int j = 1; j <= k; ++j) {
         for (int q = 0; q < dim; ++q)
-          t.emplace_back(sink.offset[j] + q, sink.offset[j] + q, amount);
+          kkt.Add(sink.offset[j] + q, sink.offset[j] + q, amount);
       }
     };
     auto regularize = [&](double first) {
@@ -233,7 +254,7 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
     // Newton step for (x, lambda_new): [H J^T; J 0] [dx; lambda_new] = -[g; c].
     bool stepped = false;
     for (int attempt = 0; attempt < 12 && !stepped; ++attempt) {
-      lu.Factorize(t);
+      lu.Factorize(kkt);
       if (!lu.factorized()) {
         regularize(1e-10 * std::fmax(1.0, g.cwiseAbs().maxCoeff()));  // singular
         continue;
@@ -254,14 +275,14 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
       // the regularized Lagrangian, dx' (H + delta I) dx >= 1e-8 |dx|^2 (scaled); else more
       // regularization. Otherwise Newton heads for a saddle or maximum on non-convex terms.
       {
+        // dx' (H + delta I) dx (the multiplier rows of dx_only are 0, so the Jacobian's
+        // entries add nothing). (Not -g' dx + c' lambda_new, which the system implies: near the
+        // solution that cancels catastrophically.)
         Eigen::VectorXd dx_only = Eigen::VectorXd::Zero(size);
         for (int j = 1; j <= k; ++j) {
           for (int q = 0; q < dim; ++q) dx_only[sink.offset[j] + q] = dx(j, q);
         }
-        // dx' (H + delta I) dx, from the triplets of the Hessian block (multiplier rows of
-        // dx_only are 0, so the Jacobian's entries add nothing).
-        double curvature = 0.0;
-        for (const auto& e : t) curvature += dx_only[e.row()] * e.value() * dx_only[e.col()];
+        const double curvature = dx_only.dot(kkt.Multiply(dx_only));
         const double floor = 1e-8 * std::fmax(1.0, weight_sum) * dx.squaredNorm();
         if (curvature < floor && dx.squaredNorm() > 0.0) {
           regularize(1e-4 * std::fmax(1.0, weight_sum));
@@ -342,6 +363,15 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
     }
     regularization *= 0.1;
     if (regularization < 1e-14) regularization = 0.0;
+  }
+  // A strict local minimizer (second-order sufficient conditions) has a KKT matrix with exactly
+  // as many negative eigenvalues as constraints and none zero.
+  if (strict_minimizer != nullptr) {
+    *strict_minimizer = false;
+    if (report.converged()) {
+      assemble(x, lambda);
+      *strict_minimizer = NegativePivots(kkt) == nc;
+    }
   }
   *start = x;
   *multipliers = lambda;

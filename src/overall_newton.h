@@ -22,9 +22,12 @@ bool Retract(const Eigen::VectorXd& lengths, int moving, Points* x);
 // are in `*x`, from the feasible configuration `*x` (point 0 the prescribed head). `*x` becomes
 // the result and `*multipliers` the Lagrange multipliers of the constraints on links
 // 1..min(moving + 1, n) (of (|D_i|^2 - L_i^2) / (2 L_i)). The report's `start` is left empty.
-// `smoothing` > 0 solves the L2 term smoothed (see Evaluate) instead.
+// `smoothing` > 0 solves the L2 term smoothed (see Evaluate) instead. If `strict_minimizer` is
+// not null, it tells whether the result is a strict local minimizer, from the inertia of the KKT
+// matrix there (false also when that cannot be decided).
 OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_points,
                           const OverallOptions& options, int moving, Points* x,
-                          Eigen::VectorXd* multipliers, double smoothing = 0.0);
+                          Eigen::VectorXd* multipliers, double smoothing = 0.0,
+                          bool* strict_minimizer = nullptr);
 
 }  // namespace flexkin::internal

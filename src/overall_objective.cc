@@ -49,7 +49,7 @@ double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const
       if (r == 0.0) continue;
       for (int k = 0; k < dim; ++k) d[k] /= r;
       sink.Gradient(j, d, s);
-      if (sink.hessian == nullptr) continue;
+      if (!sink.WantsHessian()) continue;
       for (int a = 0; a < dim; ++a) {
         for (int b = 0; b < dim; ++b) block[a * dim + b] = ((a == b ? 1.0 : 0.0) - d[a] * d[b]) / r;
       }
@@ -109,7 +109,7 @@ double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const
       const double c = w.joint_angle * 0.5 * (lengths[i - 1] + lengths[i]);
       const double delta = Wrap(TurnAngle(u.data(), v.data()) - TurnAngle(u0.data(), v0.data()));
       value += c * delta * delta;
-      if (sink.gradient == nullptr && sink.hessian == nullptr) continue;
+      if (sink.gradient == nullptr && !sink.WantsHessian()) continue;
       // Explicit return types: an Eigen expression returned by `auto` would dangle.
       auto grad_theta = [](const Eigen::Vector2d& q) -> Eigen::Vector2d {
         return Eigen::Vector2d(-q.y(), q.x()) / q.squaredNorm();

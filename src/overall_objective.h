@@ -6,6 +6,7 @@
 #include <Eigen/SparseCore>
 #include <vector>
 
+#include "banded_lu.h"
 #include "flexkin/overall.h"
 
 namespace flexkin::internal {
@@ -18,26 +19,33 @@ using Triplets = std::vector<Eigen::Triplet<double>>;
 struct Sink {
   int dim = 0;
   Eigen::VectorXd* gradient = nullptr;  // may be null
-  Triplets* hessian = nullptr;          // may be null
+  // The Hessian goes to `band` if set (the solver), else to `hessian` if set.
+  BandMatrix* band = nullptr;
+  Triplets* hessian = nullptr;
   std::vector<int> offset;              // offset[j] for j = 0..n; -1: point j is fixed
 
+  bool WantsHessian() const { return band != nullptr || hessian != nullptr; }
   void Gradient(int j, const double* g, double scale) const {
     if (gradient == nullptr || offset[j] < 0) return;
     for (int k = 0; k < dim; ++k) (*gradient)[offset[j] + k] += scale * g[k];
   }
   // Adds scale * block (dim by dim, row-major in `b`) at (point p, point q).
   void Block(int p, int q, const double* b, double scale) const {
-    if (hessian == nullptr || offset[p] < 0 || offset[q] < 0) return;
+    if (!WantsHessian() || offset[p] < 0 || offset[q] < 0) return;
     for (int r = 0; r < dim; ++r) {
-      for (int c = 0; c < dim; ++c) {
-        // Zeros too: the pattern must not change between iterations.
-        hessian->emplace_back(offset[p] + r, offset[q] + c, scale * b[r * dim + c]);
-      }
+      for (int c = 0; c < dim; ++c) Add(offset[p] + r, offset[q] + c, scale * b[r * dim + c]);
     }
   }
   void Identity(int p, int q, double scale) const {
-    if (hessian == nullptr || offset[p] < 0 || offset[q] < 0) return;
-    for (int r = 0; r < dim; ++r) hessian->emplace_back(offset[p] + r, offset[q] + r, scale);
+    if (!WantsHessian() || offset[p] < 0 || offset[q] < 0) return;
+    for (int r = 0; r < dim; ++r) Add(offset[p] + r, offset[q] + r, scale);
+  }
+  void Add(int row, int col, double value) const {
+    if (band != nullptr) {
+      band->Add(row, col, value);
+    } else {
+      hessian->emplace_back(row, col, value);
+    }
   }
 };
 
