@@ -70,6 +70,16 @@ class BandedLu {
   bool Factorize(const BandMatrix& a) {
     assert(a.size() == lu_.size_ && a.band() == lu_.band_);
     lu_.ab_ = a.ab_;
+    return FactorizeStorage();
+  }
+  // The same without the copy: takes `*a`'s storage, leaving `*a` with unspecified entries
+  // (for large systems, where the copy is a large part of the memory traffic).
+  bool FactorizeInPlace(BandMatrix* a) {
+    assert(a->size() == lu_.size_ && a->band() == lu_.band_);
+    std::swap(lu_.ab_, a->ab_);
+    return FactorizeStorage();
+  }
+  bool FactorizeStorage() {
     const int n = lu_.size_, kl = lu_.band_, ku = lu_.band_;
     factorized_ = false;
     int ju = 0;  // the last column that the pivot rows so far reach

@@ -131,6 +131,7 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
   auto evaluate = [&](const Points& p, BandMatrix* hessian, Eigen::VectorXd* grad) {
     sink.gradient = grad;
     sink.band = hessian;
+    sink.form = nullptr;
     if (grad != nullptr) grad->setZero(size);
     return Evaluate(options.weights, lengths, old_points, p, sink, last, smoothing);
   };
@@ -191,10 +192,10 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
   start_gradient = g.cwiseAbs().maxCoeff();
   Eigen::VectorXd c = constraints(x);
 
-  // The KKT matrix [H, J^T; J, 0] at (p, lam), H = hess f + sum lam_i hess c_i, into `kkt`.
-  auto assemble = [&](const Points& p, const Eigen::VectorXd& lam) {
-    kkt.SetZero();
-    evaluate(p, &kkt, nullptr);
+  // H = hess f + sum lam_i hess c_i at (p, lam), into the sink's Hessian target.
+  auto hessian_terms = [&](const Points& p, const Eigen::VectorXd& lam) {
+    sink.gradient = nullptr;
+    Evaluate(options.weights, lengths, old_points, p, sink, last, smoothing);
     for (int i = 1; i <= nc; ++i) {
       const double s = lam[i - 1] / lengths[i - 1];
       sink.Identity(i, i, s);
@@ -203,6 +204,26 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
         sink.Identity(i, i - 1, -s);
         sink.Identity(i - 1, i, -s);
       }
+    }
+  };
+  // v' H v at (p, lam), v indexed like the unknowns (its multiplier rows ignored).
+  auto curvature_along = [&](const Points& p, const Eigen::VectorXd& lam,
+                             const Eigen::VectorXd& v) {
+    double form = 0.0;
+    sink.band = nullptr;
+    sink.form = &form;
+    sink.form_vector = v.data();
+    hessian_terms(p, lam);
+    sink.form = nullptr;
+    return form;
+  };
+  // The KKT matrix [H, J^T; J, 0] at (p, lam), into `kkt`.
+  auto assemble = [&](const Points& p, const Eigen::VectorXd& lam) {
+    kkt.SetZero();
+    sink.band = &kkt;
+    sink.form = nullptr;
+    hessian_terms(p, lam);
+    for (int i = 1; i <= nc; ++i) {
       const PointVector e = (p.row(i) - p.row(i - 1)).transpose() / lengths[i - 1];
       for (int q = 0; q < dim; ++q) {
         if (i <= k) {
@@ -235,26 +256,20 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
       break;
     }
 
-    assemble(x, lambda);
     // Regularization delta I on the Hessian block, carried over (decayed) from the last
-    // iteration; `regularize` adds more: `first` if there was none, else 10 times as much.
-    auto add_to_diagonal = [&](double amount) {
-      for (int j = 1; j <= k; ++j) {
-        for (int q = 0; q < dim; ++q)
-          kkt.Add(sink.offset[j] + q, sink.offset[j] + q, amount);
-      }
-    };
+    // iteration; `regularize` raises it: to `first` if there was none, else 11 times.
     auto regularize = [&](double first) {
-      const double bump = regularization == 0.0 ? first : 10.0 * regularization;
-      add_to_diagonal(bump);
-      regularization += bump;
+      regularization += regularization == 0.0 ? first : 10.0 * regularization;
     };
-    add_to_diagonal(regularization);
 
-    // Newton step for (x, lambda_new): [H J^T; J 0] [dx; lambda_new] = -[g; c].
+    // Newton step for (x, lambda_new): [H + delta I, J^T; J, 0] [dx; lambda_new] = -[g; c].
     bool stepped = false;
     for (int attempt = 0; attempt < 12 && !stepped; ++attempt) {
-      lu.Factorize(kkt);
+      assemble(x, lambda);
+      for (int j = 1; j <= k; ++j) {
+        for (int q = 0; q < dim; ++q) kkt.Add(sink.offset[j] + q, sink.offset[j] + q, regularization);
+      }
+      lu.FactorizeInPlace(&kkt);
       if (!lu.factorized()) {
         regularize(1e-10 * std::fmax(1.0, g.cwiseAbs().maxCoeff()));  // singular
         continue;
@@ -275,14 +290,14 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
       // the regularized Lagrangian, dx' (H + delta I) dx >= 1e-8 |dx|^2 (scaled); else more
       // regularization. Otherwise Newton heads for a saddle or maximum on non-convex terms.
       {
-        // dx' (H + delta I) dx (the multiplier rows of dx_only are 0, so the Jacobian's
-        // entries add nothing). (Not -g' dx + c' lambda_new, which the system implies: near the
-        // solution that cancels catastrophically.)
+        // dx' (H + delta I) dx, evaluated term by term (not -g' dx + c' lambda_new, which the
+        // system implies: near the solution that cancels catastrophically).
         Eigen::VectorXd dx_only = Eigen::VectorXd::Zero(size);
         for (int j = 1; j <= k; ++j) {
           for (int q = 0; q < dim; ++q) dx_only[sink.offset[j] + q] = dx(j, q);
         }
-        const double curvature = dx_only.dot(kkt.Multiply(dx_only));
+        const double curvature =
+            curvature_along(x, lambda, dx_only) + regularization * dx.squaredNorm();
         const double floor = 1e-8 * std::fmax(1.0, weight_sum) * dx.squaredNorm();
         if (curvature < floor && dx.squaredNorm() > 0.0) {
           regularize(1e-4 * std::fmax(1.0, weight_sum));
@@ -321,9 +336,10 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
         Points trial;
         Eigen::VectorXd g_trial;
         const double v_trial = try_point(1.0, &trial, &g_trial);
-        const Eigen::VectorXd lag_trial = lagrangian_gradient(trial, g_trial, lambda_new);
         // (The second test accepts a step that only corrects the multipliers: with as many
         // constraints as unknowns the configuration is already determined.)
+        Eigen::VectorXd lag_trial;
+        if (std::isfinite(v_trial)) lag_trial = lagrangian_gradient(trial, g_trial, lambda_new);
         if (std::isfinite(v_trial) && v_trial <= value + allowance &&
             (lag_trial.cwiseAbs().maxCoeff() <
                  0.5 * lagrangian_gradient(x, g, lambda_new).cwiseAbs().maxCoeff() ||

@@ -19,12 +19,16 @@ using Triplets = std::vector<Eigen::Triplet<double>>;
 struct Sink {
   int dim = 0;
   Eigen::VectorXd* gradient = nullptr;  // may be null
-  // The Hessian goes to `band` if set (the solver), else to `hessian` if set.
+  // The Hessian goes to `band` if set (the solver), else into the quadratic form
+  // `*form` += v' H v with v = `form_vector` (indexed like the unknowns) if set, else to
+  // `hessian` if set.
   BandMatrix* band = nullptr;
+  double* form = nullptr;
+  const double* form_vector = nullptr;
   Triplets* hessian = nullptr;
   std::vector<int> offset;              // offset[j] for j = 0..n; -1: point j is fixed
 
-  bool WantsHessian() const { return band != nullptr || hessian != nullptr; }
+  bool WantsHessian() const { return band != nullptr || form != nullptr || hessian != nullptr; }
   void Gradient(int j, const double* g, double scale) const {
     if (gradient == nullptr || offset[j] < 0) return;
     for (int k = 0; k < dim; ++k) (*gradient)[offset[j] + k] += scale * g[k];
@@ -43,6 +47,8 @@ struct Sink {
   void Add(int row, int col, double value) const {
     if (band != nullptr) {
       band->Add(row, col, value);
+    } else if (form != nullptr) {
+      *form += value * form_vector[row] * form_vector[col];
     } else {
       hessian->emplace_back(row, col, value);
     }
