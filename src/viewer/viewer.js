@@ -126,7 +126,7 @@
   // ----- Drawing ---------------------------------------------------------------------------------
   const colors = {
     background: '#fbfbfd', grid: '#e6e9ef', gridLabel: '#8a93a5', axis: '#c9ced8',
-    leader: '#e08a1e', lead: '#d62f2f', tail: '#1d2330',
+    leader: '#e08a1e', lead: '#d62f2f', tail: '#1d2330', shadow: 'rgba(60, 70, 90, 0.18)',
   };
   const trailColors = ['#2a9d8f', '#8e44ad', '#e76f51', '#1f77b4', '#c2185b', '#6a8d1f'];
   // Chain colour and width by depth in 3D: far links light and thin, near ones dark and thick.
@@ -178,15 +178,16 @@
       g.lineTo(width, Math.round(sy) + 0.5);
     }
     g.stroke();
+    // Labels along the top and left edges, none in the corners where they would collide.
     g.textBaseline = 'top';
     for (let x = Math.ceil(x0 / step) * step; x <= x1; x += step) {
       project(x, 0, 0);
-      g.fillText(formatTick(x, step), sx + 3, 3);
+      if (sx > 36 && sx < width - 30) g.fillText(formatTick(x, step), sx + 3, 3);
     }
     g.textBaseline = 'bottom';
     for (let y = Math.ceil(y0 / step) * step; y <= y1; y += step) {
       project(0, y, 0);
-      g.fillText(formatTick(y, step), 3, sy - 2);
+      if (sy > 30 && sy < height - 24) g.fillText(formatTick(y, step), 3, sy - 2);
     }
   }
 
@@ -276,6 +277,16 @@
       for (let i = 1; i < numPoints; ++i) g.lineTo(screenX[i], screenY[i]);
       g.stroke();
     } else {
+      // The chain's shadow on the floor grid, straight down: where it is over the floor.
+      g.strokeStyle = colors.shadow;
+      g.lineWidth = 2;
+      g.beginPath();
+      for (let i = 0; i < numPoints; ++i) {
+        const o = frame * frameStride + i * dim;
+        project(pos[o], pos[o + 1], lo[2]);
+        if (i === 0) g.moveTo(sx, sy); else g.lineTo(sx, sy);
+      }
+      g.stroke();
       // Link i joins points i and i+1; far links first so near ones cover them.
       for (let i = 0; i + 1 < numPoints; ++i) linkDepth[i] = 0.5 * (linkDepth[i] + linkDepth[i + 1]);
       linkOrder.sort(byDepth);
@@ -427,8 +438,11 @@
     image.height = sparkCanvas.height;
     const ig = image.getContext('2d');
     ig.scale(r, r);
-    let max = 0;
-    for (let i = 0; i < values.length; ++i) max = Math.max(max, values[i]);
+    let max = 0, min = Infinity;
+    for (let i = 0; i < values.length; ++i) {
+      max = Math.max(max, values[i]);
+      min = Math.min(min, values[i]);
+    }
     const pad = 4;
     const xOf = (i) => pad + (w - 2 * pad) * (values.length > 1 ? i / (values.length - 1) : 0.5);
     const yOf = (v) => h - pad - (h - 2 * pad - 10) * (max > 0 ? v / max : 0);
@@ -444,7 +458,7 @@
     ig.fillStyle = '#5b6475';
     ig.font = '10px system-ui, sans-serif';
     ig.textBaseline = 'top';
-    ig.fillText('max ' + fmt(max), pad + 2, 1);
+    ig.fillText('max ' + fmt(max) + ' \u00b7 min ' + fmt(values.length ? min : 0), pad + 2, 1);
     return { g, image, w, h, xOf, yOf, r };
   }
 
