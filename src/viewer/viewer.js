@@ -1,0 +1,764 @@
+// flexkin viewer: plays a chain's recorded motion from the JSON embedded in the page.
+// Plain JavaScript and Canvas 2D; nothing is fetched. The data's layout is written by
+// src/viewer/viewer_data.cc. Drawing runs in requestAnimationFrame and allocates no arrays per
+// frame: positions sit in one Float64Array, projected points in preallocated typed arrays, and
+// the grid and the whole leader path are drawn once per view change into a background layer.
+(function () {
+  'use strict';
+
+  const $ = (id) => document.getElementById(id);
+
+  // ----- Data ----------------------------------------------------------------------------------
+  let data;
+  try {
+    data = JSON.parse($('flexkin-data').textContent);
+  } catch (e) {
+    const box = $('message');
+    box.textContent = 'This page holds no result data. Write it with flexkin ' +
+        '(flexkin render, or WriteViewerHtml in C++).';
+    box.hidden = false;
+    return;
+  }
+  const dim = data.dim;
+  const numPoints = data.num_links + 1;
+  const numFrames = data.steps.length;
+  const frameStride = numPoints * dim;
+  // Coordinate k of point i in frame f: pos[f * frameStride + i * dim + k].
+  const pos = new Float64Array(data.positions);
+  data.positions = null;
+  const steps = Float64Array.from(data.steps);
+  const options = data.options;
+
+  // Bounding box of the whole motion, its centre and the radius of its bounding sphere.
+  const lo = [Infinity, Infinity, Infinity];
+  const hi = [-Infinity, -Infinity, -Infinity];
+  for (let j = 0; j < pos.length; j += dim) {
+    for (let k = 0; k < dim; ++k) {
+      if (pos[j + k] < lo[k]) lo[k] = pos[j + k];
+      if (pos[j + k] > hi[k]) hi[k] = pos[j + k];
+    }
+  }
+  if (dim === 2) { lo[2] = 0; hi[2] = 0; }
+  const totalLength = data.link_lengths.reduce((a, b) => a + b, 0);
+  const center = [0, 1, 2].map((k) => (lo[k] + hi[k]) / 2);
+  const radius = Math.max(0.5 * Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]),
+                          1e-3 * totalLength, 1e-12);
+
+  // ----- View: 2D pan and zoom, 3D orbit ---------------------------------------------------------
+  const canvas = $('view');
+  const ctx = canvas.getContext('2d');
+  const background = document.createElement('canvas');  // grid and whole leader path
+  const bgCtx = background.getContext('2d');
+  let width = 1, height = 1, pixelRatio = 1;             // CSS pixels, device pixels per CSS pixel
+  const view = {
+    scale: 1,              // CSS pixels per length unit
+    panX: 0, panY: 0,      // CSS pixels
+    azimuth: options.azimuth_deg * Math.PI / 180,
+    elevation: options.elevation_deg * Math.PI / 180,
+    perspective: options.perspective,
+  };
+  // Camera basis for 3D: right, up and towards the viewer, 3 numbers each.
+  const basis = new Float64Array(9);
+  const cameraDistance = 3 * radius;  // perspective: eye distance from the centre
+
+  function updateBasis() {
+    const ca = Math.cos(view.azimuth), sa = Math.sin(view.azimuth);
+    const ce = Math.cos(view.elevation), se = Math.sin(view.elevation);
+    basis.set([-sa, ca, 0, -se * ca, -se * sa, ce, ce * ca, ce * sa, se]);
+  }
+
+  function fitView() {
+    const margin = 0.9;
+    if (dim === 2) {
+      const w = Math.max(hi[0] - lo[0], 1e-3 * totalLength, 1e-12);
+      const h = Math.max(hi[1] - lo[1], 1e-3 * totalLength, 1e-12);
+      view.scale = margin * Math.min(width / w, height / h);
+    } else {
+      // The nearest points are enlarged by up to 1.5 in perspective.
+      view.scale = margin * Math.min(width, height) / (2 * radius) / (view.perspective ? 1.5 : 1);
+    }
+    view.panX = 0;
+    view.panY = 0;
+    state.viewMoved = false;
+    updateBasis();
+  }
+
+  // project() leaves its result here rather than in a new object: CSS pixels and depth
+  // (length units towards the viewer, 0 at the centre; always 0 in 2D).
+  let sx = 0, sy = 0, sdepth = 0;
+  function project(x, y, z) {
+    x -= center[0];
+    y -= center[1];
+    let a = x, b = y, depth = 0, f = 1;
+    if (dim === 3) {
+      z -= center[2];
+      a = x * basis[0] + y * basis[1] + z * basis[2];
+      b = x * basis[3] + y * basis[4] + z * basis[5];
+      depth = x * basis[6] + y * basis[7] + z * basis[8];
+      if (view.perspective) f = cameraDistance / (cameraDistance - depth);
+    }
+    sx = width / 2 + view.panX + a * view.scale * f;
+    sy = height / 2 + view.panY - b * view.scale * f;
+    sdepth = depth;
+  }
+  function projectPoint(frame, i) {
+    const o = frame * frameStride + i * dim;
+    project(pos[o], pos[o + 1], dim === 3 ? pos[o + 2] : 0);
+  }
+
+  // ----- State -----------------------------------------------------------------------------------
+  const state = {
+    frame: 0,
+    playhead: 0,          // frames, fractional while playing
+    playing: false,
+    speed: 1,
+    showLeader: options.show_leader_path,
+    showTrails: options.trail_points.length > 0,
+    trails: options.trail_points.length > 0 ? options.trail_points.slice() : [numPoints - 1],
+    dirty: true,          // redraw the chain
+    backgroundDirty: true,
+    viewMoved: false,     // panned, zoomed or orbited since the last fit
+  };
+  const framesPerSecond = numFrames / options.playback_seconds;  // at 1x
+  // For tests and the curious: what has been drawn, and how long drawing took.
+  const stats = { ticks: 0, draws: 0, drawMs: 0, maxDrawMs: 0 };
+
+  // ----- Drawing ---------------------------------------------------------------------------------
+  const colors = {
+    background: '#fbfbfd', grid: '#e6e9ef', gridLabel: '#8a93a5', axis: '#c9ced8',
+    leader: '#e08a1e', lead: '#d62f2f', tail: '#1d2330', shadow: 'rgba(60, 70, 90, 0.18)',
+  };
+  const trailColors = ['#2a9d8f', '#8e44ad', '#e76f51', '#1f77b4', '#c2185b', '#6a8d1f'];
+  // Chain colour and width by depth in 3D: far links light and thin, near ones dark and thick.
+  const shades = [];
+  for (let s = 0; s < 16; ++s) {
+    const t = s / 15;
+    shades.push('rgb(' + Math.round(170 - 140 * t) + ',' + Math.round(185 - 135 * t) + ',' +
+                Math.round(215 - 95 * t) + ')');
+  }
+  const screenX = new Float64Array(numPoints);
+  const screenY = new Float64Array(numPoints);
+  const linkDepth = new Float64Array(numPoints);
+  const linkOrder = Array.from({ length: numPoints - 1 }, (_, i) => i);
+  const byDepth = (a, b) => linkDepth[a] - linkDepth[b];
+
+  // A round step (1, 2 or 5 times a power of ten) for about `count` grid lines over `range`.
+  function niceStep(range, count) {
+    const raw = range / count;
+    const p = Math.pow(10, Math.floor(Math.log10(raw)));
+    const m = raw / p;
+    return p * (m < 1.5 ? 1 : m < 3.5 ? 2 : m < 7.5 ? 5 : 10);
+  }
+
+  function formatTick(x, step) {
+    const decimals = Math.max(0, -Math.floor(Math.log10(step) + 1e-9));
+    return (Math.abs(x) < step / 2 ? 0 : x).toFixed(decimals);
+  }
+
+  function drawGrid2d(g) {
+    // World coordinates of the canvas edges.
+    const x0 = center[0] + (0 - width / 2 - view.panX) / view.scale;
+    const x1 = center[0] + (width - width / 2 - view.panX) / view.scale;
+    const y1 = center[1] + (height / 2 + view.panY) / view.scale;
+    const y0 = center[1] + (height / 2 + view.panY - height) / view.scale;
+    const step = niceStep(Math.max(x1 - x0, y1 - y0), 10);
+    g.lineWidth = 1;
+    g.strokeStyle = colors.grid;
+    g.fillStyle = colors.gridLabel;
+    g.font = '11px system-ui, sans-serif';
+    g.beginPath();
+    for (let x = Math.ceil(x0 / step) * step; x <= x1; x += step) {
+      project(x, 0, 0);
+      g.moveTo(Math.round(sx) + 0.5, 0);
+      g.lineTo(Math.round(sx) + 0.5, height);
+    }
+    for (let y = Math.ceil(y0 / step) * step; y <= y1; y += step) {
+      project(0, y, 0);
+      g.moveTo(0, Math.round(sy) + 0.5);
+      g.lineTo(width, Math.round(sy) + 0.5);
+    }
+    g.stroke();
+    // Labels along the top and left edges, none in the corners where they would collide.
+    g.textBaseline = 'top';
+    for (let x = Math.ceil(x0 / step) * step; x <= x1; x += step) {
+      project(x, 0, 0);
+      if (sx > 36 && sx < width - 30) g.fillText(formatTick(x, step), sx + 3, 3);
+    }
+    g.textBaseline = 'bottom';
+    for (let y = Math.ceil(y0 / step) * step; y <= y1; y += step) {
+      project(0, y, 0);
+      if (sy > 30 && sy < height - 24) g.fillText(formatTick(y, step), 3, sy - 2);
+    }
+  }
+
+  function drawGrid3d(g) {
+    // A floor grid under the motion and an axis triad in the corner.
+    const step = niceStep(Math.max(hi[0] - lo[0], hi[1] - lo[1], 1e-3 * totalLength), 8);
+    const xa = Math.floor(lo[0] / step) * step, xb = Math.ceil(hi[0] / step) * step;
+    const ya = Math.floor(lo[1] / step) * step, yb = Math.ceil(hi[1] / step) * step;
+    const z = lo[2];
+    g.lineWidth = 1;
+    g.strokeStyle = colors.grid;
+    g.beginPath();
+    for (let x = xa; x <= xb + step / 2; x += step) {
+      project(x, ya, z); g.moveTo(sx, sy);
+      project(x, yb, z); g.lineTo(sx, sy);
+    }
+    for (let y = ya; y <= yb + step / 2; y += step) {
+      project(xa, y, z); g.moveTo(sx, sy);
+      project(xb, y, z); g.lineTo(sx, sy);
+    }
+    g.stroke();
+    const ox = 36, oy = height - 36, len = 24;
+    const names = ['x', 'y', 'z'];
+    const axisColors = ['#d62f2f', '#2e9e44', '#2f5fd6'];
+    g.font = '11px system-ui, sans-serif';
+    g.textAlign = 'center';
+    g.textBaseline = 'middle';
+    for (let k = 0; k < 3; ++k) {
+      const ex = ox + len * basis[k], ey = oy - len * basis[3 + k];
+      g.strokeStyle = axisColors[k];
+      g.lineWidth = 2;
+      g.beginPath();
+      g.moveTo(ox, oy);
+      g.lineTo(ex, ey);
+      g.stroke();
+      g.fillStyle = axisColors[k];
+      g.fillText(names[k], ox + 1.45 * len * basis[k], oy - 1.45 * len * basis[3 + k]);
+    }
+    g.textAlign = 'start';
+  }
+
+  function drawBackground() {
+    const g = bgCtx;
+    // Every device pixel, including a last row or column only partly inside `height` or `width`.
+    g.setTransform(1, 0, 0, 1, 0, 0);
+    g.fillStyle = colors.background;
+    g.fillRect(0, 0, background.width, background.height);
+    g.setTransform(pixelRatio, 0, 0, pixelRatio, 0, 0);
+    if (dim === 2) drawGrid2d(g); else drawGrid3d(g);
+    if (state.showLeader && numFrames > 1) {
+      // The whole leader path, faint and dashed; the part travelled is drawn on top per frame.
+      g.strokeStyle = colors.leader;
+      g.globalAlpha = 0.45;
+      g.lineWidth = 1.25;
+      g.setLineDash([5, 4]);
+      strokePath(g, 0, numFrames - 1);
+      g.setLineDash([]);
+      g.globalAlpha = 1;
+    }
+    state.backgroundDirty = false;
+  }
+
+  // Strokes point i's positions from frame 0 to frame `last`.
+  function strokePath(g, i, last) {
+    g.beginPath();
+    for (let f = 0; f <= last; ++f) {
+      projectPoint(f, i);
+      if (f === 0) g.moveTo(sx, sy); else g.lineTo(sx, sy);
+    }
+    g.stroke();
+  }
+
+  function drawChain(g, frame) {
+    for (let i = 0; i < numPoints; ++i) {
+      projectPoint(frame, i);
+      screenX[i] = sx;
+      screenY[i] = sy;
+      linkDepth[i] = sdepth;
+    }
+    g.lineCap = 'round';
+    g.lineJoin = 'round';
+    if (dim === 2) {
+      g.strokeStyle = '#2b4c8c';
+      g.lineWidth = 3;
+      g.beginPath();
+      g.moveTo(screenX[0], screenY[0]);
+      for (let i = 1; i < numPoints; ++i) g.lineTo(screenX[i], screenY[i]);
+      g.stroke();
+    } else {
+      // The chain's shadow on the floor grid, straight down: where it is over the floor.
+      g.strokeStyle = colors.shadow;
+      g.lineWidth = 2;
+      g.beginPath();
+      for (let i = 0; i < numPoints; ++i) {
+        const o = frame * frameStride + i * dim;
+        project(pos[o], pos[o + 1], lo[2]);
+        if (i === 0) g.moveTo(sx, sy); else g.lineTo(sx, sy);
+      }
+      g.stroke();
+      // Link i joins points i and i+1; far links first so near ones cover them.
+      for (let i = 0; i + 1 < numPoints; ++i) linkDepth[i] = 0.5 * (linkDepth[i] + linkDepth[i + 1]);
+      linkOrder.sort(byDepth);
+      for (let j = 0; j < linkOrder.length; ++j) {
+        const i = linkOrder[j];
+        const t = Math.min(1, Math.max(0, (linkDepth[i] + radius) / (2 * radius)));
+        g.strokeStyle = shades[Math.round(15 * t)];
+        g.lineWidth = 1.5 + 2.75 * t;
+        g.beginPath();
+        g.moveTo(screenX[i], screenY[i]);
+        g.lineTo(screenX[i + 1], screenY[i + 1]);
+        g.stroke();
+      }
+    }
+    // Joints, when links are long enough on screen for them to be told apart.
+    const linkPixels = view.scale * totalLength / (numPoints - 1);
+    if (linkPixels > 7) {
+      g.fillStyle = '#ffffff';
+      g.strokeStyle = '#2b4c8c';
+      g.lineWidth = 1;
+      const r = Math.min(3, linkPixels / 5);
+      for (let i = 1; i < numPoints - 1; ++i) {
+        g.beginPath();
+        g.arc(screenX[i], screenY[i], r, 0, 2 * Math.PI);
+        g.fill();
+        g.stroke();
+      }
+    }
+    g.fillStyle = colors.tail;
+    g.beginPath();
+    g.arc(screenX[numPoints - 1], screenY[numPoints - 1], 3.5, 0, 2 * Math.PI);
+    g.fill();
+    g.fillStyle = colors.lead;
+    g.beginPath();
+    g.arc(screenX[0], screenY[0], 5, 0, 2 * Math.PI);
+    g.fill();
+  }
+
+  function draw() {
+    const t0 = performance.now();
+    if (state.backgroundDirty) drawBackground();
+    const g = ctx;
+    g.setTransform(1, 0, 0, 1, 0, 0);
+    g.drawImage(background, 0, 0);
+    g.setTransform(pixelRatio, 0, 0, pixelRatio, 0, 0);
+    g.lineCap = 'round';
+    g.lineJoin = 'round';
+    if (state.showLeader && state.frame > 0) {
+      g.strokeStyle = colors.leader;
+      g.lineWidth = 2;
+      strokePath(g, 0, state.frame);
+    }
+    if (state.showTrails) {
+      g.lineWidth = 1.5;
+      for (let j = 0; j < state.trails.length; ++j) {
+        g.strokeStyle = trailColors[j % trailColors.length];
+        strokePath(g, state.trails[j], state.frame);
+      }
+    }
+    drawChain(g, state.frame);
+    state.dirty = false;
+    const ms = performance.now() - t0;
+    stats.draws += 1;
+    stats.drawMs += ms;
+    stats.maxDrawMs = Math.max(stats.maxDrawMs, ms);
+  }
+
+  function resize() {
+    const rect = canvas.getBoundingClientRect();
+    const firstTime = width === 1 && height === 1;
+    const oldWidth = width, oldHeight = height;
+    width = Math.max(1, rect.width);
+    height = Math.max(1, rect.height);
+    pixelRatio = window.devicePixelRatio || 1;
+    canvas.width = background.width = Math.round(width * pixelRatio);
+    canvas.height = background.height = Math.round(height * pixelRatio);
+    if (firstTime || !state.viewMoved) {
+      fitView();
+    } else {
+      // Keep the picture's size relative to the smaller side.
+      view.scale *= Math.min(width, height) / Math.min(oldWidth, oldHeight);
+    }
+    state.backgroundDirty = true;
+    state.dirty = true;
+  }
+
+  // ----- Metrics panel ---------------------------------------------------------------------------
+  function fmt(x) {
+    if (x === 0) return '0';
+    const a = Math.abs(x);
+    if (a < 1e-3 || a >= 1e6) return x.toExponential(2);
+    return String(Number(x.toPrecision(5)));
+  }
+
+  function addFact(list, name, value) {
+    const dt = document.createElement('dt');
+    const dd = document.createElement('dd');
+    dt.textContent = name;
+    dd.textContent = value;
+    list.append(dt, dd);
+    return dd;
+  }
+
+  const metrics = data.metrics;
+  const nowFields = {};
+  function buildPanel() {
+    document.title = data.title + ' \u2013 flexkin viewer';
+    $('title').textContent = data.title;
+    $('subtitle').textContent = data.method + ', ' + dim + 'D, ' + data.num_links + ' links, ' +
+        data.num_steps + ' leader steps';
+    const facts = $('facts');
+    if (data.scenario) addFact(facts, 'Scenario', data.scenario);
+    addFact(facts, 'Method', data.method);
+    addFact(facts, 'Dimension', dim + 'D');
+    addFact(facts, 'Links', String(data.num_links));
+    addFact(facts, 'Chain length', fmt(totalLength));
+    addFact(facts, 'Leader steps', String(data.num_steps));
+    addFact(facts, 'Frames recorded', String(numFrames));
+    addFact(facts, 'Sub-steps per step', String(data.substeps));
+    addFact(facts, 'Link-length error (max)', fmt(metrics.max_relative_length_error));
+    addFact(facts, 'L2 total', fmt(metrics.l2_total));
+    addFact(facts, 'L2 weighted total', fmt(metrics.l2_weighted_total));
+    if (data.accuracy.enabled) {
+      addFact(facts, 'Estimated error', fmt(data.accuracy.estimated_error) + ' (tolerance ' +
+          fmt(data.accuracy.tolerance) + (data.accuracy.met ? ', met)' : ', NOT met)'));
+    }
+    if (data.method === 'overall') addFact(facts, 'Failed solves', String(data.overall_failures));
+    addFact(facts, 'Compute time', fmt(data.seconds) + ' s');
+    const now = $('now');
+    nowFields.step = addFact(now, 'Leader step', '');
+    nowFields.error = addFact(now, 'Link-length error', '');
+    nowFields.lead = addFact(now, 'Leading end', '');
+    nowFields.tail = addFact(now, 'Trailing end', '');
+    $('perspective-control').hidden = dim !== 3;
+    $('hint').textContent = dim === 2
+        ? 'drag: pan \u00b7 wheel: zoom \u00b7 click a point: trail'
+        : 'drag: orbit \u00b7 shift+drag: pan \u00b7 wheel: zoom \u00b7 click a point: trail';
+  }
+
+  // A sparkline of `values` into `canvas`, kept as an image so the marker can be moved cheaply.
+  function makeSpark(sparkCanvas, values) {
+    const w = sparkCanvas.clientWidth || 260, h = sparkCanvas.clientHeight || 64;
+    const r = window.devicePixelRatio || 1;
+    sparkCanvas.width = Math.round(w * r);
+    sparkCanvas.height = Math.round(h * r);
+    const g = sparkCanvas.getContext('2d');
+    const image = document.createElement('canvas');
+    image.width = sparkCanvas.width;
+    image.height = sparkCanvas.height;
+    const ig = image.getContext('2d');
+    ig.scale(r, r);
+    let max = 0, min = Infinity;
+    for (let i = 0; i < values.length; ++i) {
+      max = Math.max(max, values[i]);
+      min = Math.min(min, values[i]);
+    }
+    const pad = 4;
+    const xOf = (i) => pad + (w - 2 * pad) * (values.length > 1 ? i / (values.length - 1) : 0.5);
+    const yOf = (v) => h - pad - (h - 2 * pad - 10) * (max > 0 ? v / max : 0);
+    ig.fillStyle = 'rgba(43, 76, 140, 0.12)';
+    ig.strokeStyle = '#2b4c8c';
+    ig.lineWidth = 1.25;
+    ig.beginPath();
+    for (let i = 0; i < values.length; ++i) ig.lineTo(xOf(i), yOf(values[i]));
+    ig.stroke();
+    ig.lineTo(xOf(values.length - 1), h - pad);
+    ig.lineTo(xOf(0), h - pad);
+    ig.fill();
+    ig.fillStyle = '#5b6475';
+    ig.font = '10px system-ui, sans-serif';
+    ig.textBaseline = 'top';
+    ig.fillText('max ' + fmt(max) + ' \u00b7 min ' + fmt(values.length ? min : 0), pad + 2, 1);
+    return { g, image, w, h, xOf, yOf, r };
+  }
+
+  let profileSpark = null, l2Spark = null;
+  function drawSparks() {
+    if (!profileSpark) {
+      profileSpark = makeSpark($('profile'), metrics.path_length);
+      l2Spark = makeSpark($('l2plot'), metrics.l2_per_step);
+    }
+    // Path-length profile, with the points that have trails marked in their colours.
+    let s = profileSpark;
+    s.g.setTransform(1, 0, 0, 1, 0, 0);
+    s.g.clearRect(0, 0, s.image.width, s.image.height);
+    s.g.drawImage(s.image, 0, 0);
+    s.g.setTransform(s.r, 0, 0, s.r, 0, 0);
+    if (state.showTrails && metrics.path_length.length === numPoints) {
+      for (let j = 0; j < state.trails.length; ++j) {
+        const i = state.trails[j];
+        s.g.fillStyle = trailColors[j % trailColors.length];
+        s.g.beginPath();
+        s.g.arc(s.xOf(i), s.yOf(metrics.path_length[i]), 3, 0, 2 * Math.PI);
+        s.g.fill();
+      }
+    }
+    // L2 per step, with the current step marked.
+    s = l2Spark;
+    s.g.setTransform(1, 0, 0, 1, 0, 0);
+    s.g.clearRect(0, 0, s.image.width, s.image.height);
+    s.g.drawImage(s.image, 0, 0);
+    s.g.setTransform(s.r, 0, 0, s.r, 0, 0);
+    const step = steps[state.frame];
+    if (step > 0 && metrics.l2_per_step.length > 0) {
+      const x = s.xOf(Math.min(step, metrics.l2_per_step.length) - 1);
+      s.g.strokeStyle = colors.lead;
+      s.g.lineWidth = 1;
+      s.g.beginPath();
+      s.g.moveTo(x, 0);
+      s.g.lineTo(x, s.h);
+      s.g.stroke();
+    }
+  }
+
+  function pointText(frame, i) {
+    const o = frame * frameStride + i * dim;
+    let text = '(' + fmt(pos[o]);
+    for (let k = 1; k < dim; ++k) text += ', ' + fmt(pos[o + k]);
+    return text + ')';
+  }
+
+  let shownFrame = -1;
+  function updateReadouts() {
+    if (shownFrame === state.frame) return;
+    shownFrame = state.frame;
+    const f = state.frame;
+    $('timeline').value = String(f);
+    $('counter').textContent = 'frame ' + (f + 1) + ' / ' + numFrames + ' \u00b7 step ' +
+        steps[f] + ' / ' + data.num_steps;
+    nowFields.step.textContent = String(steps[f]);
+    nowFields.error.textContent = fmt(data.frame_length_error[f]);
+    nowFields.lead.textContent = pointText(f, 0);
+    nowFields.tail.textContent = pointText(f, numPoints - 1);
+    drawSparks();
+  }
+
+  function updateLegend() {
+    const legend = $('legend');
+    legend.textContent = '';
+    if (!state.showTrails || state.trails.length === 0) return;
+    legend.append('Trails:');
+    state.trails.forEach((i, j) => {
+      const dot = document.createElement('span');
+      dot.className = 'swatch';
+      dot.style.background = trailColors[j % trailColors.length];
+      legend.append(dot, 'point ' + i);
+    });
+  }
+
+  // ----- Controls --------------------------------------------------------------------------------
+  function setFrame(f) {
+    state.frame = Math.max(0, Math.min(numFrames - 1, Math.round(f)));
+    state.playhead = state.frame;
+    state.dirty = true;
+  }
+
+  function setPlaying(playing) {
+    state.playing = playing && numFrames > 1;
+    if (state.playing && state.frame === numFrames - 1 && !options.loop) setFrame(0);
+    state.playhead = state.frame;
+    $('play').textContent = state.playing ? 'Pause' : 'Play';
+  }
+
+  const speeds = [0.25, 0.5, 1, 2, 4, 8];
+  function setSpeed(speed) {
+    state.speed = speed;
+    $('speed').value = String(speed);
+  }
+
+  function setTrails(text) {
+    const list = [];
+    for (const part of text.split(/[\s,;]+/)) {
+      if (part === '') continue;
+      const i = Number(part);
+      if (Number.isInteger(i) && i >= 0 && i < numPoints && !list.includes(i)) list.push(i);
+    }
+    state.trails = list;
+    $('trail-points').value = list.join(', ');
+    state.dirty = true;
+    shownFrame = -1;
+    updateLegend();
+  }
+
+  function toggleTrail(i) {
+    const list = state.trails.slice();
+    const at = list.indexOf(i);
+    if (at >= 0) list.splice(at, 1); else list.push(i);
+    state.showTrails = true;
+    $('trails').checked = true;
+    setTrails(list.join(','));
+  }
+
+  function resetView() {
+    view.azimuth = options.azimuth_deg * Math.PI / 180;
+    view.elevation = options.elevation_deg * Math.PI / 180;
+    fitView();
+    state.backgroundDirty = true;
+    state.dirty = true;
+  }
+
+  function bindControls() {
+    $('timeline').max = String(numFrames - 1);
+    $('play').addEventListener('click', () => setPlaying(!state.playing));
+    $('prev').addEventListener('click', () => { setPlaying(false); setFrame(state.frame - 1); });
+    $('next').addEventListener('click', () => { setPlaying(false); setFrame(state.frame + 1); });
+    $('timeline').addEventListener('input', (e) => setFrame(Number(e.target.value)));
+    $('speed').addEventListener('change', (e) => setSpeed(Number(e.target.value)));
+    $('leader').checked = state.showLeader;
+    $('leader').addEventListener('change', (e) => {
+      state.showLeader = e.target.checked;
+      state.backgroundDirty = true;
+      state.dirty = true;
+    });
+    $('trails').checked = state.showTrails;
+    $('trails').addEventListener('change', (e) => {
+      state.showTrails = e.target.checked;
+      state.dirty = true;
+      shownFrame = -1;
+      updateLegend();
+    });
+    $('trail-points').value = state.trails.join(', ');
+    $('trail-points').addEventListener('change', (e) => setTrails(e.target.value));
+    $('perspective').checked = view.perspective;
+    $('perspective').addEventListener('change', (e) => {
+      view.perspective = e.target.checked;
+      resetView();
+    });
+    $('reset').addEventListener('click', resetView);
+    document.addEventListener('keydown', onKey);
+    // A focused button or checkbox would also act on the space bar's release.
+    document.addEventListener('keyup', (e) => {
+      if (e.key === ' ' && !isTextField(e.target)) e.preventDefault();
+    });
+    bindPointer();
+    new ResizeObserver(resize).observe(canvas);
+  }
+
+  function isTextField(target) {
+    return target instanceof HTMLInputElement && target.type === 'text';
+  }
+
+  function onKey(e) {
+    if (isTextField(e.target) || e.ctrlKey || e.metaKey || e.altKey) return;
+    const jump = e.shiftKey ? 10 : 1;
+    let handled = true;
+    switch (e.key) {
+      case ' ': setPlaying(!state.playing); break;
+      case 'ArrowRight': setPlaying(false); setFrame(state.frame + jump); break;
+      case 'ArrowLeft': setPlaying(false); setFrame(state.frame - jump); break;
+      case 'ArrowUp': setPlaying(false); setFrame(state.frame + 10 * jump); break;
+      case 'ArrowDown': setPlaying(false); setFrame(state.frame - 10 * jump); break;
+      case 'Home': setPlaying(false); setFrame(0); break;
+      case 'End': setPlaying(false); setFrame(numFrames - 1); break;
+      case '+': case '=': setSpeed(speeds[Math.min(speeds.length - 1, speeds.indexOf(state.speed) + 1)]); break;
+      case '-': setSpeed(speeds[Math.max(0, speeds.indexOf(state.speed) - 1)]); break;
+      case 'r': case 'R': resetView(); break;
+      case 'l': case 'L': $('leader').click(); break;
+      case 't': case 'T': $('trails').click(); break;
+      case 'p': case 'P': if (dim === 3) $('perspective').click(); break;
+      default: handled = false;
+    }
+    if (handled) e.preventDefault();
+  }
+
+  function bindPointer() {
+    let drag = null;  // {x, y, moved, pan}
+    canvas.addEventListener('pointerdown', (e) => {
+      canvas.setPointerCapture(e.pointerId);
+      canvas.focus();
+      drag = { x: e.clientX, y: e.clientY, moved: 0, pan: dim === 2 || e.shiftKey || e.button !== 0 };
+      canvas.classList.add('dragging');
+    });
+    canvas.addEventListener('pointermove', (e) => {
+      if (!drag) return;
+      const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+      drag.x = e.clientX;
+      drag.y = e.clientY;
+      drag.moved += Math.abs(dx) + Math.abs(dy);
+      if (drag.pan) {
+        view.panX += dx;
+        view.panY += dy;
+      } else {
+        view.azimuth -= dx * 0.01;
+        view.elevation = Math.max(-Math.PI / 2, Math.min(Math.PI / 2, view.elevation + dy * 0.01));
+        updateBasis();
+      }
+      state.viewMoved = true;
+      state.backgroundDirty = true;
+      state.dirty = true;
+    });
+    const end = (e) => {
+      if (!drag) return;
+      if (drag.moved < 4) pick(e);
+      drag = null;
+      canvas.classList.remove('dragging');
+    };
+    canvas.addEventListener('pointerup', end);
+    canvas.addEventListener('pointercancel', () => { drag = null; });
+    canvas.addEventListener('contextmenu', (e) => e.preventDefault());
+    canvas.addEventListener('wheel', (e) => {
+      e.preventDefault();
+      const rect = canvas.getBoundingClientRect();
+      const mx = e.clientX - rect.left - width / 2, my = e.clientY - rect.top - height / 2;
+      const k = Math.exp(-e.deltaY * (e.deltaMode === 1 ? 0.05 : 0.0015));
+      // Zoom about the cursor: the point under it stays put.
+      view.scale *= k;
+      view.panX = mx - (mx - view.panX) * k;
+      view.panY = my - (my - view.panY) * k;
+      state.viewMoved = true;
+      state.backgroundDirty = true;
+      state.dirty = true;
+    }, { passive: false });
+  }
+
+  // A click near a point of the current frame adds or removes its trail.
+  function pick(e) {
+    const rect = canvas.getBoundingClientRect();
+    const x = e.clientX - rect.left, y = e.clientY - rect.top;
+    let best = -1, bestDistance = 10;  // CSS pixels
+    for (let i = 0; i < numPoints; ++i) {
+      projectPoint(state.frame, i);
+      const d = Math.hypot(sx - x, sy - y);
+      if (d < bestDistance) { best = i; bestDistance = d; }
+    }
+    if (best >= 0) toggleTrail(best);
+  }
+
+  // ----- Main loop -------------------------------------------------------------------------------
+  let lastTime = null;
+  function tick(now) {
+    requestAnimationFrame(tick);
+    stats.ticks += 1;
+    if (state.playing) {
+      const dt = lastTime === null ? 0 : Math.min(0.25, (now - lastTime) / 1000);
+      state.playhead += dt * state.speed * framesPerSecond;
+      if (state.playhead >= numFrames) {
+        if (options.loop) {
+          state.playhead %= numFrames;
+        } else {
+          state.playhead = numFrames - 1;
+          setPlaying(false);
+        }
+      }
+      const frame = Math.floor(state.playhead);
+      if (frame !== state.frame) {
+        state.frame = frame;
+        state.dirty = true;
+      }
+    }
+    lastTime = now;
+    if (state.dirty || state.backgroundDirty) draw();
+    updateReadouts();
+  }
+
+  buildPanel();
+  bindControls();
+  resize();
+  updateLegend();
+  setPlaying(options.autoplay);
+  window.flexkinViewer = {
+    get frame() { return state.frame; },
+    get playing() { return state.playing; },
+    numFrames,
+    numPoints,
+    dim,
+    stats,
+    view,
+    // Where point i of the current frame is drawn, CSS pixels from the canvas's top left.
+    pointOnScreen(i) {
+      projectPoint(state.frame, i);
+      return { x: sx, y: sy };
+    },
+  };
+  requestAnimationFrame(tick);
+})();

@@ -1,0 +1,239 @@
+// Tests of the interactive viewer (WriteViewerHtml): the page is self-contained and carries the
+// result's data faithfully, bad input is refused without touching the output file, and the page
+// works in a real browser (headless Chromium driven by tests/viewer/browser_check.mjs) for a small
+// 2D run and the two large runs it must play smoothly: 20 links in 3D over 2650 steps and 80
+// links in 2D over 250 steps.
+#include "flexkin/viewer.h"
+#include "test_util.h"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "flexkin/chain.h"
+#include "flexkin/error.h"
+#include "flexkin/result_io.h"
+#include "flexkin/run.h"
+
+namespace flexkin {
+namespace {
+
+namespace fs = std::filesystem;
+using test_util::ExpectInputError;
+
+// A run of a curved chain of `links` links whose leading end follows a smooth wavy path of
+// `steps` leader steps of about `step` each.
+ResultFile MakeResult(int dim, int links, int steps, double step, const std::string& name) {
+  const Chain chain = MakeChain(test_util::CurvedPoints(dim, links, 1.0, 2.5 / links));
+  Points targets(steps, dim);
+  for (int s = 1; s <= steps; ++s) {
+    const double t = step * s;
+    targets(s - 1, 0) = chain.points(0, 0) - t;
+    targets(s - 1, 1) = chain.points(0, 1) + 0.6 * std::sin(1.3 * t);
+    if (dim == 3) targets(s - 1, 2) = chain.points(0, 2) + 0.5 * (1.0 - std::cos(0.9 * t));
+  }
+  ResultFile file;
+  file.result = Run(chain, targets, RunOptions());
+  file.dim = dim;
+  file.scenario_name = name;
+  return file;
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// A fresh directory under the system's temporary directory, removed at the end unless
+// FLEXKIN_VIEWER_TEST_KEEP is set (to look at the screenshots).
+class ViewerTest : public testing::Test {
+ protected:
+  void SetUp() override {
+    std::string name = (fs::temp_directory_path() / "flexkin_viewer_test_XXXXXX").string();
+    ASSERT_NE(::mkdtemp(name.data()), nullptr);
+    dir_ = name;
+  }
+  void TearDown() override {
+    if (std::getenv("FLEXKIN_VIEWER_TEST_KEEP") != nullptr) {
+      std::printf("viewer test output kept in %s\n", dir_.c_str());
+    } else if (!dir_.empty()) {
+      fs::remove_all(dir_);
+    }
+  }
+  std::string Path(const std::string& name) const { return dir_ + "/" + name; }
+  std::string dir_;
+};
+
+// The JSON embedded in a page written by WriteViewerHtml.
+nlohmann::json EmbeddedData(const std::string& page) {
+  const std::string open = "<script type=\"application/json\" id=\"flexkin-data\">";
+  const size_t begin = page.find(open);
+  EXPECT_NE(begin, std::string::npos);
+  const size_t end = page.find("</script>", begin);
+  return nlohmann::json::parse(page.substr(begin + open.size(), end - begin - open.size()));
+}
+
+TEST_F(ViewerTest, PageIsSelfContainedAndCarriesTheResult) {
+  const ResultFile file = MakeResult(2, 12, 60, 0.05, "small </script><b>&</b> 2D");
+  ViewerOptions options;
+  options.trail_points = {12};
+  WriteViewerHtml(file, options, Path("view.html"));
+  const std::string page = ReadFile(Path("view.html"));
+
+  EXPECT_EQ(page.rfind("<!DOCTYPE html>", 0), 0u);
+  // Nothing to fetch: no links to files or the network, the style and the script inline.
+  for (const char* outside : {"http:", "https:", "//cdn", "<link", "src=", "@import", "url("}) {
+    EXPECT_EQ(page.find(outside), std::string::npos) << outside;
+  }
+  EXPECT_NE(page.find("<style>"), std::string::npos);
+  EXPECT_NE(page.find("requestAnimationFrame"), std::string::npos);
+  // Three elements closed: the data, the script and the style sheet. The scenario name's
+  // "</script>" did not close the data early.
+  size_t closes = 0;
+  for (size_t at = page.find("</"); at != std::string::npos; at = page.find("</", at + 1)) {
+    closes += page.compare(at, 9, "</script>") == 0 ? 1 : 0;
+  }
+  EXPECT_EQ(closes, 2u);
+
+  const nlohmann::json data = EmbeddedData(page);
+  const RunResult& r = file.result;
+  EXPECT_EQ(data["title"], file.scenario_name);
+  EXPECT_EQ(data["method"], "tractrix");
+  EXPECT_EQ(data["dim"], 2);
+  EXPECT_EQ(data["num_links"], 12);
+  EXPECT_EQ(data["num_steps"], 60);
+  EXPECT_EQ(data["options"]["trail_points"], nlohmann::json::array({12}));
+  ASSERT_EQ(data["steps"].size(), r.frames.size());
+  ASSERT_EQ(data["positions"].size(), r.frames.size() * 13 * 2);
+  ASSERT_EQ(data["frame_length_error"].size(), r.frames.size());
+  for (size_t f = 0; f < r.frames.size(); ++f) {
+    EXPECT_EQ(data["steps"][f], r.frames[f].step);
+    EXPECT_LE(data["frame_length_error"][f].get<double>(), r.metrics.max_relative_length_error * 1.01);
+    for (int i = 0; i < 13 * 2; ++i) {
+      const double want = r.frames[f].points.data()[i];
+      EXPECT_NEAR(data["positions"][f * 26 + i].get<double>(), want, 1e-8 * (1 + std::abs(want)));
+    }
+  }
+  EXPECT_EQ(data["metrics"]["l2_total"].get<double>(), r.metrics.l2_total);
+  ASSERT_EQ(data["metrics"]["path_length"].size(), 13u);
+  EXPECT_EQ(data["metrics"]["path_length"][12].get<double>(), r.metrics.path_length[12]);
+  EXPECT_EQ(data["metrics"]["l2_per_step"].size(), 60u);
+}
+
+TEST_F(ViewerTest, OptionsAreValidatedNamingTheField) {
+  EXPECT_EQ(ViewerOptions().Validate(), "");
+  const ResultFile file = MakeResult(3, 4, 5, 0.1, "");
+  const auto expect = [&](auto change, const std::string& field) {
+    ViewerOptions options;
+    change(options);
+    ExpectInputError([&] { WriteViewerHtml(file, options, Path("v.html")); }, field);
+    EXPECT_FALSE(fs::exists(Path("v.html"))) << field;
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  expect([](ViewerOptions& o) { o.playback_seconds = 0; }, "options.playback_seconds");
+  expect([&](ViewerOptions& o) { o.playback_seconds = nan; }, "options.playback_seconds");
+  expect([](ViewerOptions& o) { o.trail_points = {1, -1}; }, "options.trail_points[1]");
+  expect([](ViewerOptions& o) { o.trail_points = {5}; }, "trail_points[0]");  // 4 links: 0..4
+  expect([](ViewerOptions& o) { o.elevation_deg = 91; }, "options.elevation_deg");
+  expect([&](ViewerOptions& o) { o.azimuth_deg = nan; }, "options.azimuth_deg");
+  expect([](ViewerOptions& o) { o.digits = 5; }, "options.digits");
+  ViewerOptions ok;
+  ok.trail_points = {0, 4};
+  WriteViewerHtml(file, ok, Path("v.html"));
+  EXPECT_EQ(EmbeddedData(ReadFile(Path("v.html")))["title"], "flexkin result");
+}
+
+TEST_F(ViewerTest, BadResultIsRefusedAndExistingFileLeftUntouched) {
+  const ResultFile good = MakeResult(2, 6, 10, 0.05, "bad");
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::ofstream(Path("existing.html")) << "the old page";
+  const auto expect = [&](auto change, const std::string& field) {
+    ResultFile file = good;
+    change(file);
+    ExpectInputError([&] { WriteViewerHtml(file, ViewerOptions(), Path("new.html")); }, field);
+    ExpectInputError([&] { WriteViewerHtml(file, ViewerOptions(), Path("existing.html")); },
+                     field);
+    EXPECT_FALSE(fs::exists(Path("new.html"))) << field;
+    EXPECT_EQ(ReadFile(Path("existing.html")), "the old page") << field;
+  };
+  expect([&](ResultFile& f) { f.result.frames[3].points(2, 1) = nan; }, "frames[3].points[2][1]");
+  expect([&](ResultFile& f) { f.result.frames[0].points(0, 0) = INFINITY; },
+         "frames[0].points[0][0]");
+  expect([&](ResultFile& f) { f.result.metrics.l2_total = nan; }, "metrics.l2_total");
+  expect([&](ResultFile& f) { f.result.metrics.path_length[6] = nan; }, "metrics.path_length[6]");
+  expect([&](ResultFile& f) { f.result.lengths[0] = 0; }, "link_lengths[0]");
+  expect([&](ResultFile& f) { f.result.frames.clear(); }, "frames");
+  expect([&](ResultFile& f) { f.dim = 4; }, "dim");
+  expect([&](ResultFile& f) { f.result.frames[1].points.conservativeResize(6, 2); },
+         "frames[1].points");
+  // Nothing else was left in the directory (no temporary files).
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
+}
+
+// Runs `command`, returns its exit status and appends its stdout and stderr to `output`.
+int RunCommand(const std::string& command, std::string* output) {
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return -1;
+  char buffer[4096];
+  size_t got;
+  while ((got = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) output->append(buffer, got);
+  const int status = ::pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+TEST_F(ViewerTest, PlaysScrubsAndMovesInHeadlessChromium) {
+  // What the browser check needs; all of it is installed by scripts/install-deps.sh.
+  const std::string source = FLEXKIN_SOURCE_DIR;
+  const std::string tools = source + "/tools/node";
+  const std::string chromium = std::getenv("FLEXKIN_CHROMIUM") ? std::getenv("FLEXKIN_CHROMIUM")
+                                                                : "/usr/bin/chromium";
+  std::string ignored;
+  ASSERT_EQ(RunCommand("node --version", &ignored), 0)
+      << "node is missing: run scripts/install-deps.sh";
+  ASSERT_TRUE(fs::exists(tools + "/node_modules/playwright-core/package.json"))
+      << "playwright-core is missing from tools/node: run scripts/install-deps.sh";
+  ASSERT_TRUE(fs::exists(chromium)) << chromium << " is missing: run scripts/install-deps.sh";
+
+  ViewerOptions options;
+  options.playback_seconds = 8.0;
+  WriteViewerHtml(MakeResult(2, 10, 80, 0.05, "small 2D"), options, Path("small_2d.html"));
+  // The sizes that must play smoothly: the paper's Figs. 12 (3D) and 10 (2D).
+  const ResultFile spatial = MakeResult(3, 20, 2650, 0.006, "20 links 3D, 2650 steps");
+  ASSERT_EQ(spatial.result.frames.size(), 2651u);
+  WriteViewerHtml(spatial, options, Path("spatial_20x2650.html"));
+  WriteViewerHtml(MakeResult(2, 80, 250, 0.07, "80 links 2D, 250 steps"), options,
+                  Path("planar_80x250.html"));
+  std::printf("page sizes: %ju, %ju, %ju bytes\n",
+              static_cast<uintmax_t>(fs::file_size(Path("small_2d.html"))),
+              static_cast<uintmax_t>(fs::file_size(Path("spatial_20x2650.html"))),
+              static_cast<uintmax_t>(fs::file_size(Path("planar_80x250.html"))));
+
+  std::string output;
+  const int status =
+      RunCommand("node '" + source + "/tests/viewer/browser_check.mjs' '" + tools + "' '" + dir_ +
+                     "' '" + Path("small_2d.html") + "' '" + Path("spatial_20x2650.html") +
+                     "' '" + Path("planar_80x250.html") + "'",
+                 &output);
+  std::printf("%s", output.c_str());
+  EXPECT_EQ(status, 0) << output;
+  EXPECT_NE(output.find("all viewer checks passed"), std::string::npos);
+  for (const char* shot : {"small_2d-playing.png", "spatial_20x2650-trails.png",
+                           "planar_80x250-dragged.png"}) {
+    EXPECT_TRUE(fs::exists(Path(shot))) << shot;
+  }
+}
+
+}  // namespace
+}  // namespace flexkin
