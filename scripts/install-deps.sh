@@ -3,11 +3,26 @@
 set -euo pipefail
 packages=(cmake make g++ pkg-config libeigen3-dev nlohmann-json3-dev libcli11-dev libgtest-dev
           libgmock-dev libbenchmark-dev libboost-dev libxsimd-dev liblapack-dev libnlopt-dev coinor-libipopt-dev)
+packages+=(libtinygltf-dev)  # glTF export (src/gltf)
+# Node.js runs the Khronos glTF validator in the tests. Debian's nodejs and npm only if there is no
+# node or npm on the PATH: one from another source (e.g. NodeSource) is used as it is.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then packages+=(nodejs npm); fi
+# The npm packages of tools/node (exact versions from its package-lock.json), installed when
+# tools/node/node_modules is missing or older than the lock file.
+install_node_tools() {
+  local dir
+  dir="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/tools/node"
+  if [ ! -d "$dir/node_modules" ] || [ "$dir/package-lock.json" -nt "$dir/node_modules" ]; then
+    echo "flexkin: installing the npm packages of tools/node (npm ci)"
+    npm ci --prefix "$dir" --no-audit --no-fund
+    touch "$dir/node_modules"
+  fi
+}
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
-[ ${#missing[@]} -eq 0 ] && exit 0
+[ ${#missing[@]} -eq 0 ] && { install_node_tools; exit 0; }
 echo "flexkin: installing missing Debian packages: ${missing[*]}"
 sudo=""
 if [ "$(id -u)" -ne 0 ]; then
@@ -17,3 +32,4 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 $sudo apt-get update -q
 $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+install_node_tools
