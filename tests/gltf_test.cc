@@ -12,12 +12,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <system_error>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "flexkin/result_io.h"
 #include "flexkin/run.h"
@@ -107,16 +106,45 @@ Comparison Compare(const ResultFile& file, const GltfJointMotion& motion, double
 
 // Writes `file` to .gltf and .glb with `options` and expects every point of every frame back to
 // 1e-6 of the scene size.
-void ExpectRoundTrip(const ResultFile& file, const GltfOptions& options, const TempDir& dir) {
-  for (const char* name : {"motion.gltf", "motion.glb"}) {
+void ExpectRoundTrip(const ResultFile& file, const GltfOptions& options, const TempDir& dir,
+                     const std::string& stem = "motion") {
+  for (const std::string name : {stem + ".gltf", stem + ".glb"}) {
     WriteGltf(file, options, dir / name);
-    const Comparison c = Compare(file, ReadGltfJointPositions(dir / name), options.steps_per_second);
+    const Comparison c =
+        Compare(file, ReadGltfJointPositions(dir / name), options.steps_per_second);
     EXPECT_GT(c.scene_size, 0.0);
     EXPECT_LE(c.max_error, 1e-6 * c.scene_size) << name << ": scene size " << c.scene_size;
     std::printf("  %s, %dD, %zu frames x %d points: max error %.3g (scene size %.3g), %zu bytes\n",
-                name, file.dim, file.result.frames.size(),
+                name.c_str(), file.dim, file.result.frames.size(),
                 static_cast<int>(file.result.lengths.size()) + 1, c.max_error, c.scene_size,
                 static_cast<size_t>(std::filesystem::file_size(dir / name)));
+  }
+}
+
+// Runs the Khronos glTF validator (tests/gltf/validate.mjs with Node.js) on `files` and expects
+// no errors and no warnings in any of them.
+void ExpectValidGltf(const std::vector<std::string>& files) {
+  const std::string modules = FLEXKIN_NODE_MODULES;
+  if (std::system("node --version > /dev/null 2>&1") != 0) {
+    FAIL() << "node (Node.js) is not on the PATH; run scripts/install-deps.sh";
+  }
+  if (!std::filesystem::exists(modules + "/gltf-validator/package.json")) {
+    FAIL() << "gltf-validator is not installed in " << modules << "; run scripts/install-deps.sh";
+  }
+  std::string command =
+      "node '" + std::string(FLEXKIN_SOURCE_DIR) + "/tests/gltf/validate.mjs' '" + modules + "'";
+  for (const std::string& f : files) command += " '" + f + "'";
+  command += " 2>&1";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string output;
+  char buffer[4096];
+  while (const size_t got = std::fread(buffer, 1, sizeof buffer, pipe)) output.append(buffer, got);
+  const int status = ::pclose(pipe);
+  std::printf("%s", output.c_str());
+  EXPECT_EQ(status, 0) << output;
+  for (const std::string& f : files) {
+    EXPECT_NE(output.find(f + ": 0 errors, 0 warnings,"), std::string::npos) << f << "\n" << output;
   }
 }
 
@@ -135,6 +163,31 @@ TEST(GltfRoundTrip, SpatialWithScaleAndEitherUpAxis) {
   options.up_axis = GltfUpAxis::kY;
   options.include_mesh = false;
   ExpectRoundTrip(file, options, dir);
+}
+
+// Links folded back onto each other (half turns between bones, and of a bone between frames),
+// in 2D and along the z axis in 3D (where the usual half-turn axis, z, is the bone itself).
+TEST(GltfRoundTrip, FoldedChains) {
+  TempDir dir;
+  std::vector<std::string> files;
+  for (const int dim : {2, 3}) {
+    const int axis = dim == 2 ? 0 : 2;
+    ResultFile file;
+    file.dim = dim;
+    file.result.lengths = Eigen::VectorXd::Ones(3);
+    for (const double sign : {1.0, -1.0, 1.0}) {
+      Frame frame;
+      frame.step = static_cast<int64_t>(file.result.frames.size());
+      frame.points = Points::Zero(4, dim);
+      frame.points(1, axis) = frame.points(3, axis) = sign;
+      file.result.frames.push_back(frame);
+    }
+    const std::string stem = "folded" + std::to_string(dim);
+    ExpectRoundTrip(file, GltfOptions{}, dir, stem);
+    files.push_back(dir / (stem + ".gltf"));
+    files.push_back(dir / (stem + ".glb"));
+  }
+  ExpectValidGltf(files);
 }
 
 // The scene's axes and units, seen without the file's flexkin extras (as another glTF reader
@@ -164,14 +217,17 @@ TEST(GltfRoundTrip, SceneAxesAndScale) {
         expected.col(2) = -0.01 * p.col(1);
       }
       EXPECT_LT((motion.positions[f] - expected).cwiseAbs().maxCoeff(),
-                1e-6 * 0.01 * p.cwiseAbs().maxCoeff()) << dim << "D frame " << f;
+                1e-6 * 0.01 * p.cwiseAbs().maxCoeff())
+          << dim << "D frame " << f;
     }
   }
 }
 
-// The paper's Figs. 10 (2D, 80 links, 250 steps) and 12 (3D, 20 links, 2650 steps).
+// The paper's Figs. 10 (2D, 80 links, 250 steps) and 12 (3D, 20 links, 2650 steps); the files
+// pass the validator too.
 TEST(GltfRoundTrip, PaperScenarios) {
   TempDir dir;
+  std::vector<std::string> files;
   for (const char* name : {"fig10_planar_curve", "fig12_spatial_curve"}) {
     const Scenario scenario =
         LoadScenarioFile(std::string(FLEXKIN_SOURCE_DIR) + "/examples/" + name + ".json");
@@ -179,19 +235,15 @@ TEST(GltfRoundTrip, PaperScenarios) {
     file.result = flexkin::Run(scenario.chain, scenario.leader_steps, scenario.options);
     file.dim = scenario.chain.dim();
     file.scenario_name = scenario.name;
-    ExpectRoundTrip(file, GltfOptions{}, dir);
+    ExpectRoundTrip(file, GltfOptions{}, dir, name);
+    files.push_back(dir / (std::string(name) + ".gltf"));
+    files.push_back(dir / (std::string(name) + ".glb"));
   }
+  ExpectValidGltf(files);
 }
 
 // Every glTF file written here passes the Khronos glTF validator without errors or warnings.
 TEST(GltfValidator, WrittenFilesAreValid) {
-  const std::string modules = FLEXKIN_NODE_MODULES;
-  if (std::system("node --version > /dev/null 2>&1") != 0) {
-    FAIL() << "node (Node.js) is not on the PATH; run scripts/install-deps.sh";
-  }
-  if (!std::filesystem::exists(modules + "/gltf-validator/package.json")) {
-    FAIL() << "gltf-validator is not installed in " << modules << "; run scripts/install-deps.sh";
-  }
   TempDir dir;
   std::vector<std::string> files;
   GltfOptions options;
@@ -210,22 +262,7 @@ TEST(GltfValidator, WrittenFilesAreValid) {
   single.result.frames.resize(1);
   files.push_back(dir / "single_frame.gltf");
   WriteGltf(single, GltfOptions{}, files.back());
-
-  std::string command = "node '" + std::string(FLEXKIN_SOURCE_DIR) + "/tests/gltf/validate.mjs' '" +
-                        modules + "'";
-  for (const std::string& f : files) command += " '" + f + "'";
-  command += " 2>&1";
-  FILE* pipe = ::popen(command.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  std::string output;
-  char buffer[4096];
-  while (const size_t got = std::fread(buffer, 1, sizeof buffer, pipe)) output.append(buffer, got);
-  const int status = ::pclose(pipe);
-  std::printf("%s", output.c_str());
-  EXPECT_EQ(status, 0) << output;
-  for (const std::string& f : files) {
-    EXPECT_NE(output.find(f + ": 0 errors, 0 warnings,"), std::string::npos) << f << "\n" << output;
-  }
+  ExpectValidGltf(files);
 }
 
 // The rig: bones along the links, translations the link vectors, unit quaternions that keep
@@ -337,6 +374,7 @@ TEST(GltfBadInput, RefusedWithoutWriting) {
   { std::ofstream(path) << "keep"; }
   const ResultFile good = MakeResult(2, 5, 6);
   const GltfOptions options;
+  GltfOptions bad;
 
   ResultFile nan = good;
   nan.result.frames[2].points(3, 1) = std::nan("");
@@ -357,7 +395,9 @@ TEST(GltfBadInput, RefusedWithoutWriting) {
   shape.result.frames[4].points.conservativeResize(4, 2);
   ExpectInputError([&] { WriteGltf(shape, options, path); }, "frames[4].points", "expected 6 by 2");
   ExpectInputError([&] { WriteGltf(good, options, dir / "out.obj"); }, "path", ".glb");
-  GltfOptions bad;
+  bad.steps_per_second = 1e-300;  // step 1 at 1e300 s
+  ExpectInputError([&] { WriteGltf(good, bad, path); }, "steps_per_second", "overflows");
+  bad = GltfOptions{};
   bad.steps_per_second = 0.0;
   ExpectInputError([&] { WriteGltf(good, bad, path); }, "steps_per_second", "> 0");
   bad = GltfOptions{};

@@ -9,9 +9,12 @@ namespace flexkin {
 
 const char* GltfUpAxisName(GltfUpAxis axis) {
   switch (axis) {
-    case GltfUpAxis::kAuto: return "auto";
-    case GltfUpAxis::kY: return "y";
-    case GltfUpAxis::kZ: return "z";
+    case GltfUpAxis::kAuto:
+      return "auto";
+    case GltfUpAxis::kY:
+      return "y";
+    case GltfUpAxis::kZ:
+      return "z";
   }
   return "?";
 }

@@ -20,7 +20,9 @@ namespace {
 
 using Eigen::Matrix4d;
 
-std::string Index(const std::string& name, size_t i) { return name + "[" + std::to_string(i) + "]"; }
+std::string Index(const std::string& name, size_t i) {
+  return name + "[" + std::to_string(i) + "]";
+}
 
 tinygltf::Model Load(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -58,9 +60,10 @@ std::vector<float> ReadFloats(const tinygltf::Model& model, int index, int compo
   if (accessor.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || accessor.sparse.isSparse ||
       tinygltf::GetNumComponentsInType(accessor.type) != components) {
     throw InputError(where, "only dense float accessors of " + std::to_string(components) +
-                     " components are supported here");
+                                " components are supported here");
   }
-  if (accessor.bufferView < 0 || accessor.bufferView >= static_cast<int>(model.bufferViews.size())) {
+  if (accessor.bufferView < 0 ||
+      accessor.bufferView >= static_cast<int>(model.bufferViews.size())) {
     throw InputError(where + ".bufferView", "does not exist");
   }
   const tinygltf::BufferView& view = model.bufferViews[accessor.bufferView];
@@ -74,7 +77,7 @@ std::vector<float> ReadFloats(const tinygltf::Model& model, int index, int compo
   const size_t start = view.byteOffset + accessor.byteOffset;
   const size_t count = accessor.count;
   if (count > 0 && (start + (count - 1) * static_cast<size_t>(stride) + element >
-                        std::min(data.size(), view.byteOffset + view.byteLength))) {
+                    std::min(data.size(), view.byteOffset + view.byteLength))) {
     throw InputError(where, "reaches past the end of its buffer view");
   }
   std::vector<float> values(count * components);
@@ -87,12 +90,12 @@ std::vector<float> ReadFloats(const tinygltf::Model& model, int index, int compo
 // One animated property of a node.
 struct Track {
   int node = -1;
-  int components = 0;           // 3 (translation, scale) or 4 (rotation)
+  int components = 0;  // 3 (translation, scale) or 4 (rotation)
   bool rotation = false;
-  bool step = false;            // STEP, else LINEAR
-  std::vector<float> times;     // increasing
-  std::vector<float> values;    // components per time
-  std::string path;             // "translation", "rotation" or "scale"
+  bool step = false;          // STEP, else LINEAR
+  std::vector<float> times;   // increasing
+  std::vector<float> values;  // components per time
+  std::string path;           // "translation", "rotation" or "scale"
 };
 
 // The track's value at time t: held before the first and after the last keyframe; exactly the
@@ -194,8 +197,8 @@ GltfJointMotion ReadGltfJointPositions(const std::string& path) {
   for (int i = 0; i < num_nodes; ++i) {
     for (const int child : model.nodes[i].children) {
       if (child < 0 || child >= num_nodes || parent[child] != -1 || child == i) {
-        throw InputError(Index("nodes", i) + ".children", "child " + std::to_string(child) +
-                         " does not exist or has two parents");
+        throw InputError(Index("nodes", i) + ".children",
+                         "child " + std::to_string(child) + " does not exist or has two parents");
       }
       parent[child] = i;
     }

@@ -59,7 +59,8 @@ RigAnimation PoseChain(const std::vector<Points>& frames) {
     }
     // Bones point from point j to point j+1: joint j's bone is link j+1.
     root = (f == 0 ? SmallestRotation(Vector3d::UnitY(), dir[1])
-                   : SmallestRotation(root_bone, dir[1]) * root).normalized();
+                   : SmallestRotation(root_bone, dir[1]) * root)
+               .normalized();
     root_bone = dir[1];
     world[0] = root;
     for (int j = 1; j + 1 < joints; ++j) {

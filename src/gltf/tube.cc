@@ -32,7 +32,9 @@ class Builder {
     return static_cast<uint32_t>(mesh_->num_vertices() - 1);
   }
 
-  void Triangle(uint32_t a, uint32_t b, uint32_t c) { mesh_->indices.insert(mesh_->indices.end(), {a, b, c}); }
+  void Triangle(uint32_t a, uint32_t b, uint32_t c) {
+    mesh_->indices.insert(mesh_->indices.end(), {a, b, c});
+  }
 
  private:
   TubeMesh* mesh_;

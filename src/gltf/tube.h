@@ -9,10 +9,10 @@ namespace flexkin::gltf {
 
 // Vertex and index arrays as they go into the file.
 struct TubeMesh {
-  std::vector<float> positions;  // 3 per vertex, glTF scene coordinates (metres)
-  std::vector<float> normals;    // 3 per vertex, unit length
-  std::vector<uint16_t> joints;  // 4 per vertex (JOINTS_0)
-  std::vector<float> weights;    // 4 per vertex (WEIGHTS_0), summing to 1
+  std::vector<float> positions;   // 3 per vertex, glTF scene coordinates (metres)
+  std::vector<float> normals;     // 3 per vertex, unit length
+  std::vector<uint16_t> joints;   // 4 per vertex (JOINTS_0)
+  std::vector<float> weights;     // 4 per vertex (WEIGHTS_0), summing to 1
   std::vector<uint32_t> indices;  // 3 per triangle, counter-clockwise seen from outside
   int num_vertices() const { return static_cast<int>(positions.size() / 3); }
 };

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <cstring>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -25,7 +24,9 @@ constexpr int kElementArrayBuffer = 34963;
 // More joints than JOINTS_0's unsigned 16-bit indices can address.
 constexpr int kMaxJoints = 65536;
 
-std::string Index(const std::string& name, size_t i) { return name + "[" + std::to_string(i) + "]"; }
+std::string Index(const std::string& name, size_t i) {
+  return name + "[" + std::to_string(i) + "]";
+}
 
 // Checks that `result` can be exported; throws InputError naming the field otherwise.
 void CheckResult(const ResultFile& file, double scale) {
@@ -36,13 +37,16 @@ void CheckResult(const ResultFile& file, double scale) {
   const Eigen::Index n = result.lengths.size();
   if (n < 1) throw InputError("link_lengths", "the result has no links; expected at least one");
   if (n + 1 > kMaxJoints) {
-    throw InputError("link_lengths", std::to_string(n) + " links is too many; glTF joint indices "
-                     "(16 bits) allow at most " + std::to_string(kMaxJoints - 1));
+    throw InputError("link_lengths", std::to_string(n) +
+                                         " links is too many; glTF joint indices "
+                                         "(16 bits) allow at most " +
+                                         std::to_string(kMaxJoints - 1));
   }
   for (Eigen::Index i = 0; i < n; ++i) {
     if (!(result.lengths[i] > 0.0) || !std::isfinite(result.lengths[i])) {
-      throw InputError(Index("link_lengths", i), FormatNumber(result.lengths[i]) +
-                       " is not valid; link lengths must be finite and > 0");
+      throw InputError(
+          Index("link_lengths", i),
+          FormatNumber(result.lengths[i]) + " is not valid; link lengths must be finite and > 0");
     }
   }
   if (result.frames.empty()) {
@@ -55,31 +59,35 @@ void CheckResult(const ResultFile& file, double scale) {
     const std::string field = Index("frames", f);
     if (frame.points.rows() != n + 1 || frame.points.cols() != file.dim) {
       throw InputError(field + ".points", "is " + std::to_string(frame.points.rows()) + " by " +
-                       std::to_string(frame.points.cols()) + "; expected " +
-                       std::to_string(n + 1) + " by " + std::to_string(file.dim) +
-                       " (one row per point, n+1 for n links)");
+                                              std::to_string(frame.points.cols()) + "; expected " +
+                                              std::to_string(n + 1) + " by " +
+                                              std::to_string(file.dim) +
+                                              " (one row per point, n+1 for n links)");
     }
     for (Eigen::Index i = 0; i <= n; ++i) {
       for (int k = 0; k < file.dim; ++k) {
         const double v = frame.points(i, k);
         if (!std::isfinite(v) || std::abs(v) > largest) {
-          throw InputError(Index(Index(field + ".points", i), k), FormatNumber(v) +
-                           " is not valid; coordinates must be finite (and fit in float32)");
+          throw InputError(
+              Index(Index(field + ".points", i), k),
+              FormatNumber(v) + " is not valid; coordinates must be finite (and fit in float32)");
         }
       }
       if (i > 0 && frame.points.row(i) == frame.points.row(i - 1)) {
-        throw InputError(Index(field + ".points", i), "coincides with point " +
-                         std::to_string(i - 1) + "; a link needs a direction");
+        throw InputError(
+            Index(field + ".points", i),
+            "coincides with point " + std::to_string(i - 1) + "; a link needs a direction");
       }
     }
     if (frame.step < 0 || (f > 0 && frame.step <= result.frames[f - 1].step)) {
-      throw InputError(field + ".step", std::to_string(frame.step) +
-                       " is not valid; steps must be >= 0 and increase from frame to frame");
+      throw InputError(field + ".step",
+                       std::to_string(frame.step) +
+                           " is not valid; steps must be >= 0 and increase from frame to frame");
     }
   }
 }
 
-// "gltf" or "glb" from the path's extension, or InputError("path").
+// True for a .glb path, false for .gltf (any case); InputError("path") for anything else.
 bool IsBinaryPath(const std::string& path) {
   const size_t dot = path.rfind('.');
   std::string ext = dot == std::string::npos ? "" : path.substr(dot + 1);
@@ -87,8 +95,10 @@ bool IsBinaryPath(const std::string& path) {
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (ext == "glb") return true;
   if (ext == "gltf") return false;
-  throw InputError("path", "\"" + path + "\" has no .gltf or .glb extension; the extension "
-                   "chooses the format (.glb binary, .gltf JSON with an embedded buffer)");
+  throw InputError("path",
+                   "\"" + path +
+                       "\" has no .gltf or .glb extension; the extension "
+                       "chooses the format (.glb binary, .gltf JSON with an embedded buffer)");
 }
 
 // Appends arrays to the model's one buffer, one buffer view each, 4-byte aligned.
@@ -148,10 +158,15 @@ std::vector<float> KeyframeTimes(const RunResult& result, double steps_per_secon
   std::vector<float> times;
   for (size_t f = 0; f < result.frames.size(); ++f) {
     times.push_back(static_cast<float>(result.frames[f].step / steps_per_second));
-    if (f > 0 && !(times[f] > times[f - 1])) {
-      throw InputError("steps_per_second", FormatNumber(steps_per_second) + " is too small "
-                       "for step " + std::to_string(result.frames[f].step) + ": its keyframe "
-                       "time rounds to the previous one in float32; use a larger value");
+    if (!std::isfinite(times[f]) || (f > 0 && !(times[f] > times[f - 1]))) {
+      throw InputError(
+          "steps_per_second",
+          FormatNumber(steps_per_second) +
+              " is too small "
+              "for step " +
+              std::to_string(result.frames[f].step) +
+              ": its keyframe "
+              "time overflows float32 or rounds to the previous one; use a larger value");
     }
   }
   return times;
@@ -188,9 +203,8 @@ void AddMesh(const ResultFile& file, const GltfOptions& options, const Eigen::Ma
   Eigen::VectorXd arc(n + 1);
   arc[0] = 0.0;
   for (int i = 0; i < n; ++i) arc[i + 1] = arc[i] + lengths[i];
-  const double radius = options.tube_radius > 0.0
-                            ? options.tube_radius
-                            : std::min(0.25 * arc[n] / n, 0.02 * arc[n]);
+  const double radius =
+      options.tube_radius > 0.0 ? options.tube_radius : std::min(0.25 * arc[n] / n, 0.02 * arc[n]);
   const gltf::TubeMesh tube = gltf::MakeTube(arc, radius, options.tube_sides, to_scene);
   const size_t vertices = tube.num_vertices();
 
@@ -209,10 +223,9 @@ void AddMesh(const ResultFile& file, const GltfOptions& options, const Eigen::Ma
   primitive.attributes["WEIGHTS_0"] =
       buffer->Accessor(buffer->View(tube.weights, kArrayBuffer, "weights"), 0,
                        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, vertices);
-  primitive.indices =
-      buffer->Accessor(buffer->View(tube.indices, kElementArrayBuffer, "indices"), 0,
-                       TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
-                       tube.indices.size());
+  primitive.indices = buffer->Accessor(buffer->View(tube.indices, kElementArrayBuffer, "indices"),
+                                       0, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+                                       TINYGLTF_TYPE_SCALAR, tube.indices.size());
   primitive.mode = TINYGLTF_MODE_TRIANGLES;
   primitive.material = 0;
 
@@ -315,16 +328,16 @@ void WriteGltf(const ResultFile& file, const GltfOptions& options, const std::st
   animation.name = "motion";
   std::vector<double> min, max;
   MinMax(times, 1, &min, &max);
-  const int input = buffer.Accessor(buffer.View(times, 0, "keyframe times"), 0,
-                                    TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_SCALAR,
-                                    times.size(), min, max);
+  const int input =
+      buffer.Accessor(buffer.View(times, 0, "keyframe times"), 0, TINYGLTF_COMPONENT_TYPE_FLOAT,
+                      TINYGLTF_TYPE_SCALAR, times.size(), min, max);
   for (int j = 0; j <= n; ++j) {
     const int translation = buffer.Accessor(
         buffer.View(rig.translation[j], 0, "joint_" + std::to_string(j) + " translation"), 0,
         TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, times.size());
-    const int rotation = buffer.Accessor(
-        buffer.View(rig.rotation[j], 0, "joint_" + std::to_string(j) + " rotation"), 0,
-        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, times.size());
+    const int rotation =
+        buffer.Accessor(buffer.View(rig.rotation[j], 0, "joint_" + std::to_string(j) + " rotation"),
+                        0, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, times.size());
     for (const auto& [output, property] :
          {std::pair<int, const char*>{translation, "translation"}, {rotation, "rotation"}}) {
       tinygltf::AnimationSampler sampler;
