@@ -432,6 +432,12 @@ TEST(GltfBadInput, ReaderErrors) {
     { std::ofstream(dir / "cut.glb", std::ios::binary) << bytes.substr(0, keep); }
     EXPECT_THROW(ReadGltfJointPositions(dir / "cut.glb"), InputError) << keep << " bytes";
   }
+  WriteGltf(MakeResult(2, 4, 5), GltfOptions{}, dir / "good.gltf");
+  const std::string text = ReadAll(dir / "good.gltf");
+  for (const size_t keep : {size_t{1}, text.size() / 3, text.size() - 10}) {
+    { std::ofstream(dir / "cut.gltf") << text.substr(0, keep); }
+    EXPECT_THROW(ReadGltfJointPositions(dir / "cut.gltf"), InputError) << keep << " bytes";
+  }
   { std::ofstream(dir / "no_skin.gltf") << R"({"asset": {"version": "2.0"}})"; }
   ExpectInputError([&] { ReadGltfJointPositions(dir / "no_skin.gltf"); }, "skins", "no skin");
 }

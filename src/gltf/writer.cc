@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cmath>
 #include <ostream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -21,7 +22,7 @@ namespace {
 // glTF enums (the specification's numbers).
 constexpr int kArrayBuffer = 34962;
 constexpr int kElementArrayBuffer = 34963;
-// More joints than JOINTS_0's unsigned 16-bit indices can address.
+// The most joints that the unsigned 16-bit indices of JOINTS_0 can address.
 constexpr int kMaxJoints = 65536;
 
 std::string Index(const std::string& name, size_t i) {
