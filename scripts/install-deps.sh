@@ -1,34 +1,40 @@
 #!/usr/bin/env bash
-# Installs the Debian packages flexkin needs, if any is missing. Safe to run repeatedly.
+# Installs what flexkin needs, if anything is missing: Debian packages (apt-get), then the npm
+# packages of tools/node that the tests use (npm ci, exact versions from its package-lock.json).
+# Safe to run repeatedly.
 set -euo pipefail
 packages=(cmake make g++ pkg-config libeigen3-dev nlohmann-json3-dev libcli11-dev libgtest-dev
           libgmock-dev libbenchmark-dev libboost-dev libxsimd-dev liblapack-dev libnlopt-dev coinor-libipopt-dev)
-packages+=(chromium)                     # the viewer's browser test (headless)
-command -v node >/dev/null || packages+=(nodejs npm)  # Node only if there is none (e.g. NodeSource's)
+packages+=(libtinygltf-dev)  # glTF export (src/gltf)
+packages+=(chromium)         # the viewer's browser test (headless)
+# Node.js runs the glTF validator and the browser test. Debian's nodejs and npm only if there is
+# no node or npm on the PATH: one from another source (e.g. NodeSource) is used as it is.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then packages+=(nodejs npm); fi
+
+# The npm packages of tools/node, when tools/node/node_modules is missing or older than the lock.
+install_node_tools() {
+  local dir
+  dir="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)/tools/node"
+  if [ ! -d "$dir/node_modules" ] || [ "$dir/package-lock.json" -nt "$dir/node_modules" ]; then
+    echo "flexkin: installing the npm packages of tools/node (npm ci)"
+    npm ci --prefix "$dir" --no-audit --no-fund
+    touch "$dir/node_modules"
+  fi
+}
+
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
-# The Node packages the tests use (tools/node/package-lock.json), after the Debian packages.
-install_node_tools() {
-  local dir tools
-  dir="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-  tools="$dir/tools/node"
-  if [ ! -d "$tools/node_modules" ] || [ "$tools/package-lock.json" -nt "$tools/node_modules" ]; then
-    echo "flexkin: installing the Node packages of tools/node (npm ci)"
-    npm ci --prefix "$tools" --no-audit --no-fund
-    touch "$tools/node_modules"
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "flexkin: installing missing Debian packages: ${missing[*]}"
+  sudo=""
+  if [ "$(id -u)" -ne 0 ]; then
+    command -v sudo >/dev/null || { echo "flexkin: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+    sudo=sudo
   fi
-}
-# On the way out, whichever exit is taken below, unless something failed.
-trap 'status=$?; [ $status -ne 0 ] || install_node_tools' EXIT
-[ ${#missing[@]} -eq 0 ] && exit 0
-echo "flexkin: installing missing Debian packages: ${missing[*]}"
-sudo=""
-if [ "$(id -u)" -ne 0 ]; then
-  command -v sudo >/dev/null || { echo "flexkin: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
-  sudo=sudo
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo apt-get update -q
+  $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
-export DEBIAN_FRONTEND=noninteractive
-$sudo apt-get update -q
-$sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+install_node_tools
