@@ -111,6 +111,16 @@ double ChainScene::Depth(const double* point) const {
   return std::clamp((depth_hi_ - Lift(point).dot(toward_)) / (depth_hi_ - depth_lo_), 0.0, 1.0);
 }
 
+std::vector<Eigen::Vector2d> ChainScene::BoxCorners() const {
+  std::vector<Eigen::Vector2d> corners;
+  for (int c = 0; dim_ == 3 && c < 8; ++c) {
+    const Eigen::Vector3d q(c & 1 ? hi_.x() : lo_.x(), c & 2 ? hi_.y() : lo_.y(),
+                            c & 4 ? hi_.z() : lo_.z());
+    corners.push_back(Pixel(q.data()));
+  }
+  return corners;
+}
+
 void ChainScene::DrawAxes(cairo_t* cr) const {
   if (dim_ == 3) {
     DrawAxes3D(cr);

@@ -40,6 +40,10 @@ class ChainScene {
   // The rectangle the data may cover (2D: the plot frame; 3D: the projected box).
   const Rect& plot() const { return plot_; }
 
+  // 3D: the 8 corners of the bounding box in pixels, corner c at (c & 1 ? hi : lo) in x,
+  // (c & 2) in y, (c & 4) in z. Empty in 2D.
+  std::vector<Eigen::Vector2d> BoxCorners() const;
+
   // 2D: framed axes with ticks and "x", "y"; 3D: back panes, grids, three ticked axes.
   void DrawAxes(cairo_t* cr) const;
   // Draws the chains (each a (k by dim) row-major array of `rows` points) in one batch. 2D: each

@@ -3,11 +3,13 @@
 
 #include <cairo.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "flexkin/render.h"
 #include "render/axes.h"
+#include "render/legend.h"
 #include "render/scene.h"
 
 namespace flexkin::render {
@@ -22,11 +24,16 @@ std::vector<double> LeaderPath(const ResultFile& file);
 // An arrowhead at half the pixel length of `path` (rows of dim values), pointing along it.
 void DrawPathArrow(cairo_t* cr, const ChainScene& scene, const std::vector<double>& path, int dim,
                    const Rgb& color, double size);
-// The height of a figure `width` pixels wide whose scene shows the data at its aspect ratio,
-// between 0.4 and 1.2 times the width.
-int AutoHeight(const ResultFile& file, const FigureOptions& options);
-// The scene a figure with `options` draws in: tests use it to find where each point was drawn.
-// `options.height` must be resolved (not 0).
-ChainScene MakeSnapshotScene(const ResultFile& file, const FigureOptions& options);
+// The layout of a snapshot figure: what WriteSnapshotFigure draws where. Tests use it to find
+// where each point was drawn.
+struct SnapshotLayout {
+  FigureOptions options;   // with the height chosen when it was 0
+  std::vector<int> drawn;  // the frames drawn (SnapshotFrames)
+  ChainScene scene;
+  std::optional<Legend> legend;  // placed; none without show_legend
+};
+// The legend goes into the corner of the plot that covers the fewest lines if one covers none;
+// otherwise beside the plot, on the right, and the scene gets narrower.
+SnapshotLayout LayoutSnapshot(const ResultFile& file, const FigureOptions& options);
 
 }  // namespace flexkin::render
