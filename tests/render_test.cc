@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <system_error>
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
@@ -263,6 +264,260 @@ TEST(SnapshotFigureTest, SvgPngPdfFromTheExtensionAndAutomaticHeight) {
   EXPECT_EQ(png.width, 960);
   EXPECT_GE(png.height, 384);
   EXPECT_LE(png.height, 1152);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Plots.
+
+// The discs (filled paths with curves) of an SVG: where each starts. cairo starts a full circle
+// at angle 0, (x + r, y), so for discs of one radius these are their centres moved by (r, 0).
+std::vector<Eigen::Vector2d> Discs(const std::vector<SvgPath>& paths) {
+  std::vector<Eigen::Vector2d> starts;
+  for (const SvgPath& p : paths) {
+    if (!p.curved || p.style.find("fill:none") != std::string::npos) continue;
+    starts.emplace_back(p.vertices.front().first, p.vertices.front().second);
+  }
+  return starts;
+}
+
+TEST(PlotTest, PathLengthHasOneMarkerPerPointAtItsValue) {
+  const ResultFile file = SmallScene(2);
+  TempDir dir;
+  WritePlot(file, PlotKind::kPathLength, PlotOptions(), dir.Path("p.svg"));
+  const std::vector<Eigen::Vector2d> marks = Discs(SvgPaths(ReadFile(dir.Path("p.svg"))));
+  const Eigen::VectorXd& length = file.result.metrics.path_length;
+  ASSERT_EQ(static_cast<Eigen::Index>(marks.size()), length.size());  // 6 points
+  // Equally spaced in x, left to right; y linear in the path length (up = longer).
+  const double dx = marks[1].x() - marks[0].x();
+  EXPECT_GT(dx, 0.0);
+  const double dy_per_unit = (marks.back().y() - marks[0].y()) / (length[length.size() - 1] - length[0]);
+  EXPECT_LT(dy_per_unit, 0.0);
+  for (size_t i = 0; i < marks.size(); ++i) {
+    EXPECT_NEAR(marks[i].x() - marks[0].x(), dx * i, 0.02) << i;
+    EXPECT_NEAR(marks[i].y() - marks[0].y(), dy_per_unit * (length[i] - length[0]), 0.05) << i;
+  }
+  // The motion dies out along the chain: the trailing end moved least.
+  EXPECT_LT(length[length.size() - 1], length[0]);
+}
+
+TEST(PlotTest, LinkAnglesHasOneLinePerLinkThroughEveryFrame) {
+  const ResultFile file = SmallScene(3);
+  TempDir dir;
+  WritePlot(file, PlotKind::kLinkAngles, PlotOptions(), dir.Path("a.svg"));
+  // Lines with one vertex per frame (7) and distinct colours: one per link (5).
+  std::vector<std::string> styles;
+  for (const SvgPath& p : SvgPaths(ReadFile(dir.Path("a.svg")))) {
+    if (!p.closed && !p.curved && p.vertices.size() == file.result.frames.size()) styles.push_back(p.style);
+  }
+  EXPECT_EQ(styles.size(), 5u);
+  std::sort(styles.begin(), styles.end());
+  EXPECT_EQ(std::unique(styles.begin(), styles.end()) - styles.begin(), 5);
+}
+
+TEST(PlotTest, LengthErrorHasOneMarkerPerFrameOnALogScale) {
+  ResultFile file = SmallScene(2);
+  // Known errors: stretch link 2 of frame f by 10^-(f + 4), frame 0 exact.
+  for (size_t f = 1; f < file.result.frames.size(); ++f) {
+    Points& p = file.result.frames[f].points;
+    const Eigen::RowVectorXd d = p.row(2) - p.row(1);
+    p.row(2) = p.row(1) + d * (1.0 + std::pow(10.0, -static_cast<double>(f + 4)));
+    // Keep the rest of the chain's links as they were.
+    for (Eigen::Index i = 3; i < p.rows(); ++i) p.row(i) += d * std::pow(10.0, -static_cast<double>(f + 4));
+  }
+  const Eigen::VectorXd errors = FrameLengthErrors(file.result);
+  for (size_t f = 1; f < file.result.frames.size(); ++f) {
+    EXPECT_NEAR(std::log10(errors[f]), -static_cast<double>(f + 4), 0.01) << f;
+  }
+  TempDir dir;
+  WritePlot(file, PlotKind::kLengthError, PlotOptions(), dir.Path("e.svg"));
+  const std::vector<Eigen::Vector2d> marks = Discs(SvgPaths(ReadFile(dir.Path("e.svg"))));
+  ASSERT_EQ(marks.size(), file.result.frames.size());
+  // One decade is the same height everywhere (log scale).
+  const double decade = marks[2].y() - marks[1].y();
+  EXPECT_GT(decade, 5.0);
+  for (size_t f = 2; f < marks.size(); ++f) EXPECT_NEAR(marks[f].y() - marks[f - 1].y(), decade, 0.3) << f;
+}
+
+TEST(PlotTest, NamesRoundTrip) {
+  for (PlotKind kind : kAllPlotKinds) EXPECT_EQ(ParsePlotKind(PlotKindName(kind)), kind);
+  test_util::ExpectInputError([] { ParsePlotKind("speed", "--plot"); }, "--plot", "path_length");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Animations: what ffprobe says about them.
+
+struct Probe {
+  std::string codec;
+  int width = 0, height = 0, frames = 0;
+  std::string pix_fmt;
+};
+
+Probe FfProbe(const std::string& path) {
+  const std::string command =
+      "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+      "stream=codec_name,width,height,nb_read_frames,pix_fmt -of default=noprint_wrappers=1 '" +
+      path + "'";
+  Probe probe;
+  FILE* out = ::popen(command.c_str(), "r");
+  if (out == nullptr) return probe;
+  char line[256];
+  while (std::fgets(line, sizeof line, out) != nullptr) {
+    std::string text(line);
+    while (!text.empty() && text.back() == '\n') text.pop_back();
+    const size_t eq = text.find('=');
+    const std::string key = text.substr(0, eq), value = text.substr(eq + 1);
+    if (key == "codec_name") probe.codec = value;
+    if (key == "width") probe.width = std::stoi(value);
+    if (key == "height") probe.height = std::stoi(value);
+    if (key == "nb_read_frames") probe.frames = std::stoi(value);
+    if (key == "pix_fmt") probe.pix_fmt = value;
+  }
+  ::pclose(out);
+  return probe;
+}
+
+AnimationOptions SmallAnimation() {
+  AnimationOptions options;
+  options.width = 201;  // odd: rounded up to 202
+  options.height = 150;
+  options.fps = 10;
+  return options;
+}
+
+TEST(AnimationTest, Mp4HasOneFramePerRecordedFrameInH264) {
+  TempDir dir;
+  WriteAnimation(SmallScene(3), SmallAnimation(), dir.Path("a.mp4"));
+  const Probe probe = FfProbe(dir.Path("a.mp4"));
+  EXPECT_EQ(probe.codec, "h264");
+  EXPECT_EQ(probe.pix_fmt, "yuv420p");
+  EXPECT_EQ(probe.width, 202);
+  EXPECT_EQ(probe.height, 150);
+  EXPECT_EQ(probe.frames, 7);
+  EXPECT_EQ(dir.Files(), std::vector<std::string>{"a.mp4"});  // no temporary file left
+}
+
+TEST(AnimationTest, GifSubsampledToMaxFrames) {
+  TempDir dir;
+  AnimationOptions options = SmallAnimation();
+  options.max_frames = 4;  // 7 frames: 0, 2, 4, 6
+  WriteAnimation(SmallScene(2), options, dir.Path("a.gif"));
+  const Probe probe = FfProbe(dir.Path("a.gif"));
+  EXPECT_EQ(probe.codec, "gif");
+  EXPECT_EQ(probe.width, 202);
+  EXPECT_EQ(probe.height, 150);
+  EXPECT_EQ(probe.frames, 4);
+}
+
+TEST(AnimationTest, MissingFfmpegIsAClearErrorAndLeavesTheOldFile) {
+  TempDir dir;
+  render_test::WriteFile(dir.Path("a.mp4"), "precious");
+  AnimationOptions options = SmallAnimation();
+  options.ffmpeg = dir.Path("no-such-ffmpeg");
+  try {
+    WriteAnimation(SmallScene(2), options, dir.Path("a.mp4"));
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot run ffmpeg"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("No such file or directory"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(ReadFile(dir.Path("a.mp4")), "precious");
+  EXPECT_EQ(dir.Files(), std::vector<std::string>{"a.mp4"});
+}
+
+TEST(AnimationTest, FailingFfmpegIsAClearErrorAndLeavesTheOldFile) {
+  TempDir dir;
+  render_test::WriteFile(dir.Path("a.gif"), "precious");
+  AnimationOptions options = SmallAnimation();
+  options.ffmpeg = "false";  // exits 1 at once, without reading its input
+  try {
+    WriteAnimation(SmallScene(2), options, dir.Path("a.gif"));
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("exit status 1"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(ReadFile(dir.Path("a.gif")), "precious");
+  EXPECT_EQ(dir.Files(), std::vector<std::string>{"a.gif"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad input: an InputError naming the field, and no file written or changed.
+
+class BadInputTest : public testing::Test {
+ protected:
+  void SetUp() override {
+    for (const char* name : {"f.svg", "f.png", "f.pdf", "p.png", "a.mp4"}) {
+      render_test::WriteFile(dir_.Path(name), "precious");
+    }
+  }
+  void TearDown() override {
+    for (const char* name : {"f.svg", "f.png", "f.pdf", "p.png", "a.mp4"}) {
+      EXPECT_EQ(ReadFile(dir_.Path(name)), "precious") << name;
+    }
+    EXPECT_EQ(dir_.Files().size(), 5u);
+  }
+  // Expects every writer to refuse `file` with an InputError for `field`.
+  void ExpectAllRefuse(const ResultFile& file, const std::string& field) {
+    for (const char* name : {"f.svg", "f.png", "f.pdf"}) {
+      test_util::ExpectInputError([&] { WriteSnapshotFigure(file, FigureOptions(), dir_.Path(name)); }, field, "");
+    }
+    test_util::ExpectInputError([&] { WritePlot(file, PlotKind::kPathLength, PlotOptions(), dir_.Path("p.png")); }, field, "");
+    test_util::ExpectInputError([&] { WriteAnimation(file, AnimationOptions(), dir_.Path("a.mp4")); }, field, "");
+  }
+  TempDir dir_;
+};
+
+TEST_F(BadInputTest, NanInAPoint) {
+  ResultFile file = SmallScene(3);
+  file.result.frames[4].points(2, 1) = std::nan("");
+  ExpectAllRefuse(file, "frames[4].points[2][1]");
+}
+
+TEST_F(BadInputTest, InfiniteLinkAngle) {
+  ResultFile file = SmallScene(2);
+  file.result.frames[1].link_angles[0] = INFINITY;
+  ExpectAllRefuse(file, "frames[1].link_angles[0]");
+}
+
+TEST_F(BadInputTest, NoFramesOrWrongShape) {
+  ResultFile file = SmallScene(2);
+  ResultFile none = file;
+  none.result.frames.clear();
+  ExpectAllRefuse(none, "frames");
+  ResultFile short_frame = file;
+  short_frame.result.frames[3].points.conservativeResize(4, 2);
+  ExpectAllRefuse(short_frame, "frames[3].points");
+}
+
+TEST_F(BadInputTest, InvalidOptionsNameTheField) {
+  const ResultFile file = SmallScene(2);
+  FigureOptions figure;
+  figure.width = 0;
+  test_util::ExpectInputError([&] { WriteSnapshotFigure(file, figure, dir_.Path("f.png")); }, "width", "64 to 8192");
+  figure = FigureOptions();
+  figure.elevation = 91;
+  test_util::ExpectInputError([&] { WriteSnapshotFigure(file, figure, dir_.Path("f.svg")); }, "elevation", "-90 to 90");
+  figure = FigureOptions();
+  figure.every_k = -1;
+  test_util::ExpectInputError([&] { WriteSnapshotFigure(file, figure, dir_.Path("f.svg")); }, "every_k", "-1");
+  PlotOptions plot;
+  plot.height = -5;
+  test_util::ExpectInputError([&] { WritePlot(file, PlotKind::kLinkAngles, plot, dir_.Path("p.png")); }, "height", "-5");
+  AnimationOptions animation;
+  animation.fps = 0;
+  test_util::ExpectInputError([&] { WriteAnimation(file, animation, dir_.Path("a.mp4")); }, "fps", "1 to 120");
+  animation = AnimationOptions();
+  animation.max_frames = 1;
+  test_util::ExpectInputError([&] { WriteAnimation(file, animation, dir_.Path("a.mp4")); }, "max_frames", ">= 2");
+  test_util::ExpectInputError([&] { WriteSnapshotFigure(file, FigureOptions(), dir_.Path("f.jpg")); }, "path", ".svg, .png or .pdf");
+  test_util::ExpectInputError([&] { WriteAnimation(file, AnimationOptions(), dir_.Path("a.avi")); }, "path", ".mp4 or .gif");
+}
+
+TEST(RenderFileErrorTest, MissingDirectoryIsASystemErrorAndWritesNothing) {
+  TempDir dir;
+  const ResultFile file = SmallScene(2);
+  EXPECT_THROW(WriteSnapshotFigure(file, FigureOptions(), dir.Path("no/such/f.png")), std::system_error);
+  EXPECT_THROW(WriteAnimation(file, SmallAnimation(), dir.Path("no/such/a.gif")), std::system_error);
+  EXPECT_TRUE(dir.Files().empty());
 }
 
 }  // namespace

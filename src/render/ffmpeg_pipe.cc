@@ -20,9 +20,12 @@ namespace {
 // The last `lines` lines of `text`, without a trailing newline.
 std::string Tail(std::string text, int lines) {
   while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
-  size_t at = text.size();
-  for (int k = 0; k < lines && at != std::string::npos && at > 0; ++k) at = text.rfind('\n', at - 1);
-  return at == std::string::npos ? text : text.substr(at + 1);
+  size_t start = text.size();
+  for (int k = 0; k < lines && start > 0; ++k) {
+    const size_t newline = text.rfind('\n', start - 1);
+    start = newline == std::string::npos ? 0 : newline;
+  }
+  return text.substr(start == 0 ? 0 : start + 1);
 }
 
 }  // namespace
