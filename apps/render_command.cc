@@ -146,7 +146,7 @@ RenderCommand::RenderCommand(CLI::App* app, const std::string& footer) {
   command_->add_option("--every", args_.every,
                        "Figures: draw every K-th recorded frame (default: about 16 frames)");
   width_ = command_->add_option("--width", args_.width, "Width in pixels (default: figures 960, plots 800, animations 640)");
-  height_ = command_->add_option("--height", args_.height, "Height in pixels (default: figures 0 = from the data's aspect ratio, plots 500, animations 480)");
+  height_ = command_->add_option("--height", args_.height, "Height in pixels; 0 = from the data's aspect ratio (default: figures and animations 0, plots 500)");
   azimuth_ = command_->add_option("--azimuth", args_.azimuth, "3D view: degrees about z from +x (default -60)");
   elevation_ = command_->add_option("--elevation", args_.elevation, "3D view: degrees above the x-y plane (default 30)");
   fps_ = command_->add_option("--fps", args_.fps, "Animations: frames per second (default 30)");
@@ -163,8 +163,8 @@ int RenderCommand::Run() const {
   job.figure.every_k = args_.every;
   job.figure.title = job.animation.title = args_.title;
   if (*width_) job.figure.width = job.plot.width = job.animation.width = args_.width;
-  if (*height_) job.figure.height = args_.height;
-  if (*height_ && args_.height != 0) job.plot.height = job.animation.height = args_.height;
+  if (*height_) job.figure.height = job.animation.height = args_.height;
+  if (*height_ && args_.height != 0) job.plot.height = args_.height;
   if (*azimuth_) job.figure.azimuth = job.animation.azimuth = args_.azimuth;
   if (*elevation_) job.figure.elevation = job.animation.elevation = args_.elevation;
   if (*fps_) job.animation.fps = args_.fps;

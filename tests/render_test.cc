@@ -381,6 +381,8 @@ AnimationOptions SmallAnimation() {
   options.width = 201;  // odd: rounded up to 202
   options.height = 150;
   options.fps = 10;
+  options.min_seconds = 0.0;  // one video frame per picture
+  options.end_pause = 0.0;
   return options;
 }
 
@@ -406,6 +408,15 @@ TEST(AnimationTest, GifSubsampledToMaxFrames) {
   EXPECT_EQ(probe.width, 202);
   EXPECT_EQ(probe.height, 150);
   EXPECT_EQ(probe.frames, 4);
+}
+
+TEST(AnimationTest, ShortRunsAreStretchedAndTheEndHeld) {
+  TempDir dir;
+  AnimationOptions options = SmallAnimation();
+  options.min_seconds = 2.0;  // 7 pictures at 10 fps: each 3 times (2.1 s)
+  options.end_pause = 0.5;    // and the last 5 more
+  WriteAnimation(SmallScene(2), options, dir.Path("a.mp4"));
+  EXPECT_EQ(FfProbe(dir.Path("a.mp4")).frames, 7 * 3 + 5);
 }
 
 TEST(AnimationTest, MissingFfmpegIsAClearErrorAndLeavesTheOldFile) {

@@ -104,9 +104,9 @@ Eigen::VectorXd FrameLengthErrors(const RunResult& result);
 // The animation: one picture per drawn frame, axes fixed over the whole motion.
 struct AnimationOptions {
   // Size in pixels, 64 to 8192; an odd value is rounded up to even (H.264 in yuv420p needs
-  // even sizes). Typical: 640 x 480.
+  // even sizes). Height 0 = automatic, as FigureOptions::height. Typical: 640 x 0.
   int width = 640;
-  int height = 480;
+  int height = 0;
   // Frames per second of the video, 1 to 120. Typical: 30.
   int fps = 30;
   // Draw recorded frames 0, k, 2k, ... and the last one. 0 = automatic: the smallest k that
@@ -115,6 +115,11 @@ struct AnimationOptions {
   // Upper bound of the pictures when every_k = 0: long runs are subsampled. >= 2. Typical: 300
   // (10 s at 30 fps).
   int max_frames = 300;
+  // Short runs play at least this long, in seconds: each picture is shown ceil(min_seconds x
+  // fps / pictures) times. 0 = one video frame per picture. Typical: 3.
+  double min_seconds = 3.0;
+  // The last picture is held this long at the end, in seconds (GIFs loop). Typical: 1.
+  double end_pause = 1.0;
   // 3D view, as FigureOptions.
   double azimuth = -60.0;
   double elevation = 30.0;

@@ -162,7 +162,10 @@ void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
   render::ThrowIfInvalid(options.Validate());
   const VideoFormat format = VideoFormatFromPath(path);
   render::CheckDrawable(file);
-  const int width = options.width + options.width % 2, height = options.height + options.height % 2;
+  const int width = options.width + options.width % 2;
+  int height = options.height != 0 ? options.height
+                                   : render::AutoHeight(file, width, options.azimuth, options.elevation, 0.0);
+  height += height % 2;
   const int num_frames = static_cast<int>(file.result.frames.size());
   const int every_k = options.every_k > 0
                           ? options.every_k
@@ -182,15 +185,23 @@ void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
   try {
     render::FfmpegPipe ffmpeg(options.ffmpeg, FfmpegArgs(format, width, height, options.fps,
                                                          options.crf, temp));
-    for (size_t d = 0; d < drawn.size() && failure.empty(); ++d) {
+    // Video frames per picture, so that short runs last min_seconds; the last one also holds
+    // for end_pause.
+    const int pictures = static_cast<int>(drawn.size());
+    const int repeat = std::max(1, static_cast<int>(std::ceil(options.min_seconds * options.fps / pictures - 1e-9)));
+    const int pause = static_cast<int>(std::lround(options.end_pause * options.fps));
+    for (int d = 0; d < pictures && failure.empty(); ++d) {
       cairo_t* cr = picture.cr();
       cairo_set_source_surface(cr, background.surface(), 0, 0);
       cairo_paint(cr);
       DrawMoment(&picture, scene, file, drawn, d);
       const unsigned char* pixels = picture.Pixels();
-      for (int y = 0; y < height && failure.empty(); ++y) {
-        if (!ffmpeg.Write(pixels + static_cast<size_t>(y) * picture.Stride(), 4 * static_cast<size_t>(width))) {
-          failure = "stopped reading";
+      const int copies = repeat + (d == pictures - 1 ? pause : 0);
+      for (int c = 0; c < copies && failure.empty(); ++c) {
+        for (int y = 0; y < height && failure.empty(); ++y) {
+          if (!ffmpeg.Write(pixels + static_cast<size_t>(y) * picture.Stride(), 4 * static_cast<size_t>(width))) {
+            failure = "stopped reading";
+          }
         }
       }
     }

@@ -93,7 +93,11 @@ void Axes::Draw(cairo_t* cr, double ui, const std::string& x_label,
       if ((e - lo) % every == 0) yt.emplace_back(std::pow(10.0, e), PowerOfTenLabel(e));
     }
   } else {
-    const std::vector<double> v = NiceTicks(y0_, y1_, std::max(2, static_cast<int>(plot_.h / (60 * ui))));
+    std::vector<double> v = NiceTicks(y0_, y1_, std::max(2, static_cast<int>(plot_.h / (60 * ui))));
+    if (y_step_ > 0.0) {
+      v.clear();
+      for (double y = y0_; y <= y1_ + 1e-9 * y_step_; y += y_step_) v.push_back(y);
+    }
     const double y_step = v.size() > 1 ? v[1] - v[0] : 1.0;
     for (double y : v) yt.emplace_back(y, TickLabel(y, y_step));
   }

@@ -32,6 +32,8 @@ class Axes {
 
   // Only integer ticks on x (point and link indices).
   void SetIntegerX() { integer_x_ = true; }
+  // y ticks every `step` from y0 instead of NiceTicks (degrees: 30).
+  void SetYTickStep(double step) { y_step_ = step; }
 
   double X(double x) const;
   double Y(double y) const;
@@ -47,6 +49,7 @@ class Axes {
   double x0_, x1_, y0_, y1_;
   bool log_y_;
   bool integer_x_ = false;
+  double y_step_ = 0.0;
 };
 
 }  // namespace flexkin::render

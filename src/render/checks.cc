@@ -126,10 +126,15 @@ std::string FigureOptions::Validate() const {
 std::string PlotOptions::Validate() const { return SizeCheck(width, height); }
 
 std::string AnimationOptions::Validate() const {
-  std::string why = SizeCheck(width, height);
+  std::string why = render::CheckRange("width", width, kMinSize, kMaxSize, true);
+  if (why.empty() && height != 0 && (height < kMinSize || height > kMaxSize)) {
+    why = "height: " + FormatNumber(height) + " is not valid; expected 0 (automatic) or an integer from 64 to 8192";
+  }
   if (why.empty()) why = render::CheckRange("fps", fps, 1, 120, true);
   if (why.empty() && every_k < 0) why = "every_k: " + FormatNumber(every_k) + " is not valid; expected 0 (automatic) or more";
   if (why.empty() && max_frames < 2) why = "max_frames: " + FormatNumber(max_frames) + " is not valid; expected an integer >= 2";
+  if (why.empty()) why = render::CheckRange("min_seconds", min_seconds, 0, 3600, false);
+  if (why.empty()) why = render::CheckRange("end_pause", end_pause, 0, 60, false);
   if (why.empty() && !std::isfinite(azimuth)) why = "azimuth: " + FormatNumber(azimuth) + " is not valid; expected a finite number of degrees";
   if (why.empty()) why = render::CheckRange("elevation", elevation, -90, 90, false);
   if (why.empty()) why = render::CheckRange("crf", crf, 0, 51, true);

@@ -83,6 +83,7 @@ void LinkAnglesPlot(render::Canvas* canvas, const ResultFile& file) {
   const double bar = 86 * ui;  // colour bar and its labels
   const auto [x0, x1] = StepRange(r);
   Axes axes(PlotArea(*canvas, bar), x0, x1, 0.0, 180.0);
+  axes.SetYTickStep(30.0);
   axes.Draw(cr, ui, "leader step", "angle to the pull direction (degrees)");
   std::vector<double> x(r.frames.size()), y(r.frames.size());
   cairo_save(cr);

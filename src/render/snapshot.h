@@ -24,6 +24,10 @@ std::vector<double> LeaderPath(const ResultFile& file);
 // An arrowhead at half the pixel length of `path` (rows of dim values), pointing along it.
 void DrawPathArrow(cairo_t* cr, const ChainScene& scene, const std::vector<double>& path, int dim,
                    const Rgb& color, double size);
+// The height of a picture `width` wide whose scene (narrowed by `reserve` ui-pixels on the
+// right) shows the data at its aspect ratio (equal scales), 0.4 to 1.2 times the width.
+int AutoHeight(const ResultFile& file, int width, double azimuth, double elevation,
+               double reserve);
 // The layout of a snapshot figure: what WriteSnapshotFigure draws where. Tests use it to find
 // where each point was drawn.
 struct SnapshotLayout {

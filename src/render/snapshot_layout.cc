@@ -15,16 +15,16 @@ Rect Narrowed(Rect r, double right) {
   return r;
 }
 
-// The height of a figure `width` wide whose scene (narrowed by `reserve` ui-pixels on the
-// right) shows the data at its aspect ratio, between 0.4 and 1.2 times the width.
-int AutoHeight(const ResultFile& file, const FigureOptions& options, double reserve) {
-  const int width = options.width;
+}  // namespace
+
+int AutoHeight(const ResultFile& file, int width, double azimuth, double elevation,
+               double reserve) {
   int height = (width * 3) / 4;
   // Twice: the text size (UiScale) and so the margins depend on the height.
   for (int pass = 0; pass < 2; ++pass) {
     const double ui = UiScale(width, height);
     const Rect area = Narrowed(SceneArea(file.dim, width, height), reserve * ui);
-    const ChainScene scene(file, area, ui, options.azimuth, options.elevation);
+    const ChainScene scene(file, area, ui, azimuth, elevation);
     // The scene's own margins: none in 2D, 58 ui on the sides and 1.5 x 58 ui in 3D.
     const double side = file.dim == 2 ? 0.0 : 58.0 * ui;
     const double scene_h = (area.w - 2 * side) * scene.aspect() + 1.5 * side;
@@ -33,6 +33,8 @@ int AutoHeight(const ResultFile& file, const FigureOptions& options, double rese
   }
   return std::clamp(height, 64, 8192);
 }
+
+namespace {
 
 std::string Ordinal(int k) {
   if (k == 1) return "every";
@@ -96,7 +98,7 @@ std::vector<Eigen::Vector2d> DrawnLines(const ResultFile& file, const ChainScene
 
 SnapshotLayout LayoutSnapshot(const ResultFile& file, const FigureOptions& options) {
   FigureOptions resolved = options;
-  if (resolved.height == 0) resolved.height = AutoHeight(file, options, 0.0);
+  if (resolved.height == 0) resolved.height = AutoHeight(file, options.width, options.azimuth, options.elevation, 0.0);
   const std::vector<int> drawn =
       SnapshotFrames(static_cast<int>(file.result.frames.size()), options.every_k);
   double ui = UiScale(resolved.width, resolved.height);
@@ -111,7 +113,7 @@ SnapshotLayout LayoutSnapshot(const ResultFile& file, const FigureOptions& optio
     // Beside the plot: narrower scene, legend at the top right.
     const double reserve = legend.width() / ui + 16.0;
     if (options.height == 0) {
-      layout.options.height = AutoHeight(file, options, reserve);
+      layout.options.height = AutoHeight(file, options.width, options.azimuth, options.elevation, reserve);
       ui = UiScale(resolved.width, layout.options.height);
       legend = Legend(ui, LegendEntries(file, options, drawn, ui));
     }
