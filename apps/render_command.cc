@@ -101,8 +101,8 @@ std::vector<const OutputFormat*> ParseFormats(const std::string& list) {
                                           FormatNames());
       }
     }
-    throw InputError("--formats", "unknown format \"" + name + "\"; expected a comma-separated list of " +
-                                      FormatNames());
+    throw InputError("--formats", "unknown format \"" + name +
+                                      "\"; expected a comma-separated list of " + FormatNames());
   }
   std::vector<const OutputFormat*> formats;
   for (size_t i = 0; i < chosen.size(); ++i) {
@@ -124,7 +124,8 @@ void CheckOptions(const std::string& why) {
 // OUTDIR/<stem>: <stem> is the result file's name without ".json".
 std::string OutputBase(const std::string& result, const std::string& output_dir) {
   std::string stem = std::filesystem::path(result).filename().string();
-  if (stem.size() > 5 && stem.compare(stem.size() - 5, 5, ".json") == 0) stem.resize(stem.size() - 5);
+  if (stem.size() > 5 && stem.compare(stem.size() - 5, 5, ".json") == 0)
+    stem.resize(stem.size() - 5);
   std::string dir = output_dir;
   if (dir.empty()) {
     dir = std::filesystem::path(result).parent_path().string();
@@ -137,22 +138,31 @@ std::string OutputBase(const std::string& result, const std::string& output_dir)
 
 RenderCommand::RenderCommand(CLI::App* app, const std::string& footer) {
   command_ = app->add_subcommand("render", "Draw a result file: figures, plots, animations.");
-  command_->add_option("result", args_.result, "Result file (JSON, docs/result-format.md)")->required();
+  command_->add_option("result", args_.result, "Result file (JSON, docs/result-format.md)")
+      ->required();
   command_->add_option("-o,--output-dir", args_.output_dir,
                        "Directory for the outputs, created if missing (default: the result's)");
   std::string formats_help = "Comma-separated outputs (default svg,png,plots):";
-  for (const OutputFormat& f : kFormats) formats_help += std::string("\n  ") + f.name + ": " + f.files;
+  for (const OutputFormat& f : kFormats)
+    formats_help += std::string("\n  ") + f.name + ": " + f.files;
   command_->add_option("--formats", args_.formats, formats_help);
   command_->add_option("--every", args_.every,
                        "Figures: draw every K-th recorded frame (default: about 16 frames)");
-  width_ = command_->add_option("--width", args_.width, "Width in pixels (default: figures 960, plots 800, animations 640)");
-  height_ = command_->add_option("--height", args_.height, "Height in pixels; 0 = from the data's aspect ratio (default: figures and animations 0, plots 500)");
-  azimuth_ = command_->add_option("--azimuth", args_.azimuth, "3D view: degrees about z from +x (default -60)");
-  elevation_ = command_->add_option("--elevation", args_.elevation, "3D view: degrees above the x-y plane (default 30)");
+  width_ = command_->add_option(
+      "--width", args_.width, "Width in pixels (default: figures 960, plots 800, animations 640)");
+  height_ = command_->add_option("--height", args_.height,
+                                 "Height in pixels; 0 = from the data's aspect ratio (default: "
+                                 "figures and animations 0, plots 500)");
+  azimuth_ = command_->add_option("--azimuth", args_.azimuth,
+                                  "3D view: degrees about z from +x (default -60)");
+  elevation_ = command_->add_option("--elevation", args_.elevation,
+                                    "3D view: degrees above the x-y plane (default 30)");
   fps_ = command_->add_option("--fps", args_.fps, "Animations: frames per second (default 30)");
-  max_frames_ = command_->add_option("--max-frames", args_.max_frames,
-                                     "Animations: at most N pictures; longer runs are subsampled (default 300)");
-  command_->add_option("--title", args_.title, "Title of figures and animations (default: the scenario's name)");
+  max_frames_ = command_->add_option(
+      "--max-frames", args_.max_frames,
+      "Animations: at most N pictures; longer runs are subsampled (default 300)");
+  command_->add_option("--title", args_.title,
+                       "Title of figures and animations (default: the scenario's name)");
   command_->add_flag("-q,--quiet", args_.quiet, "Do not list the files written");
   command_->footer(footer);
 }
@@ -180,7 +190,8 @@ int RenderCommand::Run() const {
     throw InputError(args_.result + (e.field().empty() ? "" : ": " + e.field()),
                      std::string(e.what()).substr(e.field().empty() ? 0 : e.field().size() + 2));
   }
-  if (file.result.frames.empty()) throw InputError(args_.result + ": /frames", "no frames; nothing to draw");
+  if (file.result.frames.empty())
+    throw InputError(args_.result + ": /frames", "no frames; nothing to draw");
 
   job.file = &file;
   job.base = OutputBase(args_.result, args_.output_dir);

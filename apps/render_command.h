@@ -2,9 +2,8 @@
 // `flexkin render RESULT.json [-o OUTDIR] [--formats ...]`: figures, plots and animations of a
 // result file (docs/rendering.md). Kept apart from flexkin_main.cc, which only registers it.
 
-#include <string>
-
 #include <CLI/CLI.hpp>
+#include <string>
 
 #include "flexkin/render.h"
 
@@ -33,8 +32,8 @@ class RenderCommand {
   CLI::App* command_ = nullptr;
   Args args_;
   // Which of the shared options were given (the defaults differ per output).
-  CLI::Option *width_ = nullptr, *height_ = nullptr, *azimuth_ = nullptr,
-              *elevation_ = nullptr, *fps_ = nullptr, *max_frames_ = nullptr;
+  CLI::Option *width_ = nullptr, *height_ = nullptr, *azimuth_ = nullptr, *elevation_ = nullptr,
+              *fps_ = nullptr, *max_frames_ = nullptr;
 };
 
 }  // namespace flexkin::cli

@@ -69,10 +69,10 @@ class RenderCliTest : public testing::Test {
 TEST_F(RenderCliTest, DefaultFormatsAreFiguresAndPlots) {
   const CliResult r = Cli("render run.json -o out");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_EQ(Outputs("out"), (std::vector<std::string>{
-                                "run.png", "run.svg", "run_length_error.png", "run_length_error.svg",
-                                "run_link_angles.png", "run_link_angles.svg", "run_path_length.png",
-                                "run_path_length.svg"}));
+  EXPECT_EQ(Outputs("out"), (std::vector<std::string>{"run.png", "run.svg", "run_length_error.png",
+                                                      "run_length_error.svg", "run_link_angles.png",
+                                                      "run_link_angles.svg", "run_path_length.png",
+                                                      "run_path_length.svg"}));
   EXPECT_CONTAINS(r.out, "wrote out/run.svg\n");
   EXPECT_EQ(ReadFile(Path("out/run.png")).substr(1, 3), "PNG");
 }
@@ -141,7 +141,9 @@ TEST_F(RenderCliTest, NanOrHugeNumberExitsOneAndLeavesOldOutputs) {
 TEST_F(RenderCliTest, UnknownOrReservedFormatExitsOneListingTheFormats) {
   CliResult r = Cli("render run.json -o out --formats svg,jpeg");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_CONTAINS(r.err, "--formats: unknown format \"jpeg\"; expected a comma-separated list of svg, png, pdf, plots, mp4, gif");
+  EXPECT_CONTAINS(r.err,
+                  "--formats: unknown format \"jpeg\"; expected a comma-separated list of svg, "
+                  "png, pdf, plots, mp4, gif");
   r = Cli("render run.json -o out --formats html");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_CONTAINS(r.err, "--formats: \"html\" is not available in this build");

@@ -5,19 +5,20 @@
 // Regenerate the goldens (tests/golden/*.png) after an intended change of the look with
 //   FLEXKIN_UPDATE_GOLDEN=1 build/tests/render_test --gtest_filter='*Golden*'
 // and look at them before committing.
+#include "flexkin/render.h"
+
 #include <cairo.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <system_error>
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "flexkin/error.h"
-#include "flexkin/render.h"
 #include "render/snapshot.h"
 #include "render_test_util.h"
 #include "test_util.h"
@@ -127,6 +128,18 @@ TEST(RenderGoldenTest, RenderingIsDeterministic) {
   WriteSnapshotFigure(file, GoldenOptions(), dir.Path("a.png"));
   WriteSnapshotFigure(file, GoldenOptions(), dir.Path("b.png"));
   EXPECT_EQ(ReadFile(dir.Path("a.png")), ReadFile(dir.Path("b.png")));
+  // SVG: the same paths with the same styles (the ids of surfaces and glyphs count up within a
+  // process, so the bytes differ).
+  WriteSnapshotFigure(file, GoldenOptions(), dir.Path("a.svg"));
+  WriteSnapshotFigure(file, GoldenOptions(), dir.Path("b.svg"));
+  const std::vector<SvgPath> a = SvgPaths(ReadFile(dir.Path("a.svg")));
+  const std::vector<SvgPath> b = SvgPaths(ReadFile(dir.Path("b.svg")));
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_GT(a.size(), 100u);
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].style, b[i].style) << i;
+    EXPECT_EQ(a[i].vertices, b[i].vertices) << i;
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -139,9 +152,11 @@ bool Near(const std::pair<double, double>& v, const Eigen::Vector2d& p) {
 }
 
 // Distance from `p` to the segment a-b.
-double SegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+double SegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                       const Eigen::Vector2d& b) {
   const Eigen::Vector2d d = b - a;
-  const double t = d.squaredNorm() > 0 ? std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+  const double t =
+      d.squaredNorm() > 0 ? std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
   return (a + t * d - p).norm();
 }
 
@@ -237,7 +252,9 @@ TEST_P(EveryPointTest, AMovedPointIsNotFound) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Dims, EveryPointTest, testing::Values(2, 3),
-                         [](const testing::TestParamInfo<int>& i) { return std::to_string(i.param) + "D"; });
+                         [](const testing::TestParamInfo<int>& i) {
+                           return std::to_string(i.param) + "D";
+                         });
 
 TEST(SnapshotFramesTest, StrideAndLast) {
   EXPECT_EQ(SnapshotFrames(7, 1), (std::vector<int>{0, 1, 2, 3, 4, 5, 6}));
@@ -256,7 +273,8 @@ TEST(SnapshotFigureTest, SvgPngPdfFromTheExtensionAndAutomaticHeight) {
   TempDir dir;
   FigureOptions options;  // height 0: automatic
   const ResultFile file = SmallScene(2);
-  for (const char* name : {"f.svg", "f.PNG", "f.pdf"}) WriteSnapshotFigure(file, options, dir.Path(name));
+  for (const char* name : {"f.svg", "f.PNG", "f.pdf"})
+    WriteSnapshotFigure(file, options, dir.Path(name));
   EXPECT_EQ(ReadFile(dir.Path("f.svg")).rfind("<?xml", 0), 0u);
   EXPECT_EQ(ReadFile(dir.Path("f.PNG")).substr(1, 3), "PNG");
   EXPECT_EQ(ReadFile(dir.Path("f.pdf")).rfind("%PDF-", 0), 0u);
@@ -290,7 +308,8 @@ TEST(PlotTest, PathLengthHasOneMarkerPerPointAtItsValue) {
   // Equally spaced in x, left to right; y linear in the path length (up = longer).
   const double dx = marks[1].x() - marks[0].x();
   EXPECT_GT(dx, 0.0);
-  const double dy_per_unit = (marks.back().y() - marks[0].y()) / (length[length.size() - 1] - length[0]);
+  const double dy_per_unit =
+      (marks.back().y() - marks[0].y()) / (length[length.size() - 1] - length[0]);
   EXPECT_LT(dy_per_unit, 0.0);
   for (size_t i = 0; i < marks.size(); ++i) {
     EXPECT_NEAR(marks[i].x() - marks[0].x(), dx * i, 0.02) << i;
@@ -307,7 +326,8 @@ TEST(PlotTest, LinkAnglesHasOneLinePerLinkThroughEveryFrame) {
   // Lines with one vertex per frame (7) and distinct colours: one per link (5).
   std::vector<std::string> styles;
   for (const SvgPath& p : SvgPaths(ReadFile(dir.Path("a.svg")))) {
-    if (!p.closed && !p.curved && p.vertices.size() == file.result.frames.size()) styles.push_back(p.style);
+    if (!p.closed && !p.curved && p.vertices.size() == file.result.frames.size())
+      styles.push_back(p.style);
   }
   EXPECT_EQ(styles.size(), 5u);
   std::sort(styles.begin(), styles.end());
@@ -322,7 +342,8 @@ TEST(PlotTest, LengthErrorHasOneMarkerPerFrameOnALogScale) {
     const Eigen::RowVectorXd d = p.row(2) - p.row(1);
     p.row(2) = p.row(1) + d * (1.0 + std::pow(10.0, -static_cast<double>(f + 4)));
     // Keep the rest of the chain's links as they were.
-    for (Eigen::Index i = 3; i < p.rows(); ++i) p.row(i) += d * std::pow(10.0, -static_cast<double>(f + 4));
+    for (Eigen::Index i = 3; i < p.rows(); ++i)
+      p.row(i) += d * std::pow(10.0, -static_cast<double>(f + 4));
   }
   const Eigen::VectorXd errors = FrameLengthErrors(file.result);
   for (size_t f = 1; f < file.result.frames.size(); ++f) {
@@ -335,7 +356,8 @@ TEST(PlotTest, LengthErrorHasOneMarkerPerFrameOnALogScale) {
   // One decade is the same height everywhere (log scale).
   const double decade = marks[2].y() - marks[1].y();
   EXPECT_GT(decade, 5.0);
-  for (size_t f = 2; f < marks.size(); ++f) EXPECT_NEAR(marks[f].y() - marks[f - 1].y(), decade, 0.3) << f;
+  for (size_t f = 2; f < marks.size(); ++f)
+    EXPECT_NEAR(marks[f].y() - marks[f - 1].y(), decade, 0.3) << f;
 }
 
 TEST(PlotTest, NamesRoundTrip) {
@@ -429,7 +451,8 @@ TEST(AnimationTest, MissingFfmpegIsAClearErrorAndLeavesTheOldFile) {
     ADD_FAILURE() << "no error";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("cannot run ffmpeg"), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("No such file or directory"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("No such file or directory"), std::string::npos)
+        << e.what();
   }
   EXPECT_EQ(ReadFile(dir.Path("a.mp4")), "precious");
   EXPECT_EQ(dir.Files(), std::vector<std::string>{"a.mp4"});
@@ -469,10 +492,14 @@ class BadInputTest : public testing::Test {
   // Expects every writer to refuse `file` with an InputError for `field`.
   void ExpectAllRefuse(const ResultFile& file, const std::string& field) {
     for (const char* name : {"f.svg", "f.png", "f.pdf"}) {
-      test_util::ExpectInputError([&] { WriteSnapshotFigure(file, FigureOptions(), dir_.Path(name)); }, field, "");
+      test_util::ExpectInputError(
+          [&] { WriteSnapshotFigure(file, FigureOptions(), dir_.Path(name)); }, field, "");
     }
-    test_util::ExpectInputError([&] { WritePlot(file, PlotKind::kPathLength, PlotOptions(), dir_.Path("p.png")); }, field, "");
-    test_util::ExpectInputError([&] { WriteAnimation(file, AnimationOptions(), dir_.Path("a.mp4")); }, field, "");
+    test_util::ExpectInputError(
+        [&] { WritePlot(file, PlotKind::kPathLength, PlotOptions(), dir_.Path("p.png")); }, field,
+        "");
+    test_util::ExpectInputError(
+        [&] { WriteAnimation(file, AnimationOptions(), dir_.Path("a.mp4")); }, field, "");
   }
   TempDir dir_;
 };
@@ -503,31 +530,42 @@ TEST_F(BadInputTest, InvalidOptionsNameTheField) {
   const ResultFile file = SmallScene(2);
   FigureOptions figure;
   figure.width = 0;
-  test_util::ExpectInputError([&] { WriteSnapshotFigure(file, figure, dir_.Path("f.png")); }, "width", "64 to 8192");
+  test_util::ExpectInputError([&] { WriteSnapshotFigure(file, figure, dir_.Path("f.png")); },
+                              "width", "64 to 8192");
   figure = FigureOptions();
   figure.elevation = 91;
-  test_util::ExpectInputError([&] { WriteSnapshotFigure(file, figure, dir_.Path("f.svg")); }, "elevation", "-90 to 90");
+  test_util::ExpectInputError([&] { WriteSnapshotFigure(file, figure, dir_.Path("f.svg")); },
+                              "elevation", "-90 to 90");
   figure = FigureOptions();
   figure.every_k = -1;
-  test_util::ExpectInputError([&] { WriteSnapshotFigure(file, figure, dir_.Path("f.svg")); }, "every_k", "-1");
+  test_util::ExpectInputError([&] { WriteSnapshotFigure(file, figure, dir_.Path("f.svg")); },
+                              "every_k", "-1");
   PlotOptions plot;
   plot.height = -5;
-  test_util::ExpectInputError([&] { WritePlot(file, PlotKind::kLinkAngles, plot, dir_.Path("p.png")); }, "height", "-5");
+  test_util::ExpectInputError(
+      [&] { WritePlot(file, PlotKind::kLinkAngles, plot, dir_.Path("p.png")); }, "height", "-5");
   AnimationOptions animation;
   animation.fps = 0;
-  test_util::ExpectInputError([&] { WriteAnimation(file, animation, dir_.Path("a.mp4")); }, "fps", "1 to 120");
+  test_util::ExpectInputError([&] { WriteAnimation(file, animation, dir_.Path("a.mp4")); }, "fps",
+                              "1 to 120");
   animation = AnimationOptions();
   animation.max_frames = 1;
-  test_util::ExpectInputError([&] { WriteAnimation(file, animation, dir_.Path("a.mp4")); }, "max_frames", ">= 2");
-  test_util::ExpectInputError([&] { WriteSnapshotFigure(file, FigureOptions(), dir_.Path("f.jpg")); }, "path", ".svg, .png or .pdf");
-  test_util::ExpectInputError([&] { WriteAnimation(file, AnimationOptions(), dir_.Path("a.avi")); }, "path", ".mp4 or .gif");
+  test_util::ExpectInputError([&] { WriteAnimation(file, animation, dir_.Path("a.mp4")); },
+                              "max_frames", ">= 2");
+  test_util::ExpectInputError(
+      [&] { WriteSnapshotFigure(file, FigureOptions(), dir_.Path("f.jpg")); }, "path",
+      ".svg, .png or .pdf");
+  test_util::ExpectInputError([&] { WriteAnimation(file, AnimationOptions(), dir_.Path("a.avi")); },
+                              "path", ".mp4 or .gif");
 }
 
 TEST(RenderFileErrorTest, MissingDirectoryIsASystemErrorAndWritesNothing) {
   TempDir dir;
   const ResultFile file = SmallScene(2);
-  EXPECT_THROW(WriteSnapshotFigure(file, FigureOptions(), dir.Path("no/such/f.png")), std::system_error);
-  EXPECT_THROW(WriteAnimation(file, SmallAnimation(), dir.Path("no/such/a.gif")), std::system_error);
+  EXPECT_THROW(WriteSnapshotFigure(file, FigureOptions(), dir.Path("no/such/f.png")),
+               std::system_error);
+  EXPECT_THROW(WriteAnimation(file, SmallAnimation(), dir.Path("no/such/a.gif")),
+               std::system_error);
   EXPECT_TRUE(dir.Files().empty());
 }
 

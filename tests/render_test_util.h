@@ -88,8 +88,8 @@ class TempDir {
 struct SvgPath {
   std::string style;
   std::vector<std::pair<double, double>> vertices;  // of M and L commands, in order
-  bool closed = false;                               // has a Z
-  bool curved = false;                               // has a C (a disc or ring)
+  bool closed = false;                              // has a Z
+  bool curved = false;                              // has a C (a disc or ring)
 };
 
 inline std::vector<SvgPath> SvgPaths(const std::string& svg) {
@@ -97,7 +97,8 @@ inline std::vector<SvgPath> SvgPaths(const std::string& svg) {
   const size_t defs_end = svg.find("</defs>");
   const std::string body = svg.substr(defs_end == std::string::npos ? 0 : defs_end);
   static const std::regex kPath(R"re(<path style="([^"]*)" d="([^"]*)")re");
-  for (auto it = std::sregex_iterator(body.begin(), body.end(), kPath); it != std::sregex_iterator(); ++it) {
+  for (auto it = std::sregex_iterator(body.begin(), body.end(), kPath);
+       it != std::sregex_iterator(); ++it) {
     SvgPath path;
     path.style = (*it)[1];
     std::istringstream d((*it)[2].str());

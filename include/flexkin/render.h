@@ -1,9 +1,8 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "flexkin/result_io.h"
 
@@ -127,7 +126,8 @@ struct AnimationOptions {
   std::string title;
   // The ffmpeg program: a name looked up in PATH or a path.
   std::string ffmpeg = "ffmpeg";
-  // H.264 constant rate factor for MP4, 0 (lossless) to 51; lower is better and larger. Typical: 20.
+  // H.264 constant rate factor for MP4, 0 (lossless) to 51; lower is better and larger.
+  // Typical: 20.
   int crf = 20;
 
   // Empty if valid, otherwise the reason, starting with the field's name.

@@ -30,10 +30,12 @@ enum class VideoFormat { kMp4, kGif };
 VideoFormat VideoFormatFromPath(const std::string& path) {
   const size_t dot = path.rfind('.');
   std::string ext = dot == std::string::npos ? "" : path.substr(dot);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   if (ext == ".mp4") return VideoFormat::kMp4;
   if (ext == ".gif") return VideoFormat::kGif;
-  throw InputError("path", "\"" + path + "\" has no known animation extension; expected .mp4 or .gif");
+  throw InputError("path",
+                   "\"" + path + "\" has no known animation extension; expected .mp4 or .gif");
 }
 
 // The ffmpeg command line: raw frames in (cairo's RGB24 words: bytes B, G, R, unused on a
@@ -42,18 +44,24 @@ std::vector<std::string> FfmpegArgs(VideoFormat format, int width, int height, i
                                     const std::string& output) {
   const uint32_t probe = 1;
   const bool little_endian = *reinterpret_cast<const unsigned char*>(&probe) == 1;
-  std::vector<std::string> args = {"-hide_banner", "-loglevel", "error", "-nostdin",
-                                   "-f", "rawvideo", "-pix_fmt", little_endian ? "bgr0" : "0rgb",
-                                   "-s", std::to_string(width) + "x" + std::to_string(height),
-                                   "-framerate", std::to_string(fps), "-i", "pipe:0", "-an"};
+  std::vector<std::string> args = {
+      "-hide_banner", "-loglevel",
+      "error",        "-nostdin",
+      "-f",           "rawvideo",
+      "-pix_fmt",     little_endian ? "bgr0" : "0rgb",
+      "-s",           std::to_string(width) + "x" + std::to_string(height),
+      "-framerate",   std::to_string(fps),
+      "-i",           "pipe:0",
+      "-an"};
   if (format == VideoFormat::kMp4) {
     args.insert(args.end(), {"-c:v", "libx264", "-preset", "medium", "-crf", std::to_string(crf),
                              "-pix_fmt", "yuv420p", "-movflags", "+faststart", "-f", "mp4"});
   } else {
     // One palette for the whole animation, made from all its frames.
-    args.insert(args.end(), {"-filter_complex",
-                             "split[a][b];[a]palettegen=stats_mode=full[p];[b][p]paletteuse=dither=sierra2_4a",
-                             "-loop", "0", "-f", "gif"});
+    args.insert(args.end(),
+                {"-filter_complex",
+                 "split[a][b];[a]palettegen=stats_mode=full[p];[b][p]paletteuse=dither=sierra2_4a",
+                 "-loop", "0", "-f", "gif"});
   }
   args.insert(args.end(), {"-y", output});
   return args;
@@ -66,7 +74,8 @@ std::string TemporaryNextTo(const std::string& path) {
   const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
   std::string temp = dir + "." + name + ".tmp-XXXXXX";
   const int fd = ::mkstemp(temp.data());
-  if (fd < 0) throw std::system_error(errno, std::generic_category(), "cannot write '" + path + "'");
+  if (fd < 0)
+    throw std::system_error(errno, std::generic_category(), "cannot write '" + path + "'");
   ::close(fd);
   return temp;
 }
@@ -95,7 +104,8 @@ void DrawBackground(render::Canvas* canvas, const ChainScene& scene, const Resul
                     const std::string& title) {
   cairo_t* cr = canvas->cr();
   const double ui = canvas->ui();
-  render::DrawTitle(cr, ui, canvas->width(), render::MainTitle(file, title), render::RunSummary(file));
+  render::DrawTitle(cr, ui, canvas->width(), render::MainTitle(file, title),
+                    render::RunSummary(file));
   scene.DrawAxes(cr);
   const std::vector<double> leader = render::LeaderPath(file);
   const int num_frames = static_cast<int>(file.result.frames.size());
@@ -149,10 +159,10 @@ void DrawMoment(render::Canvas* canvas, const ChainScene& scene, const ResultFil
   counter.halign = render::Align::kEnd;
   counter.valign = render::Align::kEnd;
   counter.color = render::kMuted;
-  render::DrawText(cr, canvas->width() - 10 * ui, canvas->height() - 8 * ui,
-                   "step " + std::to_string(frames[f].step) + " of " +
-                       std::to_string(file.result.num_steps),
-                   counter);
+  render::DrawText(
+      cr, canvas->width() - 10 * ui, canvas->height() - 8 * ui,
+      "step " + std::to_string(frames[f].step) + " of " + std::to_string(file.result.num_steps),
+      counter);
 }
 
 }  // namespace
@@ -163,13 +173,15 @@ void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
   const VideoFormat format = VideoFormatFromPath(path);
   render::CheckDrawable(file);
   const int width = options.width + options.width % 2;
-  int height = options.height != 0 ? options.height
-                                   : render::AutoHeight(file, width, options.azimuth, options.elevation, 0.0);
+  int height = options.height != 0
+                   ? options.height
+                   : render::AutoHeight(file, width, options.azimuth, options.elevation, 0.0);
   height += height % 2;
   const int num_frames = static_cast<int>(file.result.frames.size());
-  const int every_k = options.every_k > 0
-                          ? options.every_k
-                          : std::max(1, (num_frames - 1 + options.max_frames - 2) / (options.max_frames - 1));
+  const int every_k =
+      options.every_k > 0
+          ? options.every_k
+          : std::max(1, (num_frames - 1 + options.max_frames - 2) / (options.max_frames - 1));
   const std::vector<int> drawn = SnapshotFrames(num_frames, every_k);
 
   const double ui = render::UiScale(width, height);
@@ -183,12 +195,13 @@ void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
   const std::string temp = TemporaryNextTo(path);
   std::string failure;
   try {
-    render::FfmpegPipe ffmpeg(options.ffmpeg, FfmpegArgs(format, width, height, options.fps,
-                                                         options.crf, temp));
+    render::FfmpegPipe ffmpeg(options.ffmpeg,
+                              FfmpegArgs(format, width, height, options.fps, options.crf, temp));
     // Video frames per picture, so that short runs last min_seconds; the last one also holds
     // for end_pause.
     const int pictures = static_cast<int>(drawn.size());
-    const int repeat = std::max(1, static_cast<int>(std::ceil(options.min_seconds * options.fps / pictures - 1e-9)));
+    const int repeat = std::max(
+        1, static_cast<int>(std::ceil(options.min_seconds * options.fps / pictures - 1e-9)));
     const int pause = static_cast<int>(std::lround(options.end_pause * options.fps));
     for (int d = 0; d < pictures && failure.empty(); ++d) {
       cairo_t* cr = picture.cr();
@@ -199,7 +212,8 @@ void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
       const int copies = repeat + (d == pictures - 1 ? pause : 0);
       for (int c = 0; c < copies && failure.empty(); ++c) {
         for (int y = 0; y < height && failure.empty(); ++y) {
-          if (!ffmpeg.Write(pixels + static_cast<size_t>(y) * picture.Stride(), 4 * static_cast<size_t>(width))) {
+          if (!ffmpeg.Write(pixels + static_cast<size_t>(y) * picture.Stride(),
+                            4 * static_cast<size_t>(width))) {
             failure = "stopped reading";
           }
         }

@@ -30,7 +30,8 @@ std::string TickLabel(double value, double step) {
   const int decimals = std::clamp(static_cast<int>(std::ceil(-std::log10(step) - 1e-9)), 0, 12);
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.*f", decimals, std::abs(value));
-  const bool negative = value < 0.0 && std::string(buf).find_first_not_of("0.") != std::string::npos;
+  const bool negative =
+      value < 0.0 && std::string(buf).find_first_not_of("0.") != std::string::npos;
   return (negative ? "\u2212" : "") + std::string(buf);
 }
 
@@ -73,7 +74,8 @@ void Axes::Draw(cairo_t* cr, double ui, const std::string& x_label,
 
   // x: ticks below the frame.
   std::vector<double> xt = NiceTicks(x0_, x1_, std::max(2, static_cast<int>(plot_.w / (90 * ui))));
-  if (integer_x_ && xt.size() > 1 && xt[1] - xt[0] < 1.0) xt = NiceTicks(x0_, x1_, static_cast<int>(x1_ - x0_));
+  if (integer_x_ && xt.size() > 1 && xt[1] - xt[0] < 1.0)
+    xt = NiceTicks(x0_, x1_, static_cast<int>(x1_ - x0_));
   const double x_step = xt.size() > 1 ? xt[1] - xt[0] : 1.0;
   for (double v : xt) {
     const double px = X(v);
@@ -87,7 +89,8 @@ void Axes::Draw(cairo_t* cr, double ui, const std::string& x_label,
   // y: ticks left of the frame; decades on a log axis (every 2nd, 3rd, ... if there are many).
   std::vector<std::pair<double, std::string>> yt;
   if (log_y_) {
-    const int lo = static_cast<int>(std::ceil(y0_ - 1e-9)), hi = static_cast<int>(std::floor(y1_ + 1e-9));
+    const int lo = static_cast<int>(std::ceil(y0_ - 1e-9)),
+              hi = static_cast<int>(std::floor(y1_ + 1e-9));
     const int every = std::max(1, (hi - lo + 1 + 7) / 8);
     for (int e = lo; e <= hi; ++e) {
       if ((e - lo) % every == 0) yt.emplace_back(std::pow(10.0, e), PowerOfTenLabel(e));

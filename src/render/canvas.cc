@@ -20,8 +20,7 @@ cairo_status_t AppendBytes(void* closure, const unsigned char* data, unsigned in
 
 void CheckStatus(cairo_status_t status, const char* what) {
   if (status != CAIRO_STATUS_SUCCESS) {
-    throw std::runtime_error(std::string("cairo: ") + what + ": " +
-                             cairo_status_to_string(status));
+    throw std::runtime_error(std::string("cairo: ") + what + ": " + cairo_status_to_string(status));
   }
 }
 
@@ -123,8 +122,7 @@ double TextWidth(cairo_t* cr, const std::string& text, const TextStyle& style) {
   return extents.x_advance;
 }
 
-double DrawText(cairo_t* cr, double x, double y, const std::string& text,
-                const TextStyle& style) {
+double DrawText(cairo_t* cr, double x, double y, const std::string& text, const TextStyle& style) {
   cairo_save(cr);
   SetFont(cr, style);
   cairo_text_extents_t extents;
@@ -132,7 +130,9 @@ double DrawText(cairo_t* cr, double x, double y, const std::string& text,
   cairo_font_extents_t font;
   cairo_font_extents(cr, &font);
   const double w = extents.x_advance;
-  const double dx = style.halign == Align::kStart ? 0.0 : style.halign == Align::kCenter ? -w / 2 : -w;
+  const double dx = style.halign == Align::kStart    ? 0.0
+                    : style.halign == Align::kCenter ? -w / 2
+                                                     : -w;
   // Vertical anchors from the font's ascent (capital height is about 0.73 of the size).
   const double cap = 0.73 * style.size;
   const double dy = style.valign == Align::kStart    ? cap
@@ -155,8 +155,7 @@ void SetColor(cairo_t* cr, const Rgb& color, double alpha) {
   }
 }
 
-void Line(cairo_t* cr, double x0, double y0, double x1, double y1, const Rgb& color,
-          double width) {
+void Line(cairo_t* cr, double x0, double y0, double x1, double y1, const Rgb& color, double width) {
   cairo_move_to(cr, x0, y0);
   cairo_line_to(cr, x1, y1);
   SetColor(cr, color);

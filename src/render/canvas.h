@@ -72,8 +72,7 @@ double TextWidth(cairo_t* cr, const std::string& text, const TextStyle& style);
 
 void SetColor(cairo_t* cr, const Rgb& color, double alpha = 1.0);
 // Strokes a straight segment.
-void Line(cairo_t* cr, double x0, double y0, double x1, double y1, const Rgb& color,
-          double width);
+void Line(cairo_t* cr, double x0, double y0, double x1, double y1, const Rgb& color, double width);
 // A filled disc, optionally outlined.
 void Disc(cairo_t* cr, double x, double y, double radius, const Rgb& fill);
 void Ring(cairo_t* cr, double x, double y, double radius, const Rgb& color, double width);

@@ -53,9 +53,9 @@ void CheckDrawable(const ResultFile& file) {
   }
   for (Eigen::Index i = 0; i < r.metrics.path_length.size(); ++i) {
     if (!std::isfinite(r.metrics.path_length[i])) {
-      throw InputError("metrics.path_length[" + std::to_string(i) + "]",
-                       FormatNumber(r.metrics.path_length[i]) +
-                           " is not valid; expected a finite number");
+      throw InputError(
+          "metrics.path_length[" + std::to_string(i) + "]",
+          FormatNumber(r.metrics.path_length[i]) + " is not valid; expected a finite number");
     }
   }
 }
@@ -105,20 +105,26 @@ ImageFormat ImageFormatFromPath(const std::string& path, const std::string& fiel
   std::string ext = dot == std::string::npos || (slash != std::string::npos && dot < slash)
                         ? ""
                         : path.substr(dot);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   if (ext == ".svg") return ImageFormat::kSvg;
   if (ext == ".png") return ImageFormat::kPng;
   if (ext == ".pdf") return ImageFormat::kPdf;
-  throw InputError(field, "\"" + path + "\" has no known image extension; expected .svg, .png or .pdf");
+  throw InputError(field,
+                   "\"" + path + "\" has no known image extension; expected .svg, .png or .pdf");
 }
 
 std::string FigureOptions::Validate() const {
-  if (every_k < 0) return "every_k: " + FormatNumber(every_k) + " is not valid; expected 0 (automatic) or more";
+  if (every_k < 0)
+    return "every_k: " + FormatNumber(every_k) + " is not valid; expected 0 (automatic) or more";
   std::string why = render::CheckRange("width", width, kMinSize, kMaxSize, true);
   if (why.empty() && height != 0 && (height < kMinSize || height > kMaxSize)) {
-    why = "height: " + FormatNumber(height) + " is not valid; expected 0 (automatic) or an integer from 64 to 8192";
+    why = "height: " + FormatNumber(height) +
+          " is not valid; expected 0 (automatic) or an integer from 64 to 8192";
   }
-  if (why.empty() && !std::isfinite(azimuth)) why = "azimuth: " + FormatNumber(azimuth) + " is not valid; expected a finite number of degrees";
+  if (why.empty() && !std::isfinite(azimuth))
+    why =
+        "azimuth: " + FormatNumber(azimuth) + " is not valid; expected a finite number of degrees";
   if (why.empty()) why = render::CheckRange("elevation", elevation, -90, 90, false);
   return why;
 }
@@ -128,17 +134,23 @@ std::string PlotOptions::Validate() const { return SizeCheck(width, height); }
 std::string AnimationOptions::Validate() const {
   std::string why = render::CheckRange("width", width, kMinSize, kMaxSize, true);
   if (why.empty() && height != 0 && (height < kMinSize || height > kMaxSize)) {
-    why = "height: " + FormatNumber(height) + " is not valid; expected 0 (automatic) or an integer from 64 to 8192";
+    why = "height: " + FormatNumber(height) +
+          " is not valid; expected 0 (automatic) or an integer from 64 to 8192";
   }
   if (why.empty()) why = render::CheckRange("fps", fps, 1, 120, true);
-  if (why.empty() && every_k < 0) why = "every_k: " + FormatNumber(every_k) + " is not valid; expected 0 (automatic) or more";
-  if (why.empty() && max_frames < 2) why = "max_frames: " + FormatNumber(max_frames) + " is not valid; expected an integer >= 2";
+  if (why.empty() && every_k < 0)
+    why = "every_k: " + FormatNumber(every_k) + " is not valid; expected 0 (automatic) or more";
+  if (why.empty() && max_frames < 2)
+    why = "max_frames: " + FormatNumber(max_frames) + " is not valid; expected an integer >= 2";
   if (why.empty()) why = render::CheckRange("min_seconds", min_seconds, 0, 3600, false);
   if (why.empty()) why = render::CheckRange("end_pause", end_pause, 0, 60, false);
-  if (why.empty() && !std::isfinite(azimuth)) why = "azimuth: " + FormatNumber(azimuth) + " is not valid; expected a finite number of degrees";
+  if (why.empty() && !std::isfinite(azimuth))
+    why =
+        "azimuth: " + FormatNumber(azimuth) + " is not valid; expected a finite number of degrees";
   if (why.empty()) why = render::CheckRange("elevation", elevation, -90, 90, false);
   if (why.empty()) why = render::CheckRange("crf", crf, 0, 51, true);
-  if (why.empty() && ffmpeg.empty()) why = "ffmpeg: the program's name is empty; expected a name or path such as \"ffmpeg\"";
+  if (why.empty() && ffmpeg.empty())
+    why = "ffmpeg: the program's name is empty; expected a name or path such as \"ffmpeg\"";
   return why;
 }
 
@@ -154,9 +166,12 @@ std::vector<int> SnapshotFrames(int num_frames, int every_k) {
 
 const char* PlotKindName(PlotKind kind) {
   switch (kind) {
-    case PlotKind::kPathLength: return "path_length";
-    case PlotKind::kLinkAngles: return "link_angles";
-    case PlotKind::kLengthError: return "length_error";
+    case PlotKind::kPathLength:
+      return "path_length";
+    case PlotKind::kLinkAngles:
+      return "link_angles";
+    case PlotKind::kLengthError:
+      return "length_error";
   }
   return "?";
 }
@@ -165,7 +180,8 @@ PlotKind ParsePlotKind(const std::string& name, const std::string& field) {
   for (PlotKind kind : kAllPlotKinds) {
     if (name == PlotKindName(kind)) return kind;
   }
-  throw InputError(field, "unknown plot \"" + name + "\"; expected \"path_length\", \"link_angles\" or \"length_error\"");
+  throw InputError(field, "unknown plot \"" + name +
+                              "\"; expected \"path_length\", \"link_angles\" or \"length_error\"");
 }
 
 Eigen::VectorXd FrameLengthErrors(const RunResult& result) {

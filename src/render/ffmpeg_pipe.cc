@@ -33,7 +33,8 @@ std::string Tail(std::string text, int lines) {
 FfmpegPipe::FfmpegPipe(const std::string& program, const std::vector<std::string>& args) {
   int sockets[2];
   if (::socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, sockets) != 0) {
-    throw std::runtime_error(std::string("cannot start ffmpeg: socketpair: ") + std::strerror(errno));
+    throw std::runtime_error(std::string("cannot start ffmpeg: socketpair: ") +
+                             std::strerror(errno));
   }
   std::string error_path =
       (std::filesystem::temp_directory_path() / "flexkin-ffmpeg-XXXXXX").string();
@@ -43,7 +44,8 @@ FfmpegPipe::FfmpegPipe(const std::string& program, const std::vector<std::string
     ::close(sockets[0]);
     ::close(sockets[1]);
     throw std::runtime_error("cannot start ffmpeg: temporary file in " +
-                             std::filesystem::temp_directory_path().string() + ": " + std::strerror(e));
+                             std::filesystem::temp_directory_path().string() + ": " +
+                             std::strerror(e));
   }
   ::unlink(error_path.c_str());
 
@@ -56,7 +58,8 @@ FfmpegPipe::FfmpegPipe(const std::string& program, const std::vector<std::string
   posix_spawn_file_actions_adddup2(&actions, sockets[1], STDIN_FILENO);
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
   posix_spawn_file_actions_adddup2(&actions, errors_, STDERR_FILENO);
-  const int status = ::posix_spawnp(&pid_, program.c_str(), &actions, nullptr, argv.data(), environ);
+  const int status =
+      ::posix_spawnp(&pid_, program.c_str(), &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   ::close(sockets[1]);
   input_ = sockets[0];
@@ -111,7 +114,8 @@ std::string FfmpegPipe::Finish() {
   std::string text;
   char buf[4096];
   ::lseek(errors_, 0, SEEK_SET);
-  for (ssize_t n; (n = ::read(errors_, buf, sizeof buf)) > 0;) text.append(buf, static_cast<size_t>(n));
+  for (ssize_t n; (n = ::read(errors_, buf, sizeof buf)) > 0;)
+    text.append(buf, static_cast<size_t>(n));
   std::string why = WIFEXITED(status) ? "exit status " + std::to_string(WEXITSTATUS(status))
                                       : "killed by signal " + std::to_string(WTERMSIG(status));
   text = Tail(text, 4);

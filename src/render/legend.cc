@@ -12,7 +12,8 @@ constexpr double kSwatch = 30.0, kPad = 9.0, kRow = 19.0, kText = 12.0;  // pixe
 
 }  // namespace
 
-Legend::Legend(double ui, std::vector<LegendEntry> entries) : ui_(ui), entries_(std::move(entries)) {
+Legend::Legend(double ui, std::vector<LegendEntry> entries)
+    : ui_(ui), entries_(std::move(entries)) {
   // Text is measured on a scratch surface: with hinting off (Canvas) the advance widths are
   // the same on every surface.
   cairo_surface_t* scratch = cairo_image_surface_create(CAIRO_FORMAT_RGB24, 1, 1);
@@ -34,10 +35,11 @@ Legend::Legend(double ui, std::vector<LegendEntry> entries) : ui_(ui), entries_(
 
 size_t Legend::PlaceInCorner(const Rect& region, const std::vector<Eigen::Vector2d>& avoid) {
   const double inset = 10 * ui_, margin = 6 * ui_;
-  const Eigen::Vector2d corners[4] = {{region.right() - inset - width_, region.y + inset},
-                                      {region.x + inset, region.y + inset},
-                                      {region.right() - inset - width_, region.bottom() - inset - height_},
-                                      {region.x + inset, region.bottom() - inset - height_}};
+  const Eigen::Vector2d corners[4] = {
+      {region.right() - inset - width_, region.y + inset},
+      {region.x + inset, region.y + inset},
+      {region.right() - inset - width_, region.bottom() - inset - height_},
+      {region.x + inset, region.bottom() - inset - height_}};
   size_t fewest = std::numeric_limits<size_t>::max();
   for (const Eigen::Vector2d& c : corners) {
     size_t covered = 0;

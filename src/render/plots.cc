@@ -29,7 +29,8 @@ Rect PlotArea(const render::Canvas& canvas, double extra_right) {
 void StrokePolyline(cairo_t* cr, const Axes& axes, const std::vector<double>& x,
                     const std::vector<double>& y, const render::Rgb& color, double width) {
   for (size_t i = 0; i < x.size(); ++i) {
-    i == 0 ? cairo_move_to(cr, axes.X(x[i]), axes.Y(y[i])) : cairo_line_to(cr, axes.X(x[i]), axes.Y(y[i]));
+    i == 0 ? cairo_move_to(cr, axes.X(x[i]), axes.Y(y[i]))
+           : cairo_line_to(cr, axes.X(x[i]), axes.Y(y[i]));
   }
   render::SetColor(cr, color);
   cairo_set_line_width(cr, width);
@@ -64,7 +65,8 @@ void PathLengthPlot(render::Canvas* canvas, const ResultFile& file) {
   }
   StrokePolyline(cr, axes, x, y, render::kMarker, 1.6 * ui);
   const double radius = std::clamp(axes.plot().w / points * 0.3, 1.6 * ui, 4.0 * ui);
-  for (Eigen::Index i = 0; i < points; ++i) render::Disc(cr, axes.X(x[i]), axes.Y(y[i]), radius, render::kMarker);
+  for (Eigen::Index i = 0; i < points; ++i)
+    render::Disc(cr, axes.X(x[i]), axes.Y(y[i]), radius, render::kMarker);
 }
 
 void LinkAnglesPlot(render::Canvas* canvas, const ResultFile& file) {
@@ -93,14 +95,16 @@ void LinkAnglesPlot(render::Canvas* canvas, const ResultFile& file) {
   // the leading links are on top.
   std::vector<Eigen::Index> bold;
   if (links > 8) {
-    for (int k = 0; k < 5; ++k) bold.push_back(static_cast<Eigen::Index>(std::lround(k * (links - 1) / 4.0)));
+    for (int k = 0; k < 5; ++k)
+      bold.push_back(static_cast<Eigen::Index>(std::lround(k * (links - 1) / 4.0)));
   }
   auto draw_link = [&](Eigen::Index i, double width) {
     for (size_t f = 0; f < r.frames.size(); ++f) {
       x[f] = static_cast<double>(r.frames[f].step);
       y[f] = r.frames[f].link_angles[i] * 180.0 / M_PI;
     }
-    const render::Rgb color = render::Viridis(links == 1 ? 0.0 : static_cast<double>(i) / (links - 1));
+    const render::Rgb color =
+        render::Viridis(links == 1 ? 0.0 : static_cast<double>(i) / (links - 1));
     if (x.size() == 1) {
       render::Disc(cr, axes.X(x[0]), axes.Y(y[0]), 3.0 * ui, color);
     } else {
@@ -133,8 +137,8 @@ void LinkAnglesPlot(render::Canvas* canvas, const ResultFile& file) {
   if (ticks.empty() || links == 1) ticks = {1.0};
   for (double t : ticks) {
     if (t != std::floor(t)) continue;
-    const double py = links == 1 ? plot.bottom() - plot.h / 2
-                                 : plot.bottom() - (t - 1.0) / (links - 1) * plot.h;
+    const double py =
+        links == 1 ? plot.bottom() - plot.h / 2 : plot.bottom() - (t - 1.0) / (links - 1) * plot.h;
     render::Line(cr, bx + bw, py, bx + bw + 4 * ui, py, render::kInk, 1.0 * ui);
     render::DrawText(cr, bx + bw + 7 * ui, py, std::to_string(static_cast<long long>(t)), label);
   }
@@ -151,7 +155,8 @@ void LengthErrorPlot(render::Canvas* canvas, const ResultFile& file) {
   const Eigen::VectorXd errors = FrameLengthErrors(r);
   cairo_t* cr = canvas->cr();
   const double ui = canvas->ui();
-  const double high = std::max({errors.maxCoeff(), r.metrics.max_relative_length_error, kErrorFloor});
+  const double high =
+      std::max({errors.maxCoeff(), r.metrics.max_relative_length_error, kErrorFloor});
   double low = high;
   for (double e : errors) low = std::min(low, std::max(e, kErrorFloor));
   const double y0 = std::pow(10.0, std::floor(std::log10(low)));
@@ -172,11 +177,13 @@ void LengthErrorPlot(render::Canvas* canvas, const ResultFile& file) {
   cairo_save(cr);
   const double dash[] = {6 * ui, 4 * ui};
   cairo_set_dash(cr, dash, 2, 0.0);
-  render::Line(cr, axes.plot().x, axes.Y(worst), axes.plot().right(), axes.Y(worst), render::kFinal, 1.3 * ui);
+  render::Line(cr, axes.plot().x, axes.Y(worst), axes.plot().right(), axes.Y(worst), render::kFinal,
+               1.3 * ui);
   cairo_restore(cr);
   StrokePolyline(cr, axes, x, y, render::kMarker, 1.1 * ui);
   if (x.size() <= 200) {
-    for (size_t f = 0; f < x.size(); ++f) render::Disc(cr, axes.X(x[f]), axes.Y(y[f]), 2.4 * ui, render::kMarker);
+    for (size_t f = 0; f < x.size(); ++f)
+      render::Disc(cr, axes.X(x[f]), axes.Y(y[f]), 2.4 * ui, render::kMarker);
   }
   cairo_restore(cr);
   render::TextStyle note;
@@ -185,7 +192,8 @@ void LengthErrorPlot(render::Canvas* canvas, const ResultFile& file) {
   note.halign = render::Align::kEnd;
   note.valign = render::Align::kEnd;
   char buf[96];
-  std::snprintf(buf, sizeof buf, "worst over every leader step: %.2e", r.metrics.max_relative_length_error);
+  std::snprintf(buf, sizeof buf, "worst over every leader step: %.2e",
+                r.metrics.max_relative_length_error);
   render::DrawText(cr, axes.plot().right() - 6 * ui, axes.Y(worst) - 5 * ui, buf, note);
 }
 
@@ -203,9 +211,15 @@ void WritePlot(const ResultFile& file, PlotKind kind, const PlotOptions& options
   render::DrawTitle(canvas.cr(), canvas.ui(), canvas.width(), title,
                     render::MainTitle(file, "") + " \u00b7 " + render::RunSummary(file));
   switch (kind) {
-    case PlotKind::kPathLength: PathLengthPlot(&canvas, file); break;
-    case PlotKind::kLinkAngles: LinkAnglesPlot(&canvas, file); break;
-    case PlotKind::kLengthError: LengthErrorPlot(&canvas, file); break;
+    case PlotKind::kPathLength:
+      PathLengthPlot(&canvas, file);
+      break;
+    case PlotKind::kLinkAngles:
+      LinkAnglesPlot(&canvas, file);
+      break;
+    case PlotKind::kLengthError:
+      LengthErrorPlot(&canvas, file);
+      break;
   }
   render::SaveCanvas(&canvas, path);
 }

@@ -1,7 +1,6 @@
 #include "render/scene.h"
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -142,8 +141,8 @@ void ChainScene::DrawAxes3D(cairo_t* cr) const {
   for (int a = 0; a < 3; ++a) {
     const int b = (a + 1) % 3, c = (a + 2) % 3;
     Eigen::Vector3d q = back;
-    const double corners[4][2] = {{lo_[b], lo_[c]}, {hi_[b], lo_[c]}, {hi_[b], hi_[c]},
-                                  {lo_[b], hi_[c]}};
+    const double corners[4][2] = {
+        {lo_[b], lo_[c]}, {hi_[b], lo_[c]}, {hi_[b], hi_[c]}, {lo_[b], hi_[c]}};
     for (int k = 0; k < 4; ++k) {
       q[b] = corners[k][0];
       q[c] = corners[k][1];
@@ -200,8 +199,8 @@ void ChainScene::DrawAxes3D(cairo_t* cr) const {
       const Eigen::Vector2d p = px(q), tip = p + 5 * ui_ * out;
       Line(cr, p.x(), p.y(), tip.x(), tip.y(), kInk, 1.0 * ui_);
       const std::string text = TickLabel(t, step);
-      const double half = 0.5 * (std::abs(out.x()) * TextWidth(cr, text, label) +
-                                 std::abs(out.y()) * label.size);
+      const double half =
+          0.5 * (std::abs(out.x()) * TextWidth(cr, text, label) + std::abs(out.y()) * label.size);
       const Eigen::Vector2d at = tip + (4 * ui_ + half) * out;
       DrawText(cr, at.x(), at.y(), text, label);
       reach = std::max(reach, 4 * ui_ + 2 * half);

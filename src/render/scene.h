@@ -24,8 +24,7 @@ struct ChainStyle {
 class ChainScene {
  public:
   // Fits every point of every frame of `file` into `area` (pixels). Angles in degrees.
-  ChainScene(const ResultFile& file, const Rect& area, double ui, double azimuth,
-             double elevation);
+  ChainScene(const ResultFile& file, const Rect& area, double ui, double azimuth, double elevation);
 
   int dim() const { return dim_; }
   // A point (dim values) in pixels.

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <string>
 
 #include "flexkin/render.h"
@@ -51,7 +50,8 @@ void DrawPathArrow(cairo_t* cr, const ChainScene& scene, const std::vector<doubl
     run[j] = run[j - 1] + (scene.Pixel(&path[j * dim]) - scene.Pixel(&path[(j - 1) * dim])).norm();
   }
   if (rows < 2 || run.back() < 4 * size) return;
-  const int j = static_cast<int>(std::upper_bound(run.begin(), run.end(), run.back() / 2) - run.begin());
+  const int j =
+      static_cast<int>(std::upper_bound(run.begin(), run.end(), run.back() / 2) - run.begin());
   const Eigen::Vector2d a = scene.Pixel(&path[(j - 1) * dim]), b = scene.Pixel(&path[j * dim]);
   const double t = (run.back() / 2 - run[j - 1]) / std::max(run[j] - run[j - 1], 1e-12);
   const Eigen::Vector2d tip = a + t * (b - a), d = (b - a).normalized(), n(-d.y(), d.x());
@@ -108,7 +108,8 @@ void WriteSnapshotFigure(const ResultFile& file, const FigureOptions& options,
   for (size_t d = 1; d + 1 < drawn.size(); ++d) {
     chains.push_back(frames[drawn[d]].points.data());
     chain_rows.push_back(rows);
-    styles.push_back({FadeColor(static_cast<double>(drawn[d]) / (num_frames - 1)), 1.4 * ui, false});
+    styles.push_back(
+        {FadeColor(static_cast<double>(drawn[d]) / (num_frames - 1)), 1.4 * ui, false});
   }
   scene.DrawChains(cr, chains, chain_rows, styles);
 

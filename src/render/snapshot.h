@@ -26,8 +26,7 @@ void DrawPathArrow(cairo_t* cr, const ChainScene& scene, const std::vector<doubl
                    const Rgb& color, double size);
 // The height of a picture `width` wide whose scene (narrowed by `reserve` ui-pixels on the
 // right) shows the data at its aspect ratio (equal scales), 0.4 to 1.2 times the width.
-int AutoHeight(const ResultFile& file, int width, double azimuth, double elevation,
-               double reserve);
+int AutoHeight(const ResultFile& file, int width, double azimuth, double elevation, double reserve);
 // The layout of a snapshot figure: what WriteSnapshotFigure draws where. Tests use it to find
 // where each point was drawn.
 struct SnapshotLayout {

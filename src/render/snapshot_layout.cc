@@ -40,10 +40,10 @@ std::string Ordinal(int k) {
   if (k == 1) return "every";
   const int mod100 = k % 100, mod10 = k % 10;
   const char* suffix = (mod100 >= 11 && mod100 <= 13) ? "th"
-                       : mod10 == 1                    ? "st"
-                       : mod10 == 2                    ? "nd"
-                       : mod10 == 3                    ? "rd"
-                                                       : "th";
+                       : mod10 == 1                   ? "st"
+                       : mod10 == 2                   ? "nd"
+                       : mod10 == 3                   ? "rd"
+                                                      : "th";
   return "every " + std::to_string(k) + suffix;
 }
 
@@ -52,17 +52,24 @@ std::vector<LegendEntry> LegendEntries(const ResultFile& file, const FigureOptio
   const std::vector<Frame>& frames = file.result.frames;
   std::vector<LegendEntry> entries;
   if (frames.size() > 1) {
-    entries.push_back({LegendEntry::kLine, {kInitial, 2.0 * ui, true}, false,
+    entries.push_back({LegendEntry::kLine,
+                       {kInitial, 2.0 * ui, true},
+                       false,
                        "initial (step " + std::to_string(frames.front().step) + ")"});
   }
   if (drawn.size() > 2) {
-    entries.push_back({LegendEntry::kGradient, {}, false,
+    entries.push_back({LegendEntry::kGradient,
+                       {},
+                       false,
                        Ordinal(drawn[1] - drawn[0]) + " frame, old \u2192 new"});
   }
-  entries.push_back({LegendEntry::kLine, {kFinal, 2.6 * ui, false}, true,
+  entries.push_back({LegendEntry::kLine,
+                     {kFinal, 2.6 * ui, false},
+                     true,
                      "final (step " + std::to_string(frames.back().step) + ")"});
   if (options.show_leader_path && frames.size() > 1) {
-    entries.push_back({LegendEntry::kLine, {kLeaderPath, 1.5 * ui, false}, false, "leading end's path"});
+    entries.push_back(
+        {LegendEntry::kLine, {kLeaderPath, 1.5 * ui, false}, false, "leading end's path"});
   }
   return entries;
 }
@@ -74,14 +81,16 @@ std::vector<Eigen::Vector2d> DrawnLines(const ResultFile& file, const ChainScene
   std::vector<Eigen::Vector2d> samples;
   auto sample = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     const int pieces = 1 + static_cast<int>((b - a).norm() / (3.0 * ui));
-    for (int k = 0; k <= pieces; ++k) samples.push_back(a + (b - a) * (static_cast<double>(k) / pieces));
+    for (int k = 0; k <= pieces; ++k)
+      samples.push_back(a + (b - a) * (static_cast<double>(k) / pieces));
   };
   const int rows = static_cast<int>(file.result.frames[0].points.rows());
   for (int f : drawn) {
     for (int i = 0; i + 1 < rows; ++i) sample(scene.Pixel(file, f, i), scene.Pixel(file, f, i + 1));
   }
   for (size_t f = 0; f + 1 < file.result.frames.size(); ++f) {
-    sample(scene.Pixel(file, static_cast<int>(f), 0), scene.Pixel(file, static_cast<int>(f) + 1, 0));
+    sample(scene.Pixel(file, static_cast<int>(f), 0),
+           scene.Pixel(file, static_cast<int>(f) + 1, 0));
   }
   // 3D: the box's edges (corners that differ in one coordinate).
   const std::vector<Eigen::Vector2d> box = scene.BoxCorners();
@@ -98,13 +107,14 @@ std::vector<Eigen::Vector2d> DrawnLines(const ResultFile& file, const ChainScene
 
 SnapshotLayout LayoutSnapshot(const ResultFile& file, const FigureOptions& options) {
   FigureOptions resolved = options;
-  if (resolved.height == 0) resolved.height = AutoHeight(file, options.width, options.azimuth, options.elevation, 0.0);
+  if (resolved.height == 0)
+    resolved.height = AutoHeight(file, options.width, options.azimuth, options.elevation, 0.0);
   const std::vector<int> drawn =
       SnapshotFrames(static_cast<int>(file.result.frames.size()), options.every_k);
   double ui = UiScale(resolved.width, resolved.height);
   Rect area = SceneArea(file.dim, resolved.width, resolved.height);
-  SnapshotLayout layout{resolved, drawn,
-                        ChainScene(file, area, ui, options.azimuth, options.elevation), {}};
+  SnapshotLayout layout{
+      resolved, drawn, ChainScene(file, area, ui, options.azimuth, options.elevation), {}};
   if (!options.show_legend) return layout;
 
   Legend legend(ui, LegendEntries(file, options, drawn, ui));
@@ -113,7 +123,8 @@ SnapshotLayout LayoutSnapshot(const ResultFile& file, const FigureOptions& optio
     // Beside the plot: narrower scene, legend at the top right.
     const double reserve = legend.width() / ui + 16.0;
     if (options.height == 0) {
-      layout.options.height = AutoHeight(file, options.width, options.azimuth, options.elevation, reserve);
+      layout.options.height =
+          AutoHeight(file, options.width, options.azimuth, options.elevation, reserve);
       ui = UiScale(resolved.width, layout.options.height);
       legend = Legend(ui, LegendEntries(file, options, drawn, ui));
     }

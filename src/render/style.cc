@@ -17,8 +17,11 @@ Rgb Interpolate(const Rgb (&table)[N], double t) {
 
 Rgb FadeColor(double t) {
   // From a light grey-blue to a deep navy, light enough at the start that the old frames recede.
-  static constexpr Rgb kRamp[] = {{0.70, 0.80, 0.91}, {0.47, 0.65, 0.84}, {0.25, 0.50, 0.75},
-                                  {0.09, 0.31, 0.60}, {0.03, 0.17, 0.40}};
+  static constexpr Rgb kRamp[] = {{0.70, 0.80, 0.91},
+                                  {0.47, 0.65, 0.84},
+                                  {0.25, 0.50, 0.75},
+                                  {0.09, 0.31, 0.60},
+                                  {0.03, 0.17, 0.40}};
   return Interpolate(kRamp, t);
 }
 
