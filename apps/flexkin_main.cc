@@ -27,6 +27,7 @@
 #include "flexkin/result_io.h"
 #include "flexkin/run.h"
 #include "flexkin/scenario.h"
+#include "render_command.h"
 
 namespace {
 
@@ -210,6 +211,8 @@ int Main(int argc, char** argv) {
   validate->add_option("scenario", validate_path, "Scenario file (JSON)")->required();
   validate->footer(kExitCodesHelp);
 
+  const flexkin::cli::RenderCommand render(&app, kExitCodesHelp);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -217,6 +220,7 @@ int Main(int argc, char** argv) {
   }
   try {
     if (*run) return RunCommand(args);
+    if (render.Parsed()) return render.Run();
     return ValidateCommand(validate_path);
   } catch (const flexkin::InputError& e) {
     PrintError(e.what());

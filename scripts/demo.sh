@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # make demo: runs the paper's scenarios (examples/*.json) with the flexkin command line, writes
 # the results to out/, and prints for each the link-length error, the L2 metric and the
-# path-length profile; then the closed-form check of Fig. 7 and the Fig. 6 comparison.
+# path-length profile; then the closed-form check of Fig. 7 and the Fig. 6 comparison; then
+# renders every result into out/ (figures, plots, MP4 and GIF animations).
 set -euo pipefail
 build=${1:-build}
 cd "$(dirname "$0")/.."
@@ -17,4 +18,10 @@ echo "== closed form and comparisons"
 "$build/examples/fig06_compare" examples/fig06_parabola_multi_step.json \
   examples/fig06_parabola_single_step.json examples/fig06_parabola_overall_multi_step.json \
   examples/fig06_parabola_overall_single_step.json
+echo "== figures, plots and animations (docs/rendering.md)"
+for result in out/fig*.json; do
+  "$flexkin" render "$result" -o out --formats svg,png,pdf,plots,mp4,gif --quiet
+done
 echo "results: out/*.json (format: docs/result-format.md)"
+echo "pictures: out/*.{svg,png,pdf}, out/*_{path_length,link_angles,length_error}.{svg,png},"
+echo "  out/*.{mp4,gif} (docs/rendering.md)"

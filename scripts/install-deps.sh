@@ -5,6 +5,7 @@
 set -euo pipefail
 packages=(cmake make g++ pkg-config libeigen3-dev nlohmann-json3-dev libcli11-dev libgtest-dev
           libgmock-dev libbenchmark-dev libboost-dev libxsimd-dev liblapack-dev libnlopt-dev coinor-libipopt-dev)
+packages+=(libcairo2-dev fonts-dejavu-core ffmpeg)  # flexkin render (src/render)
 packages+=(libtinygltf-dev)  # glTF export (src/gltf)
 packages+=(chromium)         # the viewer's browser test (headless)
 # Node.js runs the glTF validator and the browser test. Debian's nodejs and npm only if there is

@@ -1,0 +1,221 @@
+// flexkin render: one result file in, the chosen formats out, each file written whole or not at
+// all. The formats are a table: an entry names a format and the function that writes its files.
+#include "render_command.h"
+
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <filesystem>
+#include <iostream>
+#include <stdexcept>
+#include <system_error>
+#include <vector>
+
+#include "flexkin/error.h"
+#include "flexkin/result_io.h"
+
+namespace flexkin::cli {
+namespace {
+
+// Everything a format's writer needs.
+struct RenderJob {
+  const ResultFile* file = nullptr;
+  std::string base;  // OUTDIR/<stem>: each writer appends its suffix and extension
+  FigureOptions figure;
+  PlotOptions plot;
+  AnimationOptions animation;
+  std::vector<std::string>* written = nullptr;  // paths written, for the report
+};
+
+void Figure(const RenderJob& job, const char* extension) {
+  const std::string path = job.base + extension;
+  WriteSnapshotFigure(*job.file, job.figure, path);
+  job.written->push_back(path);
+}
+
+void Plots(const RenderJob& job) {
+  const bool have_angles = job.file->result.frames.front().link_angles.size() > 0;
+  for (PlotKind kind : kAllPlotKinds) {
+    if (kind == PlotKind::kLinkAngles && !have_angles) {
+      std::cerr << "flexkin: note: no link_angles plot: the leading end never moves\n";
+      continue;
+    }
+    for (const char* extension : {".svg", ".png"}) {
+      const std::string path = job.base + "_" + PlotKindName(kind) + extension;
+      WritePlot(*job.file, kind, job.plot, path);
+      job.written->push_back(path);
+    }
+  }
+}
+
+void Animation(const RenderJob& job, const char* extension) {
+  const std::string path = job.base + extension;
+  WriteAnimation(*job.file, job.animation, path);
+  job.written->push_back(path);
+}
+
+struct OutputFormat {
+  const char* name;
+  const char* files;  // what it writes, for --help
+  void (*write)(const RenderJob& job);
+};
+
+// The formats, in the order they are written. Add a format with one line here.
+const OutputFormat kFormats[] = {
+    {"svg", "<stem>.svg", [](const RenderJob& j) { Figure(j, ".svg"); }},
+    {"png", "<stem>.png", [](const RenderJob& j) { Figure(j, ".png"); }},
+    {"pdf", "<stem>.pdf", [](const RenderJob& j) { Figure(j, ".pdf"); }},
+    {"plots", "<stem>_{path_length,link_angles,length_error}.{svg,png}", Plots},
+    {"mp4", "<stem>.mp4", [](const RenderJob& j) { Animation(j, ".mp4"); }},
+    {"gif", "<stem>.gif", [](const RenderJob& j) { Animation(j, ".gif"); }},
+    // {"html", "<stem>.html", WriteViewer},  (the interactive viewer)
+    // {"gltf", "<stem>.gltf", WriteGltf},    (glTF 2.0 animation export)
+};
+// Names kept for formats not in this build yet.
+const char* const kReservedFormats[] = {"html", "gltf"};
+
+std::string FormatNames() {
+  std::string names;
+  for (const OutputFormat& f : kFormats) names += std::string(names.empty() ? "" : ", ") + f.name;
+  return names;
+}
+
+// "svg,png,plots" -> the table's entries, in table order, each once.
+std::vector<const OutputFormat*> ParseFormats(const std::string& list) {
+  std::vector<bool> chosen(std::size(kFormats), false);
+  size_t start = 0;
+  while (start <= list.size()) {
+    size_t end = list.find(',', start);
+    if (end == std::string::npos) end = list.size();
+    const std::string name = list.substr(start, end - start);
+    start = end + 1;
+    size_t i = 0;
+    while (i < std::size(kFormats) && name != kFormats[i].name) ++i;
+    if (i < std::size(kFormats)) {
+      chosen[i] = true;
+      continue;
+    }
+    for (const char* reserved : kReservedFormats) {
+      if (name == reserved) {
+        throw InputError("--formats", "\"" + name + "\" is not available in this build; expected " +
+                                          FormatNames());
+      }
+    }
+    throw InputError("--formats", "unknown format \"" + name +
+                                      "\"; expected a comma-separated list of " + FormatNames());
+  }
+  std::vector<const OutputFormat*> formats;
+  for (size_t i = 0; i < chosen.size(); ++i) {
+    if (chosen[i]) formats.push_back(&kFormats[i]);
+  }
+  return formats;
+}
+
+// A Validate() message "every_k: ..." as an InputError naming the command-line option.
+void CheckOptions(const std::string& why) {
+  if (why.empty()) return;
+  const size_t colon = why.find(": ");
+  std::string field = why.substr(0, colon);
+  if (field == "every_k") field = "every";
+  for (char& c : field) c = c == '_' ? '-' : c;
+  throw InputError("--" + field, why.substr(colon + 2));
+}
+
+// OUTDIR/<stem>: <stem> is the result file's name without ".json".
+std::string OutputBase(const std::string& result, const std::string& output_dir) {
+  std::string stem = std::filesystem::path(result).filename().string();
+  if (stem.size() > 5 && stem.compare(stem.size() - 5, 5, ".json") == 0)
+    stem.resize(stem.size() - 5);
+  std::string dir = output_dir;
+  if (dir.empty()) {
+    dir = std::filesystem::path(result).parent_path().string();
+    if (dir.empty()) dir = ".";
+  }
+  return dir + "/" + stem;
+}
+
+}  // namespace
+
+RenderCommand::RenderCommand(CLI::App* app, const std::string& footer) {
+  command_ = app->add_subcommand("render", "Draw a result file: figures, plots, animations.");
+  command_->add_option("result", args_.result, "Result file (JSON, docs/result-format.md)")
+      ->required();
+  command_->add_option("-o,--output-dir", args_.output_dir,
+                       "Directory for the outputs, created if missing (default: the result's)");
+  std::string formats_help = "Comma-separated outputs (default svg,png,plots):";
+  for (const OutputFormat& f : kFormats)
+    formats_help += std::string("\n  ") + f.name + ": " + f.files;
+  command_->add_option("--formats", args_.formats, formats_help);
+  command_->add_option("--every", args_.every,
+                       "Figures: draw every K-th recorded frame (default: about 16 frames)");
+  width_ = command_->add_option(
+      "--width", args_.width, "Width in pixels (default: figures 960, plots 800, animations 640)");
+  height_ = command_->add_option("--height", args_.height,
+                                 "Height in pixels; 0 = from the data's aspect ratio (default: "
+                                 "figures and animations 0, plots 500)");
+  azimuth_ = command_->add_option("--azimuth", args_.azimuth,
+                                  "3D view: degrees about z from +x (default -60)");
+  elevation_ = command_->add_option("--elevation", args_.elevation,
+                                    "3D view: degrees above the x-y plane (default 30)");
+  fps_ = command_->add_option("--fps", args_.fps, "Animations: frames per second (default 30)");
+  max_frames_ = command_->add_option(
+      "--max-frames", args_.max_frames,
+      "Animations: at most N pictures; longer runs are subsampled (default 300)");
+  command_->add_option("--title", args_.title,
+                       "Title of figures and animations (default: the scenario's name)");
+  command_->add_flag("-q,--quiet", args_.quiet, "Do not list the files written");
+  command_->footer(footer);
+}
+
+int RenderCommand::Run() const {
+  const std::vector<const OutputFormat*> formats = ParseFormats(args_.formats);
+  RenderJob job;
+  job.figure.every_k = args_.every;
+  job.figure.title = job.animation.title = args_.title;
+  if (*width_) job.figure.width = job.plot.width = job.animation.width = args_.width;
+  if (*height_) job.figure.height = job.animation.height = args_.height;
+  if (*height_ && args_.height != 0) job.plot.height = args_.height;
+  if (*azimuth_) job.figure.azimuth = job.animation.azimuth = args_.azimuth;
+  if (*elevation_) job.figure.elevation = job.animation.elevation = args_.elevation;
+  if (*fps_) job.animation.fps = args_.fps;
+  if (*max_frames_) job.animation.max_frames = args_.max_frames;
+  CheckOptions(job.figure.Validate());
+  CheckOptions(job.plot.Validate());
+  CheckOptions(job.animation.Validate());
+
+  ResultFile file;
+  try {
+    file = ReadResultJson(args_.result);
+  } catch (const InputError& e) {
+    throw InputError(args_.result + (e.field().empty() ? "" : ": " + e.field()),
+                     std::string(e.what()).substr(e.field().empty() ? 0 : e.field().size() + 2));
+  }
+  if (file.result.frames.empty())
+    throw InputError(args_.result + ": /frames", "no frames; nothing to draw");
+
+  job.file = &file;
+  job.base = OutputBase(args_.result, args_.output_dir);
+  const std::string dir = job.base.substr(0, job.base.rfind('/'));
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error) throw std::system_error(error, "cannot create the output directory '" + dir + "'");
+  std::vector<std::string> written;
+  job.written = &written;
+  try {
+    for (const OutputFormat* format : formats) format->write(job);
+  } catch (const InputError& e) {
+    throw InputError(args_.result + (e.field().empty() ? "" : ": " + e.field()),
+                     std::string(e.what()).substr(e.field().empty() ? 0 : e.field().size() + 2));
+  } catch (const std::system_error&) {
+    throw;
+  } catch (const std::runtime_error& e) {  // ffmpeg missing or failing, cairo
+    std::cerr << "flexkin: error: " << e.what() << "\n";
+    return 1;
+  }
+  if (!args_.quiet) {
+    for (const std::string& path : written) std::cout << "wrote " << path << "\n";
+  }
+  return 0;
+}
+
+}  // namespace flexkin::cli

@@ -1,0 +1,144 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "flexkin/result_io.h"
+
+namespace flexkin {
+
+// Pictures of a result (docs/rendering.md): snapshot figures (SVG, PNG, PDF), plots of the
+// paper's claims, and animations (MP4, GIF). cairo draws; ffmpeg encodes the animations.
+//
+// Library target flexkin_render (built with the apps or the tests; not installed).
+//
+// Errors: InputError for an invalid option (field: the option's name, e.g. "width") or a result
+// that cannot be drawn (field: "frames[f].points[i][k]" for a non-finite number, "frames" if there
+// are none); std::system_error for a file that cannot be written; std::runtime_error when ffmpeg
+// is missing or fails. Every writer is all-or-nothing: it writes a temporary file in the
+// destination's directory and renames it over the destination only on success, so on any error
+// an existing destination is left untouched and no partial file remains.
+
+// Image formats of figures and plots, chosen by the file name's extension.
+enum class ImageFormat {
+  kSvg,  // ".svg": vector, sizes in px
+  kPng,  // ".png": raster, 8-bit RGB
+  kPdf,  // ".pdf": vector, one pixel of the options = one point (1/72 in)
+};
+// The format of `path` by its extension (case-insensitive); throws InputError (field `field`)
+// for any other extension.
+ImageFormat ImageFormatFromPath(const std::string& path, const std::string& field = "path");
+
+// The snapshot figure: the chain every k-th recorded frame, overlaid, in the style of the paper's
+// Figs. 6 to 12.
+struct FigureOptions {
+  // Draw recorded frames 0, k, 2k, ... and the last one. 0 = automatic: the smallest k that
+  // draws at most 16 frames (every frame when there are at most 16). Typical: 0, 1, 10.
+  int every_k = 0;
+  // Size of the picture in pixels (SVG px; PDF points), 64 to 8192. Height 0 = automatic: the
+  // data's aspect ratio (equal scales) with little white space, 0.4 to 1.2 times the width.
+  int width = 960;
+  int height = 0;
+  // 3D only: the direction the chain is seen from (orthographic projection). Azimuth: degrees
+  // about the z axis from the +x axis (any value); elevation: degrees above the x-y plane,
+  // -90 to 90. The default is matplotlib's usual 3D view.
+  double azimuth = -60.0;
+  double elevation = 30.0;
+  // The title's first line; "" = the scenario's name (or "flexkin result" without one). A second,
+  // smaller line always gives the method, links, steps and k.
+  std::string title;
+  // Draw the path of the leading end (point 0) through every recorded frame, with an arrowhead.
+  bool show_leader_path = true;
+  // Draw the legend (in the corner of the plot that covers the fewest drawn points).
+  bool show_legend = true;
+
+  // Empty if valid, otherwise the reason, starting with the field's name.
+  std::string Validate() const;
+};
+
+// The recorded frames a figure draws: 0, k, 2k, ... and the last one (indices into frames).
+// `every_k` = 0 picks k as FigureOptions::every_k says. Requires num_frames >= 1, every_k >= 0.
+std::vector<int> SnapshotFrames(int num_frames, int every_k);
+
+// Writes the snapshot figure of `file` to `path` (.svg, .png or .pdf).
+void WriteSnapshotFigure(const ResultFile& file, const FigureOptions& options,
+                         const std::string& path);
+
+// Plots of one quantity of a result.
+enum class PlotKind {
+  kPathLength,   // "path_length": distance travelled by each point (metrics.path_length) against
+                 // the point's index: the motion dying out along the chain
+  kLinkAngles,   // "link_angles": each link's angle to the pull direction (frame.link_angles)
+                 // against the leader step, coloured by link index: the alignment
+  kLengthError,  // "length_error": largest relative link-length error of each recorded frame
+                 // against the leader step, log scale (FrameLengthErrors)
+};
+inline constexpr PlotKind kAllPlotKinds[] = {PlotKind::kPathLength, PlotKind::kLinkAngles,
+                                             PlotKind::kLengthError};
+// "path_length", "link_angles", "length_error".
+const char* PlotKindName(PlotKind kind);
+// The inverse of PlotKindName; throws InputError naming `field` and listing the names.
+PlotKind ParsePlotKind(const std::string& name, const std::string& field = "plot");
+
+struct PlotOptions {
+  // Size in pixels (SVG px; PDF points). 64 to 8192. Typical: 800 x 500.
+  int width = 800;
+  int height = 500;
+  // The title; "" = what is plotted and the scenario's name.
+  std::string title;
+
+  // Empty if valid, otherwise the reason, starting with the field's name.
+  std::string Validate() const;
+};
+
+// Writes one plot of `file` to `path` (.svg, .png or .pdf). kLinkAngles needs link angles
+// (InputError "frames[f].link_angles" if a frame has none).
+void WritePlot(const ResultFile& file, PlotKind kind, const PlotOptions& options,
+               const std::string& path);
+
+// For each recorded frame, max over the links of |(|x_i - x_{i-1}| - L_i)| / L_i.
+Eigen::VectorXd FrameLengthErrors(const RunResult& result);
+
+// The animation: one picture per drawn frame, axes fixed over the whole motion.
+struct AnimationOptions {
+  // Size in pixels, 64 to 8192; an odd value is rounded up to even (H.264 in yuv420p needs
+  // even sizes). Height 0 = automatic, as FigureOptions::height. Typical: 640 x 0.
+  int width = 640;
+  int height = 0;
+  // Frames per second of the video, 1 to 120. Typical: 30.
+  int fps = 30;
+  // Draw recorded frames 0, k, 2k, ... and the last one. 0 = automatic: the smallest k that
+  // draws at most `max_frames` frames. Typical: 0 or 1.
+  int every_k = 0;
+  // Upper bound of the pictures when every_k = 0: long runs are subsampled. >= 2. Typical: 300
+  // (10 s at 30 fps).
+  int max_frames = 300;
+  // Short runs play at least this long, in seconds: each picture is shown ceil(min_seconds x
+  // fps / pictures) times. 0 = one video frame per picture. Typical: 3.
+  double min_seconds = 3.0;
+  // The last picture is held this long at the end, in seconds (GIFs loop). Typical: 1.
+  double end_pause = 1.0;
+  // 3D view, as FigureOptions.
+  double azimuth = -60.0;
+  double elevation = 30.0;
+  // The title's first line; "" = the scenario's name.
+  std::string title;
+  // The ffmpeg program: a name looked up in PATH or a path.
+  std::string ffmpeg = "ffmpeg";
+  // H.264 constant rate factor for MP4, 0 (lossless) to 51; lower is better and larger.
+  // Typical: 20.
+  int crf = 20;
+
+  // Empty if valid, otherwise the reason, starting with the field's name.
+  std::string Validate() const;
+};
+
+// Writes the animation of `file` to `path`: ".mp4" (H.264, yuv420p) or ".gif" (palette made from
+// the whole animation), by extension; InputError (field "path") for any other. Frames are drawn
+// with cairo and piped raw into an ffmpeg process; the output goes to a temporary file in the
+// destination's directory that is renamed over `path` only when ffmpeg succeeds.
+void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
+                    const std::string& path);
+
+}  // namespace flexkin

@@ -1,0 +1,236 @@
+// WriteAnimation: the frames drawn with cairo, piped raw into ffmpeg, which writes an MP4 (H.264)
+// or a GIF to a temporary file that is renamed over the destination only on success.
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "flexkin/error.h"
+#include "flexkin/render.h"
+#include "render/canvas.h"
+#include "render/checks.h"
+#include "render/ffmpeg_pipe.h"
+#include "render/scene.h"
+#include "render/snapshot.h"
+
+namespace flexkin {
+namespace {
+
+using render::ChainScene;
+
+enum class VideoFormat { kMp4, kGif };
+
+VideoFormat VideoFormatFromPath(const std::string& path) {
+  const size_t dot = path.rfind('.');
+  std::string ext = dot == std::string::npos ? "" : path.substr(dot);
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".mp4") return VideoFormat::kMp4;
+  if (ext == ".gif") return VideoFormat::kGif;
+  throw InputError("path",
+                   "\"" + path + "\" has no known animation extension; expected .mp4 or .gif");
+}
+
+// The ffmpeg command line: raw frames in (cairo's RGB24 words: bytes B, G, R, unused on a
+// little-endian machine), the video out.
+std::vector<std::string> FfmpegArgs(VideoFormat format, int width, int height, int fps, int crf,
+                                    const std::string& output) {
+  const uint32_t probe = 1;
+  const bool little_endian = *reinterpret_cast<const unsigned char*>(&probe) == 1;
+  std::vector<std::string> args = {
+      "-hide_banner", "-loglevel",
+      "error",        "-nostdin",
+      "-f",           "rawvideo",
+      "-pix_fmt",     little_endian ? "bgr0" : "0rgb",
+      "-s",           std::to_string(width) + "x" + std::to_string(height),
+      "-framerate",   std::to_string(fps),
+      "-i",           "pipe:0",
+      "-an"};
+  if (format == VideoFormat::kMp4) {
+    args.insert(args.end(), {"-c:v", "libx264", "-preset", "medium", "-crf", std::to_string(crf),
+                             "-pix_fmt", "yuv420p", "-movflags", "+faststart", "-f", "mp4"});
+  } else {
+    // One palette for the whole animation, made from all its frames.
+    args.insert(args.end(),
+                {"-filter_complex",
+                 "split[a][b];[a]palettegen=stats_mode=full[p];[b][p]paletteuse=dither=sierra2_4a",
+                 "-loop", "0", "-f", "gif"});
+  }
+  args.insert(args.end(), {"-y", output});
+  return args;
+}
+
+// A temporary file next to `path` (".NAME.tmp-XXXXXX"), created empty.
+std::string TemporaryNextTo(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  const std::string dir = slash == std::string::npos ? "" : path.substr(0, slash + 1);
+  const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  std::string temp = dir + "." + name + ".tmp-XXXXXX";
+  const int fd = ::mkstemp(temp.data());
+  if (fd < 0)
+    throw std::system_error(errno, std::generic_category(), "cannot write '" + path + "'");
+  ::close(fd);
+  return temp;
+}
+
+// Gives `temp` the mode `path` has, or 0666 less the umask for a new file, and renames it.
+void Publish(const std::string& temp, const std::string& path) {
+  struct stat st;
+  mode_t mode;
+  if (::stat(path.c_str(), &st) == 0) {
+    mode = st.st_mode & 07777;
+  } else {
+    const mode_t mask = ::umask(0);
+    ::umask(mask);
+    mode = 0666 & ~mask;
+  }
+  if (::chmod(temp.c_str(), mode) != 0 || ::rename(temp.c_str(), path.c_str()) != 0) {
+    const int e = errno;
+    ::unlink(temp.c_str());
+    throw std::system_error(e, std::generic_category(), "cannot write '" + path + "'");
+  }
+}
+
+// What stays the same in every picture: title, axes, the whole leader path faintly, the
+// initial configuration.
+void DrawBackground(render::Canvas* canvas, const ChainScene& scene, const ResultFile& file,
+                    const std::string& title) {
+  cairo_t* cr = canvas->cr();
+  const double ui = canvas->ui();
+  render::DrawTitle(cr, ui, canvas->width(), render::MainTitle(file, title),
+                    render::RunSummary(file));
+  scene.DrawAxes(cr);
+  const std::vector<double> leader = render::LeaderPath(file);
+  const int num_frames = static_cast<int>(file.result.frames.size());
+  scene.DrawChains(cr, {leader.data()}, {num_frames},
+                   {{render::Mix(render::kLeaderPath, render::kWhite, 0.65), 1.2 * ui, true}});
+  const Points& first = file.result.frames.front().points;
+  scene.DrawChains(cr, {first.data()}, {static_cast<int>(first.rows())},
+                   {{render::Mix(render::kInitial, render::kWhite, 0.55), 1.6 * ui, true}});
+}
+
+// The moving parts of drawn frame `d` (recorded frame drawn[d]): the leader's path so far,
+// a few earlier drawn frames fading out, the current configuration and the step counter.
+void DrawMoment(render::Canvas* canvas, const ChainScene& scene, const ResultFile& file,
+                const std::vector<int>& drawn, size_t d) {
+  cairo_t* cr = canvas->cr();
+  const double ui = canvas->ui();
+  const std::vector<Frame>& frames = file.result.frames;
+  const int f = drawn[d];
+  const int rows = static_cast<int>(frames[f].points.rows());
+  if (f > 0) {
+    std::vector<double> path;
+    for (int g = 0; g <= f; ++g) {
+      for (int k = 0; k < file.dim; ++k) path.push_back(frames[g].points(0, k));
+    }
+    scene.DrawChains(cr, {path.data()}, {f + 1}, {{render::kLeaderPath, 1.8 * ui, false}});
+  }
+  constexpr int kGhosts = 4;
+  std::vector<const double*> chains;
+  std::vector<int> chain_rows;
+  std::vector<render::ChainStyle> styles;
+  for (int g = kGhosts; g >= 1; --g) {
+    if (d < static_cast<size_t>(g)) continue;
+    chains.push_back(frames[drawn[d - g]].points.data());
+    chain_rows.push_back(rows);
+    styles.push_back({render::FadeColor(0.15 + 0.6 * (kGhosts - g) / kGhosts), 1.2 * ui, false});
+  }
+  chains.push_back(frames[f].points.data());
+  chain_rows.push_back(rows);
+  styles.push_back({render::kFinal, 2.6 * ui, false});
+  scene.DrawChains(cr, chains, chain_rows, styles);
+  if (rows <= 41) {
+    for (int i = 1; i < rows; ++i) {
+      const Eigen::Vector2d p = scene.Pixel(file, f, i);
+      render::Disc(cr, p.x(), p.y(), 2.2 * ui, render::kFinal);
+    }
+  }
+  const Eigen::Vector2d head = scene.Pixel(file, f, 0);
+  render::Disc(cr, head.x(), head.y(), 4.2 * ui, render::kFinal);
+  render::TextStyle counter;
+  counter.size = 12 * ui;
+  counter.halign = render::Align::kEnd;
+  counter.valign = render::Align::kEnd;
+  counter.color = render::kMuted;
+  render::DrawText(
+      cr, canvas->width() - 10 * ui, canvas->height() - 8 * ui,
+      "step " + std::to_string(frames[f].step) + " of " + std::to_string(file.result.num_steps),
+      counter);
+}
+
+}  // namespace
+
+void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
+                    const std::string& path) {
+  render::ThrowIfInvalid(options.Validate());
+  const VideoFormat format = VideoFormatFromPath(path);
+  render::CheckDrawable(file);
+  const int width = options.width + options.width % 2;
+  int height = options.height != 0
+                   ? options.height
+                   : render::AutoHeight(file, width, options.azimuth, options.elevation, 0.0);
+  height += height % 2;
+  const int num_frames = static_cast<int>(file.result.frames.size());
+  const int every_k =
+      options.every_k > 0
+          ? options.every_k
+          : std::max(1, (num_frames - 1 + options.max_frames - 2) / (options.max_frames - 1));
+  const std::vector<int> drawn = SnapshotFrames(num_frames, every_k);
+
+  const double ui = render::UiScale(width, height);
+  const ChainScene scene(file, render::SceneArea(file.dim, width, height), ui, options.azimuth,
+                         options.elevation);
+  render::Canvas background(ImageFormat::kPng, width, height);
+  DrawBackground(&background, scene, file, options.title);
+  cairo_surface_flush(background.surface());
+  render::Canvas picture(ImageFormat::kPng, width, height);
+
+  const std::string temp = TemporaryNextTo(path);
+  std::string failure;
+  try {
+    render::FfmpegPipe ffmpeg(options.ffmpeg,
+                              FfmpegArgs(format, width, height, options.fps, options.crf, temp));
+    // Video frames per picture, so that short runs last min_seconds; the last one also holds
+    // for end_pause.
+    const int pictures = static_cast<int>(drawn.size());
+    const int repeat = std::max(
+        1, static_cast<int>(std::ceil(options.min_seconds * options.fps / pictures - 1e-9)));
+    const int pause = static_cast<int>(std::lround(options.end_pause * options.fps));
+    for (int d = 0; d < pictures && failure.empty(); ++d) {
+      cairo_t* cr = picture.cr();
+      cairo_set_source_surface(cr, background.surface(), 0, 0);
+      cairo_paint(cr);
+      DrawMoment(&picture, scene, file, drawn, d);
+      const unsigned char* pixels = picture.Pixels();
+      const int copies = repeat + (d == pictures - 1 ? pause : 0);
+      for (int c = 0; c < copies && failure.empty(); ++c) {
+        for (int y = 0; y < height && failure.empty(); ++y) {
+          if (!ffmpeg.Write(pixels + static_cast<size_t>(y) * picture.Stride(),
+                            4 * static_cast<size_t>(width))) {
+            failure = "stopped reading";
+          }
+        }
+      }
+    }
+    const std::string status = ffmpeg.Finish();
+    if (!status.empty()) failure = status;
+  } catch (...) {
+    ::unlink(temp.c_str());
+    throw;
+  }
+  if (!failure.empty()) {
+    ::unlink(temp.c_str());
+    throw std::runtime_error("ffmpeg (\"" + options.ffmpeg + "\") failed writing '" + path +
+                             "': " + failure);
+  }
+  Publish(temp, path);
+}
+
+}  // namespace flexkin

@@ -1,0 +1,37 @@
+#pragma once
+// An ffmpeg process fed raw video frames on its standard input.
+
+#include <sys/types.h>
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace flexkin::render {
+
+class FfmpegPipe {
+ public:
+  // Starts `program` (looked up in PATH unless it contains a '/') with `args`. Its standard
+  // input is a socket this object writes to (a socket, not a pipe, so that writing after ffmpeg
+  // has died returns EPIPE instead of raising SIGPIPE in the caller); its standard output goes
+  // to /dev/null and its standard error to an unlinked temporary file read by Finish. Throws
+  // std::runtime_error if the program cannot be started (e.g. not installed).
+  FfmpegPipe(const std::string& program, const std::vector<std::string>& args);
+  // Kills and reaps the process if Finish was not called.
+  ~FfmpegPipe();
+  FfmpegPipe(const FfmpegPipe&) = delete;
+  FfmpegPipe& operator=(const FfmpegPipe&) = delete;
+
+  // Writes `size` bytes to ffmpeg's input; false if ffmpeg stopped reading (it failed).
+  bool Write(const void* data, size_t size);
+  // Closes ffmpeg's input and waits for it. "" if it exited with status 0, otherwise the reason:
+  // the exit status or signal and the last lines ffmpeg wrote to its standard error.
+  std::string Finish();
+
+ private:
+  pid_t pid_ = -1;
+  int input_ = -1;   // our end of ffmpeg's standard input
+  int errors_ = -1;  // the temporary file holding ffmpeg's standard error
+};
+
+}  // namespace flexkin::render

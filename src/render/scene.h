@@ -1,0 +1,70 @@
+#pragma once
+// The chain's recorded frames laid out in a picture: 2D as they are, 3D by an orthographic view
+// from (azimuth, elevation); equal scales on every axis; the axes (2D: a framed plot, 3D: the
+// back panes of the bounding box with grids and ticks); the chains drawn with depth cues.
+
+#include <cairo.h>
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "flexkin/result_io.h"
+#include "render/axes.h"
+#include "render/style.h"
+
+namespace flexkin::render {
+
+// How to draw one chain (or one path) in ChainScene::DrawChains.
+struct ChainStyle {
+  Rgb color;
+  double width = 1.0;  // pixels, before depth cues
+  bool dashed = false;
+};
+
+class ChainScene {
+ public:
+  // Fits every point of every frame of `file` into `area` (pixels). Angles in degrees.
+  ChainScene(const ResultFile& file, const Rect& area, double ui, double azimuth, double elevation);
+
+  int dim() const { return dim_; }
+  // A point (dim values) in pixels.
+  Eigen::Vector2d Pixel(const double* point) const;
+  // Point i of frame f in pixels.
+  Eigen::Vector2d Pixel(const ResultFile& file, int frame, int point) const;
+  // 0 for the nearest corner of the bounding box to 1 for the farthest; 0 in 2D.
+  double Depth(const double* point) const;
+  // Height over width of what the scene must show (2D: the padded data; 3D: the projected
+  // box), for choosing a picture's height.
+  double aspect() const { return aspect_; }
+  // The rectangle the data may cover (2D: the plot frame; 3D: the projected box).
+  const Rect& plot() const { return plot_; }
+
+  // 3D: the 8 corners of the bounding box in pixels, corner c at (c & 1 ? hi : lo) in x,
+  // (c & 2) in y, (c & 4) in z. Empty in 2D.
+  std::vector<Eigen::Vector2d> BoxCorners() const;
+
+  // 2D: framed axes with ticks and "x", "y"; 3D: back panes, grids, three ticked axes.
+  void DrawAxes(cairo_t* cr) const;
+  // Draws the chains (each a (k by dim) row-major array of `rows` points) in one batch. 2D: each
+  // a polyline, in order. 3D: all their segments sorted from far to near (painter's order),
+  // the farther lighter and thinner; dashes continue along a chain.
+  void DrawChains(cairo_t* cr, const std::vector<const double*>& chains,
+                  const std::vector<int>& rows, const std::vector<ChainStyle>& styles) const;
+
+ private:
+  Eigen::Vector3d Lift(const double* point) const;  // 2D points get z = 0
+  void DrawAxes3D(cairo_t* cr) const;
+
+  int dim_;
+  double ui_;
+  Eigen::Vector3d right_, up_, toward_;  // view axes in data space (3D)
+  Eigen::Vector3d lo_, hi_;              // bounding box of the data (3D: with a minimum extent)
+  double scale_ = 1.0;                   // pixels per data unit
+  Eigen::Vector2d origin_;               // pixel of view-plane coordinates (0, 0)
+  double depth_lo_ = 0.0, depth_hi_ = 1.0;
+  Rect plot_;
+  double aspect_ = 1.0;
+  double x0_ = 0, x1_ = 1, y0_ = 0, y1_ = 1;  // 2D axis ranges
+};
+
+}  // namespace flexkin::render

@@ -1,0 +1,192 @@
+// Tests of `flexkin render` (the FLEXKIN_CLI executable): the files each format writes, the
+// documented exit codes, messages naming the file, the option or the field, and no output file
+// written or changed when the input is bad.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "flexkin/result_io.h"
+#include "render_test_util.h"
+
+namespace flexkin {
+namespace {
+
+using render_test::Exists;
+using render_test::ReadFile;
+using render_test::WriteFile;
+
+const std::string kCli = FLEXKIN_CLI;
+
+#define EXPECT_CONTAINS(text, part) \
+  EXPECT_NE(std::string(text).find(part), std::string::npos) << "in: " << (text)
+
+struct CliResult {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+class RenderCliTest : public testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_FALSE(kCli.empty()) << "FLEXKIN_CLI is empty: configure with FLEXKIN_BUILD_APPS=ON";
+    ASSERT_FALSE(dir_.dir().empty());
+    WriteResultJson(render_test::SmallScene(2).result, dir_.Path("run.json"), "small");
+  }
+
+  std::string Path(const std::string& name) const { return dir_.Path(name); }
+
+  // Runs `flexkin ARGS` in the temporary directory.
+  CliResult Cli(const std::string& args) const {
+    const std::string command = "cd '" + dir_.dir() + "' && '" + kCli + "' " + args + " > '" +
+                                Path("stdout.txt") + "' 2> '" + Path("stderr.txt") + "'";
+    const int status = std::system(command.c_str());
+    CliResult r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.out = ReadFile(Path("stdout.txt"));
+    r.err = ReadFile(Path("stderr.txt"));
+    std::filesystem::remove(Path("stdout.txt"));
+    std::filesystem::remove(Path("stderr.txt"));
+    return r;
+  }
+
+  // The files in OUTDIR `name`, sorted; empty if it does not exist.
+  std::vector<std::string> Outputs(const std::string& name) const {
+    std::vector<std::string> files;
+    if (!Exists(Path(name))) return files;
+    for (const auto& e : std::filesystem::directory_iterator(Path(name))) {
+      files.push_back(e.path().filename().string());
+    }
+    std::sort(files.begin(), files.end());
+    return files;
+  }
+
+  render_test::TempDir dir_;
+};
+
+TEST_F(RenderCliTest, DefaultFormatsAreFiguresAndPlots) {
+  const CliResult r = Cli("render run.json -o out");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(Outputs("out"), (std::vector<std::string>{"run.png", "run.svg", "run_length_error.png",
+                                                      "run_length_error.svg", "run_link_angles.png",
+                                                      "run_link_angles.svg", "run_path_length.png",
+                                                      "run_path_length.svg"}));
+  EXPECT_CONTAINS(r.out, "wrote out/run.svg\n");
+  EXPECT_EQ(ReadFile(Path("out/run.png")).substr(1, 3), "PNG");
+}
+
+TEST_F(RenderCliTest, EveryFormatWithOptions) {
+  const CliResult r = Cli(
+      "render run.json -o out --formats gif,pdf,mp4 --every 2 --width 320 --height 240 --fps 12 "
+      "--title 'A title' --azimuth 10 --elevation 45 --max-frames 50 --quiet");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(Outputs("out"), (std::vector<std::string>{"run.gif", "run.mp4", "run.pdf"}));
+  EXPECT_EQ(ReadFile(Path("out/run.pdf")).rfind("%PDF-", 0), 0u);
+}
+
+TEST_F(RenderCliTest, OutputDirectoryDefaultsToTheResults) {
+  const CliResult r = Cli("render run.json --formats svg -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(Exists(Path("run.svg")));
+}
+
+TEST_F(RenderCliTest, TruncatedResultExitsOneAndWritesNothing) {
+  const std::string text = ReadFile(Path("run.json"));
+  WriteFile(Path("cut.json"), text.substr(0, text.size() / 2));
+  const CliResult r = Cli("render cut.json -o out");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "flexkin: error: cut.json: line ");
+  EXPECT_TRUE(Outputs("out").empty());
+}
+
+TEST_F(RenderCliTest, WrongVersionExitsOneNamingIt) {
+  std::string text = ReadFile(Path("run.json"));
+  const size_t at = text.find("\"version\": 1");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 12, "\"version\": 7");
+  WriteFile(Path("v7.json"), text);
+  const CliResult r = Cli("render v7.json -o out");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "v7.json: /version");
+  EXPECT_TRUE(Outputs("out").empty());
+}
+
+TEST_F(RenderCliTest, NanOrHugeNumberExitsOneAndLeavesOldOutputs) {
+  std::string text = ReadFile(Path("run.json"));
+  const size_t at = text.find("\"points\": [[");
+  ASSERT_NE(at, std::string::npos);
+  std::string nan = text, huge = text;
+  nan.insert(at + 12, "NaN, 0], [");
+  huge.insert(at + 12, "1e999, 0], [");
+  WriteFile(Path("nan.json"), nan);
+  WriteFile(Path("huge.json"), huge);
+  ASSERT_EQ(Cli("render run.json -o out --formats svg -q").exit_code, 0);
+  const std::string before = ReadFile(Path("out/run.svg"));
+  std::filesystem::rename(Path("out/run.svg"), Path("out/nan.svg"));
+  WriteFile(Path("out/huge.svg"), "precious");
+  CliResult r = Cli("render nan.json -o out --formats svg");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "nan.json: line ");
+  r = Cli("render huge.json -o out --formats svg");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "huge.json: /frames/0/points/0/0");
+  EXPECT_EQ(ReadFile(Path("out/nan.svg")), before);
+  EXPECT_EQ(ReadFile(Path("out/huge.svg")), "precious");
+  EXPECT_EQ(Outputs("out"), (std::vector<std::string>{"huge.svg", "nan.svg"}));
+}
+
+TEST_F(RenderCliTest, UnknownOrReservedFormatExitsOneListingTheFormats) {
+  CliResult r = Cli("render run.json -o out --formats svg,jpeg");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err,
+                  "--formats: unknown format \"jpeg\"; expected a comma-separated list of svg, "
+                  "png, pdf, plots, mp4, gif");
+  r = Cli("render run.json -o out --formats html");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "--formats: \"html\" is not available in this build");
+  r = Cli("render run.json -o out --formats ''");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_TRUE(Outputs("out").empty());
+}
+
+TEST_F(RenderCliTest, InvalidSizesExitOneNamingTheOption) {
+  CliResult r = Cli("render run.json -o out --width 0");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "--width: 0 is not valid; expected an integer from 64 to 8192");
+  r = Cli("render run.json -o out --height -3");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "--height: -3 is not valid");
+  r = Cli("render run.json -o out --fps 0 --formats gif");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "--fps: 0 is not valid");
+  r = Cli("render run.json -o out --every -1");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "--every: -1 is not valid");
+  EXPECT_TRUE(Outputs("out").empty());
+}
+
+TEST_F(RenderCliTest, UsageErrorsExitTwo) {
+  EXPECT_EQ(Cli("render").exit_code, 2);
+  EXPECT_EQ(Cli("render run.json --width wide").exit_code, 2);
+  EXPECT_EQ(Cli("render run.json --no-such-option").exit_code, 2);
+  const CliResult help = Cli("render --help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_CONTAINS(help.out, "--formats");
+  EXPECT_CONTAINS(help.out, "Exit codes:");
+}
+
+TEST_F(RenderCliTest, MissingResultOrUnwritableOutputExitsFour) {
+  CliResult r = Cli("render missing.json -o out");
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_CONTAINS(r.err, "cannot read 'missing.json'");
+  WriteFile(Path("plain"), "a file, not a directory");
+  r = Cli("render run.json -o plain");
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_EQ(ReadFile(Path("plain")), "a file, not a directory");
+}
+
+}  // namespace
+}  // namespace flexkin
