@@ -12,7 +12,9 @@
 #include <vector>
 
 #include "flexkin/error.h"
+#include "flexkin/gltf.h"
 #include "flexkin/result_io.h"
+#include "flexkin/viewer.h"
 
 namespace flexkin::cli {
 namespace {
@@ -54,6 +56,22 @@ void Animation(const RenderJob& job, const char* extension) {
   job.written->push_back(path);
 }
 
+// The interactive viewer: one self-contained HTML page (docs/viewer.md).
+void Viewer(const RenderJob& job) {
+  const std::string path = job.base + ".html";
+  ViewerOptions options;
+  options.title = job.figure.title;
+  WriteViewerHtml(*job.file, options, path);
+  job.written->push_back(path);
+}
+
+// glTF 2.0: the chain as a skinned skeleton with keyframed joints (docs/gltf-export.md).
+void Gltf(const RenderJob& job, const char* extension) {
+  const std::string path = job.base + extension;
+  WriteGltf(*job.file, GltfOptions{}, path);
+  job.written->push_back(path);
+}
+
 struct OutputFormat {
   const char* name;
   const char* files;  // what it writes, for --help
@@ -68,11 +86,10 @@ const OutputFormat kFormats[] = {
     {"plots", "<stem>_{path_length,link_angles,length_error}.{svg,png}", Plots},
     {"mp4", "<stem>.mp4", [](const RenderJob& j) { Animation(j, ".mp4"); }},
     {"gif", "<stem>.gif", [](const RenderJob& j) { Animation(j, ".gif"); }},
-    // {"html", "<stem>.html", WriteViewer},  (the interactive viewer)
-    // {"gltf", "<stem>.gltf", WriteGltf},    (glTF 2.0 animation export)
+    {"html", "<stem>.html", Viewer},
+    {"gltf", "<stem>.gltf", [](const RenderJob& j) { Gltf(j, ".gltf"); }},
+    {"glb", "<stem>.glb", [](const RenderJob& j) { Gltf(j, ".glb"); }},
 };
-// Names kept for formats not in this build yet.
-const char* const kReservedFormats[] = {"html", "gltf"};
 
 std::string FormatNames() {
   std::string names;
@@ -94,12 +111,6 @@ std::vector<const OutputFormat*> ParseFormats(const std::string& list) {
     if (i < std::size(kFormats)) {
       chosen[i] = true;
       continue;
-    }
-    for (const char* reserved : kReservedFormats) {
-      if (name == reserved) {
-        throw InputError("--formats", "\"" + name + "\" is not available in this build; expected " +
-                                          FormatNames());
-      }
     }
     throw InputError("--formats", "unknown format \"" + name +
                                       "\"; expected a comma-separated list of " + FormatNames());

@@ -18,10 +18,10 @@ echo "== closed form and comparisons"
 "$build/examples/fig06_compare" examples/fig06_parabola_multi_step.json \
   examples/fig06_parabola_single_step.json examples/fig06_parabola_overall_multi_step.json \
   examples/fig06_parabola_overall_single_step.json
-echo "== figures, plots and animations (docs/rendering.md)"
+echo "== figures, plots, animations, viewers and glTF (docs/rendering.md)"
 for result in out/fig*.json; do
-  "$flexkin" render "$result" -o out --formats svg,png,pdf,plots,mp4,gif --quiet
+  "$flexkin" render "$result" -o out --formats svg,png,pdf,plots,mp4,gif,html,glb --quiet
 done
 echo "results: out/*.json (format: docs/result-format.md)"
 echo "pictures: out/*.{svg,png,pdf}, out/*_{path_length,link_angles,length_error}.{svg,png},"
-echo "  out/*.{mp4,gif} (docs/rendering.md)"
+echo "  out/*.{mp4,gif}, out/*.html (open in a browser), out/*.glb (docs/rendering.md)"

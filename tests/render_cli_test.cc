@@ -138,18 +138,26 @@ TEST_F(RenderCliTest, NanOrHugeNumberExitsOneAndLeavesOldOutputs) {
   EXPECT_EQ(Outputs("out"), (std::vector<std::string>{"huge.svg", "nan.svg"}));
 }
 
-TEST_F(RenderCliTest, UnknownOrReservedFormatExitsOneListingTheFormats) {
+TEST_F(RenderCliTest, UnknownFormatExitsOneListingTheFormats) {
   CliResult r = Cli("render run.json -o out --formats svg,jpeg");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_CONTAINS(r.err,
                   "--formats: unknown format \"jpeg\"; expected a comma-separated list of svg, "
-                  "png, pdf, plots, mp4, gif");
-  r = Cli("render run.json -o out --formats html");
-  EXPECT_EQ(r.exit_code, 1);
-  EXPECT_CONTAINS(r.err, "--formats: \"html\" is not available in this build");
+                  "png, pdf, plots, mp4, gif, html, gltf, glb");
   r = Cli("render run.json -o out --formats ''");
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_TRUE(Outputs("out").empty());
+}
+
+// The viewer and the glTF export through the command: the files are there and are what their
+// writers make (their content is tested in viewer_test and gltf_test).
+TEST_F(RenderCliTest, WritesTheViewerAndTheGltfFiles) {
+  const CliResult r = Cli("render run.json -o out --formats html,gltf,glb -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(Outputs("out"), (std::vector<std::string>{"run.glb", "run.gltf", "run.html"}));
+  EXPECT_EQ(ReadFile(Path("out/run.html")).rfind("<!DOCTYPE html>", 0), 0u);
+  EXPECT_EQ(ReadFile(Path("out/run.glb")).substr(0, 4), "glTF");
+  EXPECT_CONTAINS(ReadFile(Path("out/run.gltf")), "\"version\": \"2.0\"");
 }
 
 TEST_F(RenderCliTest, InvalidSizesExitOneNamingTheOption) {
