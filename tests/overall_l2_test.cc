@@ -19,12 +19,7 @@ namespace {
 
 using test_util::CurvedPoints;
 using test_util::ExpectInputError;
-
-Eigen::VectorXd LengthsOf(const Points& p) {
-  Eigen::VectorXd l(p.rows() - 1);
-  for (Eigen::Index i = 1; i < p.rows(); ++i) l[i - 1] = (p.row(i) - p.row(i - 1)).norm();
-  return l;
-}
+using test_util::LengthsOf;
 
 ObjectiveWeights L2Weights(double l2, double l2_weighted, double squared, double rotation) {
   ObjectiveWeights w;

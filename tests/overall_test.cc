@@ -19,6 +19,7 @@ namespace {
 
 using test_util::CurvedPoints;
 using test_util::ExpectInputError;
+using test_util::LengthsOf;
 
 // The weight mixes tested: each term alone and mixtures (the joint-angle term only in 2D).
 std::vector<ObjectiveWeights> Mixes(int dim) {
@@ -29,12 +30,6 @@ std::vector<ObjectiveWeights> Mixes(int dim) {
     mixes.push_back({0.2, 0.1, 0.5, 3});
   }
   return mixes;
-}
-
-Eigen::VectorXd LengthsOf(const Points& p) {
-  Eigen::VectorXd l(p.rows() - 1);
-  for (Eigen::Index i = 1; i < p.rows(); ++i) l[i - 1] = (p.row(i) - p.row(i - 1)).norm();
-  return l;
 }
 
 TEST(OverallObjectiveTest, GradientAndHessianMatchFiniteDifferences) {

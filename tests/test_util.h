@@ -51,4 +51,11 @@ inline Points CurvedPoints(int dim, int n, double radius, double turn) {
   return p;
 }
 
+// The link lengths of a chain of points, (n+1) by dim -> n.
+inline Eigen::VectorXd LengthsOf(const Points& p) {
+  Eigen::VectorXd l(p.rows() - 1);
+  for (Eigen::Index i = 1; i < p.rows(); ++i) l[i - 1] = (p.row(i) - p.row(i - 1)).norm();
+  return l;
+}
+
 }  // namespace flexkin::test_util
