@@ -1,0 +1,180 @@
+#include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+
+#include "flexkin/error.h"
+#include "flexkin/result_io.h"
+
+// Result files in (docs/result-format.md): the first problem is thrown, naming its JSON pointer.
+
+namespace flexkin {
+namespace {
+
+using json = nlohmann::json;
+
+
+std::string Show(const json& v) {
+  std::string text = v.dump(-1, ' ', false, json::error_handler_t::replace);
+  return text.size() > 60 ? text.substr(0, 56) + " ..." : text;
+}
+
+const json& Member(const json& object, const std::string& ptr, const char* key) {
+  if (!object.is_object()) throw InputError(ptr, "value " + Show(object) + " is not an object");
+  const auto it = object.find(key);
+  if (it == object.end()) throw InputError(ptr + "/" + key, "is missing");
+  return *it;
+}
+
+double ReadNumber(const json& v, const std::string& ptr) {
+  if (!v.is_number() || !std::isfinite(v.get<double>())) {
+    throw InputError(ptr, "value " + Show(v) + " is not valid; expected a finite number");
+  }
+  return v.get<double>();
+}
+
+int64_t ReadInteger(const json& v, const std::string& ptr, int64_t min) {
+  if (!v.is_number_integer() || v.get<int64_t>() < min) {
+    throw InputError(
+        ptr, "value " + Show(v) + " is not valid; expected an integer >= " + std::to_string(min));
+  }
+  return v.get<int64_t>();
+}
+
+bool ReadBool(const json& v, const std::string& ptr) {
+  if (!v.is_boolean()) throw InputError(ptr, "value " + Show(v) + " is not true or false");
+  return v.get<bool>();
+}
+
+// An array of numbers; `size` < 0 accepts any length.
+Eigen::VectorXd ReadVector(const json& v, const std::string& ptr, Eigen::Index size) {
+  if (!v.is_array() || (size >= 0 && v.size() != static_cast<size_t>(size))) {
+    throw InputError(ptr, "value " + Show(v) + " is not valid; expected an array of " +
+                              (size >= 0 ? std::to_string(size) + " " : std::string()) + "numbers");
+  }
+  Eigen::VectorXd out(v.size());
+  for (size_t i = 0; i < v.size(); ++i) out[i] = ReadNumber(v[i], ptr + "/" + std::to_string(i));
+  return out;
+}
+
+Points ReadPoints(const json& v, const std::string& ptr, Eigen::Index rows, int dim) {
+  if (!v.is_array() || v.size() != static_cast<size_t>(rows)) {
+    throw InputError(ptr, "is not valid; expected an array of " + std::to_string(rows) +
+                              " points (one per link end)");
+  }
+  Points points(rows, dim);
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    points.row(i) = ReadVector(v[i], ptr + "/" + std::to_string(i), dim).transpose();
+  }
+  return points;
+}
+
+}  // namespace
+
+ResultFile ResultFromJson(const json& j) {
+  ResultFile file;
+  RunResult& r = file.result;
+  const json& format = Member(j, "", "format");
+  if (format != kResultFormat) {
+    throw InputError("/format",
+                     "value " + Show(format) + " is not valid; expected \"" + kResultFormat + "\"");
+  }
+  const json& version = Member(j, "", "version");
+  if (version != kResultVersion) {
+    throw InputError("/version", "value " + Show(version) + " is not supported; expected " +
+                                     std::to_string(kResultVersion));
+  }
+  const json& method = Member(j, "", "method");
+  if (!method.is_string())
+    throw InputError("/method", "value " + Show(method) + " is not a string");
+  r.method = ParseMethod(method.get<std::string>(), "/method");
+  if (const auto it = j.find("scenario"); it != j.end()) {
+    if (!it->is_string()) throw InputError("/scenario", "value " + Show(*it) + " is not a string");
+    file.scenario_name = it->get<std::string>();
+  }
+  file.dim = static_cast<int>(ReadInteger(Member(j, "", "dim"), "/dim", 2));
+  if (file.dim > 3)
+    throw InputError("/dim", "value " + std::to_string(file.dim) + " is not 2 or 3");
+  r.lengths = ReadVector(Member(j, "", "link_lengths"), "/link_lengths", -1);
+  const Eigen::Index n = r.lengths.size();
+  if (n < 1 || !(r.lengths.minCoeff() > 0.0)) {
+    throw InputError("/link_lengths", "is not valid; expected at least one positive length");
+  }
+  r.num_steps = ReadInteger(Member(j, "", "num_steps"), "/num_steps", 0);
+
+  const json& accuracy = Member(j, "", "accuracy");
+  r.accuracy.enabled = ReadBool(Member(accuracy, "/accuracy", "enabled"), "/accuracy/enabled");
+  r.accuracy.tolerance =
+      ReadNumber(Member(accuracy, "/accuracy", "tolerance"), "/accuracy/tolerance");
+  r.accuracy.max_substeps = static_cast<int>(
+      ReadInteger(Member(accuracy, "/accuracy", "max_substeps"), "/accuracy/max_substeps", 0));
+  r.accuracy.substeps = static_cast<int>(
+      ReadInteger(Member(accuracy, "/accuracy", "substeps"), "/accuracy/substeps", 1));
+  r.accuracy.order =
+      static_cast<int>(ReadInteger(Member(accuracy, "/accuracy", "order"), "/accuracy/order", 0));
+  r.accuracy.estimated_error =
+      ReadNumber(Member(accuracy, "/accuracy", "estimated_error"), "/accuracy/estimated_error");
+  r.accuracy.met = ReadBool(Member(accuracy, "/accuracy", "met"), "/accuracy/met");
+  if (const auto it = j.find("overall"); it != j.end()) {
+    const json& o = *it;
+    const json& w = Member(o, "/overall", "objective");
+    // (The L2 terms are optional: files written before they existed lack them.)
+    for (const auto& [name, weight] : {std::pair<const char*, double*>{"l2", &r.weights.l2},
+                                       {"l2_weighted", &r.weights.l2_weighted}}) {
+      if (const auto term = w.find(name); term != w.end()) {
+        *weight = ReadNumber(*term, std::string("/overall/objective/") + name);
+      }
+    }
+    r.weights.squared =
+        ReadNumber(Member(w, "/overall/objective", "squared"), "/overall/objective/squared");
+    r.weights.squared_weighted = ReadNumber(Member(w, "/overall/objective", "squared_weighted"),
+                                            "/overall/objective/squared_weighted");
+    r.weights.rotation =
+        ReadNumber(Member(w, "/overall/objective", "rotation"), "/overall/objective/rotation");
+    r.weights.joint_angle = ReadNumber(Member(w, "/overall/objective", "joint_angle"),
+                                       "/overall/objective/joint_angle");
+    r.overall.solves = ReadInteger(Member(o, "/overall", "solves"), "/overall/solves", 0);
+    r.overall.failures = ReadInteger(Member(o, "/overall", "failures"), "/overall/failures", 0);
+    r.overall.iterations =
+        ReadInteger(Member(o, "/overall", "iterations"), "/overall/iterations", 0);
+    r.overall.max_iterations = static_cast<int>(
+        ReadInteger(Member(o, "/overall", "max_iterations"), "/overall/max_iterations", 0));
+    r.overall.constraint_violation =
+        ReadNumber(Member(o, "/overall", "constraint_violation"), "/overall/constraint_violation");
+    r.overall.optimality = ReadNumber(Member(o, "/overall", "optimality"), "/overall/optimality");
+  }
+
+  const json& metrics = Member(j, "", "metrics");
+  Metrics& m = r.metrics;
+  m.l2_total = ReadNumber(Member(metrics, "/metrics", "l2_total"), "/metrics/l2_total");
+  m.l2_weighted_total =
+      ReadNumber(Member(metrics, "/metrics", "l2_weighted_total"), "/metrics/l2_weighted_total");
+  m.max_relative_length_error = ReadNumber(Member(metrics, "/metrics", "max_relative_length_error"),
+                                           "/metrics/max_relative_length_error");
+  m.path_length =
+      ReadVector(Member(metrics, "/metrics", "path_length"), "/metrics/path_length", n + 1);
+  m.l2_per_step =
+      ReadVector(Member(metrics, "/metrics", "l2_per_step"), "/metrics/l2_per_step", r.num_steps);
+  m.l2_weighted_per_step = ReadVector(Member(metrics, "/metrics", "l2_weighted_per_step"),
+                                      "/metrics/l2_weighted_per_step", r.num_steps);
+  if (const auto it = j.find("seconds"); it != j.end()) r.seconds = ReadNumber(*it, "/seconds");
+
+  const json& frames = Member(j, "", "frames");
+  if (!frames.is_array() || frames.empty()) {
+    throw InputError("/frames", "is not valid; expected an array of at least one frame");
+  }
+  r.frames.reserve(frames.size());
+  for (size_t f = 0; f < frames.size(); ++f) {
+    const std::string ptr = "/frames/" + std::to_string(f);
+    Frame frame;
+    frame.step = ReadInteger(Member(frames[f], ptr, "step"), ptr + "/step", 0);
+    frame.points = ReadPoints(Member(frames[f], ptr, "points"), ptr + "/points", n + 1, file.dim);
+    const json& angles = Member(frames[f], ptr, "link_angles");
+    frame.link_angles = ReadVector(angles, ptr + "/link_angles", angles.empty() ? 0 : n);
+    r.frames.push_back(std::move(frame));
+  }
+  return file;
+}
+
+ResultFile ReadResultJson(const std::string& path) { return ResultFromJson(ReadJsonFile(path)); }
+
+}  // namespace flexkin
