@@ -51,7 +51,7 @@ class BandMatrix {
 
  private:
   friend class BandedLu;
-  friend int NegativePivots(const BandMatrix& a);
+  friend class BandedLdlt;
   size_t Index(int i, int j) const {
     return static_cast<size_t>(j) * ldab_ + (2 * band_ + i - j);
   }
@@ -143,37 +143,89 @@ class BandedLu {
   bool factorized_ = false;
 };
 
-// The inertia of a symmetric BandMatrix: by Sylvester's law, the signs of the pivots of its
-// LDL^T factorization without pivoting. Returns the number of negative pivots, or -1 when a pivot
-// is tiny (below 1e-12 times the largest entry: the factorization without pivoting is then not
-// to be trusted, and the caller must decide another way). Cost O(size band^2).
+// LDL^T factorization without pivoting of a symmetric BandMatrix (its lower band is read): a
+// quarter of the LU's work, and the inertia comes with it (by Sylvester's law, the signs of the
+// pivots). Without pivoting it can fail: Factorize returns false when a pivot is tiny, below
+// `tiny` times the largest entry, and the caller then uses BandedLu (or decides another way).
+class BandedLdlt {
+ public:
+  explicit BandedLdlt(const BandMatrix& shape)
+      : size_(shape.size()), band_(shape.band()), l_(static_cast<size_t>(size_) * (band_ + 1)) {}
+
+  bool Factorize(const BandMatrix& a, double tiny) {
+    const int n = size_, band = band_, width = band + 1;
+    double scale = 0.0;
+    for (int j = 0; j < n; ++j) {
+      double* column = &l_[static_cast<size_t>(j) * width];
+      const double* source = &a.ab_[a.Index(j, j)];  // source[r] = A(j + r, j)
+      const int last = std::min(n - 1 - j, band);
+      for (int r = 0; r <= last; ++r) {
+        column[r] = source[r];
+        scale = std::max(scale, std::fabs(source[r]));
+      }
+      for (int r = last + 1; r <= band; ++r) column[r] = 0.0;
+    }
+    negative_ = 0;
+    factorized_ = false;
+    for (int j = 0; j < n; ++j) {
+      double* column = &l_[static_cast<size_t>(j) * width];
+      const double pivot = column[0];
+      if (!(std::fabs(pivot) > tiny * scale)) return false;
+      if (pivot < 0.0) ++negative_;
+      // A(i, k) -= A(i, j) A(k, j) / pivot for j < k <= i <= j + band, then L(i, j) = A(i, j) / pivot.
+      const int last = std::min(n - 1, j + band);
+      const double inverse = 1.0 / pivot;
+      for (int k = j + 1; k <= last; ++k) {
+        const double f = column[k - j] * inverse;
+        if (f == 0.0) continue;
+        double* target = &l_[static_cast<size_t>(k) * width];
+        for (int i = k; i <= last; ++i) target[i - k] -= f * column[i - j];
+      }
+      for (int r = 1; r <= last - j; ++r) column[r] *= inverse;
+    }
+    factorized_ = true;
+    return true;
+  }
+  // The number of negative pivots, i.e. of negative eigenvalues, of the last factorization.
+  int negative() const { return negative_; }
+  bool factorized() const { return factorized_; }
+
+  Eigen::VectorXd Solve(const Eigen::VectorXd& rhs) const {
+    assert(factorized_);
+    const int n = size_, band = band_, width = band + 1;
+    Eigen::VectorXd solution = rhs;
+    double* y = solution.data();
+    for (int j = 0; j < n; ++j) {  // L y = rhs
+      const double* column = &l_[static_cast<size_t>(j) * width];
+      const int last = std::min(n - 1 - j, band);
+      const double yj = y[j];
+      for (int r = 1; r <= last; ++r) y[j + r] -= column[r] * yj;
+    }
+    for (int j = 0; j < n; ++j) y[j] /= l_[static_cast<size_t>(j) * width];  // D
+    for (int j = n - 1; j >= 0; --j) {  // L^T x = y
+      const double* column = &l_[static_cast<size_t>(j) * width];
+      const int last = std::min(n - 1 - j, band);
+      double yj = y[j];
+      for (int r = 1; r <= last; ++r) yj -= column[r] * y[j + r];
+      y[j] = yj;
+    }
+    return solution;
+  }
+
+ private:
+  int size_, band_;
+  std::vector<double> l_;  // column j: D(j) at [0], then L(j + r, j) at [r]
+  int negative_ = 0;
+  bool factorized_ = false;
+};
+
+// The inertia of a symmetric BandMatrix: the number of negative eigenvalues, from the signs of
+// the pivots of its LDL^T factorization without pivoting, or -1 when a pivot is tiny (below
+// 1e-12 times the largest entry: the factorization without pivoting is then not to be trusted,
+// and the caller must decide another way). Cost O(size band^2).
 inline int NegativePivots(const BandMatrix& a) {
-  const int n = a.size_, band = a.band_, width = band + 1;
-  // The lower triangle, column by column: l[j * width + (i - j)] for j <= i <= j + band.
-  std::vector<double> l(static_cast<size_t>(n) * width, 0.0);
-  double scale = 0.0;
-  for (int j = 0; j < n; ++j) {
-    for (int i = j; i <= std::min(n - 1, j + band); ++i) {
-      l[static_cast<size_t>(j) * width + (i - j)] = a(i, j);
-      scale = std::max(scale, std::fabs(a(i, j)));
-    }
-  }
-  int negative = 0;
-  for (int j = 0; j < n; ++j) {
-    const double* column = &l[static_cast<size_t>(j) * width];
-    const double pivot = column[0];
-    if (!(std::fabs(pivot) > 1e-12 * scale)) return -1;
-    if (pivot < 0.0) ++negative;
-    // A(i, k) -= A(i, j) A(k, j) / pivot for j < k <= i <= j + band.
-    const int last = std::min(n - 1, j + band);
-    for (int k = j + 1; k <= last; ++k) {
-      const double f = column[k - j] / pivot;
-      if (f == 0.0) continue;
-      double* target = &l[static_cast<size_t>(k) * width];
-      for (int i = k; i <= last; ++i) target[i - k] -= f * column[i - j];
-    }
-  }
-  return negative;
+  BandedLdlt ldlt(a);
+  return ldlt.Factorize(a, 1e-12) ? ldlt.negative() : -1;
 }
 
 }  // namespace flexkin::internal
