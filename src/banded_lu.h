@@ -17,12 +17,17 @@
 namespace flexkin::internal {
 
 // A square matrix of half-bandwidth `band` (entries with |i - j| > band are 0), stored by
-// columns in LAPACK's band layout with room for the fill-in of partial pivoting:
-// A(i, j) = ab[j * ldab + 2 band + i - j], ldab = 3 band + 1.
+// columns in LAPACK's band layout: A(i, j) = ab[j * ldab + offset + i - j], with ldab = 2 band + 1
+// and offset = band; or, with `room_for_fill`, ldab = 3 band + 1 and offset = 2 band, the extra
+// rows above holding the fill-in of partial pivoting (BandedLu's own copy).
 class BandMatrix {
  public:
-  BandMatrix(int size, int band)
-      : size_(size), band_(band), ldab_(3 * band + 1), ab_(static_cast<size_t>(ldab_) * size) {}
+  BandMatrix(int size, int band, bool room_for_fill = false)
+      : size_(size),
+        band_(band),
+        ldab_((room_for_fill ? 3 : 2) * band + 1),
+        offset_((room_for_fill ? 2 : 1) * band),
+        ab_(static_cast<size_t>(ldab_) * size) {}
 
   int size() const { return size_; }
   int band() const { return band_; }
@@ -53,10 +58,10 @@ class BandMatrix {
   friend class BandedLu;
   friend class BandedLdlt;
   size_t Index(int i, int j) const {
-    return static_cast<size_t>(j) * ldab_ + (2 * band_ + i - j);
+    return static_cast<size_t>(j) * ldab_ + (offset_ + i - j);
   }
 
-  int size_, band_, ldab_;
+  int size_, band_, ldab_, offset_;
   std::vector<double> ab_;
 };
 
@@ -64,21 +69,20 @@ class BandMatrix {
 class BandedLu {
  public:
   explicit BandedLu(const BandMatrix& shape)
-      : lu_(shape.size(), shape.band()), ipiv_(shape.size()) {}
+      : lu_(shape.size(), shape.band(), /*room_for_fill=*/true), ipiv_(shape.size()) {}
 
   // Factors a copy of `a` (of the shape given at construction). False if it is singular.
   bool Factorize(const BandMatrix& a) {
     assert(a.size() == lu_.size_ && a.band() == lu_.band_);
-    lu_.ab_ = a.ab_;
+    lu_.SetZero();
+    for (int j = 0; j < a.size_; ++j) {
+      const int first = std::max(0, j - a.band_), last = std::min(a.size_ - 1, j + a.band_);
+      for (int i = first; i <= last; ++i) lu_.ab_[lu_.Index(i, j)] = a.ab_[a.Index(i, j)];
+    }
     return FactorizeStorage();
   }
-  // The same without the copy: takes `*a`'s storage, leaving `*a` with unspecified entries
-  // (for large systems, where the copy is a large part of the memory traffic).
-  bool FactorizeInPlace(BandMatrix* a) {
-    assert(a->size() == lu_.size_ && a->band() == lu_.band_);
-    std::swap(lu_.ab_, a->ab_);
-    return FactorizeStorage();
-  }
+
+ private:
   bool FactorizeStorage() {
     const int n = lu_.size_, kl = lu_.band_, ku = lu_.band_;
     factorized_ = false;
@@ -114,6 +118,8 @@ class BandedLu {
     return true;
   }
 
+
+ public:
   // Solves A x = rhs with the last factorization.
   Eigen::VectorXd Solve(const Eigen::VectorXd& rhs) const {
     assert(factorized_);

@@ -317,7 +317,7 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
         }
       }
       if (sol.size() == 0) {
-        factorized = lu.FactorizeInPlace(&kkt);
+        factorized = lu.Factorize(kkt);
         if (!factorized) {
           regularize(1e-10 * std::fmax(1.0, g.cwiseAbs().maxCoeff()));  // singular
           continue;
