@@ -40,6 +40,20 @@ class BandMatrix {
   double operator()(int i, int j) const {
     return std::abs(i - j) <= band_ ? ab_[Index(i, j)] : 0.0;
   }
+  // y = A x for a symmetric A, from its lower band: y_i = (column i) . x over the band, since
+  // A(i, j) = A(j, i). (Dot products: no chain of updates to the same y_i.)
+  Eigen::VectorXd MultiplySymmetric(const Eigen::VectorXd& x) const {
+    Eigen::VectorXd y(size_);
+    const double* in = x.data();
+    for (int i = 0; i < size_; ++i) {
+      const int first = std::max(0, i - band_), last = std::min(size_ - 1, i + band_);
+      const double* column = &ab_[Index(0, i)];  // column[j] = A(j, i) = A(i, j)
+      double sum = 0.0;
+      for (int j = first; j <= last; ++j) sum += column[j] * in[j];
+      y[i] = sum;
+    }
+    return y;
+  }
   // y = A x.
   Eigen::VectorXd Multiply(const Eigen::VectorXd& x) const {
     Eigen::VectorXd y = Eigen::VectorXd::Zero(size_);
@@ -165,11 +179,13 @@ class BandedLdlt {
       double* column = &l_[static_cast<size_t>(j) * width];
       const double* source = &a.ab_[a.Index(j, j)];  // source[r] = A(j + r, j)
       const int last = std::min(n - 1 - j, band);
+      double largest = 0.0;  // (per column: one long chain of max through `scale` is slow)
       for (int r = 0; r <= last; ++r) {
         column[r] = source[r];
-        scale = std::max(scale, std::fabs(source[r]));
+        largest = std::max(largest, std::fabs(source[r]));
       }
       for (int r = last + 1; r <= band; ++r) column[r] = 0.0;
+      scale = std::max(scale, largest);
     }
     negative_ = 0;
     factorized_ = false;

@@ -311,7 +311,7 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
       Eigen::VectorXd sol;
       if (ldlt.Factorize(kkt, 1e-10)) {
         sol = ldlt.Solve(rhs);
-        const double residual = (kkt.Multiply(sol) - rhs).cwiseAbs().maxCoeff();
+        const double residual = (kkt.MultiplySymmetric(sol) - rhs).cwiseAbs().maxCoeff();
         if (!(residual <= 1e-12 * (rhs.cwiseAbs().maxCoeff() + sol.cwiseAbs().maxCoeff()))) {
           sol.resize(0);
         }

@@ -114,6 +114,8 @@ TEST(BandedLuTest, NegativePivotsCountNegativeEigenvalues) {
     const int negative = NegativePivots(a);
     if (negative < 0) continue;  // a tiny pivot: undecided, allowed
     EXPECT_EQ(negative, (eigenvalues.array() < 0.0).count()) << "trial " << trial;
+    const Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(size, -1.0, 2.0);
+    EXPECT_LE((a.MultiplySymmetric(x) - dense * x).cwiseAbs().maxCoeff(), 1e-14 * size);
     ++compared;
   }
   EXPECT_GE(compared, 150);  // undecided must stay the exception
