@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "flexkin/error.h"
@@ -87,6 +88,214 @@ TEST(ArmKinematics, PlanarAnglesAreCounterClockwise) {
   EXPECT_NEAR(p(1, 1), 1.0, 1e-15);
   EXPECT_NEAR(p(2, 0), 1.0, 1e-15);
   EXPECT_NEAR(p(2, 1), 1.0, 1e-15);
+}
+
+// A circle of `steps` targets of radius `radius` through the end effector's start (planar, or
+// tilted out of the plane in 3D).
+Points CirclePath(const ArmModel& model, double radius, int steps, int turns = 1) {
+  const Points start = ForwardKinematics(model, model.initial);
+  const Eigen::VectorXd ee = start.row(model.num_links()).transpose();
+  Points path(steps, model.dim);
+  for (int i = 0; i < steps; ++i) {
+    const double a = 2.0 * kPi * turns * (i + 1) / steps;
+    Eigen::VectorXd p = ee;
+    p[0] += radius * (std::cos(a) - 1.0);
+    p[1] += radius * std::sin(a);
+    if (model.dim == 3) p[2] += 0.5 * radius * std::sin(a);
+    path.row(i) = p.transpose();
+  }
+  return path;
+}
+
+void ExpectStepInvariants(const ArmModel& model, const ArmStepReport& r, int step) {
+  ASSERT_TRUE(r.state.points.allFinite()) << step;
+  EXPECT_LT((r.state.points.row(0).transpose() - model.base).norm(), 1e-12) << step;
+  EXPECT_LT(MaxLengthError(model, r.state.points), 1e-14) << step;
+  EXPECT_LT((ForwardKinematics(model, r.state.angles) - r.state.points).cwiseAbs().maxCoeff(),
+            1e-12)
+      << step;
+  EXPECT_TRUE(WithinLimits(model, r.state.angles, 1e-12)) << step;
+  EXPECT_TRUE(std::isfinite(r.ee_error) && std::isfinite(r.base_error)) << step;
+}
+
+TEST(ArmStep, FixedBaseHeldAndTargetsReachedOverALongPath) {
+  for (int dim : {2, 3}) {
+    const ArmModel model = CurledArm(dim, 32, 0.05);
+    const Points path = CirclePath(model, 3.0, 1000, 2);
+    const ArmTrajectory t = TrackPath(model, path, ArmOptions{});
+    ASSERT_EQ(t.steps.size(), 1000u);
+    EXPECT_EQ(t.unreached, 0) << dim;
+    EXPECT_LE(t.max_iterations, 10) << dim;
+    for (size_t i = 0; i < t.steps.size(); ++i) {
+      const ArmStepReport& r = t.steps[i];
+      ExpectStepInvariants(model, r, static_cast<int>(i));
+      EXPECT_LE(r.ee_error, 2.1e-10) << dim << " step " << i;
+      EXPECT_LE(r.base_error, 1e-10) << dim << " step " << i;
+      EXPECT_LT((r.state.points.row(32) - path.row(i)).norm(), 2.1e-10);
+    }
+  }
+}
+
+TEST(ArmStep, NewtonNeedsAFewIterationsWhereTheFixedPointNeedsMany) {
+  // Near the edge of the workspace (end effector at 0.98 of the reach), where the base's reply
+  // to a move of the end effector is nearly a translation.
+  ArmModel model = CurledArm(2, 128, 0.005);
+  const Points path = CirclePath(model, 1.0, 40);
+  ArmOptions newton, fixed;
+  fixed.method = FixedBaseMethod::kFixedPoint;
+  const ArmTrajectory a = TrackPath(model, path, newton);
+  const ArmTrajectory b = TrackPath(model, path, fixed);
+  EXPECT_EQ(a.unreached, 0);
+  EXPECT_EQ(b.unreached, 0);
+  EXPECT_LE(a.max_iterations, 10);
+  EXPECT_LE(a.total_sweeps, 10 * 40);
+  EXPECT_GT(b.total_sweeps, 5 * a.total_sweeps) << a.total_sweeps << " " << b.total_sweeps;
+  std::printf("128 links, 40 steps near the edge: newton %lld sweeps (max %d iterations a step), "
+              "fixed point %lld sweeps\n", a.total_sweeps, a.max_iterations, b.total_sweeps);
+  for (const ArmStepReport& r : b.steps) EXPECT_LE(r.ee_error, 2.1e-10);
+}
+
+TEST(ArmStep, MotionDiesOutTowardTheBase) {
+  for (int dim : {2, 3}) {
+    const int n = 24;
+    const ArmModel model = CurledArm(dim, n, 0.06);
+    const ArmTrajectory t = TrackPath(model, CirclePath(model, 2.0, 200), ArmOptions{});
+    EXPECT_EQ(t.unreached, 0);
+    // Total motion of each joint: its point's path length (angles of spherical joints have an
+    // azimuth that is ill-defined near zero bend, so use the points).
+    Eigen::VectorXd motion = Eigen::VectorXd::Zero(n + 1);
+    Points previous = ForwardKinematics(model, model.initial);
+    for (const ArmStepReport& r : t.steps) {
+      for (int j = 0; j <= n; ++j) motion[j] += (r.state.points.row(j) - previous.row(j)).norm();
+      previous = r.state.points;
+    }
+    EXPECT_EQ(motion[0], 0.0);
+    EXPECT_GT(motion.segment(3 * n / 4, n / 4).mean(), 2.0 * motion.segment(1, n / 4).mean());
+    // Joint angles too (planar): the end-effector half turns more than the base half.
+    if (dim == 2) {
+      Eigen::VectorXd turn = Eigen::VectorXd::Zero(n);
+      Eigen::VectorXd before = model.initial.angle;
+      for (const ArmStepReport& r : t.steps) {
+        turn += (r.state.angles.angle - before).cwiseAbs();
+        before = r.state.angles.angle;
+      }
+      EXPECT_GT(turn.tail(n / 2).sum(), turn.head(n / 2).sum());
+    }
+  }
+}
+
+TEST(ArmStep, JointLimitsAreNeverViolated) {
+  for (int dim : {2, 3}) {
+    ArmModel model = CurledArm(dim, 16, 0.05);
+    if (dim == 2) {
+      model.joint_min = Eigen::VectorXd::Constant(16, -0.2);
+      model.joint_max = Eigen::VectorXd::Constant(16, 0.12);
+    } else {
+      model.max_bend = Eigen::VectorXd::Constant(16, 0.15);
+    }
+    const ArmTrajectory t = TrackPath(model, CirclePath(model, 4.0, 300), ArmOptions{});
+    bool any_limited = false, any_reached = false;
+    for (size_t i = 0; i < t.steps.size(); ++i) {
+      ExpectStepInvariants(model, t.steps[i], static_cast<int>(i));
+      any_limited |= t.steps[i].limited;
+      any_reached |= t.steps[i].reached && t.steps[i].limited;
+      if (t.steps[i].reached) EXPECT_LE(t.steps[i].ee_error, 2.1e-10);
+    }
+    EXPECT_TRUE(any_limited) << dim;
+    EXPECT_TRUE(any_reached) << dim << ": limits active and the target still reached";
+  }
+}
+
+TEST(ArmStep, UnreachableTargetsAreReportedWithoutNaN) {
+  for (int dim : {2, 3}) {
+    const ArmModel model = CurledArm(dim, 10, 0.1);
+    const ArmState start = InitialState(model);
+    // Beyond reach: stretched toward the target, at distance |target| - reach.
+    Eigen::VectorXd far = Eigen::VectorXd::Zero(dim);
+    far[1] = 25.0;
+    ArmStepReport r = ArmStep(model, start, far, ArmOptions{});
+    ExpectStepInvariants(model, r, 0);
+    EXPECT_FALSE(r.reached);
+    EXPECT_TRUE(r.stretched);
+    EXPECT_NEAR(r.ee_error, 15.0, 1e-12);
+    // Through the base, and behind it.
+    for (double x : {0.0, -0.5}) {
+      Eigen::VectorXd at_base = model.base;
+      at_base[0] += x;
+      r = ArmStep(model, start, at_base, ArmOptions{});
+      ExpectStepInvariants(model, r, 1);
+      if (!r.reached) EXPECT_GT(r.ee_error, 0.0);
+    }
+  }
+}
+
+TEST(ArmStep, StretchedArmPushedAlongItselfStaysFinite) {
+  for (int dim : {2, 3}) {
+    const ArmModel model = StraightArm(dim, 12, 1.0);  // straight along +x
+    const ArmState start = InitialState(model);
+    for (double x : {11.5, 6.0, 12.0, 12.5}) {  // pushed in, far in, on the edge, pulled out
+      Eigen::VectorXd target = Eigen::VectorXd::Zero(dim);
+      target[0] = x;
+      const ArmStepReport r = ArmStep(model, start, target, ArmOptions{});
+      ExpectStepInvariants(model, r, static_cast<int>(x));
+      EXPECT_EQ(r.reached, r.ee_error <= 2.1e-10);
+      if (x > 12.0) EXPECT_FALSE(r.reached);
+    }
+  }
+}
+
+TEST(ArmStep, FixedPointBaselineKeepsTheSameInvariants) {
+  const ArmModel model = CurledArm(3, 16, 0.08);
+  ArmOptions options;
+  options.method = FixedBaseMethod::kFixedPoint;
+  const ArmTrajectory t = TrackPath(model, CirclePath(model, 2.0, 100), options);
+  EXPECT_EQ(t.unreached, 0);
+  for (size_t i = 0; i < t.steps.size(); ++i) ExpectStepInvariants(model, t.steps[i], int(i));
+}
+
+// The message of the InputError that `f` throws ("" if none).
+template <class F>
+std::string ErrorOf(F f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ArmStep, BadInputIsRefusedWithTheField) {
+  ArmModel model = StraightArm(2, 4, 1.0);
+  const ArmState start = InitialState(model);
+  const Eigen::Vector2d target(3.0, 1.0);
+  ArmModel bad = model;
+  bad.link_lengths[2] = 0.0;
+  EXPECT_NE(ErrorOf([&] { ArmStep(bad, start, target, {}); }).find("link_lengths[2]"), std::string::npos);
+  bad = model;
+  bad.dim = 4;
+  EXPECT_NE(ErrorOf([&] { InitialState(bad); }).find("dim"), std::string::npos);
+  bad = model;
+  bad.base_direction.setZero();
+  EXPECT_NE(ErrorOf([&] { InitialState(bad); }).find("base_direction"), std::string::npos);
+  bad = model;
+  bad.joint_min = Eigen::VectorXd::Constant(4, 0.1);
+  bad.joint_max = Eigen::VectorXd::Constant(4, 0.2);
+  EXPECT_NE(ErrorOf([&] { InitialState(bad); }).find("initial.angle[0]"), std::string::npos);
+  bad.joint_max[1] = 0.0;
+  EXPECT_NE(ErrorOf([&] { InitialState(bad); }).find("joint_min[1]"), std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ArmStep(model, start, Eigen::Vector2d(1.0, NAN), {}); }).find("target[1]"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ArmStep(model, start, Eigen::Vector3d(1.0, 0.0, 0.0), {}); }).find("target"),
+            std::string::npos);
+  ArmOptions options;
+  options.tolerance = 0.0;
+  EXPECT_NE(ErrorOf([&] { ArmStep(model, start, target, options); }).find("options.tolerance"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ParseFixedBaseMethod("jacobian", "method"); }).find("\"newton\""),
+            std::string::npos);
+  Points path(2, 2);
+  path << 1.0, 1.0, INFINITY, 0.0;
+  EXPECT_NE(ErrorOf([&] { TrackPath(model, path, {}); }).find("path[1][0]"), std::string::npos);
 }
 
 }  // namespace
