@@ -28,6 +28,7 @@
 #include "flexkin/run.h"
 #include "flexkin/scenario.h"
 #include "render_command.h"
+#include "robot_command.h"
 
 namespace {
 
@@ -212,6 +213,7 @@ int Main(int argc, char** argv) {
   validate->footer(kExitCodesHelp);
 
   const flexkin::cli::RenderCommand render(&app, kExitCodesHelp);
+  const flexkin::cli::RobotCommand robot(&app, kExitCodesHelp);
 
   try {
     app.parse(argc, argv);
@@ -221,6 +223,7 @@ int Main(int argc, char** argv) {
   try {
     if (*run) return RunCommand(args);
     if (render.Parsed()) return render.Run();
+    if (robot.Parsed()) return robot.Run();
     return ValidateCommand(validate_path);
   } catch (const flexkin::InputError& e) {
     PrintError(e.what());

@@ -1,0 +1,72 @@
+// Fixed-base arm step: Newton on the base residual against the predecessors' fixed-point
+// iteration, per step, for 8 to 512 links and for end-effector positions nearer and nearer the
+// edge of the workspace. Counters: iterations and sweeps per step (a sweep costs ~n link steps).
+//   build/bench/arm_benchmark --benchmark_counters_tabular=true
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+#include "flexkin/arm.h"
+
+namespace {
+
+// A planar arm bent into a circular arc whose end effector is at `reach_fraction` of the reach
+// from the base (reach_fraction in (0, 1)): the chord of an arc of total turn phi is
+// reach * sin(phi/2) / (phi/2).
+flexkin::ArmModel ArcArm(int links, double reach_fraction) {
+  double lo = 1e-9, hi = 2.0 * M_PI;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (std::sin(0.5 * mid) / (0.5 * mid) > reach_fraction ? lo : hi) = mid;
+  }
+  flexkin::ArmModel model = flexkin::StraightArm(2, links, 1.0);
+  model.initial.angle.setConstant(lo / links);
+  return model;
+}
+
+void Track(benchmark::State& state, flexkin::FixedBaseMethod method) {
+  const int links = static_cast<int>(state.range(0));
+  const double fraction = state.range(1) / 1000.0;
+  const flexkin::ArmModel model = ArcArm(links, fraction);
+  // A small circle (radius: one link) traced by the end effector in 64 steps.
+  const flexkin::ArmState start = flexkin::InitialState(model);
+  const Eigen::Vector2d ee = start.points.row(links).transpose();
+  flexkin::Points path(64, 2);
+  for (int i = 0; i < 64; ++i) {
+    const double a = 2.0 * M_PI * (i + 1) / 64;
+    path.row(i) = (ee + Eigen::Vector2d(std::cos(a) - 1.0, std::sin(a))).transpose();
+  }
+  flexkin::ArmOptions options;
+  options.method = method;
+  long long steps = 0, iterations = 0, sweeps = 0, unreached = 0;
+  for (auto _ : state) {
+    const flexkin::ArmTrajectory t = flexkin::TrackPath(model, path, options);
+    benchmark::DoNotOptimize(t.steps.back().state.points.data());
+    for (const auto& s : t.steps) iterations += s.iterations, sweeps += s.sweeps;
+    steps += t.steps.size();
+    unreached += t.unreached;
+  }
+  state.SetItemsProcessed(steps);  // items = steps: items_per_second is steps per second
+  state.counters["iters/step"] = double(iterations) / steps;
+  state.counters["sweeps/step"] = double(sweeps) / steps;
+  state.counters["unreached"] = double(unreached) / state.iterations();
+  // Seconds per step (printed with an SI prefix: 34u = 34 microseconds).
+  state.counters["s/step"] =
+      benchmark::Counter(double(steps), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+void Newton(benchmark::State& state) { Track(state, flexkin::FixedBaseMethod::kNewton); }
+void FixedPoint(benchmark::State& state) { Track(state, flexkin::FixedBaseMethod::kFixedPoint); }
+
+// Links 8..512 at 70% of the reach; then 128 links at 30%..99% of the reach.
+void Sizes(benchmark::internal::Benchmark* b) {
+  for (int n : {8, 32, 128, 512}) b->Args({n, 700});
+  for (int f : {300, 900, 970, 990}) b->Args({128, f});
+  b->ArgNames({"links", "reach_permille"})->Unit(benchmark::kMicrosecond);
+}
+BENCHMARK(Newton)->Apply(Sizes);
+BENCHMARK(FixedPoint)->Apply(Sizes);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,153 @@
+#pragma once
+// Hyper-redundant robot arms with a fixed base (docs/robots.md): joint angles <-> link points,
+// and redundancy resolution by the tractrix sweep from the end effector with the base held.
+//
+// Order: everything in this header is in robot order, base first. Point 0 is the base, point n
+// the end effector; link k (1-based) joins points k-1 and k and has length link_lengths[k-1];
+// joint j (0-based) sits at point j and turns link j+1 relative to link j, where "link 0" is the
+// base direction of the model. (Internally the sweep runs on flexkin's chain order, point 0 = the
+// leading end = the end effector.)
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "flexkin/chain.h"
+
+namespace flexkin {
+
+// Joint angles of an arm with n links.
+//   Planar (dim 2), revolute joints: angle[j] is the signed angle (rad, (-pi, pi], counter-
+//   clockwise positive) from the direction of link j to the direction of link j+1.
+//   Spatial (dim 3), spherical joints without twist: angle[j] is the bend angle (rad, [0, pi])
+//   between the directions of links j and j+1, and azimuth[j] (rad, (-pi, pi]) the direction of
+//   the bend in link j's frame: link j+1 points along (cos b, sin b cos a, sin b sin a) there.
+//   Each link carries a frame whose x axis is along the link; the base frame is the smallest
+//   rotation taking the world x axis to the base direction, and each joint's rotation (see
+//   JointQuaternions) is the smallest one taking link j's direction to link j+1's: its axis is
+//   perpendicular to link j, so no joint twists. azimuth is 0 where angle is 0.
+struct JointAngles {
+  Eigen::VectorXd angle;    // n
+  Eigen::VectorXd azimuth;  // n in 3D, empty in 2D
+};
+
+// The joint kinds. (A later one: revolute joints about given axes, as read from a URDF.)
+enum class ArmJoint {
+  kRevolute,   // "revolute": planar arms, one angle per joint
+  kSpherical,  // "spherical": spatial arms, bend angle and azimuth per joint
+};
+
+struct ArmModel {
+  int dim = 2;                                // 2 (revolute joints) or 3 (spherical joints)
+  Eigen::VectorXd link_lengths;               // n >= 1 positive lengths, base link first
+  Eigen::VectorXd base;                       // dim; where the base is bolted
+  Eigen::VectorXd base_direction;             // dim, non-zero; the direction of "link 0"
+  // Planar limits (rad): joint j stays in [joint_min[j], joint_max[j]], with
+  // -pi <= min <= max <= pi. Empty: no limits.
+  Eigen::VectorXd joint_min, joint_max;
+  // Spatial limits (rad): joint j's bend angle stays <= max_bend[j], in (0, pi]. Empty: none.
+  Eigen::VectorXd max_bend;
+  JointAngles initial;                        // the joint angles at the start; within the limits
+
+  ArmJoint joint() const { return dim == 2 ? ArmJoint::kRevolute : ArmJoint::kSpherical; }
+  int num_links() const { return static_cast<int>(link_lengths.size()); }
+  bool has_limits() const { return joint_min.size() > 0 || max_bend.size() > 0; }
+  double reach() const { return link_lengths.sum(); }
+  // "" if the model is usable, otherwise "field: reason" (the field as named above).
+  std::string Validate() const;
+};
+
+// A straight arm of `links` links of length `link_length` from the origin along +x (all joint
+// angles 0, no limits): the usual start for tests and benchmarks.
+ArmModel StraightArm(int dim, int links, double link_length);
+
+// Forward kinematics: the (n+1) by dim points (base first) of the arm at `angles`. Throws
+// InputError if the model is invalid or the angles have the wrong size or non-finite values.
+Points ForwardKinematics(const ArmModel& model, const JointAngles& angles);
+// Inverse: the joint angles of an arm whose points are `points` (base first; the link lengths
+// are taken from the model, the points' own distances are not checked). FK of the result
+// reproduces `points` to rounding when the points have the model's link lengths and base.
+JointAngles JointAnglesFromPoints(const ArmModel& model, const Points& points);
+// Each joint's rotation as a unit quaternion, in the frame of the link before it: an n by 4
+// matrix of rows (w, x, y, z). Planar arms: rotations about z. See JointAngles.
+Eigen::MatrixXd JointQuaternions(const ArmModel& model, const JointAngles& angles);
+// Whether every joint is within its limits, with `slack` (rad) of tolerance.
+bool WithinLimits(const ArmModel& model, const JointAngles& angles, double slack = 0.0);
+
+// How the base is brought back after the sweep from the end effector has moved it.
+enum class FixedBaseMethod {
+  // "newton": the chain is translated by u before one sweep; u solves base(u) = fixed base by
+  // Newton's method (finite-difference Jacobian, Broyden updates, backtracking line search).
+  kNewton,
+  // "fixed_point": the predecessors' scheme: translate the chain back to the base and sweep
+  // again from where it is, until the base stays within the tolerance. Converges linearly.
+  kFixedPoint,
+};
+const char* FixedBaseMethodName(FixedBaseMethod method);
+// Parses "newton" or "fixed_point"; throws InputError naming `field` otherwise.
+FixedBaseMethod ParseFixedBaseMethod(std::string_view name, const std::string& field = "method");
+
+struct ArmOptions {
+  FixedBaseMethod method = FixedBaseMethod::kNewton;  // see FixedBaseMethod
+  // Base residual at which the solver stops, relative to the mean link length. Typical 1e-10.
+  double tolerance = 1e-10;
+  // Cap on the solver's iterations per step. Newton typically needs 2 to 5; the fixed-point
+  // baseline needs hundreds to thousands near the edge of the workspace.
+  int max_iterations = 100;
+  int max_fixed_point_iterations = 100000;
+  // Sub-steps of the sweep: the end effector's move to the target is split in this many straight
+  // pieces (finer = closer to the continuous tractrix motion). Typical 1.
+  int substeps = 1;
+  // Targets farther from the base than (1 - edge_margin) times the reach are treated as out of
+  // reach: the arm is stretched straight toward them. Typical 1e-9.
+  double edge_margin = 1e-9;
+  // "" if valid, otherwise "field: reason".
+  std::string Validate() const;
+};
+
+// The arm between steps: its points (base first) and joint angles, which agree.
+struct ArmState {
+  Points points;
+  JointAngles angles;
+};
+// The state at the model's initial angles.
+ArmState InitialState(const ArmModel& model);
+
+struct ArmStepReport {
+  ArmState state;          // after the step; the base exactly at model.base, limits held
+  double ee_error = 0.0;   // |end effector - target| after the step (length unit)
+  double base_error = 0.0; // the solver's last base residual before the base was re-anchored
+  int iterations = 0;      // solver iterations (Newton steps or fixed-point sweeps)
+  int sweeps = 0;          // sweeps from the end effector, all included (cost ~ sweeps * n)
+  bool converged = false;  // the base residual reached the tolerance
+  bool reached = false;    // converged and ee_error within the tolerance: the target was reached
+  bool stretched = false;  // out of reach: the arm was stretched straight toward the target
+  bool limited = false;    // a joint limit was active
+  std::string BriefReport() const;
+};
+
+// Moves the end effector of the arm in `state` to `target` (dim) with the base held at
+// model.base. Every link keeps its length (the points are rebuilt from the joint angles), every
+// joint stays within its limits, and nothing is NaN: an unreachable target gives the nearest
+// configuration the method finds and reached = false. Throws InputError on an invalid model,
+// options, state or target.
+ArmStepReport ArmStep(const ArmModel& model, const ArmState& state,
+                      const Eigen::Ref<const Eigen::VectorXd>& target, const ArmOptions& options);
+
+struct ArmTrajectory {
+  std::vector<ArmStepReport> steps;  // one per path point
+  double max_ee_error = 0.0, max_base_error = 0.0;
+  int unreached = 0;                 // steps with reached = false
+  int max_iterations = 0;
+  long long total_sweeps = 0;
+  double seconds = 0.0;              // wall time of TrackPath
+  std::string BriefReport() const;
+};
+
+// Tracks `path` (m by dim targets, one per row) from the model's initial state: one ArmStep per
+// row. The first step moves the end effector from its initial position to path row 0.
+ArmTrajectory TrackPath(const ArmModel& model, const Points& path, const ArmOptions& options);
+
+}  // namespace flexkin

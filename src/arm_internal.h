@@ -1,0 +1,26 @@
+#pragma once
+// Helpers shared by the arm's kinematics (arm_kinematics.cc) and its solver (arm_solver.cc).
+
+#include <Eigen/Core>
+
+#include "flexkin/arm.h"
+
+namespace flexkin::arm_internal {
+
+// Throws InputError with model.Validate()'s reason, if any.
+void CheckModel(const ArmModel& model);
+
+// Angle in [lo, hi] nearest to `theta` on the circle (theta, lo, hi in [-pi, pi]).
+double ClampCircular(double theta, double lo, double hi);
+
+// Clamps every joint of `angles` into the model's limits (no-op without limits). Returns
+// whether any angle changed.
+bool ClampToLimits(const ArmModel& model, JointAngles* angles);
+
+// Puts unit vector `dir` into the set the joint limit allows relative to the unit `reference`
+// direction: for a planar joint the signed angle from `reference` to `dir` is clamped into
+// [lo, hi]; for a spherical joint the angle between them to <= hi (lo unused). Returns whether
+// `dir` changed. `dim` is 2 or 3; both point to dim doubles.
+bool ClampDirection(int dim, const double* reference, double lo, double hi, double* dir);
+
+}  // namespace flexkin::arm_internal

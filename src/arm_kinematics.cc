@@ -1,0 +1,289 @@
+// Joint angles <-> link points of a fixed-base arm (include/flexkin/arm.h), the model's checks
+// and the joint-limit projections the solver uses.
+#include <cmath>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "arm_internal.h"
+#include "flexkin/arm.h"
+#include "flexkin/error.h"
+
+namespace flexkin {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// x mapped to (-pi, pi] by a multiple of 2 pi.
+double Wrap(double x) {
+  const double r = std::remainder(x, 2.0 * kPi);
+  return r <= -kPi ? r + 2.0 * kPi : r;
+}
+
+std::string Indexed(const char* field, int i) { return std::string(field) + "[" + std::to_string(i) + "]"; }
+
+std::string CheckVector(const Eigen::VectorXd& v, const char* field, int size) {
+  if (v.size() != size) {
+    return std::string(field) + ": has " + std::to_string(v.size()) + " values; expected " +
+           std::to_string(size);
+  }
+  for (int i = 0; i < v.size(); ++i) {
+    if (!std::isfinite(v[i])) {
+      return Indexed(field, i) + ": value " + FormatNumber(v[i]) + " is not a finite number";
+    }
+  }
+  return "";
+}
+
+// The base frame: the smallest rotation taking the world x axis to the base direction.
+Eigen::Quaterniond BaseFrame(const ArmModel& model) {
+  return Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitX(),
+                                            model.base_direction.head<3>().normalized());
+}
+
+// The rotation of a spherical joint in the frame of the link before it (see JointAngles).
+Eigen::Quaterniond LocalRotation(double bend, double azimuth) {
+  const double s = std::sin(0.5 * bend);
+  return Eigen::Quaterniond(std::cos(0.5 * bend), 0.0, -std::sin(azimuth) * s,
+                            std::cos(azimuth) * s);
+}
+
+void CheckAngles(const ArmModel& model, const JointAngles& angles, const char* field) {
+  const int n = model.num_links();
+  std::string why = CheckVector(angles.angle, "angle", n);
+  if (why.empty() && model.dim == 3) why = CheckVector(angles.azimuth, "azimuth", n);
+  if (why.empty() && model.dim == 2 && angles.azimuth.size() != 0) {
+    why = "azimuth: planar arms have no azimuths; expected none";
+  }
+  if (!why.empty()) throw InputError(std::string(field) + "." + why.substr(0, why.find(':')),
+                                     why.substr(why.find(':') + 2));
+}
+
+}  // namespace
+
+namespace arm_internal {
+
+void CheckModel(const ArmModel& model) {
+  const std::string why = model.Validate();
+  if (!why.empty()) throw InputError(why.substr(0, why.find(':')), why.substr(why.find(':') + 2));
+}
+
+double ClampCircular(double theta, double lo, double hi) {
+  if (theta >= lo && theta <= hi) return theta;
+  return std::abs(Wrap(theta - lo)) <= std::abs(Wrap(theta - hi)) ? lo : hi;
+}
+
+bool ClampToLimits(const ArmModel& model, JointAngles* angles) {
+  bool changed = false;
+  for (int j = 0; j < model.joint_min.size(); ++j) {
+    const double c = ClampCircular(angles->angle[j], model.joint_min[j], model.joint_max[j]);
+    changed |= c != angles->angle[j];
+    angles->angle[j] = c;
+  }
+  for (int j = 0; j < model.max_bend.size(); ++j) {
+    if (angles->angle[j] > model.max_bend[j]) {
+      angles->angle[j] = model.max_bend[j];
+      changed = true;
+    }
+  }
+  return changed;
+}
+
+bool ClampDirection(int dim, const double* reference, double lo, double hi, double* dir) {
+  if (dim == 2) {
+    const double cross = reference[0] * dir[1] - reference[1] * dir[0];
+    const double dot = reference[0] * dir[0] + reference[1] * dir[1];
+    const double theta = std::atan2(cross, dot);
+    const double c = ClampCircular(theta, lo, hi);
+    if (c == theta) return false;
+    const double cs = std::cos(c), sn = std::sin(c);
+    dir[0] = cs * reference[0] - sn * reference[1];
+    dir[1] = sn * reference[0] + cs * reference[1];
+    return true;
+  }
+  const Eigen::Map<const Eigen::Vector3d> ref(reference);
+  Eigen::Map<Eigen::Vector3d> d(dir);
+  const double dot = ref.dot(d);
+  Eigen::Vector3d w = d - dot * ref;
+  const double angle = std::atan2(w.norm(), dot);
+  if (angle <= hi) return false;
+  if (!(w.squaredNorm() > 0.0)) w = ref.unitOrthogonal();  // exact reversal: any side will do
+  d = std::cos(hi) * ref + std::sin(hi) * w.normalized();
+  return true;
+}
+
+}  // namespace arm_internal
+
+std::string ArmModel::Validate() const {
+  if (dim != 2 && dim != 3) return "dim: value " + std::to_string(dim) + " is not 2 or 3";
+  const int n = num_links();
+  if (n < 1) return "link_lengths: the arm has no links; expected at least 1";
+  for (int i = 0; i < n; ++i) {
+    if (!(link_lengths[i] > 0.0) || !std::isfinite(link_lengths[i])) {
+      return Indexed("link_lengths", i) + ": value " + FormatNumber(link_lengths[i]) +
+             " is not a positive finite number";
+    }
+  }
+  std::string why = CheckVector(base, "base", dim);
+  if (why.empty()) why = CheckVector(base_direction, "base_direction", dim);
+  if (!why.empty()) return why;
+  if (!(base_direction.squaredNorm() > 0.0)) return "base_direction: is zero; expected a non-zero vector";
+  if (dim == 2) {
+    if (max_bend.size() != 0) return "max_bend: planar arms have joint_min and joint_max instead";
+    if (joint_min.size() != joint_max.size()) return "joint_max: joint_min and joint_max differ in size";
+    if (joint_min.size() != 0) {
+      if (!(why = CheckVector(joint_min, "joint_min", n)).empty()) return why;
+      if (!(why = CheckVector(joint_max, "joint_max", n)).empty()) return why;
+      for (int j = 0; j < n; ++j) {
+        if (!(joint_min[j] >= -kPi && joint_min[j] <= joint_max[j] && joint_max[j] <= kPi)) {
+          return Indexed("joint_min", j) + ": limits [" + FormatNumber(joint_min[j]) + ", " +
+                 FormatNumber(joint_max[j]) + "] rad are not valid; expected -pi <= min <= max <= pi";
+        }
+      }
+    }
+  } else {
+    if (joint_min.size() != 0 || joint_max.size() != 0) {
+      return "joint_min: spherical joints have max_bend instead";
+    }
+    if (max_bend.size() != 0) {
+      if (!(why = CheckVector(max_bend, "max_bend", n)).empty()) return why;
+      for (int j = 0; j < n; ++j) {
+        if (!(max_bend[j] > 0.0 && max_bend[j] <= kPi)) {
+          return Indexed("max_bend", j) + ": value " + FormatNumber(max_bend[j]) +
+                 " rad is not valid; expected 0 < max_bend <= pi";
+        }
+      }
+    }
+  }
+  why = CheckVector(initial.angle, "initial.angle", n);
+  if (why.empty() && dim == 3) why = CheckVector(initial.azimuth, "initial.azimuth", n);
+  if (why.empty() && dim == 2 && initial.azimuth.size() != 0) {
+    why = "initial.azimuth: planar arms have no azimuths; expected none";
+  }
+  if (!why.empty()) return why;
+  for (int j = 0; j < n; ++j) {
+    const double a = initial.angle[j];
+    const bool ok = dim == 2 ? a >= -kPi && a <= kPi : a >= 0.0 && a <= kPi;
+    if (!ok) {
+      return Indexed("initial.angle", j) + ": value " + FormatNumber(a) + " rad is not valid; expected " +
+             (dim == 2 ? "-pi <= angle <= pi" : "0 <= bend angle <= pi");
+    }
+    const bool inside = dim == 2 ? joint_min.size() == 0 || (a >= joint_min[j] && a <= joint_max[j])
+                                 : max_bend.size() == 0 || a <= max_bend[j];
+    if (!inside) {
+      return Indexed("initial.angle", j) + ": value " + FormatNumber(a) +
+             " rad is outside the joint's limits; the initial angles must be within them";
+    }
+  }
+  return "";
+}
+
+ArmModel StraightArm(int dim, int links, double link_length) {
+  ArmModel model;
+  model.dim = dim;
+  model.link_lengths = Eigen::VectorXd::Constant(links, link_length);
+  model.base = Eigen::VectorXd::Zero(dim);
+  model.base_direction = Eigen::VectorXd::Unit(dim, 0);
+  model.initial.angle = Eigen::VectorXd::Zero(links);
+  if (dim == 3) model.initial.azimuth = Eigen::VectorXd::Zero(links);
+  return model;
+}
+
+Points ForwardKinematics(const ArmModel& model, const JointAngles& angles) {
+  arm_internal::CheckModel(model);
+  CheckAngles(model, angles, "angles");
+  const int n = model.num_links();
+  Points points(n + 1, model.dim);
+  points.row(0) = model.base.transpose();
+  if (model.dim == 2) {
+    double heading = std::atan2(model.base_direction[1], model.base_direction[0]);
+    for (int j = 0; j < n; ++j) {
+      heading += angles.angle[j];
+      const double l = model.link_lengths[j];
+      points(j + 1, 0) = points(j, 0) + l * std::cos(heading);
+      points(j + 1, 1) = points(j, 1) + l * std::sin(heading);
+    }
+    return points;
+  }
+  Eigen::Quaterniond frame = BaseFrame(model);
+  for (int j = 0; j < n; ++j) {
+    frame = (frame * LocalRotation(angles.angle[j], angles.azimuth[j])).normalized();
+    const Eigen::Vector3d d = frame * Eigen::Vector3d::UnitX();
+    points.row(j + 1) = points.row(j) + model.link_lengths[j] * d.transpose();
+  }
+  return points;
+}
+
+JointAngles JointAnglesFromPoints(const ArmModel& model, const Points& points) {
+  arm_internal::CheckModel(model);
+  const int n = model.num_links();
+  if (points.rows() != n + 1 || points.cols() != model.dim) {
+    throw InputError("points", "shape " + std::to_string(points.rows()) + " by " +
+                                   std::to_string(points.cols()) + " is not valid; expected " +
+                                   std::to_string(n + 1) + " by " + std::to_string(model.dim));
+  }
+  if (!points.allFinite()) throw InputError("points", "a value is not a finite number");
+  JointAngles angles;
+  angles.angle.resize(n);
+  // Each angle is measured against the frame that forward kinematics accumulates, with the same
+  // operations, so FK reproduces every direction to rounding without drift along the arm.
+  if (model.dim == 2) {
+    double heading = std::atan2(model.base_direction[1], model.base_direction[0]);
+    for (int j = 0; j < n; ++j) {
+      const double dx = points(j + 1, 0) - points(j, 0), dy = points(j + 1, 1) - points(j, 1);
+      const double theta = (dx == 0.0 && dy == 0.0) ? 0.0 : Wrap(std::atan2(dy, dx) - heading);
+      angles.angle[j] = theta;
+      heading += theta;
+    }
+    return angles;
+  }
+  angles.azimuth.resize(n);
+  Eigen::Quaterniond frame = BaseFrame(model);
+  for (int j = 0; j < n; ++j) {
+    const Eigen::Vector3d d = (points.row(j + 1) - points.row(j)).transpose();
+    const Eigen::Vector3d v = frame.conjugate() * d;
+    const double side = std::hypot(v.y(), v.z());
+    angles.angle[j] = std::atan2(side, v.x());
+    angles.azimuth[j] = side > 0.0 ? std::atan2(v.z(), v.y()) : 0.0;
+    frame = (frame * LocalRotation(angles.angle[j], angles.azimuth[j])).normalized();
+  }
+  return angles;
+}
+
+Eigen::MatrixXd JointQuaternions(const ArmModel& model, const JointAngles& angles) {
+  arm_internal::CheckModel(model);
+  CheckAngles(model, angles, "angles");
+  const int n = model.num_links();
+  Eigen::MatrixXd q(n, 4);
+  for (int j = 0; j < n; ++j) {
+    if (model.dim == 2) {
+      q.row(j) << std::cos(0.5 * angles.angle[j]), 0.0, 0.0, std::sin(0.5 * angles.angle[j]);
+    } else {
+      const Eigen::Quaterniond r = LocalRotation(angles.angle[j], angles.azimuth[j]);
+      q.row(j) << r.w(), r.x(), r.y(), r.z();
+    }
+  }
+  return q;
+}
+
+bool WithinLimits(const ArmModel& model, const JointAngles& angles, double slack) {
+  for (int j = 0; j < model.joint_min.size(); ++j) {
+    if (!(angles.angle[j] >= model.joint_min[j] - slack &&
+          angles.angle[j] <= model.joint_max[j] + slack)) {
+      return false;
+    }
+  }
+  for (int j = 0; j < model.max_bend.size(); ++j) {
+    if (!(angles.angle[j] <= model.max_bend[j] + slack)) return false;
+  }
+  return true;
+}
+
+ArmState InitialState(const ArmModel& model) {
+  ArmState state;
+  state.points = ForwardKinematics(model, model.initial);
+  state.angles = model.initial;
+  return state;
+}
+
+}  // namespace flexkin

@@ -1,0 +1,302 @@
+// The fixed-base arm (include/flexkin/arm.h): kinematics, the solver's invariants, limits,
+// unreachable targets and bad input.
+#include "flexkin/arm.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "flexkin/error.h"
+
+namespace flexkin {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A gently curled arm: every joint turned by `turn` (planar) or bent by `turn` about a slowly
+// turning azimuth (spatial).
+ArmModel CurledArm(int dim, int links, double turn) {
+  ArmModel model = StraightArm(dim, links, 1.0);
+  model.initial.angle.setConstant(dim == 2 ? turn : std::abs(turn));
+  if (dim == 3) {
+    for (int j = 0; j < links; ++j) model.initial.azimuth[j] = 0.3 * j - kPi * std::floor(0.3 * j / kPi);
+  }
+  return model;
+}
+
+double MaxLengthError(const ArmModel& model, const Points& p) {
+  double worst = 0.0;
+  for (int k = 0; k < model.num_links(); ++k) {
+    const double l = (p.row(k + 1) - p.row(k)).norm();
+    worst = std::max(worst, std::abs(l - model.link_lengths[k]) / model.link_lengths[k]);
+  }
+  return worst;
+}
+
+TEST(ArmKinematics, ForwardOfInverseReproducesPointsPlanarAndSpatial) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> angle(-2.5, 2.5), bend(0.0, 2.5), len(0.2, 2.0);
+  for (int dim : {2, 3}) {
+    for (int links : {1, 2, 16, 128}) {
+      ArmModel model = StraightArm(dim, links, 1.0);
+      for (int k = 0; k < links; ++k) model.link_lengths[k] = len(rng);
+      model.base = Eigen::VectorXd::Constant(dim, 0.5);
+      model.base_direction = Eigen::VectorXd::Constant(dim, -1.0);
+      JointAngles a;
+      a.angle.resize(links);
+      for (int k = 0; k < links; ++k) a.angle[k] = dim == 2 ? angle(rng) : bend(rng);
+      if (dim == 3) {
+        a.azimuth.resize(links);
+        for (int k = 0; k < links; ++k) a.azimuth[k] = angle(rng);
+      }
+      const Points p = ForwardKinematics(model, a);
+      EXPECT_LT(MaxLengthError(model, p), 1e-14);
+      EXPECT_EQ((p.row(0).transpose() - model.base).norm(), 0.0);
+      const JointAngles back = JointAnglesFromPoints(model, p);
+      EXPECT_LT((back.angle - a.angle).cwiseAbs().maxCoeff(), 1e-9) << dim << " " << links;
+      const Points again = ForwardKinematics(model, back);
+      EXPECT_LT((again - p).cwiseAbs().maxCoeff(), 1e-12) << dim << " " << links;
+    }
+  }
+}
+
+TEST(ArmKinematics, QuaternionsAreUnitAndTurnTheLinkDirection) {
+  const ArmModel model = CurledArm(3, 6, 0.4);
+  const Points p = ForwardKinematics(model, model.initial);
+  const Eigen::MatrixXd q = JointQuaternions(model, model.initial);
+  ASSERT_EQ(q.rows(), 6);
+  for (int j = 0; j < 6; ++j) {
+    EXPECT_NEAR(q.row(j).norm(), 1.0, 1e-15);
+    EXPECT_EQ(q(j, 1), 0.0);  // no twist: the axis is perpendicular to the link (x)
+    EXPECT_NEAR(2.0 * std::acos(q(j, 0)), model.initial.angle[j], 1e-12);
+  }
+  // Bend angles are the angles between consecutive link directions.
+  for (int j = 1; j < 6; ++j) {
+    const Eigen::Vector3d a = (p.row(j) - p.row(j - 1)).transpose().normalized();
+    const Eigen::Vector3d b = (p.row(j + 1) - p.row(j)).transpose().normalized();
+    EXPECT_NEAR(std::acos(std::clamp(a.dot(b), -1.0, 1.0)), 0.4, 1e-7);
+  }
+}
+
+TEST(ArmKinematics, PlanarAnglesAreCounterClockwise) {
+  ArmModel model = StraightArm(2, 2, 1.0);
+  model.initial.angle << kPi / 2, -kPi / 2;
+  const Points p = ForwardKinematics(model, model.initial);
+  EXPECT_NEAR(p(1, 0), 0.0, 1e-15);
+  EXPECT_NEAR(p(1, 1), 1.0, 1e-15);
+  EXPECT_NEAR(p(2, 0), 1.0, 1e-15);
+  EXPECT_NEAR(p(2, 1), 1.0, 1e-15);
+}
+
+// A circle of `steps` targets of radius `radius` through the end effector's start (planar, or
+// tilted out of the plane in 3D).
+Points CirclePath(const ArmModel& model, double radius, int steps, int turns = 1) {
+  const Points start = ForwardKinematics(model, model.initial);
+  const Eigen::VectorXd ee = start.row(model.num_links()).transpose();
+  Points path(steps, model.dim);
+  for (int i = 0; i < steps; ++i) {
+    const double a = 2.0 * kPi * turns * (i + 1) / steps;
+    Eigen::VectorXd p = ee;
+    p[0] += radius * (std::cos(a) - 1.0);
+    p[1] += radius * std::sin(a);
+    if (model.dim == 3) p[2] += 0.5 * radius * std::sin(a);
+    path.row(i) = p.transpose();
+  }
+  return path;
+}
+
+void ExpectStepInvariants(const ArmModel& model, const ArmStepReport& r, int step) {
+  ASSERT_TRUE(r.state.points.allFinite()) << step;
+  EXPECT_LT((r.state.points.row(0).transpose() - model.base).norm(), 1e-12) << step;
+  EXPECT_LT(MaxLengthError(model, r.state.points), 1e-14) << step;
+  EXPECT_LT((ForwardKinematics(model, r.state.angles) - r.state.points).cwiseAbs().maxCoeff(),
+            1e-12)
+      << step;
+  EXPECT_TRUE(WithinLimits(model, r.state.angles, 1e-12)) << step;
+  EXPECT_TRUE(std::isfinite(r.ee_error) && std::isfinite(r.base_error)) << step;
+}
+
+TEST(ArmStep, FixedBaseHeldAndTargetsReachedOverALongPath) {
+  for (int dim : {2, 3}) {
+    const ArmModel model = CurledArm(dim, 32, 0.05);
+    const Points path = CirclePath(model, 3.0, 1000, 2);
+    const ArmTrajectory t = TrackPath(model, path, ArmOptions{});
+    ASSERT_EQ(t.steps.size(), 1000u);
+    EXPECT_EQ(t.unreached, 0) << dim;
+    EXPECT_LE(t.max_iterations, 10) << dim;
+    for (size_t i = 0; i < t.steps.size(); ++i) {
+      const ArmStepReport& r = t.steps[i];
+      ExpectStepInvariants(model, r, static_cast<int>(i));
+      EXPECT_LE(r.ee_error, 2.1e-10) << dim << " step " << i;
+      EXPECT_LE(r.base_error, 1e-10) << dim << " step " << i;
+      EXPECT_LT((r.state.points.row(32) - path.row(i)).norm(), 2.1e-10);
+    }
+  }
+}
+
+TEST(ArmStep, NewtonNeedsAFewIterationsWhereTheFixedPointNeedsMany) {
+  // Near the edge of the workspace (end effector at 0.98 of the reach), where the base's reply
+  // to a move of the end effector is nearly a translation.
+  ArmModel model = CurledArm(2, 128, 0.005);
+  const Points path = CirclePath(model, 1.0, 40);
+  ArmOptions newton, fixed;
+  fixed.method = FixedBaseMethod::kFixedPoint;
+  const ArmTrajectory a = TrackPath(model, path, newton);
+  const ArmTrajectory b = TrackPath(model, path, fixed);
+  EXPECT_EQ(a.unreached, 0);
+  EXPECT_EQ(b.unreached, 0);
+  EXPECT_LE(a.max_iterations, 10);
+  EXPECT_LE(a.total_sweeps, 10 * 40);
+  EXPECT_GT(b.total_sweeps, 5 * a.total_sweeps) << a.total_sweeps << " " << b.total_sweeps;
+  std::printf("128 links, 40 steps near the edge: newton %lld sweeps (max %d iterations a step), "
+              "fixed point %lld sweeps\n", a.total_sweeps, a.max_iterations, b.total_sweeps);
+  for (const ArmStepReport& r : b.steps) EXPECT_LE(r.ee_error, 2.1e-10);
+}
+
+TEST(ArmStep, MotionDiesOutTowardTheBase) {
+  for (int dim : {2, 3}) {
+    const int n = 24;
+    const ArmModel model = CurledArm(dim, n, 0.06);
+    const ArmTrajectory t = TrackPath(model, CirclePath(model, 2.0, 200), ArmOptions{});
+    EXPECT_EQ(t.unreached, 0);
+    // Total motion of each joint: its point's path length (angles of spherical joints have an
+    // azimuth that is ill-defined near zero bend, so use the points).
+    Eigen::VectorXd motion = Eigen::VectorXd::Zero(n + 1);
+    Points previous = ForwardKinematics(model, model.initial);
+    for (const ArmStepReport& r : t.steps) {
+      for (int j = 0; j <= n; ++j) motion[j] += (r.state.points.row(j) - previous.row(j)).norm();
+      previous = r.state.points;
+    }
+    EXPECT_EQ(motion[0], 0.0);
+    EXPECT_GT(motion.segment(3 * n / 4, n / 4).mean(), 2.0 * motion.segment(1, n / 4).mean());
+    // Joint angles too (planar): the end-effector half turns more than the base half.
+    if (dim == 2) {
+      Eigen::VectorXd turn = Eigen::VectorXd::Zero(n);
+      Eigen::VectorXd before = model.initial.angle;
+      for (const ArmStepReport& r : t.steps) {
+        turn += (r.state.angles.angle - before).cwiseAbs();
+        before = r.state.angles.angle;
+      }
+      EXPECT_GT(turn.tail(n / 2).sum(), turn.head(n / 2).sum());
+    }
+  }
+}
+
+TEST(ArmStep, JointLimitsAreNeverViolated) {
+  for (int dim : {2, 3}) {
+    ArmModel model = CurledArm(dim, 16, 0.05);
+    if (dim == 2) {
+      model.joint_min = Eigen::VectorXd::Constant(16, -0.2);
+      model.joint_max = Eigen::VectorXd::Constant(16, 0.12);
+    } else {
+      model.max_bend = Eigen::VectorXd::Constant(16, 0.15);
+    }
+    const ArmTrajectory t = TrackPath(model, CirclePath(model, 4.0, 300), ArmOptions{});
+    bool any_limited = false, any_reached = false;
+    for (size_t i = 0; i < t.steps.size(); ++i) {
+      ExpectStepInvariants(model, t.steps[i], static_cast<int>(i));
+      any_limited |= t.steps[i].limited;
+      any_reached |= t.steps[i].reached && t.steps[i].limited;
+      if (t.steps[i].reached) EXPECT_LE(t.steps[i].ee_error, 2.1e-10);
+    }
+    EXPECT_TRUE(any_limited) << dim;
+    EXPECT_TRUE(any_reached) << dim << ": limits active and the target still reached";
+  }
+}
+
+TEST(ArmStep, UnreachableTargetsAreReportedWithoutNaN) {
+  for (int dim : {2, 3}) {
+    const ArmModel model = CurledArm(dim, 10, 0.1);
+    const ArmState start = InitialState(model);
+    // Beyond reach: stretched toward the target, at distance |target| - reach.
+    Eigen::VectorXd far = Eigen::VectorXd::Zero(dim);
+    far[1] = 25.0;
+    ArmStepReport r = ArmStep(model, start, far, ArmOptions{});
+    ExpectStepInvariants(model, r, 0);
+    EXPECT_FALSE(r.reached);
+    EXPECT_TRUE(r.stretched);
+    EXPECT_NEAR(r.ee_error, 15.0, 1e-12);
+    // Through the base, and behind it.
+    for (double x : {0.0, -0.5}) {
+      Eigen::VectorXd at_base = model.base;
+      at_base[0] += x;
+      r = ArmStep(model, start, at_base, ArmOptions{});
+      ExpectStepInvariants(model, r, 1);
+      if (!r.reached) EXPECT_GT(r.ee_error, 0.0);
+    }
+  }
+}
+
+TEST(ArmStep, StretchedArmPushedAlongItselfStaysFinite) {
+  for (int dim : {2, 3}) {
+    const ArmModel model = StraightArm(dim, 12, 1.0);  // straight along +x
+    const ArmState start = InitialState(model);
+    for (double x : {11.5, 6.0, 12.0, 12.5}) {  // pushed in, far in, on the edge, pulled out
+      Eigen::VectorXd target = Eigen::VectorXd::Zero(dim);
+      target[0] = x;
+      const ArmStepReport r = ArmStep(model, start, target, ArmOptions{});
+      ExpectStepInvariants(model, r, static_cast<int>(x));
+      EXPECT_EQ(r.reached, r.ee_error <= 2.1e-10);
+      if (x > 12.0) EXPECT_FALSE(r.reached);
+    }
+  }
+}
+
+TEST(ArmStep, FixedPointBaselineKeepsTheSameInvariants) {
+  const ArmModel model = CurledArm(3, 16, 0.08);
+  ArmOptions options;
+  options.method = FixedBaseMethod::kFixedPoint;
+  const ArmTrajectory t = TrackPath(model, CirclePath(model, 2.0, 100), options);
+  EXPECT_EQ(t.unreached, 0);
+  for (size_t i = 0; i < t.steps.size(); ++i) ExpectStepInvariants(model, t.steps[i], int(i));
+}
+
+// The message of the InputError that `f` throws ("" if none).
+template <class F>
+std::string ErrorOf(F f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ArmStep, BadInputIsRefusedWithTheField) {
+  ArmModel model = StraightArm(2, 4, 1.0);
+  const ArmState start = InitialState(model);
+  const Eigen::Vector2d target(3.0, 1.0);
+  ArmModel bad = model;
+  bad.link_lengths[2] = 0.0;
+  EXPECT_NE(ErrorOf([&] { ArmStep(bad, start, target, {}); }).find("link_lengths[2]"), std::string::npos);
+  bad = model;
+  bad.dim = 4;
+  EXPECT_NE(ErrorOf([&] { InitialState(bad); }).find("dim"), std::string::npos);
+  bad = model;
+  bad.base_direction.setZero();
+  EXPECT_NE(ErrorOf([&] { InitialState(bad); }).find("base_direction"), std::string::npos);
+  bad = model;
+  bad.joint_min = Eigen::VectorXd::Constant(4, 0.1);
+  bad.joint_max = Eigen::VectorXd::Constant(4, 0.2);
+  EXPECT_NE(ErrorOf([&] { InitialState(bad); }).find("initial.angle[0]"), std::string::npos);
+  bad.joint_max[1] = 0.0;
+  EXPECT_NE(ErrorOf([&] { InitialState(bad); }).find("joint_min[1]"), std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ArmStep(model, start, Eigen::Vector2d(1.0, NAN), {}); }).find("target[1]"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ArmStep(model, start, Eigen::Vector3d(1.0, 0.0, 0.0), {}); }).find("target"),
+            std::string::npos);
+  ArmOptions options;
+  options.tolerance = 0.0;
+  EXPECT_NE(ErrorOf([&] { ArmStep(model, start, target, options); }).find("options.tolerance"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ParseFixedBaseMethod("jacobian", "method"); }).find("\"newton\""),
+            std::string::npos);
+  Points path(2, 2);
+  path << 1.0, 1.0, INFINITY, 0.0;
+  EXPECT_NE(ErrorOf([&] { TrackPath(model, path, {}); }).find("path[1][0]"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace flexkin

@@ -1,0 +1,144 @@
+// Tests of `flexkin robot` (the FLEXKIN_CLI executable): the trajectory JSON and joint CSV of the
+// example scenario, exit codes, and bad scenarios refused with the field and no output.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace {
+
+const std::string kCli = FLEXKIN_CLI;
+using nlohmann::json;
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class RobotCliTest : public testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_FALSE(kCli.empty()) << "FLEXKIN_CLI is empty: configure with FLEXKIN_BUILD_APPS=ON";
+    char pattern[] = "/tmp/flexkin_robot_cli_XXXXXX";
+    ASSERT_NE(mkdtemp(pattern), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string Path(const std::string& name) const { return dir_ + "/" + name; }
+  void Write(const std::string& name, const std::string& text) const { std::ofstream(Path(name)) << text; }
+
+  // Runs `flexkin robot ARGS`; returns the exit code, stderr in *err.
+  int Robot(const std::string& args, std::string* err = nullptr) const {
+    const std::string command = "'" + kCli + "' robot " + args + " > '" + Path("out.txt") +
+                                "' 2> '" + Path("err.txt") + "'";
+    const int status = std::system(command.c_str());
+    if (err != nullptr) *err = ReadFile(Path("err.txt"));
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+  std::string dir_;
+};
+
+TEST_F(RobotCliTest, ExampleScenarioGivesATrajectoryAndAJointCsv) {
+  const std::string scenario = std::string(FLEXKIN_SOURCE_DIR) + "/examples/robot_planar_8link.json";
+  ASSERT_EQ(Robot("'" + scenario + "' -o " + Path("t.json") + " --csv " + Path("j.csv")), 0);
+  const json t = json::parse(ReadFile(Path("t.json")));
+  EXPECT_EQ(t["format"], "flexkin-robot-trajectory");
+  ASSERT_EQ(t["steps"].size(), 200u);
+  EXPECT_EQ(t["summary"]["unreached"], 0);
+  for (const json& step : t["steps"]) {
+    EXPECT_TRUE(step["reached"].get<bool>());
+    EXPECT_LE(step["ee_error"].get<double>(), 2.1e-10);
+    const json& p = step["points"];
+    ASSERT_EQ(p.size(), 9u);
+    EXPECT_EQ(p[0][0].get<double>(), 0.0);  // the base, bolted at the origin
+    EXPECT_EQ(p[0][1].get<double>(), 0.0);
+    for (int k = 1; k < 9; ++k) {
+      const double l = std::hypot(p[k][0].get<double>() - p[k - 1][0].get<double>(),
+                                  p[k][1].get<double>() - p[k - 1][1].get<double>());
+      EXPECT_NEAR(l, 0.07, 1e-15);
+    }
+    EXPECT_NEAR(p[8][0].get<double>(), step["target"][0].get<double>(), 2.1e-10);
+    for (const json& a : step["joint_angles"]) EXPECT_LE(std::abs(a.get<double>()), 1.2 + 1e-12);
+  }
+  // The CSV: a header, the initial angles (step 0), then one row per step, as in the JSON.
+  std::istringstream csv(ReadFile(Path("j.csv")));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "step,joint_0,joint_1,joint_2,joint_3,joint_4,joint_5,joint_6,joint_7");
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    if (rows == 150) {
+      std::istringstream cells(line);
+      std::string cell;
+      std::getline(cells, cell, ',');
+      EXPECT_EQ(cell, "150");
+      for (int j = 0; j < 8; ++j) {
+        std::getline(cells, cell, ',');
+        EXPECT_EQ(std::stod(cell), t["steps"][149]["joint_angles"][j].get<double>());
+      }
+    }
+    ++rows;
+  }
+  EXPECT_EQ(rows, 201);
+}
+
+TEST_F(RobotCliTest, SpatialUnreachableTargetIsWrittenAndReported) {
+  Write("s.json", R"({"arm": {"dim": 3, "links": 6, "link_length": 1, "initial_angles": 0.2,
+    "joint_limits": {"max_bend": 0.5}},
+    "path": {"type": "points", "points": [[4.5, 3.2, 0.3], [9, 0, 0]]},
+    "solver": {"tolerance": 1e-11}})");
+  std::string err;
+  EXPECT_EQ(Robot(Path("s.json") + " -o " + Path("t.json") + " --method fixed_point", &err), 3);
+  EXPECT_NE(err.find("1 of 2 targets were not reached"), std::string::npos) << err;
+  const json t = json::parse(ReadFile(Path("t.json")));
+  EXPECT_EQ(t["method"], "fixed_point");
+  EXPECT_TRUE(t["steps"][0]["reached"].get<bool>());
+  EXPECT_FALSE(t["steps"][1]["reached"].get<bool>());
+  EXPECT_TRUE(t["steps"][1]["stretched"].get<bool>());
+  EXPECT_NEAR(t["steps"][1]["ee_error"].get<double>(), 3.0, 1e-12);
+  EXPECT_EQ(t["steps"][1]["joint_quaternions"].size(), 6u);
+}
+
+TEST_F(RobotCliTest, BadScenariosNameTheFieldAndWriteNothing) {
+  const std::pair<const char*, const char*> cases[] = {
+      {R"({"arm": {"links": 3, "link_length": -1}, "path": {"type": "line", "to": [1, 1], "steps": 3}})",
+       "/arm/link_length: value -1"},
+      {R"({"arm": {"links": 3, "link_lenght": 1}, "path": {"type": "line", "to": [1, 1], "steps": 3}})",
+       "did you mean \"link_length\""},
+      {R"({"arm": {"links": 2, "link_length": 1, "joint_limits": {"min": 0.1, "max": 0.2}},
+           "path": {"type": "line", "to": [1, 1], "steps": 3}})",
+       "/arm/initial_angles/0"},
+      {R"({"arm": {"links": 2, "link_length": 1}, "path": {"type": "points", "points": [[1, "x"]]}})",
+       "/path/points/0/1"},
+      {R"({"arm": {"links": 2, "link_length": 1}, "path": {"type": "spiral"}})", "/path/type"},
+      {R"({"arm": {"links": 2, "link_length": 1}, "path": {"type": "line", "to": [1, 1], "steps": 2},
+           "solver": {"method": "pinv"}})",
+       "/solver/method"},
+      {R"({"arm": {"links": 2, "link_length": 1, "dim": 3, "joint_limits": {"max_bend": 4}},
+           "path": {"type": "line", "to": [1, 1, 1], "steps": 2}})",
+       "/arm/joint_limits/max_bend/0"},
+      {R"({"arm": {"links": 2, "link_length": 1}})", "/path: missing"},
+  };
+  for (const auto& [text, expected] : cases) {
+    Write("bad.json", text);
+    std::string err;
+    EXPECT_EQ(Robot(Path("bad.json") + " -o " + Path("t.json") + " --csv " + Path("j.csv"), &err), 1) << text;
+    EXPECT_NE(err.find(expected), std::string::npos) << err;
+    EXPECT_FALSE(std::filesystem::exists(Path("t.json")));
+    EXPECT_FALSE(std::filesystem::exists(Path("j.csv")));
+  }
+  // A missing output directory is found before anything is written.
+  Write("ok.json", R"({"arm": {"links": 2, "link_length": 1}, "path": {"type": "line", "to": [1, 1], "steps": 2}})");
+  EXPECT_EQ(Robot(Path("ok.json") + " -o " + Path("t.json") + " --csv " + Path("no/j.csv")), 4);
+  EXPECT_FALSE(std::filesystem::exists(Path("t.json")));
+}
+
+}  // namespace
