@@ -35,8 +35,9 @@ test-sanitize: deps
 	  ctest --test-dir $(BUILD_SAN) --output-on-failure -j$(JOBS)
 
 bench: build
-	@$(BUILD)/bench/propagation_benchmark --benchmark_repetitions=5 \
-	  --benchmark_report_aggregates_only=true
+	@for b in propagation_benchmark overall_benchmark arm_benchmark; do \
+	  $(BUILD)/bench/$$b --benchmark_repetitions=5 --benchmark_report_aggregates_only=true || exit 1; \
+	done
 
 install: build
 	@cmake --install $(BUILD) --prefix $(PREFIX)

@@ -18,6 +18,9 @@ echo "== closed form and comparisons"
 "$build/examples/fig06_compare" examples/fig06_parabola_multi_step.json \
   examples/fig06_parabola_single_step.json examples/fig06_parabola_overall_multi_step.json \
   examples/fig06_parabola_overall_single_step.json
+echo "== robot arm with a fixed base (docs/robots.md)"
+"$flexkin" robot examples/robot_planar_8link.json -o out/robot_planar_8link.json \
+  --csv out/robot_planar_8link_joints.csv
 echo "== figures, plots, animations, viewers and glTF (docs/rendering.md)"
 for result in out/fig*.json; do
   "$flexkin" render "$result" -o out --formats svg,png,pdf,plots,mp4,gif,html,glb --quiet
