@@ -170,7 +170,10 @@ class BandedLu {
 class BandedLdlt {
  public:
   explicit BandedLdlt(const BandMatrix& shape)
-      : size_(shape.size()), band_(shape.band()), l_(static_cast<size_t>(size_) * (band_ + 1)) {}
+      : size_(shape.size()),
+        band_(shape.band()),
+        l_(static_cast<size_t>(size_) * (band_ + 1)),
+        inverse_pivot_(size_) {}
 
   bool Factorize(const BandMatrix& a, double tiny) {
     const int n = size_, band = band_, width = band + 1;
@@ -204,6 +207,7 @@ class BandedLdlt {
         for (int i = k; i <= last; ++i) target[i - k] -= f * column[i - j];
       }
       for (int r = 1; r <= last - j; ++r) column[r] *= inverse;
+      inverse_pivot_[j] = inverse;
     }
     factorized_ = true;
     return true;
@@ -217,13 +221,15 @@ class BandedLdlt {
     const int n = size_, band = band_, width = band + 1;
     Eigen::VectorXd solution = rhs;
     double* y = solution.data();
-    for (int j = 0; j < n; ++j) {  // L y = rhs
-      const double* column = &l_[static_cast<size_t>(j) * width];
-      const int last = std::min(n - 1 - j, band);
-      const double yj = y[j];
-      for (int r = 1; r <= last; ++r) y[j + r] -= column[r] * yj;
+    // L y = rhs by rows, y_i -= L(i, j) y_j, L(i, j) at l_[j width + i - j] (dot products: no
+    // chain of updates to the same y_i), then D.
+    for (int i = 1; i < n; ++i) {
+      const int first = std::max(0, i - band);
+      double yi = y[i];
+      for (int j = first; j < i; ++j) yi -= l_[static_cast<size_t>(j) * width + (i - j)] * y[j];
+      y[i] = yi;
     }
-    for (int j = 0; j < n; ++j) y[j] /= l_[static_cast<size_t>(j) * width];  // D
+    for (int j = 0; j < n; ++j) y[j] *= inverse_pivot_[j];
     for (int j = n - 1; j >= 0; --j) {  // L^T x = y
       const double* column = &l_[static_cast<size_t>(j) * width];
       const int last = std::min(n - 1 - j, band);
@@ -237,6 +243,7 @@ class BandedLdlt {
  private:
   int size_, band_;
   std::vector<double> l_;  // column j: D(j) at [0], then L(j + r, j) at [r]
+  std::vector<double> inverse_pivot_;  // 1 / D(j)
   int negative_ = 0;
   bool factorized_ = false;
 };

@@ -432,7 +432,7 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
     *strict_minimizer = false;
     if (report.converged()) {
       assemble(x, lambda);
-      *strict_minimizer = NegativePivots(kkt) == nc;
+      *strict_minimizer = ldlt.Factorize(kkt, 1e-12) && ldlt.negative() == nc;
     }
   }
   *start = x;
