@@ -41,8 +41,9 @@ const char* KdlSolverName(KdlSolver solver);  // "kdl_nr_pinv", "kdl_lma"
 struct KdlOptions {
   // Stop when the end-effector error is below tolerance x the mean link length (the same measure
   // as ArmOptions::tolerance). NR: every twist component below it (rotation in rad, also scaled
-  // by the mean link length); LMA: the norm of the weighted error
-  // below it (KDL's eps; its header calls it E, the source compares the norm). Typical 1e-10.
+  // by the mean link length); LMA: KDL's eps = the same length (its header
+  // speaks of the squared error E; the measured errors stay below the tolerance, as a test on the
+  // norm would give; the peer checks ee_error itself). Typical 1e-10.
   double tolerance = 1e-10;
   // Iterations per step at most (NR default 100, LMA default 500 in KDL). Typical 500.
   int max_iterations = 500;
