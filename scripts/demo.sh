@@ -21,6 +21,10 @@ echo "== closed form and comparisons"
 echo "== robot arm with a fixed base (docs/robots.md)"
 "$flexkin" robot examples/robot_planar_8link.json -o out/robot_planar_8link.json \
   --csv out/robot_planar_8link_joints.csv
+echo "== tractrix against the Jacobian pseudo-inverse (Orocos KDL), Ravi et al. 2010's arm"
+for scenario in robot_ravi_lines robot_ravi_circle; do
+  "$build/examples/robot_compare" "examples/$scenario.json" "out/${scenario}_compare"
+done
 echo "== figures, plots, animations, viewers and glTF (docs/rendering.md)"
 for result in out/fig*.json; do
   "$flexkin" render "$result" -o out --formats svg,png,pdf,plots,mp4,gif,html,glb --quiet

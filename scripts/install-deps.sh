@@ -7,6 +7,7 @@ packages=(cmake make g++ pkg-config libeigen3-dev nlohmann-json3-dev libcli11-de
           libgmock-dev libbenchmark-dev libboost-dev libxsimd-dev liblapack-dev libnlopt-dev coinor-libipopt-dev)
 packages+=(libcairo2-dev fonts-dejavu-core ffmpeg)  # flexkin render (src/render)
 packages+=(libtinygltf-dev)  # glTF export (src/gltf)
+packages+=(liborocos-kdl-dev)  # the pseudo-inverse peer of the arm comparison (testing/kdl_peer.h)
 packages+=(chromium)         # the viewer's browser test (headless)
 # Node.js runs the glTF validator and the browser test. Debian's nodejs and npm only if there is
 # no node or npm on the PATH: one from another source (e.g. NodeSource) is used as it is.

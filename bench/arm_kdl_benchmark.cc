@@ -1,0 +1,148 @@
+// flexkin's fixed-base arm (TrackPath, Newton fixed base) against Orocos KDL's Jacobian
+// pseudo-inverse (ChainIkSolverPos_NR + ChainIkSolverVel_pinv) and Levenberg-Marquardt
+// (ChainIkSolverPos_LMA), testing/kdl_peer.h, on the same arm and the same end-effector path:
+// a planar arm of 8 to 512 unit links bent into a circular arc with the end effector at 70% of
+// the reach, the end effector tracing a circle of one link radius in 64 steps, each KDL step
+// warm-started from the previous one, tolerance 1e-10 of a link for all three.
+//   build/bench/arm_kdl_benchmark --benchmark_counters_tabular=true
+// Counters: s/step (time per step); x_flexkin (this solver's time per step over flexkin's, both
+// measured in this run as CPU time: flexkin's before the timed loop, the median of 5 runs); max_err (largest
+// end-effector error, link lengths); unreached; motion of the joint nearest the end effector
+// (m_ee), at the middle (m_mid) and nearest the base (m_base), total |dtheta| along the path
+// (rad), and their sum over all joints (m_sum); iters/step.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+#include <vector>
+
+#include "arm_metrics.h"
+#include "flexkin/arm.h"
+#include "kdl_peer.h"
+
+namespace {
+
+using flexkin::peers::KdlSolver;
+
+// As bench/arm_benchmark.cc: an arc of total turn phi has chord reach * sin(phi/2) / (phi/2).
+flexkin::ArmModel ArcArm(int links, double reach_fraction) {
+  double lo = 1e-9, hi = 2.0 * M_PI;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (std::sin(0.5 * mid) / (0.5 * mid) > reach_fraction ? lo : hi) = mid;
+  }
+  flexkin::ArmModel model = flexkin::StraightArm(2, links, 1.0);
+  model.initial.angle.setConstant(lo / links);
+  return model;
+}
+
+flexkin::Points CirclePath(const flexkin::ArmModel& model) {
+  const flexkin::Points start = flexkin::ForwardKinematics(model, model.initial);
+  const Eigen::Vector2d ee = start.row(model.num_links()).transpose();
+  flexkin::Points path(64, 2);
+  for (int i = 0; i < 64; ++i) {
+    const double a = 2.0 * M_PI * (i + 1) / 64;
+    path.row(i) = (ee + Eigen::Vector2d(std::cos(a) - 1.0, std::sin(a))).transpose();
+  }
+  return path;
+}
+
+// This thread's CPU time (s): the machine is shared, and Google Benchmark's s/step is CPU time too.
+double CpuSeconds() {
+  timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec + 1e-9 * t.tv_nsec;
+}
+
+// flexkin's seconds per step: the median of 5 runs of TrackPath.
+double FlexkinSecondsPerStep(const flexkin::ArmModel& model, const flexkin::Points& path) {
+  std::vector<double> times;
+  for (int r = 0; r < 5; ++r) {
+    const auto start = CpuSeconds();
+    const flexkin::ArmTrajectory t = flexkin::TrackPath(model, path, flexkin::ArmOptions{});
+    benchmark::DoNotOptimize(t.steps.back().state.points.data());
+    times.push_back(CpuSeconds() - start);
+  }
+  std::nth_element(times.begin(), times.begin() + 2, times.end());
+  return times[2] / static_cast<double>(path.rows());
+}
+
+void SetMotionCounters(benchmark::State& state, const Eigen::VectorXd& motion) {
+  const Eigen::Index n = motion.size();
+  state.counters["m_ee"] = motion[n - 1];
+  state.counters["m_mid"] = motion[n / 2];
+  state.counters["m_base"] = motion[0];
+  state.counters["m_sum"] = motion.sum();
+}
+
+// `seconds`: the timed loop's wall time, measured by the caller around it.
+void SetStepCounters(benchmark::State& state, double steps, double seconds,
+                     double flexkin_per_step) {
+  state.SetItemsProcessed(static_cast<int64_t>(steps));  // items = steps
+  // Seconds per step (printed with an SI prefix: 34u = 34 microseconds).
+  state.counters["s/step"] =
+      benchmark::Counter(steps, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  // This solver's time per step over flexkin's.
+  state.counters["x_flexkin"] = seconds / steps / flexkin_per_step;
+}
+
+void Flexkin(benchmark::State& state) {
+  const flexkin::ArmModel model = ArcArm(static_cast<int>(state.range(0)), 0.7);
+  const flexkin::Points path = CirclePath(model);
+  const double reference = FlexkinSecondsPerStep(model, path);
+  flexkin::ArmTrajectory t;
+  double steps = 0, iterations = 0;
+  const auto start = CpuSeconds();
+  for (auto _ : state) {
+    t = flexkin::TrackPath(model, path, flexkin::ArmOptions{});
+    benchmark::DoNotOptimize(t.steps.back().state.points.data());
+    steps += t.steps.size();
+    for (const auto& s : t.steps) iterations += s.iterations;
+  }
+  const double seconds = CpuSeconds() - start;
+  SetStepCounters(state, steps, seconds, reference);
+  state.counters["iters/step"] = iterations / steps;
+  state.counters["max_err"] = t.max_ee_error;
+  state.counters["unreached"] = t.unreached;
+  SetMotionCounters(state,
+                    flexkin::peers::TotalJointMotion(model, model.initial, flexkin::peers::AnglesOf(t)));
+}
+
+void Kdl(benchmark::State& state, KdlSolver solver) {
+  const flexkin::ArmModel model = ArcArm(static_cast<int>(state.range(0)), 0.7);
+  const flexkin::Points path = CirclePath(model);
+  const double reference = FlexkinSecondsPerStep(model, path);
+  flexkin::peers::KdlTrajectory t;
+  double steps = 0, iterations = 0;
+  const auto start = CpuSeconds();
+  for (auto _ : state) {
+    t = flexkin::peers::TrackPathWithKdl(model, path, solver, flexkin::peers::KdlOptions{});
+    benchmark::DoNotOptimize(t.steps.back().q.data.data());
+    steps += t.steps.size();
+    iterations += t.mean_iterations * t.steps.size();
+  }
+  const double seconds = CpuSeconds() - start;
+  SetStepCounters(state, steps, seconds, reference);
+  state.counters["iters/step"] = iterations / steps;
+  state.counters["max_err"] = t.max_ee_error;
+  state.counters["unreached"] = t.unreached;
+  std::vector<flexkin::JointAngles> angles;
+  for (const auto& s : t.steps) angles.push_back(s.angles);
+  SetMotionCounters(state, flexkin::peers::TotalJointMotion(model, model.initial, angles));
+}
+
+void KdlNrPinv(benchmark::State& state) { Kdl(state, KdlSolver::kNewtonPinv); }
+void KdlLma(benchmark::State& state) { Kdl(state, KdlSolver::kLma); }
+
+void Sizes(benchmark::internal::Benchmark* b) {
+  for (int n : {8, 32, 128, 512}) b->Arg(n);
+  b->ArgName("links")->Unit(benchmark::kMicrosecond);
+}
+BENCHMARK(Flexkin)->Apply(Sizes);
+BENCHMARK(KdlNrPinv)->Apply(Sizes);
+BENCHMARK(KdlLma)->Apply(Sizes);
+
+}  // namespace
+
+BENCHMARK_MAIN();
