@@ -151,7 +151,6 @@ Eigen::VectorXd RevoluteSweeper::Evaluate(const Eigen::VectorXd& u) {
     q0 = c;
   }
   angle_[0] = q0;
-  if (n_ == 1) angle_[0] = q0;
   points_ = RevoluteForward(model_, angle_);
   return points_.row(n_).transpose() - target_;
 }
