@@ -14,6 +14,7 @@
 
 #include "flexkin/error.h"
 #include "flexkin/result_io.h"
+#include "flexkin/urdf.h"
 #include "scenario_parser.h"
 
 namespace flexkin::cli {
@@ -248,7 +249,7 @@ json StateJson(const ArmModel& model, const ArmState& state) {
   json out;
   out["joint_angles"] = Row(state.angles.angle);
   if (model.dim == 3) {
-    out["joint_azimuths"] = Row(state.angles.azimuth);
+    if (model.joint() == ArmJoint::kSpherical) out["joint_azimuths"] = Row(state.angles.azimuth);
     const Eigen::MatrixXd q = JointQuaternions(model, state.angles);
     out["joint_quaternions"] = json::array();
     for (int j = 0; j < q.rows(); ++j) out["joint_quaternions"].push_back(Row(q.row(j).transpose()));
@@ -260,9 +261,32 @@ json StateJson(const ArmModel& model, const ArmState& state) {
 
 }  // namespace
 
-RobotScenario ParseRobotScenario(const json& root) {
+// The arm of a scenario that names a URDF file ("urdf", "base_link", "tip_link").
+ArmModel ParseUrdfArm(const json& root, const std::string& scenario_dir) {
+  const json& file = Require(root, "", "urdf");
+  if (!file.is_string() || file.get<std::string>().empty()) TypeFail(file, "/urdf", "a URDF file name");
+  if (Find(root, "arm")) Fail("/arm", "give arm or urdf, not both");
+  UrdfChain chain;
+  for (const char* key : {"base_link", "tip_link"}) {
+    if (const json* v = Find(root, key)) {
+      if (!v->is_string()) TypeFail(*v, std::string("/") + key, "a link name");
+      (key[0] == 'b' ? chain.base_link : chain.tip_link) = v->get<std::string>();
+    }
+  }
+  std::filesystem::path path(file.get<std::string>());
+  if (path.is_relative() && !scenario_dir.empty()) path = std::filesystem::path(scenario_dir) / path;
+  try {
+    return ArmFromUrdfFile(path.string(), chain);
+  } catch (const InputError& e) {
+    const std::string what = std::string(e.what()).substr(e.field().size() + 2);
+    if (e.field() == "base_link" || e.field() == "tip_link") throw InputError("/" + e.field(), what);
+    throw InputError("/urdf", path.string() + ": " + e.field() + ": " + what);
+  }
+}
+
+RobotScenario ParseRobotScenario(const json& root, const std::string& scenario_dir) {
   Object(root, "");
-  CheckKeys(root, "", {"format", "name", "arm", "path", "solver"});
+  CheckKeys(root, "", {"format", "name", "arm", "urdf", "base_link", "tip_link", "path", "solver"});
   if (const json* f = Find(root, "format")) {
     if (*f != "flexkin-robot") TypeFail(*f, "/format", "\"flexkin-robot\"");
   }
@@ -271,7 +295,14 @@ RobotScenario ParseRobotScenario(const json& root) {
     if (!name->is_string()) TypeFail(*name, "/name", "a string");
     s.name = name->get<std::string>();
   }
-  s.model = ParseArm(Require(root, "", "arm"), "/arm");
+  if (Find(root, "urdf")) {
+    s.model = ParseUrdfArm(root, scenario_dir);
+  } else {
+    for (const char* key : {"base_link", "tip_link"}) {
+      if (Find(root, key)) Fail(std::string("/") + key, "belongs to a URDF arm; expected \"urdf\" too");
+    }
+    s.model = ParseArm(Require(root, "", "arm"), "/arm");
+  }
   s.path = ParsePath(Require(root, "", "path"), "/path", s.model);
   if (const json* solver = Find(root, "solver")) s.options = ParseSolver(*solver, "/solver");
   return s;
@@ -291,7 +322,8 @@ RobotCommand::RobotCommand(CLI::App* app, const std::string& footer) {
 int RobotCommand::Run() const {
   RobotScenario s;
   try {
-    s = ParseRobotScenario(ReadJsonFile(scenario_));
+    s = ParseRobotScenario(ReadJsonFile(scenario_),
+                           std::filesystem::path(scenario_).parent_path().string());
     if (!method_.empty()) s.options.method = ParseFixedBaseMethod(method_, "--method");
   } catch (const InputError& e) {
     throw InputError(scenario_ + ": " + e.field(), std::string(e.what()).substr(e.field().size() + 2));

@@ -21,8 +21,9 @@ struct RobotScenario {
 };
 
 // Reads a robot scenario document (docs/robot-format.md). Throws InputError whose field is the
-// JSON pointer of the first problem ("/arm/link_lengths/2").
-RobotScenario ParseRobotScenario(const nlohmann::json& json);
+// JSON pointer of the first problem ("/arm/link_lengths/2"). A relative "urdf" file name is
+// taken relative to `scenario_dir` ("" = the working directory).
+RobotScenario ParseRobotScenario(const nlohmann::json& json, const std::string& scenario_dir = "");
 
 class RobotCommand {
  public:

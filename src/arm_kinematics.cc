@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include "arm_internal.h"
+#include "arm_revolute.h"
 #include "flexkin/arm.h"
 #include "flexkin/error.h"
 
@@ -50,10 +51,11 @@ Eigen::Quaterniond LocalRotation(double bend, double azimuth) {
 
 void CheckAngles(const ArmModel& model, const JointAngles& angles, const char* field) {
   const int n = model.num_links();
+  const bool spherical = model.joint() == ArmJoint::kSpherical;
   std::string why = CheckVector(angles.angle, "angle", n);
-  if (why.empty() && model.dim == 3) why = CheckVector(angles.azimuth, "azimuth", n);
-  if (why.empty() && model.dim == 2 && angles.azimuth.size() != 0) {
-    why = "azimuth: planar arms have no azimuths; expected none";
+  if (why.empty() && spherical) why = CheckVector(angles.azimuth, "azimuth", n);
+  if (why.empty() && !spherical && angles.azimuth.size() != 0) {
+    why = "azimuth: revolute joints have no azimuths; expected none";
   }
   if (!why.empty()) throw InputError(std::string(field) + "." + why.substr(0, why.find(':')),
                                      why.substr(why.find(':') + 2));
@@ -128,8 +130,13 @@ std::string ArmModel::Validate() const {
   if (why.empty()) why = CheckVector(base_direction, "base_direction", dim);
   if (!why.empty()) return why;
   if (!(base_direction.squaredNorm() > 0.0)) return "base_direction: is zero; expected a non-zero vector";
-  if (dim == 2) {
-    if (max_bend.size() != 0) return "max_bend: planar arms have joint_min and joint_max instead";
+  if (has_axes() || link_directions.size() != 0) {
+    if (!has_axes()) return "link_directions: only arms with joint_axes have link directions";
+    if (!(why = arm_internal::ValidateAxes(*this)).empty()) return why;
+  }
+  const bool revolute = joint() == ArmJoint::kRevolute;
+  if (revolute) {
+    if (max_bend.size() != 0) return "max_bend: revolute joints have joint_min and joint_max instead";
     if (joint_min.size() != joint_max.size()) return "joint_max: joint_min and joint_max differ in size";
     if (joint_min.size() != 0) {
       if (!(why = CheckVector(joint_min, "joint_min", n)).empty()) return why;
@@ -156,19 +163,19 @@ std::string ArmModel::Validate() const {
     }
   }
   why = CheckVector(initial.angle, "initial.angle", n);
-  if (why.empty() && dim == 3) why = CheckVector(initial.azimuth, "initial.azimuth", n);
-  if (why.empty() && dim == 2 && initial.azimuth.size() != 0) {
-    why = "initial.azimuth: planar arms have no azimuths; expected none";
+  if (why.empty() && !revolute) why = CheckVector(initial.azimuth, "initial.azimuth", n);
+  if (why.empty() && revolute && initial.azimuth.size() != 0) {
+    why = "initial.azimuth: revolute joints have no azimuths; expected none";
   }
   if (!why.empty()) return why;
   for (int j = 0; j < n; ++j) {
     const double a = initial.angle[j];
-    const bool ok = dim == 2 ? a >= -kPi && a <= kPi : a >= 0.0 && a <= kPi;
+    const bool ok = revolute ? a >= -kPi && a <= kPi : a >= 0.0 && a <= kPi;
     if (!ok) {
       return Indexed("initial.angle", j) + ": value " + FormatNumber(a) + " rad is not valid; expected " +
-             (dim == 2 ? "-pi <= angle <= pi" : "0 <= bend angle <= pi");
+             (revolute ? "-pi <= angle <= pi" : "0 <= bend angle <= pi");
     }
-    const bool inside = dim == 2 ? joint_min.size() == 0 || (a >= joint_min[j] && a <= joint_max[j])
+    const bool inside = revolute ? joint_min.size() == 0 || (a >= joint_min[j] && a <= joint_max[j])
                                  : max_bend.size() == 0 || a <= max_bend[j];
     if (!inside) {
       return Indexed("initial.angle", j) + ": value " + FormatNumber(a) +
@@ -205,6 +212,7 @@ Points ForwardKinematics(const ArmModel& model, const JointAngles& angles) {
     }
     return points;
   }
+  if (model.has_axes()) return arm_internal::RevoluteForward(model, angles.angle);
   Eigen::Quaterniond frame = BaseFrame(model);
   for (int j = 0; j < n; ++j) {
     frame = (frame * LocalRotation(angles.angle[j], angles.azimuth[j])).normalized();
@@ -237,6 +245,10 @@ JointAngles JointAnglesFromPoints(const ArmModel& model, const Points& points) {
     }
     return angles;
   }
+  if (model.has_axes()) {
+    angles.angle = arm_internal::RevoluteInverse(model, points);
+    return angles;
+  }
   angles.azimuth.resize(n);
   Eigen::Quaterniond frame = BaseFrame(model);
   for (int j = 0; j < n; ++j) {
@@ -258,6 +270,9 @@ Eigen::MatrixXd JointQuaternions(const ArmModel& model, const JointAngles& angle
   for (int j = 0; j < n; ++j) {
     if (model.dim == 2) {
       q.row(j) << std::cos(0.5 * angles.angle[j]), 0.0, 0.0, std::sin(0.5 * angles.angle[j]);
+    } else if (model.has_axes()) {
+      const double s = std::sin(0.5 * angles.angle[j]);
+      q.row(j) << std::cos(0.5 * angles.angle[j]), s * model.joint_axes.row(j);
     } else {
       const Eigen::Quaterniond r = LocalRotation(angles.angle[j], angles.azimuth[j]);
       q.row(j) << r.w(), r.x(), r.y(), r.z();

@@ -17,6 +17,7 @@
 #include <string>
 
 #include "arm_internal.h"
+#include "arm_revolute.h"
 #include "flexkin/arm.h"
 #include "flexkin/error.h"
 #include "link_rules.h"
@@ -132,7 +133,9 @@ Vec Perpendicular(const Vec& v) {
   return Eigen::Vector3d(dir[0], dir[1], dir[2]).unitOrthogonal();
 }
 
-SolveResult SolveNewton(Sweeper* sweeper, const ArmModel& model, const Vec& move,
+// Sweeper: Sweeper, or arm_internal::RevoluteSweeper for revolute joints about given axes.
+template <typename AnySweeper>
+SolveResult SolveNewton(AnySweeper* sweeper, const ArmModel& model, const Vec& move,
                         const ArmOptions& options, double tol, double scale) {
   const int dim = model.dim;
   Vec u = Vec::Zero(dim);
@@ -228,6 +231,26 @@ SolveResult SolveFixedPoint(Sweeper* sweeper, const ArmModel& model, const Point
   return result;
 }
 
+// The fixed-point baseline for revolute joints about axes: u <- u + F(u), F being the rebuilt
+// end effector's miss, which is about minus the base residual of the other arms.
+SolveResult SolveFixedPointRevolute(arm_internal::RevoluteSweeper* sweeper, const ArmOptions& options,
+                                    double tol) {
+  SolveResult result;
+  Vec u = Vec::Zero(3);
+  Vec f = sweeper->Evaluate(u);
+  result.iterations = 1;
+  while (f.allFinite() && f.norm() > tol && result.iterations < options.max_fixed_point_iterations) {
+    u += f;
+    f = sweeper->Evaluate(u);
+    ++result.iterations;
+  }
+  result.points = sweeper->points();
+  result.residual = f.norm();
+  result.converged = result.residual <= tol;
+  result.limited = sweeper->limited();
+  return result;
+}
+
 void CheckState(const ArmModel& model, const ArmState& state, const Vec& target) {
   const int n = model.num_links();
   if (state.points.rows() != n + 1 || state.points.cols() != model.dim) {
@@ -300,6 +323,22 @@ ArmStepReport ArmStep(const ArmModel& model, const ArmState& state,
     points.row(0) = model.base.transpose();
     for (int j = 0; j < n; ++j) points.row(j + 1) = points.row(j) + model.link_lengths[j] * dir.transpose();
     report.converged = true;
+  } else if (model.has_axes()) {
+    if (state.angles.angle.size() != n || !state.angles.angle.allFinite()) {
+      throw InputError("state.angles", "has " + std::to_string(state.angles.angle.size()) +
+                                           " finite values or fewer; expected " + std::to_string(n));
+    }
+    arm_internal::RevoluteSweeper sweeper(model, state, target, options.substeps);
+    const SolveResult solved =
+        options.method == FixedBaseMethod::kNewton
+            ? SolveNewton(&sweeper, model, target - state.points.row(n).transpose(), options, tol, scale)
+            : SolveFixedPointRevolute(&sweeper, options, tol);
+    points = solved.points;
+    report.base_error = solved.residual;
+    report.iterations = solved.iterations;
+    report.converged = solved.converged;
+    report.limited = solved.limited;
+    report.sweeps = sweeper.sweeps();
   } else {
     Sweeper sweeper(model, state.points, target, options.substeps);
     const SolveResult solved =

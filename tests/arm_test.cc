@@ -300,3 +300,100 @@ TEST(ArmStep, BadInputIsRefusedWithTheField) {
 
 }  // namespace
 }  // namespace flexkin
+
+namespace flexkin {
+namespace {
+
+// A spatial snake with revolute joints about alternating pitch (y) and yaw (z) axes, limits
+// +-0.6 rad, gently curled.
+ArmModel RevoluteSnake(int links) {
+  ArmModel m = StraightArm(3, links, 1.0);
+  m.initial.azimuth.resize(0);
+  m.joint_axes.resize(links, 3);
+  for (int j = 0; j < links; ++j) {
+    m.joint_axes.row(j) = j % 2 == 0 ? Eigen::RowVector3d::UnitY() : Eigen::RowVector3d::UnitZ();
+    m.initial.angle[j] = j % 2 == 0 ? 0.15 : 0.1;
+  }
+  m.joint_min = Eigen::VectorXd::Constant(links, -0.6);
+  m.joint_max = Eigen::VectorXd::Constant(links, 0.6);
+  return m;
+}
+
+TEST(ArmRevolute, ForwardOfInverseReproducesPoints) {
+  ArmModel model = RevoluteSnake(64);
+  model.base << 0.5, -1.0, 2.0;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> angle(-0.6, 0.6);
+  JointAngles a;
+  a.angle.resize(64);
+  for (int j = 0; j < 64; ++j) a.angle[j] = angle(rng);
+  const Points p = ForwardKinematics(model, a);
+  const JointAngles back = JointAnglesFromPoints(model, p);
+  EXPECT_LT((back.angle - a.angle).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((ForwardKinematics(model, back) - p).cwiseAbs().maxCoeff(), 1e-12);
+  // The quaternion of joint j is the rotation about its axis.
+  const Eigen::MatrixXd q = JointQuaternions(model, a);
+  EXPECT_NEAR(q(1, 3), std::sin(0.5 * a.angle[1]), 1e-15);
+  EXPECT_EQ(q(1, 1), 0.0);
+}
+
+// Known limitation (docs/robots.md): the sweep's frames, carried down from the end effector, do
+// not always meet the base's frame, and the three translation unknowns cannot always close the
+// gap, so about half of these reachable targets end with reached = false. What holds for every
+// step: base exact, limits, lengths, FK = points, and reached means within the tolerance.
+TEST(ArmRevolute, TracksAReachablePathWithTheBaseFixedAndLimitsKept) {
+  const int n = 16;
+  const ArmModel model = RevoluteSnake(n);
+  // Targets that the arm can reach: end effectors of a smooth family of joint angles within the
+  // limits (the arm is free to reach them with other angles).
+  const int steps = 60;
+  Points path(steps, 3);
+  for (int i = 0; i < steps; ++i) {
+    JointAngles a = model.initial;
+    const double t = 2.0 * kPi * (i + 1) / steps;
+    for (int j = 0; j < n; ++j) a.angle[j] += 0.1 * std::sin(t + 0.4 * j) * (j + 1) / n;
+    path.row(i) = ForwardKinematics(model, a).row(n);
+  }
+  const ArmTrajectory t = TrackPath(model, path, ArmOptions());
+  EXPECT_LT(t.unreached, steps) << t.BriefReport();
+  EXPECT_LE(t.max_iterations, 100) << t.BriefReport();
+  Eigen::VectorXd motion = Eigen::VectorXd::Zero(n);
+  JointAngles previous = model.initial;
+  for (const ArmStepReport& step : t.steps) {
+    if (step.reached) EXPECT_LE(step.ee_error, 2.1e-10);
+    EXPECT_TRUE(step.state.points.allFinite());
+    EXPECT_EQ((step.state.points.row(0).transpose() - model.base).norm(), 0.0);
+    EXPECT_TRUE(WithinLimits(model, step.state.angles, 1e-12));
+    EXPECT_LT(MaxLengthError(model, step.state.points), 1e-13);
+    EXPECT_LT((ForwardKinematics(model, step.state.angles) - step.state.points).cwiseAbs().maxCoeff(), 1e-12);
+    motion += (step.state.angles.angle - previous.angle).cwiseAbs();
+    previous = step.state.angles;
+  }
+  std::printf("revolute snake, 16 links: %s\n", t.BriefReport().c_str());
+}
+
+TEST(ArmRevolute, UnreachableTargetIsReportedWithoutNaN) {
+  const ArmModel model = RevoluteSnake(8);
+  const ArmStepReport far = ArmStep(model, InitialState(model), Eigen::Vector3d(20.0, 0.0, 0.0), ArmOptions());
+  EXPECT_FALSE(far.reached);
+  EXPECT_TRUE(far.state.points.allFinite());
+  // Behind the base, beyond what +-0.6 rad joints can fold to.
+  const ArmStepReport back = ArmStep(model, InitialState(model), Eigen::Vector3d(-1.0, 0.0, 0.0), ArmOptions());
+  EXPECT_FALSE(back.reached);
+  EXPECT_TRUE(back.state.points.allFinite());
+  EXPECT_TRUE(WithinLimits(model, back.state.angles, 1e-12));
+}
+
+TEST(ArmRevolute, BadAxesAreRefusedWithTheField) {
+  ArmModel model = RevoluteSnake(4);
+  model.joint_axes.row(2) = Eigen::RowVector3d(1.0, 0.0, 0.0);  // along the link: a twist
+  EXPECT_NE(model.Validate().find("joint_axes[2]"), std::string::npos);
+  model.joint_axes.row(2) = Eigen::RowVector3d(0.0, 2.0, 0.0);  // not unit
+  EXPECT_NE(model.Validate().find("joint_axes[2]"), std::string::npos);
+  model = RevoluteSnake(4);
+  model.joint_axes.resize(3, 3);
+  EXPECT_NE(model.Validate().find("joint_axes"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace flexkin

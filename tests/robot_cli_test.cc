@@ -142,3 +142,37 @@ TEST_F(RobotCliTest, BadScenariosNameTheFieldAndWriteNothing) {
 }
 
 }  // namespace
+
+namespace {
+
+// A scenario that points at a URDF next to it (a relative path): a 3-link planar arm.
+TEST_F(RobotCliTest, ScenarioWithAUrdfArm) {
+  Write("arm.urdf", R"(<robot name="three"><link name="b"/><link name="l1"/><link name="l2"/><link name="l3"/><link name="t"/>
+    <joint name="j0" type="continuous"><parent link="b"/><child link="l1"/><axis xyz="0 0 1"/></joint>
+    <joint name="j1" type="continuous"><parent link="l1"/><child link="l2"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/></joint>
+    <joint name="j2" type="continuous"><parent link="l2"/><child link="l3"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/></joint>
+    <joint name="tj" type="fixed"><parent link="l3"/><child link="t"/><origin xyz="1 0 0"/></joint></robot>)");
+  Write("s.json", R"({"urdf": "arm.urdf", "base_link": "b", "tip_link": "t",
+    "path": {"type": "points", "points": [[2.5, 0.5], [2.0, 1.0]]}})");
+  ASSERT_EQ(Robot(Path("s.json") + " -o " + Path("t.json")), 0);
+  const json t = json::parse(ReadFile(Path("t.json")));
+  EXPECT_EQ(t["dim"], 2);
+  EXPECT_EQ(t["link_lengths"], json({1.0, 1.0, 1.0}));
+  ASSERT_EQ(t["steps"].size(), 2u);
+  const json& ee = t["steps"][1]["points"][3];
+  EXPECT_NEAR(ee[0].get<double>(), 2.0, 1e-9);
+  EXPECT_NEAR(ee[1].get<double>(), 1.0, 1e-9);
+  // A missing tip link and a missing file: named, nothing written.
+  std::filesystem::remove(Path("t.json"));
+  Write("bad.json", R"({"urdf": "arm.urdf", "tip_link": "hand", "path": {"type": "points", "points": [[2, 1]]}})");
+  std::string err;
+  EXPECT_EQ(Robot(Path("bad.json") + " -o " + Path("t.json"), &err), 1);
+  EXPECT_NE(err.find("/tip_link"), std::string::npos) << err;
+  EXPECT_NE(err.find("\"hand\""), std::string::npos) << err;
+  Write("gone.json", R"({"urdf": "nowhere.urdf", "path": {"type": "points", "points": [[2, 1]]}})");
+  EXPECT_EQ(Robot(Path("gone.json") + " -o " + Path("t.json"), &err), 4);
+  EXPECT_NE(err.find("nowhere.urdf"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(Path("t.json")));
+}
+
+}  // namespace

@@ -28,30 +28,46 @@ namespace flexkin {
 //   rotation taking the world x axis to the base direction, and each joint's rotation (see
 //   JointQuaternions) is the smallest one taking link j's direction to link j+1's: its axis is
 //   perpendicular to link j, so no joint twists. azimuth is 0 where angle is 0.
+//   Spatial (dim 3), revolute joints about given axes (ArmModel::joint_axes, e.g. from a URDF):
+//   angle[j] (rad, (-pi, pi]) is the right-handed rotation of link j+1 about joint j's axis;
+//   every link frame coincides with the world frame when all angles are 0, and link j+1's frame
+//   is link j's frame times the rotation about joint j's axis (given in link j's frame).
+//   azimuth is empty.
 struct JointAngles {
   Eigen::VectorXd angle;    // n
-  Eigen::VectorXd azimuth;  // n in 3D, empty in 2D
+  Eigen::VectorXd azimuth;  // n for spherical joints, otherwise empty
 };
 
-// The joint kinds. (A later one: revolute joints about given axes, as read from a URDF.)
+// The joint kinds.
 enum class ArmJoint {
-  kRevolute,   // "revolute": planar arms, one angle per joint
+  kRevolute,   // "revolute": one angle per joint; planar arms, or spatial arms with joint_axes
   kSpherical,  // "spherical": spatial arms, bend angle and azimuth per joint
 };
 
 struct ArmModel {
-  int dim = 2;                                // 2 (revolute joints) or 3 (spherical joints)
+  int dim = 2;                                // 2 (revolute) or 3 (spherical, or revolute with axes)
   Eigen::VectorXd link_lengths;               // n >= 1 positive lengths, base link first
   Eigen::VectorXd base;                       // dim; where the base is bolted
   Eigen::VectorXd base_direction;             // dim, non-zero; the direction of "link 0"
-  // Planar limits (rad): joint j stays in [joint_min[j], joint_max[j]], with
-  // -pi <= min <= max <= pi. Empty: no limits.
+  // Revolute limits (rad, planar or with joint_axes): joint j stays in [joint_min[j],
+  // joint_max[j]], with -pi <= min <= max <= pi. Empty: no limits.
   Eigen::VectorXd joint_min, joint_max;
-  // Spatial limits (rad): joint j's bend angle stays <= max_bend[j], in (0, pi]. Empty: none.
+  // Spherical limits (rad): joint j's bend angle stays <= max_bend[j], in (0, pi]. Empty: none.
   Eigen::VectorXd max_bend;
+  // Spatial revolute joints (dim 3): n by 3, row j the unit axis of joint j in link j's frame
+  // (the base frame for j = 0), which is the world frame when all angles are 0. No axis may lie
+  // along the link its joint turns (a pure twist cannot be read back from link positions).
+  // Empty: spherical joints.
+  Eigen::MatrixXd joint_axes;
+  // With joint_axes: n by 3, row k the unit direction of link k+1 in its own frame (its world
+  // direction when all angles are 0). Empty: every link along base_direction.
+  Eigen::MatrixXd link_directions;
   JointAngles initial;                        // the joint angles at the start; within the limits
 
-  ArmJoint joint() const { return dim == 2 ? ArmJoint::kRevolute : ArmJoint::kSpherical; }
+  bool has_axes() const { return joint_axes.size() > 0; }
+  ArmJoint joint() const {
+    return dim == 2 || has_axes() ? ArmJoint::kRevolute : ArmJoint::kSpherical;
+  }
   int num_links() const { return static_cast<int>(link_lengths.size()); }
   bool has_limits() const { return joint_min.size() > 0 || max_bend.size() > 0; }
   double reach() const { return link_lengths.sum(); }

@@ -1,0 +1,158 @@
+// Spatial arms with revolute joints about given axes (src/arm_revolute.h, docs/robots.md).
+#include "arm_revolute.h"
+
+#include <cmath>
+#include <string>
+
+#include "arm_internal.h"
+#include "flexkin/error.h"
+#include "link_rules.h"
+
+namespace flexkin::arm_internal {
+namespace {
+
+std::string Row(const char* field, int i) { return std::string(field) + "[" + std::to_string(i) + "]"; }
+
+std::string CheckUnitRows(const Eigen::MatrixXd& m, const char* field, int n) {
+  if (m.rows() != n || m.cols() != 3) {
+    return std::string(field) + ": shape " + std::to_string(m.rows()) + " by " +
+           std::to_string(m.cols()) + " is not valid; expected " + std::to_string(n) + " by 3";
+  }
+  for (int i = 0; i < n; ++i) {
+    if (!m.row(i).allFinite() || std::abs(m.row(i).norm() - 1.0) > 1e-9) {
+      return Row(field, i) + ": is not a finite unit vector (norm " + FormatNumber(m.row(i).norm()) +
+             "); expected norm 1";
+    }
+  }
+  return "";
+}
+
+}  // namespace
+
+std::string ValidateAxes(const ArmModel& model) {
+  const int n = model.num_links();
+  if (model.dim != 3) return "joint_axes: only spatial arms (dim 3) have joint axes";
+  if (model.max_bend.size() != 0) return "max_bend: revolute joints have joint_min and joint_max instead";
+  std::string why = CheckUnitRows(model.joint_axes, "joint_axes", n);
+  if (why.empty() && model.link_directions.size() != 0) {
+    why = CheckUnitRows(model.link_directions, "link_directions", n);
+  }
+  if (!why.empty()) return why;
+  for (int j = 0; j < n; ++j) {
+    const Eigen::Vector3d a = model.joint_axes.row(j).transpose();
+    if (a.cross(RestDirection(model, j)).norm() < 1e-6) {
+      return Row("joint_axes", j) + ": lies along link " + std::to_string(j + 1) +
+             ", which the joint turns; a joint that only twists its link is not supported";
+    }
+  }
+  return "";
+}
+
+Eigen::Vector3d RestDirection(const ArmModel& model, int k) {
+  if (model.link_directions.size() != 0) return model.link_directions.row(k).transpose();
+  return model.base_direction.head<3>().normalized();
+}
+
+double AngleAbout(const Eigen::Vector3d& axis, const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+  const Eigen::Vector3d f = from - axis.dot(from) * axis, t = to - axis.dot(to) * axis;
+  if (!(f.squaredNorm() > 0.0) || !(t.squaredNorm() > 0.0)) return 0.0;
+  return std::atan2(axis.dot(f.cross(t)), f.dot(t));
+}
+
+Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle) {
+  const int n = model.num_links();
+  Points points(n + 1, 3);
+  points.row(0) = model.base.transpose();
+  Eigen::Quaterniond frame = Eigen::Quaterniond::Identity();
+  for (int j = 0; j < n; ++j) {
+    const Eigen::Vector3d a = model.joint_axes.row(j).transpose();
+    frame = (frame * Eigen::Quaterniond(Eigen::AngleAxisd(angle[j], a))).normalized();
+    points.row(j + 1) = points.row(j) + model.link_lengths[j] * (frame * RestDirection(model, j)).transpose();
+  }
+  return points;
+}
+
+Eigen::VectorXd RevoluteInverse(const ArmModel& model, const Points& points) {
+  const int n = model.num_links();
+  Eigen::VectorXd angle(n);
+  Eigen::Quaterniond frame = Eigen::Quaterniond::Identity();
+  for (int j = 0; j < n; ++j) {
+    const Eigen::Vector3d a = model.joint_axes.row(j).transpose();
+    const Eigen::Vector3d d = (points.row(j + 1) - points.row(j)).transpose();
+    angle[j] = AngleAbout(a, RestDirection(model, j), frame.conjugate() * d);
+    frame = (frame * Eigen::Quaterniond(Eigen::AngleAxisd(angle[j], a))).normalized();
+  }
+  return angle;
+}
+
+RevoluteSweeper::RevoluteSweeper(const ArmModel& model, const ArmState& start,
+                                 const Eigen::VectorXd& target, int substeps)
+    : model_(model), start_(start), target_(target), substeps_(substeps), n_(model.num_links()) {
+  for (int j = 0; j < n_; ++j) {
+    axes_.push_back(model.joint_axes.row(j).transpose());
+    rest_.push_back(RestDirection(model, j));
+  }
+  // The frames of the start, accumulated from the base as forward kinematics does.
+  Eigen::Quaterniond frame = Eigen::Quaterniond::Identity();
+  for (int j = 0; j < n_; ++j) {
+    frame = (frame * Eigen::Quaterniond(Eigen::AngleAxisd(start.angles.angle[j], axes_[j]))).normalized();
+    start_frames_.push_back(frame);
+  }
+  angle_.resize(n_);
+}
+
+Eigen::VectorXd RevoluteSweeper::Evaluate(const Eigen::VectorXd& u) {
+  ++sweeps_;
+  limited_ = false;
+  const bool limits = model_.joint_min.size() > 0;
+  Points p = start_.points;
+  p.rowwise() += u.transpose();
+  frames_ = start_frames_;
+  const Eigen::Vector3d from = p.row(n_).transpose();
+  double head_old[3], tail_old[3];
+  for (int s = 1; s <= substeps_; ++s) {
+    for (int k = 0; k < 3; ++k) head_old[k] = p(n_, k);
+    const Eigen::Vector3d head =
+        s == substeps_ ? Eigen::Vector3d(target_) : Eigen::Vector3d(from + (target_ - from) * (double(s) / substeps_));
+    p.row(n_) = head.transpose();
+    for (int j = n_; j >= 1; --j) {
+      const double length = model_.link_lengths[j - 1];
+      double* tail = p.row(j - 1).data();
+      for (int k = 0; k < 3; ++k) tail_old[k] = tail[k];
+      internal::TractrixStep<3>(head_old, p.row(j).data(), tail, length, 1.0 / length);
+      const Eigen::Vector3d e = (p.row(j) - p.row(j - 1)).transpose() / length;
+      if (j == n_) {
+        // The end-effector link: the smallest rotation from its old direction to the new one.
+        const Eigen::Vector3d e_old = frames_[j - 1] * rest_[j - 1];
+        frames_[j - 1] = (Eigen::Quaterniond::FromTwoVectors(e_old, e) * frames_[j - 1]).normalized();
+      } else {
+        // Joint j turns link j into link j+1 (frame j): link j's direction lies on the cone
+        // frames_[j] * Rot(axis_j, -q) * rest_[j-1].
+        double q = -AngleAbout(axes_[j], rest_[j - 1], frames_[j].conjugate() * e);
+        if (limits) {
+          const double c = ClampCircular(q, model_.joint_min[j], model_.joint_max[j]);
+          limited_ |= c != q;
+          q = c;
+        }
+        angle_[j] = q;
+        frames_[j - 1] = (frames_[j] * Eigen::Quaterniond(Eigen::AngleAxisd(-q, axes_[j]))).normalized();
+        const Eigen::Vector3d on_cone = frames_[j - 1] * rest_[j - 1];
+        for (int k = 0; k < 3; ++k) tail[k] = p(j, k) - length * on_cone[k];
+      }
+      for (int k = 0; k < 3; ++k) head_old[k] = tail_old[k];
+    }
+  }
+  // Joint 0 turns the base link against the fixed base frame.
+  const Eigen::Vector3d e1 = (p.row(1) - p.row(0)).transpose() / model_.link_lengths[0];
+  double q0 = AngleAbout(axes_[0], rest_[0], e1);
+  if (limits) {
+    const double c = ClampCircular(q0, model_.joint_min[0], model_.joint_max[0]);
+    limited_ |= c != q0;
+    q0 = c;
+  }
+  angle_[0] = q0;
+  points_ = RevoluteForward(model_, angle_);
+  return points_.row(n_).transpose() - target_;
+}
+
+}  // namespace flexkin::arm_internal

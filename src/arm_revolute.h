@@ -1,0 +1,61 @@
+#pragma once
+// Spatial arms with revolute joints about given axes (ArmModel::joint_axes, docs/robots.md):
+// kinematics and the sweep that keeps every link on the circle of directions its joint allows.
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "flexkin/arm.h"
+
+namespace flexkin::arm_internal {
+
+// The checks of ArmModel::Validate for joint_axes and link_directions: "" or "field: reason".
+std::string ValidateAxes(const ArmModel& model);
+
+// Unit direction of link k+1 (0-based k) in its own frame.
+Eigen::Vector3d RestDirection(const ArmModel& model, int k);
+
+// The angle (rad, (-pi, pi]) of the rotation about unit `axis` that takes `from` nearest to
+// `to` (both in the same frame): the signed angle between their components across the axis;
+// 0 where either lies along the axis.
+double AngleAbout(const Eigen::Vector3d& axis, const Eigen::Vector3d& from, const Eigen::Vector3d& to);
+
+// Forward kinematics at `angle` (n): the n+1 points, base first.
+Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle);
+// The angles whose forward kinematics puts every link nearest to the points' link directions
+// (exactly, for points that FK produced).
+Eigen::VectorXd RevoluteInverse(const ArmModel& model, const Points& points);
+
+// The sweep of one step for these arms. Each link's frame is carried from the end effector
+// down: the end-effector link turns by the smallest rotation that the tractrix step gives it;
+// every other link's direction, proposed by the tractrix step, is put on the cone of directions
+// that its joint with the link above allows (rotation about that joint's axis, angle within its
+// limits). The joint angles so found are rebuilt into points from the fixed base, and F(u) is
+// the rebuilt end effector minus the target: the same root-finding problem in dim = 3
+// unknowns as the base residual of the other arms (F ~ -(base residual) where frames agree).
+class RevoluteSweeper {
+ public:
+  RevoluteSweeper(const ArmModel& model, const ArmState& start, const Eigen::VectorXd& target,
+                  int substeps);
+  // Sweeps the start translated by u; returns F(u) and leaves the rebuilt points in points().
+  Eigen::VectorXd Evaluate(const Eigen::VectorXd& u);
+  const Points& points() const { return points_; }
+  bool limited() const { return limited_; }
+  int sweeps() const { return sweeps_; }
+
+ private:
+  const ArmModel& model_;
+  const ArmState& start_;
+  const Eigen::VectorXd target_;
+  const int substeps_, n_;
+  std::vector<Eigen::Quaterniond> start_frames_, frames_;
+  std::vector<Eigen::Vector3d> axes_, rest_;
+  Eigen::VectorXd angle_;
+  Points points_;
+  bool limited_ = false;
+  int sweeps_ = 0;
+};
+
+}  // namespace flexkin::arm_internal
