@@ -7,22 +7,11 @@
 #include <cmath>
 
 #include "flexkin/arm.h"
+#include "arm_scenes.h"
 
 namespace {
 
-// A planar arm bent into a circular arc whose end effector is at `reach_fraction` of the reach
-// from the base (reach_fraction in (0, 1)): the chord of an arc of total turn phi is
-// reach * sin(phi/2) / (phi/2).
-flexkin::ArmModel ArcArm(int links, double reach_fraction) {
-  double lo = 1e-9, hi = 2.0 * M_PI;
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (std::sin(0.5 * mid) / (0.5 * mid) > reach_fraction ? lo : hi) = mid;
-  }
-  flexkin::ArmModel model = flexkin::StraightArm(2, links, 1.0);
-  model.initial.angle.setConstant(lo / links);
-  return model;
-}
+using flexkin::bench::ArcArm;
 
 void Track(benchmark::State& state, flexkin::FixedBaseMethod method) {
   const int links = static_cast<int>(state.range(0));

@@ -19,23 +19,14 @@
 
 #include "arm_metrics.h"
 #include "flexkin/arm.h"
+#include "arm_scenes.h"
 #include "kdl_peer.h"
 
 namespace {
 
 using flexkin::peers::KdlSolver;
 
-// As bench/arm_benchmark.cc: an arc of total turn phi has chord reach * sin(phi/2) / (phi/2).
-flexkin::ArmModel ArcArm(int links, double reach_fraction) {
-  double lo = 1e-9, hi = 2.0 * M_PI;
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (std::sin(0.5 * mid) / (0.5 * mid) > reach_fraction ? lo : hi) = mid;
-  }
-  flexkin::ArmModel model = flexkin::StraightArm(2, links, 1.0);
-  model.initial.angle.setConstant(lo / links);
-  return model;
-}
+using flexkin::bench::ArcArm;
 
 flexkin::Points CirclePath(const flexkin::ArmModel& model) {
   const flexkin::Points start = flexkin::ForwardKinematics(model, model.initial);

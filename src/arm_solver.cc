@@ -315,6 +315,15 @@ ArmStepReport ArmStep(const ArmModel& model, const ArmState& state,
   ArmStepReport report;
   Points points;
   const Vec to_target = target - model.base;
+  // The solver's result into the report (`sweeps` read after the solve).
+  auto take = [&](const SolveResult& solved, int sweeps) {
+    points = solved.points;
+    report.base_error = solved.residual;
+    report.iterations = solved.iterations;
+    report.converged = solved.converged;
+    report.limited = solved.limited;
+    report.sweeps = sweeps;
+  };
   if (to_target.norm() >= model.reach() * (1.0 - options.edge_margin)) {
     // Out of reach (or on its edge, where the Jacobian is singular): stretched toward the target.
     report.stretched = true;
@@ -331,26 +340,18 @@ ArmStepReport ArmStep(const ArmModel& model, const ArmState& state,
     arm_internal::RevoluteSweeper sweeper(model, state, target, options.substeps);
     const SolveResult solved =
         options.method == FixedBaseMethod::kNewton
-            ? SolveNewton(&sweeper, model, target - state.points.row(n).transpose(), options, tol, scale)
+            ? SolveNewton(&sweeper, model, target - state.points.row(n).transpose(), options, tol,
+                          scale)
             : SolveFixedPointRevolute(&sweeper, options, tol);
-    points = solved.points;
-    report.base_error = solved.residual;
-    report.iterations = solved.iterations;
-    report.converged = solved.converged;
-    report.limited = solved.limited;
-    report.sweeps = sweeper.sweeps();
+    take(solved, sweeper.sweeps());
   } else {
     Sweeper sweeper(model, state.points, target, options.substeps);
     const SolveResult solved =
         options.method == FixedBaseMethod::kNewton
-            ? SolveNewton(&sweeper, model, target - state.points.row(n).transpose(), options, tol, scale)
+            ? SolveNewton(&sweeper, model, target - state.points.row(n).transpose(), options, tol,
+                          scale)
             : SolveFixedPoint(&sweeper, model, state.points, options, tol);
-    points = solved.points;
-    report.base_error = solved.residual;
-    report.iterations = solved.iterations;
-    report.converged = solved.converged;
-    report.limited = solved.limited;
-    report.sweeps = sweeper.sweeps();
+    take(solved, sweeper.sweeps());
   }
   // Re-anchor: rebuild the points from the joint angles at the fixed base; this also puts any
   // joint the sweep could not keep within its limits (the base link between two limits) there.
