@@ -248,13 +248,4 @@ class BandedLdlt {
   bool factorized_ = false;
 };
 
-// The inertia of a symmetric BandMatrix: the number of negative eigenvalues, from the signs of
-// the pivots of its LDL^T factorization without pivoting, or -1 when a pivot is tiny (below
-// 1e-12 times the largest entry: the factorization without pivoting is then not to be trusted,
-// and the caller must decide another way). Cost O(size band^2).
-inline int NegativePivots(const BandMatrix& a) {
-  BandedLdlt ldlt(a);
-  return ldlt.Factorize(a, 1e-12) ? ldlt.negative() : -1;
-}
-
 }  // namespace flexkin::internal

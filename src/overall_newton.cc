@@ -32,6 +32,31 @@ void RetractFollowTheLeader(const Eigen::VectorXd& lengths, Points* x) {
   }
 }
 
+// Solves (J J^T) y = rhs in place, J the constraint Jacobian of links 1..m (rows of `e`: D_i / L_i)
+// with points 1..moving free: row i of J is +e_i at x_i (i <= moving) and -e_i at x_{i-1}
+// (i >= 2), so J J^T is tridiagonal (symmetric positive definite while J has full rank). False
+// when a pivot is not positive or the last one is below `tiny` times the largest.
+bool SolveChainNormalEquations(const Eigen::MatrixXd& e, int moving, double tiny,
+                               Eigen::VectorXd* rhs) {
+  const int m = static_cast<int>(e.rows());
+  Eigen::VectorXd diag(m), off(m);
+  Eigen::VectorXd& y = *rhs;
+  for (int i = 1; i <= m; ++i) {
+    diag[i - 1] = e.row(i - 1).squaredNorm() * ((i <= moving ? 1.0 : 0.0) + (i >= 2 ? 1.0 : 0.0));
+    off[i - 1] = i < m ? -e.row(i - 1).dot(e.row(i)) : 0.0;  // (i, i+1), shared point x_i
+  }
+  for (int i = 1; i < m; ++i) {
+    if (!(diag[i - 1] > 0.0)) return false;
+    const double f = off[i - 1] / diag[i - 1];
+    diag[i] -= f * off[i - 1];
+    y[i] -= f * y[i - 1];
+  }
+  if (!(diag[m - 1] > tiny * diag.cwiseAbs().maxCoeff())) return false;
+  y[m - 1] /= diag[m - 1];
+  for (int i = m - 2; i >= 0; --i) y[i] = (y[i] - off[i] * y[i + 1]) / diag[i];
+  return y.allFinite();
+}
+
 // Least-change projection of points 1..moving onto the chain of links 1..moving+1 between the
 // head and the fixed point moving+1: Gauss-Newton steps x -= J^T (J J^T)^-1 c(x) with
 // c_i = (|D_i|^2 - L_i^2) / (2 L_i). J J^T is tridiagonal, so each step is linear.
@@ -39,7 +64,7 @@ bool RetractBetweenEnds(const Eigen::VectorXd& lengths, int moving, Points* x) {
   const int m = moving + 1;  // constraints
   const int dim = static_cast<int>(x->cols());
   Eigen::MatrixXd e(m, dim);  // rows: D_i / L_i
-  Eigen::VectorXd c(m), diag(m), off(m), y(m);
+  Eigen::VectorXd c(m), y(m);
   double last_violation = std::numeric_limits<double>::infinity();
   for (int iteration = 0; iteration < 30; ++iteration) {
     double violation = 0.0;
@@ -57,23 +82,8 @@ bool RetractBetweenEnds(const Eigen::VectorXd& lengths, int moving, Points* x) {
     }
     if (iteration > 0 && violation > 0.9 * last_violation && violation > 1e-8) return false;
     last_violation = violation;
-    // J J^T: row i of J is +e_i at x_i (i <= moving) and -e_i at x_{i-1} (i >= 2).
-    for (int i = 1; i <= m; ++i) {
-      const double ee = e.row(i - 1).squaredNorm();
-      diag[i - 1] = ee * ((i <= moving ? 1.0 : 0.0) + (i >= 2 ? 1.0 : 0.0));
-      off[i - 1] = i < m ? -e.row(i - 1).dot(e.row(i)) : 0.0;  // (i, i+1), shared point x_i
-    }
-    // Tridiagonal solve (J J^T is symmetric positive definite while J has full rank).
     y = c;
-    for (int i = 1; i < m; ++i) {
-      if (!(diag[i - 1] > 0.0)) return false;
-      const double f = off[i - 1] / diag[i - 1];
-      diag[i] -= f * off[i - 1];
-      y[i] -= f * y[i - 1];
-    }
-    if (!(diag[m - 1] > 1e-14 * diag.head(m).cwiseAbs().maxCoeff())) return false;
-    y[m - 1] /= diag[m - 1];
-    for (int i = m - 2; i >= 0; --i) y[i] = (y[i] - off[i] * y[i + 1]) / diag[i];
+    if (!SolveChainNormalEquations(e, moving, 1e-14, &y)) return false;
     // x -= J^T y.
     for (int i = 1; i <= m; ++i) {
       if (i <= moving) x->row(i) -= y[i - 1] * e.row(i - 1);
@@ -196,13 +206,11 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
   // Starting multipliers: the least-squares ones, J J^T lambda = -J g (J J^T is tridiagonal),
   // so that the first Newton step already sees the constraints' curvature.
   {
-    Eigen::VectorXd diag(nc), off(nc), y(nc);
     Eigen::MatrixXd e(nc, dim);
-    for (int i = 1; i <= nc; ++i) e.row(i - 1) = (x.row(i) - x.row(i - 1)) / lengths[i - 1];
+    Eigen::VectorXd y(nc);
     for (int i = 1; i <= nc; ++i) {
-      diag[i - 1] = e.row(i - 1).squaredNorm() * ((i <= k ? 1.0 : 0.0) + (i >= 2 ? 1.0 : 0.0));
-      off[i - 1] = i < nc ? -e.row(i - 1).dot(e.row(i)) : 0.0;
-      // (J g)_i = e_i . g_i - e_i . g_{i-1}
+      e.row(i - 1) = (x.row(i) - x.row(i - 1)) / lengths[i - 1];
+      // -(J g)_i = -(e_i . g_i - e_i . g_{i-1})
       double jg = 0.0;
       for (int q = 0; q < dim; ++q) {
         if (i <= k) jg += e(i - 1, q) * g[sink.offset[i] + q];
@@ -210,19 +218,7 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
       }
       y[i - 1] = -jg;
     }
-    bool ok = true;
-    for (int i = 1; i < nc && ok; ++i) {
-      ok = diag[i - 1] > 0.0;
-      if (!ok) break;
-      const double f = off[i - 1] / diag[i - 1];
-      diag[i] -= f * off[i - 1];
-      y[i] -= f * y[i - 1];
-    }
-    if (ok && diag[nc - 1] > 1e-12 * diag.cwiseAbs().maxCoeff()) {
-      y[nc - 1] /= diag[nc - 1];
-      for (int i = nc - 2; i >= 0; --i) y[i] = (y[i] - off[i] * y[i + 1]) / diag[i];
-      if (y.allFinite()) lambda = y;
-    }
+    if (SolveChainNormalEquations(e, k, 1e-12, &y)) lambda = y;
   }
 
   // H = hess f + sum lam_i hess c_i at (p, lam), into the sink's Hessian target.

@@ -16,9 +16,14 @@
 #include <vector>
 
 #include "flexkin/result_io.h"
+#include "test_util.h"
 
 namespace flexkin {
 namespace {
+
+using test_util::CliResult;
+using test_util::ReadFile;
+using test_util::RunCli;
 
 const std::string kCli = FLEXKIN_CLI;
 
@@ -26,22 +31,10 @@ std::string Example(const std::string& name) {
   return std::string(FLEXKIN_SOURCE_DIR) + "/examples/" + name;
 }
 
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 bool Exists(const std::string& path) {
   struct stat st;
   return ::stat(path.c_str(), &st) == 0;
 }
-
-struct CliResult {
-  int exit_code = -1;
-  std::string out, err;
-};
 
 class CliTest : public testing::Test {
  protected:
@@ -71,20 +64,8 @@ class CliTest : public testing::Test {
     std::ofstream(Path(name), std::ios::binary) << text;
   }
 
-  // Runs `flexkin ARGS` in the temporary directory, stdout and stderr captured to files (so
-  // stderr is not a terminal and no progress is shown).
-  CliResult Cli(const std::string& args) const {
-    const std::string command = "cd '" + dir_ + "' && '" + kCli + "' " + args + " > '" +
-                                Path("stdout.txt") + "' 2> '" + Path("stderr.txt") + "'";
-    const int status = std::system(command.c_str());
-    CliResult r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    r.out = ReadFile(Path("stdout.txt"));
-    r.err = ReadFile(Path("stderr.txt"));
-    ::unlink(Path("stdout.txt").c_str());
-    ::unlink(Path("stderr.txt").c_str());
-    return r;
-  }
+  // Runs `flexkin ARGS` in the temporary directory.
+  CliResult Cli(const std::string& args) const { return RunCli(kCli, dir_, args); }
 
   std::string dir_;
 };

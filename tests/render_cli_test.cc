@@ -15,18 +15,15 @@ namespace flexkin {
 namespace {
 
 using render_test::Exists;
-using render_test::ReadFile;
+using test_util::CliResult;
+using test_util::ReadFile;
+using test_util::RunCli;
 using render_test::WriteFile;
 
 const std::string kCli = FLEXKIN_CLI;
 
 #define EXPECT_CONTAINS(text, part) \
   EXPECT_NE(std::string(text).find(part), std::string::npos) << "in: " << (text)
-
-struct CliResult {
-  int exit_code = -1;
-  std::string out, err;
-};
 
 class RenderCliTest : public testing::Test {
  protected:
@@ -39,18 +36,7 @@ class RenderCliTest : public testing::Test {
   std::string Path(const std::string& name) const { return dir_.Path(name); }
 
   // Runs `flexkin ARGS` in the temporary directory.
-  CliResult Cli(const std::string& args) const {
-    const std::string command = "cd '" + dir_.dir() + "' && '" + kCli + "' " + args + " > '" +
-                                Path("stdout.txt") + "' 2> '" + Path("stderr.txt") + "'";
-    const int status = std::system(command.c_str());
-    CliResult r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    r.out = ReadFile(Path("stdout.txt"));
-    r.err = ReadFile(Path("stderr.txt"));
-    std::filesystem::remove(Path("stdout.txt"));
-    std::filesystem::remove(Path("stderr.txt"));
-    return r;
-  }
+  CliResult Cli(const std::string& args) const { return RunCli(kCli, dir_.dir(), args); }
 
   // The files in OUTDIR `name`, sorted; empty if it does not exist.
   std::vector<std::string> Outputs(const std::string& name) const {

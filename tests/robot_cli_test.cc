@@ -11,24 +11,22 @@
 #include <sstream>
 #include <string>
 
+#include "test_util.h"
+
 namespace {
 
 const std::string kCli = FLEXKIN_CLI;
 using nlohmann::json;
 
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using flexkin::test_util::ReadFile;
 
 class RobotCliTest : public testing::Test {
  protected:
   void SetUp() override {
     ASSERT_FALSE(kCli.empty()) << "FLEXKIN_CLI is empty: configure with FLEXKIN_BUILD_APPS=ON";
-    char pattern[] = "/tmp/flexkin_robot_cli_XXXXXX";
-    ASSERT_NE(mkdtemp(pattern), nullptr);
+    std::string pattern =
+        (std::filesystem::temp_directory_path() / "flexkin_robot_cli_XXXXXX").string();
+    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
     dir_ = pattern;
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }

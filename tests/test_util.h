@@ -2,9 +2,14 @@
 // Helpers shared by the test programs.
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "flexkin/chain.h"
@@ -56,6 +61,36 @@ inline Eigen::VectorXd LengthsOf(const Points& p) {
   Eigen::VectorXd l(p.rows() - 1);
   for (Eigen::Index i = 1; i < p.rows(); ++i) l[i - 1] = (p.row(i) - p.row(i - 1)).norm();
   return l;
+}
+
+// The whole content of a file ("" if it cannot be read).
+inline std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// What a run of the command line gave.
+struct CliResult {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+// Runs `cli ARGS` in the directory `dir`, stdout and stderr captured through files there (so
+// stderr is not a terminal and no progress is shown), which are removed afterwards.
+inline CliResult RunCli(const std::string& cli, const std::string& dir, const std::string& args) {
+  const std::string out = dir + "/stdout.txt", err = dir + "/stderr.txt";
+  const std::string command =
+      "cd '" + dir + "' && '" + cli + "' " + args + " > '" + out + "' 2> '" + err + "'";
+  const int status = std::system(command.c_str());
+  CliResult r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.out = ReadFile(out);
+  r.err = ReadFile(err);
+  std::filesystem::remove(out);
+  std::filesystem::remove(err);
+  return r;
 }
 
 }  // namespace flexkin::test_util
