@@ -17,17 +17,25 @@
 namespace flexkin::internal {
 
 // A square matrix of half-bandwidth `band` (entries with |i - j| > band are 0), stored by
-// columns in LAPACK's band layout: A(i, j) = ab[j * ldab + offset + i - j], with ldab = 2 band + 1
-// and offset = band; or, with `room_for_fill`, ldab = 3 band + 1 and offset = 2 band, the extra
-// rows above holding the fill-in of partial pivoting (BandedLu's own copy).
+// columns: A(i, j) = ab[j * ldab + offset + i - j]. Layouts:
+//  - kGeneral: LAPACK's band layout, ldab = 2 band + 1 and offset = band;
+//  - kWithFill: ldab = 3 band + 1 and offset = 2 band, the extra rows above holding the fill-in of
+//    partial pivoting (BandedLu's own copy);
+//  - kLowerSymmetric: a symmetric matrix by its lower band, ldab = band + 1 and offset = 0, with
+//    `band` columns of room after the last (BandedLdlt factors it in place). Add() ignores entries
+//    above the diagonal: symmetric assemblers add both (i, j) and (j, i).
 class BandMatrix {
  public:
-  BandMatrix(int size, int band, bool room_for_fill = false)
+  enum class Layout { kGeneral, kWithFill, kLowerSymmetric };
+  BandMatrix(int size, int band, Layout layout = Layout::kGeneral)
       : size_(size),
         band_(band),
-        ldab_((room_for_fill ? 3 : 2) * band + 1),
-        offset_((room_for_fill ? 2 : 1) * band),
-        ab_(static_cast<size_t>(ldab_) * size) {}
+        ldab_(layout == Layout::kWithFill ? 3 * band + 1
+              : layout == Layout::kGeneral ? 2 * band + 1
+                                           : band + 1),
+        offset_(layout == Layout::kWithFill ? 2 * band : layout == Layout::kGeneral ? band : 0),
+        lower_(layout == Layout::kLowerSymmetric),
+        ab_(static_cast<size_t>(ldab_) * (size + (lower_ ? band : 0))) {}
 
   int size() const { return size_; }
   int band() const { return band_; }
@@ -35,14 +43,17 @@ class BandMatrix {
   // Adds v to A(i, j); (i, j) must lie in the band.
   void Add(int i, int j, double v) {
     assert(i >= 0 && j >= 0 && i < size_ && j < size_ && std::abs(i - j) <= band_);
+    if (lower_ && i < j) return;
     ab_[Index(i, j)] += v;
   }
   double operator()(int i, int j) const {
+    if (lower_ && i < j) std::swap(i, j);
     return std::abs(i - j) <= band_ ? ab_[Index(i, j)] : 0.0;
   }
-  // y = A x for a symmetric A, from its lower band: y_i = (column i) . x over the band, since
+  // y = A x for a symmetric A (general layout): y_i = (column i) . x over the band, since
   // A(i, j) = A(j, i). (Dot products: no chain of updates to the same y_i.)
   Eigen::VectorXd MultiplySymmetric(const Eigen::VectorXd& x) const {
+    assert(!lower_);
     Eigen::VectorXd y(size_);
     const double* in = x.data();
     for (int i = 0; i < size_; ++i) {
@@ -54,8 +65,23 @@ class BandMatrix {
     }
     return y;
   }
+  // max_i |(A x - b)_i| for a symmetric A, as MultiplySymmetric (without a temporary).
+  double SymmetricResidual(const Eigen::VectorXd& x, const Eigen::VectorXd& b) const {
+    assert(!lower_);
+    const double* in = x.data();
+    double worst = 0.0;
+    for (int i = 0; i < size_; ++i) {
+      const int first = std::max(0, i - band_), last = std::min(size_ - 1, i + band_);
+      const double* column = &ab_[Index(0, i)];
+      double sum = -b[i];
+      for (int j = first; j <= last; ++j) sum += column[j] * in[j];
+      worst = std::max(worst, std::fabs(sum));
+    }
+    return worst;
+  }
   // y = A x.
   Eigen::VectorXd Multiply(const Eigen::VectorXd& x) const {
+    assert(!lower_);
     Eigen::VectorXd y = Eigen::VectorXd::Zero(size_);
     double* out = y.data();
     for (int j = 0; j < size_; ++j) {
@@ -76,6 +102,7 @@ class BandMatrix {
   }
 
   int size_, band_, ldab_, offset_;
+  bool lower_;
   std::vector<double> ab_;
 };
 
@@ -83,11 +110,11 @@ class BandMatrix {
 class BandedLu {
  public:
   explicit BandedLu(const BandMatrix& shape)
-      : lu_(shape.size(), shape.band(), /*room_for_fill=*/true), ipiv_(shape.size()) {}
+      : lu_(shape.size(), shape.band(), BandMatrix::Layout::kWithFill), ipiv_(shape.size()) {}
 
   // Factors a copy of `a` (of the shape given at construction). False if it is singular.
   bool Factorize(const BandMatrix& a) {
-    assert(a.size() == lu_.size_ && a.band() == lu_.band_);
+    assert(a.size() == lu_.size_ && a.band() == lu_.band_ && !a.lower_);
     lu_.SetZero();
     for (int j = 0; j < a.size_; ++j) {
       const int first = std::max(0, j - a.band_), last = std::min(a.size_ - 1, j + a.band_);
@@ -163,87 +190,163 @@ class BandedLu {
   bool factorized_ = false;
 };
 
-// LDL^T factorization without pivoting of a symmetric BandMatrix (its lower band is read): a
-// quarter of the LU's work, and the inertia comes with it (by Sylvester's law, the signs of the
-// pivots). Without pivoting it can fail: Factorize returns false when a pivot is tiny, below
-// `tiny` times the largest entry, and the caller then uses BandedLu (or decides another way).
+// LDL^T factorization without pivoting of a symmetric banded matrix: a quarter of the LU's
+// work, and the inertia comes with it (by Sylvester's law, the signs of the pivots). Without
+// pivoting it can fail or be inaccurate: Factorize returns false when a pivot is tiny (below
+// `tiny` times the largest entry) or when the factors grew, and the caller then uses BandedLu
+// (or decides another way). The growth bound: the computed factors are exact for A + E with
+// |E| <= c eps |L| |D| |L^T| entrywise (the backward error of Gaussian elimination), and every
+// entry of |L| |D| |L^T| is at most (band + 1) max_j |D(j)| max(1, max_i |L(i, j)|)^2; the
+// factorization is accepted while that is within `max_growth` times the largest entry of A.
+//
+// The matrix is assembled into matrix() (lower symmetric layout) and factored in place. Its
+// `band` columns of room after the last are set to the identity, so that every column's loops
+// run over the full band (no end-of-matrix bounds): their entries are 0 off the diagonal and
+// change nothing. The overall solver's half-bandwidths (5 and 7: 2 dim + 1 in 2D and 3D, 3 dim + 1
+// with the joint-angle term in 2D) get loops of compile-time length, which the compiler unrolls:
+// these small systems are solved at every Newton iteration.
 class BandedLdlt {
  public:
-  explicit BandedLdlt(const BandMatrix& shape)
-      : size_(shape.size()),
-        band_(shape.band()),
-        l_(static_cast<size_t>(size_) * (band_ + 1)),
-        inverse_pivot_(size_) {}
+  BandedLdlt(int size, int band)
+      : size_(size),
+        band_(band),
+        a_(size, band, BandMatrix::Layout::kLowerSymmetric),
+        inverse_pivot_(size),
+        work_(size + band) {}
+  explicit BandedLdlt(const BandMatrix& shape) : BandedLdlt(shape.size(), shape.band()) {}
 
-  bool Factorize(const BandMatrix& a, double tiny) {
+  // Where to assemble the matrix to factor (call SetZero first); the factors replace it.
+  BandMatrix& matrix() { return a_; }
+
+  // Factors matrix() in place.
+  bool Factorize(double tiny, double max_growth = 1e4) {
     const int n = size_, band = band_, width = band + 1;
-    double scale = 0.0;
-    for (int j = 0; j < n; ++j) {
-      double* column = &l_[static_cast<size_t>(j) * width];
-      const double* source = &a.ab_[a.Index(j, j)];  // source[r] = A(j + r, j)
-      const int last = std::min(n - 1 - j, band);
-      double largest = 0.0;  // (per column: one long chain of max through `scale` is slow)
-      for (int r = 0; r <= last; ++r) {
-        column[r] = source[r];
-        largest = std::max(largest, std::fabs(source[r]));
-      }
-      for (int r = last + 1; r <= band; ++r) column[r] = 0.0;
-      scale = std::max(scale, largest);
+    for (int j = n; j < n + band; ++j) {  // room after the last column: the identity
+      double* column = &a_.ab_[static_cast<size_t>(j) * width];
+      column[0] = 1.0;
+      for (int r = 1; r <= band; ++r) column[r] = 0.0;
     }
-    negative_ = 0;
-    factorized_ = false;
-    for (int j = 0; j < n; ++j) {
-      double* column = &l_[static_cast<size_t>(j) * width];
-      const double pivot = column[0];
-      if (!(std::fabs(pivot) > tiny * scale)) return false;
-      if (pivot < 0.0) ++negative_;
-      // A(i, k) -= A(i, j) A(k, j) / pivot for j < k <= i <= j + band, then L(i, j) = A(i, j) / pivot.
-      const int last = std::min(n - 1, j + band);
-      const double inverse = 1.0 / pivot;
-      for (int k = j + 1; k <= last; ++k) {
-        const double f = column[k - j] * inverse;
-        if (f == 0.0) continue;
-        double* target = &l_[static_cast<size_t>(k) * width];
-        for (int i = k; i <= last; ++i) target[i - k] -= f * column[i - j];
-      }
-      for (int r = 1; r <= last - j; ++r) column[r] *= inverse;
-      inverse_pivot_[j] = inverse;
+    // The largest entry, in four independent chains of max (one chain is latency-bound).
+    const size_t stored = static_cast<size_t>(n) * width;
+    double largest[4] = {0.0, 0.0, 0.0, 0.0};
+    size_t i = 0;
+    for (; i + 4 <= stored; i += 4) {
+      for (int q = 0; q < 4; ++q) largest[q] = std::max(largest[q], std::fabs(a_.ab_[i + q]));
     }
-    factorized_ = true;
-    return true;
+    for (; i < stored; ++i) largest[0] = std::max(largest[0], std::fabs(a_.ab_[i]));
+    const double scale =
+        std::max(std::max(largest[0], largest[1]), std::max(largest[2], largest[3]));
+    bool ok = false;
+    switch (band) {
+      case 5:
+        ok = Run<5>(tiny * scale);
+        break;
+      case 7:
+        ok = Run<7>(tiny * scale);
+        break;
+      default:
+        ok = Run<0>(tiny * scale);
+    }
+    factorized_ = ok && (band + 1) * growth_ <= max_growth * scale;
+    return factorized_;
+  }
+  // Copies the lower band of `a` (any layout) into matrix() and factors it.
+  bool Factorize(const BandMatrix& a, double tiny, double max_growth = 1e4) {
+    assert(a.size() == size_ && a.band() == band_);
+    a_.SetZero();
+    for (int j = 0; j < size_; ++j) {
+      for (int i = j; i <= std::min(size_ - 1, j + band_); ++i) a_.Add(i, j, a(i, j));
+    }
+    return Factorize(tiny, max_growth);
   }
   // The number of negative pivots, i.e. of negative eigenvalues, of the last factorization.
   int negative() const { return negative_; }
   bool factorized() const { return factorized_; }
 
   Eigen::VectorXd Solve(const Eigen::VectorXd& rhs) const {
-    assert(factorized_);
-    const int n = size_, band = band_, width = band + 1;
-    Eigen::VectorXd solution = rhs;
-    double* y = solution.data();
-    // L y = rhs by rows, y_i -= L(i, j) y_j, L(i, j) at l_[j width + i - j] (dot products: no
-    // chain of updates to the same y_i), then D.
-    for (int i = 1; i < n; ++i) {
-      const int first = std::max(0, i - band);
-      double yi = y[i];
-      for (int j = first; j < i; ++j) yi -= l_[static_cast<size_t>(j) * width + (i - j)] * y[j];
-      y[i] = yi;
-    }
-    for (int j = 0; j < n; ++j) y[j] *= inverse_pivot_[j];
-    for (int j = n - 1; j >= 0; --j) {  // L^T x = y
-      const double* column = &l_[static_cast<size_t>(j) * width];
-      const int last = std::min(n - 1 - j, band);
-      double yj = y[j];
-      for (int r = 1; r <= last; ++r) yj -= column[r] * y[j + r];
-      y[j] = yj;
-    }
+    Eigen::VectorXd solution;
+    SolveInto(rhs, &solution);
     return solution;
+  }
+  // Solve into `solution` (resized if needed; no allocation when it has the right size).
+  void SolveInto(const Eigen::VectorXd& rhs, Eigen::VectorXd* solution) const {
+    assert(factorized_);
+    switch (band_) {
+      case 5:
+        return SolveFixed<5>(rhs, solution);
+      case 7:
+        return SolveFixed<7>(rhs, solution);
+      default:
+        return SolveFixed<0>(rhs, solution);
+    }
   }
 
  private:
+  // The factorization proper, for half-bandwidth B (0: the run-time band_). Column j of the
+  // storage: D(j) at [0], then L(j + r, j) at [r].
+  template <int B>
+  bool Run(double smallest) {
+    const int n = size_, band = B > 0 ? B : band_, width = band + 1;
+    negative_ = 0;
+    growth_ = 0.0;
+    for (int j = 0; j < n; ++j) {
+      double* column = &a_.ab_[static_cast<size_t>(j) * width];
+      const double pivot = column[0];
+      if (!(std::fabs(pivot) > smallest)) return false;
+      if (pivot < 0.0) ++negative_;
+      // A(j + i, j + k) -= A(j + i, j) A(j + k, j) / pivot for 1 <= k <= i <= band (column
+      // j + k of the factor), then L(j + r, j) = A(j + r, j) / pivot.
+      const double inverse = 1.0 / pivot;
+      for (int k = 1; k <= band; ++k) {
+        const double f = column[k] * inverse;
+        double* target = column + static_cast<size_t>(k) * width;
+        for (int i = k; i <= band; ++i) target[i - k] -= f * column[i];
+      }
+      double largest = 1.0;
+      for (int r = 1; r <= band; ++r) {
+        column[r] *= inverse;
+        largest = std::max(largest, std::fabs(column[r]));
+      }
+      growth_ = std::max(growth_, std::fabs(pivot) * largest * largest);
+      inverse_pivot_[j] = inverse;
+    }
+    return std::isfinite(growth_);
+  }
+
+  template <int B>
+  void SolveFixed(const Eigen::VectorXd& rhs, Eigen::VectorXd* solution) const {
+    const int n = size_, band = B > 0 ? B : band_, width = band + 1;
+    const double* l = a_.ab_.data();
+    double* y = work_.data();
+    for (int i = 0; i < n; ++i) y[i] = rhs[i];
+    for (int i = n; i < n + band; ++i) y[i] = 0.0;
+    // L y = rhs by columns: y_{j+r} -= L(j + r, j) y_j. On the critical path is only y_{j+1}'s
+    // update, one multiply-add per row.
+    for (int j = 0; j < n; ++j) {
+      const double* column = l + static_cast<size_t>(j) * width;
+      const double yj = y[j];
+      for (int r = 1; r <= band; ++r) y[j + r] -= column[r] * yj;
+    }
+    for (int j = 0; j < n; ++j) y[j] *= inverse_pivot_[j];
+    // L^T x = y by rows, the term of x_{j+1} (just computed) last: again one multiply-add per row
+    // on the critical path.
+    if (band >= 1) {
+      for (int j = n - 1; j >= 0; --j) {
+        const double* column = l + static_cast<size_t>(j) * width;
+        double others = 0.0;
+        for (int r = band; r >= 2; --r) others += column[r] * y[j + r];
+        y[j] = (y[j] - others) - column[1] * y[j + 1];
+      }
+    }
+    solution->resize(n);
+    for (int i = 0; i < n; ++i) (*solution)[i] = y[i];
+  }
+
   int size_, band_;
-  std::vector<double> l_;  // column j: D(j) at [0], then L(j + r, j) at [r]
+  BandMatrix a_;                       // the matrix, then its factors (lower symmetric layout)
   std::vector<double> inverse_pivot_;  // 1 / D(j)
+  mutable std::vector<double> work_;   // the solve's right-hand side, padded
+  double growth_ = 0.0;                // max_j |D(j)| max(1, max_i |L(i, j)|)^2
   int negative_ = 0;
   bool factorized_ = false;
 };

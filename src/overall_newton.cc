@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "banded_lu.h"
@@ -145,18 +146,19 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
     if (grad != nullptr) grad->setZero(size);
     return Evaluate(options.weights, lengths, old_points, p, sink, last, smoothing);
   };
-  auto constraints = [&](const Points& p) {
-    Eigen::VectorXd c(nc);
+  auto constraints = [&](const Points& p, Eigen::VectorXd* out) {
+    Eigen::VectorXd& c = *out;
     for (int i = 1; i <= nc; ++i) {
       c[i - 1] = ((p.row(i) - p.row(i - 1)).squaredNorm() - lengths[i - 1] * lengths[i - 1]) /
                  (2.0 * lengths[i - 1]);
     }
-    return c;
   };
-  // Gradient of the Lagrangian g + J^T lambda (x rows only).
-  auto lagrangian_gradient = [&](const Points& p, const Eigen::VectorXd& grad,
-                                 const Eigen::VectorXd& lam) {
-    Eigen::VectorXd result = grad;
+  // Gradient of the Lagrangian g + J^T lambda (x rows only), into `result` (no allocation: this
+  // runs three times per iteration).
+  auto lagrangian_gradient_into = [&](const Points& p, const Eigen::VectorXd& grad,
+                                      const Eigen::VectorXd& lam, Eigen::VectorXd* out) {
+    Eigen::VectorXd& result = *out;
+    result = grad;
     double* r = result.data();
     const double* points = p.data();
     for (int i = 1; i <= nc; ++i) {
@@ -169,6 +171,11 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
       }
     }
     for (int i = 1; i <= nc; ++i) r[multiplier_row(i)] = 0.0;
+  };
+  auto lagrangian_gradient = [&](const Points& p, const Eigen::VectorXd& grad,
+                                 const Eigen::VectorXd& lam) {
+    Eigen::VectorXd result(size);
+    lagrangian_gradient_into(p, grad, lam, &result);
     return result;
   };
   // First-order optimality: the Lagrangian's gradient relative to the objective's gradient (now
@@ -195,14 +202,17 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
   // Half-bandwidth of the KKT matrix in the interleaved order: x_j reaches x_{j+1} (2 dim) and
   // lambda_j reaches x_{j-1} (2 dim + 1); the joint-angle term reaches x_{j+2} (3 dim + 1).
   const int band = options.weights.joint_angle > 0.0 ? 3 * dim + 1 : 2 * dim + 1;
-  BandMatrix kkt(size, std::min(band, size - 1));  // the KKT matrix, assembled in place
-  BandedLu lu(kkt);
-  BandedLdlt ldlt(kkt);
+  // The KKT matrix is assembled into the LDL^T's storage and factored there; the LU fallback's
+  // general storage and factors are made when first needed.
+  BandedLdlt ldlt(size, std::min(band, size - 1));
+  std::optional<BandMatrix> kkt_general;
+  std::optional<BandedLu> lu;
   bool factorized = false;  // the last attempt's matrix was not singular
   double regularization = 0.0;
   double value = evaluate(x, nullptr, &g);
   start_gradient = g.cwiseAbs().maxCoeff();
-  Eigen::VectorXd c = constraints(x);
+  Eigen::VectorXd c(nc);
+  constraints(x, &c);
   // Starting multipliers: the least-squares ones, J J^T lambda = -J g (J J^T is tridiagonal),
   // so that the first Newton step already sees the constraints' curvature.
   {
@@ -246,28 +256,38 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
     sink.form = nullptr;
     return form;
   };
-  // The KKT matrix [H, J^T; J, 0] at (p, lam), into `kkt`.
-  auto assemble = [&](const Points& p, const Eigen::VectorXd& lam) {
-    kkt.SetZero();
-    sink.band = &kkt;
+  // The KKT matrix [H + delta I, J^T; J, 0] at (p, lam), into `kkt`.
+  auto assemble = [&](const Points& p, const Eigen::VectorXd& lam, double delta, BandMatrix* kkt) {
+    kkt->SetZero();
+    sink.band = kkt;
     sink.form = nullptr;
     hessian_terms(p, lam);
     for (int i = 1; i <= nc; ++i) {
       const PointVector e = (p.row(i) - p.row(i - 1)).transpose() / lengths[i - 1];
       for (int q = 0; q < dim; ++q) {
         if (i <= k) {
-          kkt.Add(multiplier_row(i), sink.offset[i] + q, e[q]);
-          kkt.Add(sink.offset[i] + q, multiplier_row(i), e[q]);
+          kkt->Add(multiplier_row(i), sink.offset[i] + q, e[q]);
+          kkt->Add(sink.offset[i] + q, multiplier_row(i), e[q]);
         }
         if (i > 1) {
-          kkt.Add(multiplier_row(i), sink.offset[i - 1] + q, -e[q]);
-          kkt.Add(sink.offset[i - 1] + q, multiplier_row(i), -e[q]);
+          kkt->Add(multiplier_row(i), sink.offset[i - 1] + q, -e[q]);
+          kkt->Add(sink.offset[i - 1] + q, multiplier_row(i), -e[q]);
         }
       }
     }
+    if (delta == 0.0) return;
+    for (int j = 1; j <= k; ++j) {
+      for (int q = 0; q < dim; ++q) kkt->Add(sink.offset[j] + q, sink.offset[j] + q, delta);
+    }
   };
+  // The iteration's work vectors, allocated once.
+  Eigen::VectorXd lag(size), lag_trial(size), lag_new(size), sol(size), lambda_new(nc),
+      dx_only(size), g_trial(size);
+  Points dx = Points::Zero(n + 1, dim), trial(n + 1, dim);
+  bool lag_current = false;  // `lag` already holds the gradient at (x, lambda)
   for (report.iterations = 0;; ++report.iterations) {
-    const Eigen::VectorXd lag = lagrangian_gradient(x, g, lambda);
+    if (!lag_current) lagrangian_gradient_into(x, g, lambda, &lag);
+    lag_current = false;
     report.objective = value;
     report.constraint_violation = ConstraintViolation(lengths, x);
     report.optimality = optimality(x, g, lag);
@@ -294,47 +314,48 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
     // Newton step for (x, lambda_new): [H + delta I, J^T; J, 0] [dx; lambda_new] = -[g; c].
     bool stepped = false;
     for (int attempt = 0; attempt < 12 && !stepped; ++attempt) {
-      assemble(x, lambda);
-      for (int j = 1; j <= k; ++j) {
-        for (int q = 0; q < dim; ++q) kkt.Add(sink.offset[j] + q, sink.offset[j] + q, regularization);
-      }
+      assemble(x, lambda, regularization, &ldlt.matrix());
       for (int j = 1; j <= k; ++j) {
         for (int q = 0; q < dim; ++q) rhs[sink.offset[j] + q] = -g[sink.offset[j] + q];
       }
       for (int i = 1; i <= nc; ++i) rhs[multiplier_row(i)] = -c[i - 1];
-      // First LDL^T without pivoting (a quarter of the LU's work), kept if its solution's
-      // residual is at the rounding level; otherwise the LU with partial pivoting.
-      Eigen::VectorXd sol;
-      if (ldlt.Factorize(kkt, 1e-10)) {
-        sol = ldlt.Solve(rhs);
-        const double residual = (kkt.MultiplySymmetric(sol) - rhs).cwiseAbs().maxCoeff();
-        if (!(residual <= 1e-12 * (rhs.cwiseAbs().maxCoeff() + sol.cwiseAbs().maxCoeff()))) {
-          sol.resize(0);
+      // First LDL^T without pivoting (a quarter of the LU's work), kept if no pivot is tiny and
+      // its factors did not grow (so that its backward error is at the rounding level);
+      // otherwise the LU with partial pivoting.
+      bool inertia_ok = false;
+      if (ldlt.Factorize(1e-10)) {
+        ldlt.SolveInto(rhs, &sol);
+        // As many negative pivots as constraints: H + delta I is positive definite on the
+        // constraints' tangent space (the KKT matrix's inertia, by Sylvester's law), so the
+        // step minimizes the local quadratic model there.
+        inertia_ok = ldlt.negative() == nc;
+      } else {
+        if (!kkt_general) {
+          kkt_general.emplace(size, ldlt.matrix().band());
+          lu.emplace(*kkt_general);
         }
-      }
-      if (sol.size() == 0) {
-        factorized = lu.Factorize(kkt);
+        assemble(x, lambda, regularization, &*kkt_general);
+        factorized = lu->Factorize(*kkt_general);
         if (!factorized) {
           regularize(1e-10 * std::fmax(1.0, g.cwiseAbs().maxCoeff()));  // singular
           continue;
         }
-        sol = lu.Solve(rhs);
+        sol = lu->Solve(rhs);
       }
       factorized = true;
       if (!sol.allFinite()) break;
-      Eigen::VectorXd lambda_new(nc);
-      Points dx = Points::Zero(n + 1, dim);
       for (int j = 1; j <= k; ++j) {
         for (int q = 0; q < dim; ++q) dx(j, q) = sol[sink.offset[j] + q];
       }
       for (int i = 1; i <= nc; ++i) lambda_new[i - 1] = sol[multiplier_row(i)];
-      // Curvature test (an LU gives no inertia): the step must see positive curvature of
-      // the regularized Lagrangian, dx' (H + delta I) dx >= 1e-8 |dx|^2 (scaled); else more
-      // regularization. Otherwise Newton heads for a saddle or maximum on non-convex terms.
-      {
+      // Without that inertia (an LU gives none), a curvature test: the step must see positive
+      // curvature of the regularized Lagrangian, dx' (H + delta I) dx >= 1e-8 |dx|^2 (scaled);
+      // else more regularization. Otherwise Newton heads for a saddle or maximum on non-convex
+      // terms.
+      if (!inertia_ok) {
         // dx' (H + delta I) dx, evaluated term by term (not -g' dx + c' lambda_new, which the
         // system implies: near the solution that cancels catastrophically).
-        Eigen::VectorXd dx_only = Eigen::VectorXd::Zero(size);
+        dx_only.setZero();
         for (int j = 1; j <= k; ++j) {
           for (int q = 0; q < dim; ++q) dx_only[sink.offset[j] + q] = dx(j, q);
         }
@@ -350,19 +371,19 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
       // Line search on the metric itself, every trial put back on the constraint manifold by
       // the retraction. Iterates stay feasible, so no merit function is needed and full Newton
       // steps are never rejected near the solution for leaving the manifold (no Maratos effect).
-      auto accept = [&](Points&& trial, double v_trial, Eigen::VectorXd&& g_trial) {
-        x = std::move(trial);
+      // (Swaps: the trial buffers take the old iterate, to be overwritten by the next trial.)
+      auto accept = [&](double v_trial) {
+        x.swap(trial);
         value = v_trial;
-        g = std::move(g_trial);
-        c = constraints(x);
+        g.swap(g_trial);
+        constraints(x, &c);
         lambda = lambda_new;
         stepped = true;
       };
-      auto try_point = [&](double alpha, Points* trial, Eigen::VectorXd* g_trial) {
-        *trial = x + alpha * dx;
-        if (!Retract(lengths, k, trial)) return std::numeric_limits<double>::infinity();
-        g_trial->resize(size);
-        return evaluate(*trial, nullptr, g_trial);
+      auto try_point = [&](double alpha) {
+        trial = x + alpha * dx;
+        if (!Retract(lengths, k, &trial)) return std::numeric_limits<double>::infinity();
+        return evaluate(trial, nullptr, &g_trial);
       };
       // First the full Newton step: near the solution the metric changes by less than rounding,
       // so it is judged by the Lagrangian's gradient, which it must halve, without raising the
@@ -375,19 +396,19 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
           (std::fabs(value) +
            g.cwiseAbs().sum() * std::fmax(x.cwiseAbs().maxCoeff(), lengths.maxCoeff()));
       {
-        Points trial;
-        Eigen::VectorXd g_trial;
-        const double v_trial = try_point(1.0, &trial, &g_trial);
+        const double v_trial = try_point(1.0);
         // (The second test accepts a step that only corrects the multipliers: with as many
         // constraints as unknowns the configuration is already determined.)
-        Eigen::VectorXd lag_trial;
-        if (std::isfinite(v_trial)) lag_trial = lagrangian_gradient(trial, g_trial, lambda_new);
-        if (std::isfinite(v_trial) && v_trial <= value + allowance &&
-            (lag_trial.cwiseAbs().maxCoeff() <
-                 0.5 * lagrangian_gradient(x, g, lambda_new).cwiseAbs().maxCoeff() ||
-             optimality(trial, g_trial, lag_trial) <= options.optimality_tolerance)) {
-          accept(std::move(trial), v_trial, std::move(g_trial));
-          break;
+        if (std::isfinite(v_trial) && v_trial <= value + allowance) {
+          lagrangian_gradient_into(trial, g_trial, lambda_new, &lag_trial);
+          lagrangian_gradient_into(x, g, lambda_new, &lag_new);
+          if (lag_trial.cwiseAbs().maxCoeff() < 0.5 * lag_new.cwiseAbs().maxCoeff() ||
+              optimality(trial, g_trial, lag_trial) <= options.optimality_tolerance) {
+            accept(v_trial);
+            lag.swap(lag_trial);  // the next iteration's (x, lambda)
+            lag_current = true;
+            break;
+          }
         }
       }
       // Otherwise Armijo backtracking on the metric, from a descent direction only.
@@ -397,11 +418,9 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
       }
       if (slope < 0.0) {
         for (double alpha = 1.0; alpha > 1e-12 && !stepped; alpha *= 0.5) {
-          Points trial;
-          Eigen::VectorXd g_trial;
-          const double v_trial = try_point(alpha, &trial, &g_trial);
+          const double v_trial = try_point(alpha);
           if (std::isfinite(v_trial) && v_trial <= value + 1e-4 * alpha * slope + allowance) {
-            accept(std::move(trial), v_trial, std::move(g_trial));
+            accept(v_trial);
           }
         }
       }
@@ -427,8 +446,8 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
   if (strict_minimizer != nullptr) {
     *strict_minimizer = false;
     if (report.converged()) {
-      assemble(x, lambda);
-      *strict_minimizer = ldlt.Factorize(kkt, 1e-12) && ldlt.negative() == nc;
+      assemble(x, lambda, 0.0, &ldlt.matrix());
+      *strict_minimizer = ldlt.Factorize(1e-12) && ldlt.negative() == nc;
     }
   }
   *start = x;
