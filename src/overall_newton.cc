@@ -256,12 +256,33 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
     sink.form = nullptr;
     return form;
   };
-  // The KKT matrix [H + delta I, J^T; J, 0] at (p, lam), into `kkt`.
+  // The KKT matrix [H + delta I, J^T; J, 0] at (p, lam), into `kkt`. The terms that are
+  // multiples of the identity per pair of neighbouring points are summed by point first (see
+  // Sink) and written in one pass.
+  std::vector<double> identity_diagonal(n + 1), identity_below(n + 1);
   auto assemble = [&](const Points& p, const Eigen::VectorXd& lam, double delta, BandMatrix* kkt) {
     kkt->SetZero();
+    std::fill(identity_diagonal.begin(), identity_diagonal.end(), 0.0);
+    std::fill(identity_below.begin(), identity_below.end(), 0.0);
     sink.band = kkt;
     sink.form = nullptr;
+    sink.identity_diagonal = identity_diagonal.data();
+    sink.identity_below = identity_below.data();
     hessian_terms(p, lam);
+    sink.identity_diagonal = nullptr;
+    sink.identity_below = nullptr;
+    for (int j = 1; j <= k; ++j) {
+      const int row = sink.offset[j];
+      const double diagonal = identity_diagonal[j] + delta;
+      for (int q = 0; q < dim; ++q) kkt->Add(row + q, row + q, diagonal);
+      if (j == 1) continue;  // point 0 is fixed
+      const int column = sink.offset[j - 1];
+      const double below = identity_below[j];
+      for (int q = 0; q < dim; ++q) {
+        kkt->Add(row + q, column + q, below);
+        kkt->Add(column + q, row + q, below);
+      }
+    }
     for (int i = 1; i <= nc; ++i) {
       const PointVector e = (p.row(i) - p.row(i - 1)).transpose() / lengths[i - 1];
       for (int q = 0; q < dim; ++q) {
@@ -274,10 +295,6 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
           kkt->Add(sink.offset[i - 1] + q, multiplier_row(i), -e[q]);
         }
       }
-    }
-    if (delta == 0.0) return;
-    for (int j = 1; j <= k; ++j) {
-      for (int q = 0; q < dim; ++q) kkt->Add(sink.offset[j] + q, sink.offset[j] + q, delta);
     }
   };
   // The iteration's work vectors, allocated once.

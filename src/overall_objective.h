@@ -4,6 +4,8 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <cassert>
+#include <cstdlib>
 #include <vector>
 
 #include "banded_lu.h"
@@ -27,6 +29,12 @@ struct Sink {
   const double* form_vector = nullptr;
   Triplets* hessian = nullptr;
   std::vector<int> offset;              // offset[j] for j = 0..n; -1: point j is fixed
+  // With `band`: if set, Identity() terms are summed here by point instead, s I at (j, j) into
+  // identity_diagonal[j] and at (j, j - 1) into identity_below[j] (its mirror (j - 1, j) is not
+  // summed again), and the caller writes them into the band in one pass. (Such terms, of the
+  // squared and rotation metrics and of the constraints, couple neighbours only.)
+  double* identity_diagonal = nullptr;
+  double* identity_below = nullptr;
 
   bool WantsHessian() const { return band != nullptr || form != nullptr || hessian != nullptr; }
   void Gradient(int j, const double* g, double scale) const {
@@ -41,6 +49,15 @@ struct Sink {
     }
   }
   void Identity(int p, int q, double scale) const {
+    if (band != nullptr && identity_diagonal != nullptr) {
+      assert(std::abs(p - q) <= 1);
+      if (p == q) {
+        identity_diagonal[p] += scale;
+      } else if (p == q + 1) {
+        identity_below[p] += scale;
+      }
+      return;
+    }
     if (!WantsHessian() || offset[p] < 0 || offset[q] < 0) return;
     for (int r = 0; r < dim; ++r) Add(offset[p] + r, offset[q] + r, scale);
   }
