@@ -9,7 +9,8 @@
 // measured in this run as CPU time: flexkin's before the timed loop, the median of 5 runs); max_err (largest
 // end-effector error, link lengths); unreached; motion of the joint nearest the end effector
 // (m_ee), at the middle (m_mid) and nearest the base (m_base), total |dtheta| along the path
-// (rad), and their sum over all joints (m_sum); iters/step.
+// (rad), and their sum over all joints (m_sum); iters/step; flexkin's passes over the links per step
+// (passes/step).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
