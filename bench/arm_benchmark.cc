@@ -1,6 +1,7 @@
 // Fixed-base arm step: Newton on the base residual against the predecessors' fixed-point
 // iteration, per step, for 8 to 512 links and for end-effector positions nearer and nearer the
-// edge of the workspace. Counters: iterations and sweeps per step (a sweep costs ~n link steps).
+// edge of the workspace. Counters: iterations, sweeps and passes over the links per step (a pass
+// costs ~n link steps; the sweeps of a finite-difference Jacobian share one pass).
 //   build/bench/arm_benchmark --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
 
@@ -27,17 +28,18 @@ void Track(benchmark::State& state, flexkin::FixedBaseMethod method) {
   }
   flexkin::ArmOptions options;
   options.method = method;
-  long long steps = 0, iterations = 0, sweeps = 0, unreached = 0;
+  long long steps = 0, iterations = 0, sweeps = 0, passes = 0, unreached = 0;
   for (auto _ : state) {
     const flexkin::ArmTrajectory t = flexkin::TrackPath(model, path, options);
     benchmark::DoNotOptimize(t.steps.back().state.points.data());
-    for (const auto& s : t.steps) iterations += s.iterations, sweeps += s.sweeps;
+    for (const auto& s : t.steps) iterations += s.iterations, sweeps += s.sweeps, passes += s.passes;
     steps += t.steps.size();
     unreached += t.unreached;
   }
   state.SetItemsProcessed(steps);  // items = steps: items_per_second is steps per second
   state.counters["iters/step"] = double(iterations) / steps;
   state.counters["sweeps/step"] = double(sweeps) / steps;
+  state.counters["passes/step"] = double(passes) / steps;
   state.counters["unreached"] = double(unreached) / state.iterations();
   // Seconds per step (printed with an SI prefix: 34u = 34 microseconds).
   state.counters["s/step"] =

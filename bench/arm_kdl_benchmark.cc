@@ -9,7 +9,8 @@
 // measured in this run as CPU time: flexkin's before the timed loop, the median of 5 runs); max_err (largest
 // end-effector error, link lengths); unreached; motion of the joint nearest the end effector
 // (m_ee), at the middle (m_mid) and nearest the base (m_base), total |dtheta| along the path
-// (rad), and their sum over all joints (m_sum); iters/step.
+// (rad), and their sum over all joints (m_sum); iters/step; flexkin's passes over the links per step
+// (passes/step).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -83,17 +84,19 @@ void Flexkin(benchmark::State& state) {
   const flexkin::Points path = CirclePath(model);
   const double reference = FlexkinSecondsPerStep(model, path);
   flexkin::ArmTrajectory t;
-  double steps = 0, iterations = 0;
+  double steps = 0, iterations = 0, passes = 0;
   const auto start = CpuSeconds();
   for (auto _ : state) {
     t = flexkin::TrackPath(model, path, flexkin::ArmOptions{});
     benchmark::DoNotOptimize(t.steps.back().state.points.data());
     steps += t.steps.size();
+    passes += t.total_passes;
     for (const auto& s : t.steps) iterations += s.iterations;
   }
   const double seconds = CpuSeconds() - start;
   SetStepCounters(state, steps, seconds, reference);
   state.counters["iters/step"] = iterations / steps;
+  state.counters["passes/step"] = passes / steps;  // passes over the links (cost ~ passes * n)
   state.counters["max_err"] = t.max_ee_error;
   state.counters["unreached"] = t.unreached;
   SetMotionCounters(state,

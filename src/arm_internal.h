@@ -7,6 +7,16 @@
 
 namespace flexkin::arm_internal {
 
+// Vectors and matrices of at most 3 by 3 (the translation, the base residual, its Jacobian),
+// sized dim at run time but stored inline: the solver's arithmetic allocates nothing.
+using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3, 1>;
+using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
+
+// ForwardKinematics and JointAnglesFromPoints without their checks of the model and the input
+// (for the solver, whose input is checked once).
+Points ForwardUnchecked(const ArmModel& model, const JointAngles& angles);
+JointAngles AnglesUnchecked(const ArmModel& model, const Points& points);
+
 // Throws InputError with model.Validate()'s reason, if any.
 void CheckModel(const ArmModel& model);
 

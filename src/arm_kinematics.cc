@@ -17,6 +17,7 @@ constexpr double kPi = 3.14159265358979323846;
 
 // x mapped to (-pi, pi] by a multiple of 2 pi.
 double Wrap(double x) {
+  if (x > -kPi && x <= kPi) return x;  // what remainder gives, without its cost
   const double r = std::remainder(x, 2.0 * kPi);
   return r <= -kPi ? r + 2.0 * kPi : r;
 }
@@ -199,6 +200,24 @@ ArmModel StraightArm(int dim, int links, double link_length) {
 Points ForwardKinematics(const ArmModel& model, const JointAngles& angles) {
   arm_internal::CheckModel(model);
   CheckAngles(model, angles, "angles");
+  return arm_internal::ForwardUnchecked(model, angles);
+}
+
+JointAngles JointAnglesFromPoints(const ArmModel& model, const Points& points) {
+  arm_internal::CheckModel(model);
+  const int n = model.num_links();
+  if (points.rows() != n + 1 || points.cols() != model.dim) {
+    throw InputError("points", "shape " + std::to_string(points.rows()) + " by " +
+                                   std::to_string(points.cols()) + " is not valid; expected " +
+                                   std::to_string(n + 1) + " by " + std::to_string(model.dim));
+  }
+  if (!points.allFinite()) throw InputError("points", "a value is not a finite number");
+  return arm_internal::AnglesUnchecked(model, points);
+}
+
+namespace arm_internal {
+
+Points ForwardUnchecked(const ArmModel& model, const JointAngles& angles) {
   const int n = model.num_links();
   Points points(n + 1, model.dim);
   points.row(0) = model.base.transpose();
@@ -212,7 +231,7 @@ Points ForwardKinematics(const ArmModel& model, const JointAngles& angles) {
     }
     return points;
   }
-  if (model.has_axes()) return arm_internal::RevoluteForward(model, angles.angle);
+  if (model.has_axes()) return RevoluteForward(model, angles.angle);
   Eigen::Quaterniond frame = BaseFrame(model);
   for (int j = 0; j < n; ++j) {
     frame = (frame * LocalRotation(angles.angle[j], angles.azimuth[j])).normalized();
@@ -222,15 +241,8 @@ Points ForwardKinematics(const ArmModel& model, const JointAngles& angles) {
   return points;
 }
 
-JointAngles JointAnglesFromPoints(const ArmModel& model, const Points& points) {
-  arm_internal::CheckModel(model);
+JointAngles AnglesUnchecked(const ArmModel& model, const Points& points) {
   const int n = model.num_links();
-  if (points.rows() != n + 1 || points.cols() != model.dim) {
-    throw InputError("points", "shape " + std::to_string(points.rows()) + " by " +
-                                   std::to_string(points.cols()) + " is not valid; expected " +
-                                   std::to_string(n + 1) + " by " + std::to_string(model.dim));
-  }
-  if (!points.allFinite()) throw InputError("points", "a value is not a finite number");
   JointAngles angles;
   angles.angle.resize(n);
   // Each angle is measured against the frame that forward kinematics accumulates, with the same
@@ -246,7 +258,7 @@ JointAngles JointAnglesFromPoints(const ArmModel& model, const Points& points) {
     return angles;
   }
   if (model.has_axes()) {
-    angles.angle = arm_internal::RevoluteInverse(model, points);
+    angles.angle = RevoluteInverse(model, points);
     return angles;
   }
   angles.azimuth.resize(n);
@@ -261,6 +273,8 @@ JointAngles JointAnglesFromPoints(const ArmModel& model, const Points& points) {
   }
   return angles;
 }
+
+}  // namespace arm_internal
 
 Eigen::MatrixXd JointQuaternions(const ArmModel& model, const JointAngles& angles) {
   arm_internal::CheckModel(model);

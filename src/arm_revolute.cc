@@ -101,7 +101,7 @@ RevoluteSweeper::RevoluteSweeper(const ArmModel& model, const ArmState& start,
   angle_.resize(n_);
 }
 
-Eigen::VectorXd RevoluteSweeper::Evaluate(const Eigen::VectorXd& u) {
+SmallVec RevoluteSweeper::Evaluate(const SmallVec& u) {
   ++sweeps_;
   limited_ = false;
   const bool limits = model_.joint_min.size() > 0;
@@ -153,6 +153,24 @@ Eigen::VectorXd RevoluteSweeper::Evaluate(const Eigen::VectorXd& u) {
   angle_[0] = q0;
   points_ = RevoluteForward(model_, angle_);
   return points_.row(n_).transpose() - target_;
+}
+
+void RevoluteSweeper::Jacobian(const SmallVec& u, const SmallVec& f, double h, SmallMat* jac) {
+  const Points kept = points_;
+  const bool kept_limited = limited_;
+  for (int k = 0; k < 3; ++k) {
+    SmallVec uk = u;
+    uk[k] += h;
+    jac->col(k) = (Evaluate(uk) - f) / h;
+  }
+  points_ = kept;
+  limited_ = kept_limited;
+}
+
+SmallVec RevoluteSweeper::EvaluateWithJacobian(const SmallVec& u, double h, SmallMat* jac) {
+  const SmallVec f = Evaluate(u);
+  Jacobian(u, f, h, jac);
+  return f;
 }
 
 }  // namespace flexkin::arm_internal

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "arm_internal.h"
 #include "flexkin/arm.h"
 
 namespace flexkin::arm_internal {
@@ -40,10 +41,17 @@ class RevoluteSweeper {
   RevoluteSweeper(const ArmModel& model, const ArmState& start, const Eigen::VectorXd& target,
                   int substeps);
   // Sweeps the start translated by u; returns F(u) and leaves the rebuilt points in points().
-  Eigen::VectorXd Evaluate(const Eigen::VectorXd& u);
+  SmallVec Evaluate(const SmallVec& u);
+  // The forward-difference Jacobian at u, F(u) being `f`: columns (F(u + h e_k) - f) / h, one
+  // sweep after another. points() is left as it was.
+  void Jacobian(const SmallVec& u, const SmallVec& f, double h, SmallMat* jac);
+  // F(u) and that Jacobian; leaves the points of u in points().
+  SmallVec EvaluateWithJacobian(const SmallVec& u, double h, SmallMat* jac);
   const Points& points() const { return points_; }
   bool limited() const { return limited_; }
   int sweeps() const { return sweeps_; }
+  int passes() const { return sweeps_; }  // one sweep per pass
+  bool cheap_jacobian() const { return false; }
 
  private:
   const ArmModel& model_;

@@ -123,10 +123,23 @@ struct ArmOptions {
   std::string Validate() const;
 };
 
+// What the Newton fixed-base solver learned in a step, to start the next one from (continuation
+// along a path: consecutive steps solve nearby problems). ArmStep fills it in the state it returns
+// when Newton converged, and TrackPath passes it on. It is only a hint: ArmStep works without it
+// (the first step, a state built by hand) and checks it (a remembered translation whose base
+// residual exceeds the move is dropped for u = 0), so a stale one costs a sweep, never accuracy.
+struct ArmSolverMemory {
+  // dim: the translation u that solved the last step (length unit); empty: none.
+  Eigen::VectorXd translation;
+  // Whether there is a memory of the right size (dim) with finite values; otherwise it is ignored.
+  bool Usable(int dim) const;
+};
+
 // The arm between steps: its points (base first) and joint angles, which agree.
 struct ArmState {
   Points points;
   JointAngles angles;
+  ArmSolverMemory memory;  // optional (empty by default): see ArmSolverMemory
 };
 // The state at the model's initial angles.
 ArmState InitialState(const ArmModel& model);
@@ -136,7 +149,8 @@ struct ArmStepReport {
   double ee_error = 0.0;   // |end effector - target| after the step (length unit)
   double base_error = 0.0; // the solver's last base residual before the base was re-anchored
   int iterations = 0;      // solver iterations (Newton steps or fixed-point sweeps)
-  int sweeps = 0;          // sweeps from the end effector, all included (cost ~ sweeps * n)
+  int sweeps = 0;          // sweeps from the end effector, all included
+  int passes = 0;          // passes over the links (cost ~ passes * n): sweeps done together count once
   bool converged = false;  // the base residual reached the tolerance
   bool reached = false;    // converged and ee_error within the tolerance: the target was reached
   bool stretched = false;  // out of reach: the arm was stretched straight toward the target
@@ -158,6 +172,7 @@ struct ArmTrajectory {
   int unreached = 0;                 // steps with reached = false
   int max_iterations = 0;
   long long total_sweeps = 0;
+  long long total_passes = 0;        // passes over the links (see ArmStepReport::passes)
   double seconds = 0.0;              // wall time of TrackPath
   std::string BriefReport() const;
 };
