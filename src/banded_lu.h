@@ -226,16 +226,11 @@ class BandedLdlt {
       column[0] = 1.0;
       for (int r = 1; r <= band; ++r) column[r] = 0.0;
     }
-    // The largest entry, in four independent chains of max (one chain is latency-bound).
-    const size_t stored = static_cast<size_t>(n) * width;
-    double largest[4] = {0.0, 0.0, 0.0, 0.0};
-    size_t i = 0;
-    for (; i + 4 <= stored; i += 4) {
-      for (int q = 0; q < 4; ++q) largest[q] = std::max(largest[q], std::fabs(a_.ab_[i + q]));
-    }
-    for (; i < stored; ++i) largest[0] = std::max(largest[0], std::fabs(a_.ab_[i]));
+    // The largest entry (Eigen's reduction runs in SIMD registers; a plain loop of std::max is
+    // one latency-bound chain).
+    const Eigen::Index stored = static_cast<Eigen::Index>(n) * width;
     const double scale =
-        std::max(std::max(largest[0], largest[1]), std::max(largest[2], largest[3]));
+        stored > 0 ? Eigen::Map<const Eigen::ArrayXd>(a_.ab_.data(), stored).abs().maxCoeff() : 0.0;
     bool ok = false;
     switch (band) {
       case 5:
