@@ -25,7 +25,8 @@ using internal::Clock;
 class Epigraph : public Ipopt::TNLP {
  public:
   Epigraph(const Eigen::VectorXd& lengths, const Eigen::Ref<const Eigen::VectorXd>& head,
-           const ObjectiveWeights& weights, const Points& old_points, const EpigraphOptions& epigraph)
+           const ObjectiveWeights& weights, const Points& old_points,
+           const EpigraphOptions& epigraph)
       : lengths_(lengths), old_points_(old_points), smooth_(weights) {
     const int n = num_links(), dim = this->dim();
     smooth_.l2 = 0.0;
@@ -36,8 +37,8 @@ class Epigraph : public Ipopt::TNLP {
     // w_j = l2 + l2_weighted (L_j + L_{j+1}) / 2, L_{n+1} = 0 (internal::L2Weight's).
     weight_.resize(n);
     for (int j = 1; j <= n; ++j) {
-      weight_[j - 1] = weights.l2 + weights.l2_weighted * 0.5 *
-                                        (lengths[j - 1] + (j < n ? lengths[j] : 0.0));
+      weight_[j - 1] =
+          weights.l2 + weights.l2_weighted * 0.5 * (lengths[j - 1] + (j < n ? lengths[j] : 0.0));
     }
     Points x;
     if (epigraph.start.size() == 0) {
@@ -130,7 +131,8 @@ class Epigraph : public Ipopt::TNLP {
     for (int i = 1; i <= links; ++i) {
       const double l = lengths_[i - 1];
       g[i - 1] = ((x_.row(i) - x_.row(i - 1)).squaredNorm() - l * l) / (2.0 * l);
-      g[links + i - 1] = v[nx + i - 1] * v[nx + i - 1] - (x_.row(i) - old_points_.row(i)).squaredNorm();
+      g[links + i - 1] =
+          v[nx + i - 1] * v[nx + i - 1] - (x_.row(i) - old_points_.row(i)).squaredNorm();
     }
     return true;
   }
@@ -205,11 +207,11 @@ class Epigraph : public Ipopt::TNLP {
     return true;
   }
 
-  void finalize_solution(Ipopt::SolverReturn /*status*/, Ipopt::Index /*n*/,
-                         const Ipopt::Number* v, const Ipopt::Number* /*z_L*/,
-                         const Ipopt::Number* /*z_U*/, Ipopt::Index /*m*/,
-                         const Ipopt::Number* /*g*/, const Ipopt::Number* /*lambda*/,
-                         Ipopt::Number /*obj_value*/, const Ipopt::IpoptData* /*ip_data*/,
+  void finalize_solution(Ipopt::SolverReturn /*status*/, Ipopt::Index /*n*/, const Ipopt::Number* v,
+                         const Ipopt::Number* /*z_L*/, const Ipopt::Number* /*z_U*/,
+                         Ipopt::Index /*m*/, const Ipopt::Number* /*g*/,
+                         const Ipopt::Number* /*lambda*/, Ipopt::Number /*obj_value*/,
+                         const Ipopt::IpoptData* /*ip_data*/,
                          Ipopt::IpoptCalculatedQuantities* /*ip_cq*/) override {
     Load(v);
     const int nx = num_links() * dim();
@@ -220,13 +222,9 @@ class Epigraph : public Ipopt::TNLP {
   // First column of row r (r < n dim) in the Hessian's lower-triangle pattern.
   int FirstColumn(int r) const { return std::max(0, r / dim() - band_) * dim(); }
 
-  double LinkDirection(int i, int a) const {
-    return (x_(i, a) - x_(i - 1, a)) / lengths_[i - 1];
-  }
+  double LinkDirection(int i, int a) const { return (x_(i, a) - x_(i - 1, a)) / lengths_[i - 1]; }
 
-  void Load(const double* v) {
-    std::copy(v, v + num_links() * dim(), x_.data() + dim());
-  }
+  void Load(const double* v) { std::copy(v, v + num_links() * dim(), x_.data() + dim()); }
 
   // The smooth terms and their gradient at v's x, once per new point. IPOPT's new_x is false
   // when any eval_* method has seen v before, so every one of them clears the cache on a new v.
@@ -237,8 +235,7 @@ class Epigraph : public Ipopt::TNLP {
     smooth_value_ = 0.0;
     if (has_smooth_) {
       try {
-        smooth_value_ =
-            OverallObjective(smooth_, lengths_, old_points_, x_, &smooth_gradient_);
+        smooth_value_ = OverallObjective(smooth_, lengths_, old_points_, x_, &smooth_gradient_);
       } catch (...) {
         cached_ = false;
         return false;
@@ -267,7 +264,7 @@ class Epigraph : public Ipopt::TNLP {
 void ValidateEpigraph(const EpigraphOptions& epigraph, const Points& old_points) {
   if (!(epigraph.margin > 0.0) || !std::isfinite(epigraph.margin)) {
     throw InputError("epigraph.margin", "is " + std::to_string(epigraph.margin) +
-                                         "; must be a finite number > 0 (typical: 1e-2)");
+                                            "; must be a finite number > 0 (typical: 1e-2)");
   }
   if (!(epigraph.error_scaling_limit >= 1.0)) {
     throw InputError("epigraph.error_scaling_limit",
@@ -278,8 +275,8 @@ void ValidateEpigraph(const EpigraphOptions& epigraph, const Points& old_points)
   if (epigraph.start.rows() != old_points.rows() || epigraph.start.cols() != old_points.cols() ||
       !epigraph.start.allFinite()) {
     throw InputError("epigraph.start", "must be empty or " + std::to_string(old_points.rows()) +
-                                         " by " + std::to_string(old_points.cols()) +
-                                         " finite coordinates, like the chain's points");
+                                           " by " + std::to_string(old_points.cols()) +
+                                           " finite coordinates, like the chain's points");
   }
 }
 
@@ -334,7 +331,7 @@ PeerReport SolveL2WithIpopt(const Eigen::VectorXd& lengths,
     // still points creep); a huge s_max makes the test absolute: the answer is then exact to
     // rounding, but IPOPT converges far less often (35 of 99). The caller chooses.
     o->SetNumericValue("s_max", epigraph.error_scaling_limit);
-    status = app->Initialize("");  // "": no ipopt.opt file from the working directory  // "": no ipopt.opt file from the working directory
+    status = app->Initialize("");  // "": no ipopt.opt file from the working directory
     if (status == Ipopt::Solve_Succeeded) {
       status = app->OptimizeTNLP(Ipopt::SmartPtr<Ipopt::TNLP>(GetRawPtr(problem)));
       if (Ipopt::SmartPtr<Ipopt::SolveStatistics> stats = app->Statistics();

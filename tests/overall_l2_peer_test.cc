@@ -145,8 +145,8 @@ struct Tally {
 
 // One case: OverallStep and IPOPT; the comparison where both converged.
 void Compare(const Case& c, const std::string& objective, const ObjectiveWeights& weights,
-             const peers::EpigraphOptions& epigraph, int max_iterations,
-             double objective_tolerance, double still, Tally* tally) {
+             const peers::EpigraphOptions& epigraph, int max_iterations, double objective_tolerance,
+             double still, Tally* tally) {
   SCOPED_TRACE(Describe(c, objective));
   const int n = c.chain.num_links();
   OverallOptions options;
@@ -186,7 +186,8 @@ void Compare(const Case& c, const std::string& objective, const ObjectiveWeights
         "IPOPT found a LOWER value: %s: OverallStep %.15g (points 1..%d of %d move; %s) vs IPOPT "
         "%.15g (points 1..%d move; %s)\n",
         Describe(c, objective).c_str(), report.objective, report.moving_points, n,
-        report.BriefReport().c_str(), peer.objective, MovingPoints(c.chain, peer.points, still), peer.BriefReport().c_str());
+        report.BriefReport().c_str(), peer.objective, MovingPoints(c.chain, peer.points, still),
+        peer.BriefReport().c_str());
     return;
   }
   tally->worst_objective = std::fmax(tally->worst_objective, std::fabs(gap) / scale);
@@ -208,8 +209,9 @@ void Compare(const Case& c, const std::string& objective, const ObjectiveWeights
   const double position = (overall - peer.points).cwiseAbs().maxCoeff();
   tally->worst_position = std::fmax(tally->worst_position, position);
   // Measured: 1.3e-6 under the default stop (the creeping still points), 1.2e-12 when strict.
-  EXPECT_LT(position, 1e6 * objective_tolerance * c.chain.lengths.maxCoeff()) << "moving points: OverallStep " << report.moving_points << ", IPOPT "
-                            << MovingPoints(c.chain, peer.points, still) << "; " << peer.BriefReport();
+  EXPECT_LT(position, std::fmax(objective_tolerance, 1e-10) * c.chain.lengths.maxCoeff())
+      << "moving points: OverallStep " << report.moving_points << ", IPOPT "
+      << MovingPoints(c.chain, peer.points, still) << "; " << peer.BriefReport();
 }
 
 void Summarize(const char* what, const Tally& t, double seconds) {
@@ -237,8 +239,8 @@ TEST(OverallL2PeerTest, SameMinimumAsIpoptOnTheEpigraphForm) {
   Summarize("default stop", tally, SecondsSince(started));
   RecordProperty("ipopt_converged",
                  std::to_string(tally.converged) + " of " + std::to_string(tally.total));
-  // Measured: 77 of 98 (OverallStep's failure below not counted) (the others: Solved_To_Acceptable_Level, Search_Direction_Becomes_Too_Small,
-  // restoration failures; all printed above).
+  // Measured: 77 of 99 (the others: Solved_To_Acceptable_Level, Search_Direction_Becomes_Too_Small,
+  // restoration failures, all printed; and OverallStep's failure below, not compared).
   EXPECT_GE(tally.converged, 0.75 * tally.total);
   // Known and reported, not hidden (see the printed lines):
   // - random3d_0_25links / l2 (head moved by 0.063, a twentieth of a link): OverallStep moves
@@ -292,7 +294,8 @@ TEST(OverallL2PeerTest, StartsWhereToldAndRejectsBadInput) {
   peers::EpigraphOptions start;
   start.start = overall;
   start.margin = 1e-3;
-  const PeerReport peer = peers::SolveL2WithIpopt(chain.lengths, head, options, chain.points, start);
+  const PeerReport peer =
+      peers::SolveL2WithIpopt(chain.lengths, head, options, chain.points, start);
   EXPECT_EQ(peer.solver, "ipopt_l2");
   ASSERT_TRUE(peer.converged) << peer.BriefReport();
   EXPECT_EQ(peer.points.row(0), head.transpose());
