@@ -14,17 +14,15 @@
 
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
+#include "peer_internal.h"
 
 namespace flexkin::peers {
-namespace {
-
-using Clock = std::chrono::steady_clock;
+namespace internal {
 
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Largest |(|D_i|^2 - L_i^2)| / (2 L_i^2): OverallReport::constraint_violation's measure.
 double ConstraintViolation(const Eigen::VectorXd& lengths, const Points& x) {
   double worst = 0.0;
   for (Eigen::Index i = 1; i < x.rows(); ++i) {
@@ -47,6 +45,43 @@ void ValidateInput(const Eigen::VectorXd& lengths, const Eigen::Ref<const Eigen:
     throw InputError("weights.joint_angle", "is defined for planar (2D) chains only; set it to 0");
   }
 }
+
+const char* IpoptStatusName(int status) {
+  static const std::pair<Ipopt::ApplicationReturnStatus, const char*> kNames[] = {
+      {Ipopt::Solve_Succeeded, "Solve_Succeeded"},
+      {Ipopt::Solved_To_Acceptable_Level, "Solved_To_Acceptable_Level"},
+      {Ipopt::Infeasible_Problem_Detected, "Infeasible_Problem_Detected"},
+      {Ipopt::Search_Direction_Becomes_Too_Small, "Search_Direction_Becomes_Too_Small"},
+      {Ipopt::Diverging_Iterates, "Diverging_Iterates"},
+      {Ipopt::User_Requested_Stop, "User_Requested_Stop"},
+      {Ipopt::Feasible_Point_Found, "Feasible_Point_Found"},
+      {Ipopt::Maximum_Iterations_Exceeded, "Maximum_Iterations_Exceeded"},
+      {Ipopt::Restoration_Failed, "Restoration_Failed"},
+      {Ipopt::Error_In_Step_Computation, "Error_In_Step_Computation"},
+      {Ipopt::Maximum_CpuTime_Exceeded, "Maximum_CpuTime_Exceeded"},
+      {Ipopt::Not_Enough_Degrees_Of_Freedom, "Not_Enough_Degrees_Of_Freedom"},
+      {Ipopt::Invalid_Problem_Definition, "Invalid_Problem_Definition"},
+      {Ipopt::Invalid_Option, "Invalid_Option"},
+      {Ipopt::Invalid_Number_Detected, "Invalid_Number_Detected"},
+      {Ipopt::Unrecoverable_Exception, "Unrecoverable_Exception"},
+      {Ipopt::NonIpopt_Exception_Thrown, "NonIpopt_Exception_Thrown"},
+      {Ipopt::Insufficient_Memory, "Insufficient_Memory"},
+      {Ipopt::Internal_Error, "Internal_Error"},
+  };
+  for (const auto& [code, name] : kNames) {
+    if (code == status) return name;
+  }
+  return "unknown";
+}
+
+}  // namespace internal
+namespace {
+
+using internal::Clock;
+using internal::ConstraintViolation;
+using internal::IpoptStatusName;
+using internal::SecondsSince;
+using internal::ValidateInput;
 
 // The problem shared by both adapters: the unknowns x_1..x_n flattened row by row (point j's
 // coordinates at (j - 1) dim), point 0 pinned at the head.
@@ -97,6 +132,7 @@ class StepProblem {
   void Finish(PeerReport* report) const {
     report->points = x_;
     report->objective = OverallObjective(weights_, lengths_, old_points_, x_);
+    report->solver_objective = report->objective;
     report->constraint_violation = ConstraintViolation(lengths_, x_);
     report->evaluations = evaluations_;
   }
@@ -152,34 +188,6 @@ void SlsqpConstraints(unsigned m, double* result, unsigned n, const double* v, d
 }
 
 // ---- IPOPT -------------------------------------------------------------------------------------
-
-const char* IpoptStatusName(Ipopt::ApplicationReturnStatus status) {
-  static const std::pair<Ipopt::ApplicationReturnStatus, const char*> kNames[] = {
-      {Ipopt::Solve_Succeeded, "Solve_Succeeded"},
-      {Ipopt::Solved_To_Acceptable_Level, "Solved_To_Acceptable_Level"},
-      {Ipopt::Infeasible_Problem_Detected, "Infeasible_Problem_Detected"},
-      {Ipopt::Search_Direction_Becomes_Too_Small, "Search_Direction_Becomes_Too_Small"},
-      {Ipopt::Diverging_Iterates, "Diverging_Iterates"},
-      {Ipopt::User_Requested_Stop, "User_Requested_Stop"},
-      {Ipopt::Feasible_Point_Found, "Feasible_Point_Found"},
-      {Ipopt::Maximum_Iterations_Exceeded, "Maximum_Iterations_Exceeded"},
-      {Ipopt::Restoration_Failed, "Restoration_Failed"},
-      {Ipopt::Error_In_Step_Computation, "Error_In_Step_Computation"},
-      {Ipopt::Maximum_CpuTime_Exceeded, "Maximum_CpuTime_Exceeded"},
-      {Ipopt::Not_Enough_Degrees_Of_Freedom, "Not_Enough_Degrees_Of_Freedom"},
-      {Ipopt::Invalid_Problem_Definition, "Invalid_Problem_Definition"},
-      {Ipopt::Invalid_Option, "Invalid_Option"},
-      {Ipopt::Invalid_Number_Detected, "Invalid_Number_Detected"},
-      {Ipopt::Unrecoverable_Exception, "Unrecoverable_Exception"},
-      {Ipopt::NonIpopt_Exception_Thrown, "NonIpopt_Exception_Thrown"},
-      {Ipopt::Insufficient_Memory, "Insufficient_Memory"},
-      {Ipopt::Internal_Error, "Internal_Error"},
-  };
-  for (const auto& [code, name] : kNames) {
-    if (code == status) return name;
-  }
-  return "unknown";
-}
 
 // The step as an Ipopt::TNLP. Jacobian and Hessian of the Lagrangian are declared with their
 // banded patterns (the Hessian's lower triangle: point j with points j - band .. j).

@@ -55,6 +55,10 @@ struct PeerReport {
   int status_code = 0;     // nlopt_result or Ipopt::ApplicationReturnStatus
   Points points;           // (n+1) by dim, the configuration returned; row 0 is `head`
   double objective = 0.0;  // OverallObjective at `points`
+  // The solver's own objective at its answer: `objective` for SolveWithSlsqp and SolveWithIpopt;
+  // for SolveL2WithIpopt (l2_peer.h) its epigraph's sum of w_j t_j plus the smooth terms, which
+  // is >= `objective` (t_j >= |x_j - a_j|) and shows how tightly the cones close.
+  double solver_objective = 0.0;
   double constraint_violation = 0.0;  // largest |(|D_i|^2 - L_i^2)| / (2 L_i^2) at `points`
   int iterations = -1;   // IPOPT's iterations; -1 for SLSQP (NLopt does not report them)
   int evaluations = 0;   // objective evaluations
