@@ -181,19 +181,35 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
   // First-order optimality: the Lagrangian's gradient relative to the objective's gradient (now
   // or at the start, whichever is larger). Where the metric is 0 at the solution (a still head,
   // or a pure translation under the rotation metric) that ratio means nothing; a gradient at the
-  // rounding level of the positions, 64 eps (sum of weights) max(|x|, L), counts as 0 instead.
+  // rounding level of the positions counts as 0 instead: positions are known to about
+  // eps max(|x|, L), and a point's gradient moves by its curvature times that, so the level of
+  // point j's components is 64 eps max(|x|, L) kappa_j, with kappa_j the sum of the weights plus
+  // the constraints' curvature |lambda_j| / L_j + |lambda_j+1| / L_j+1 plus, under the L2
+  // metric, w_j / sqrt(r_j^2 + mu^2) (r_j = |x_j - a_j|, mu the smoothing): large where a point
+  // moves by little, whose direction of motion is then known only to eps |x| / r_j.
   const ObjectiveWeights& w = options.weights;
   const double weight_sum = w.squared + w.squared_weighted * lengths.maxCoeff() +
                             (w.rotation + w.l2 + w.l2_weighted * lengths.maxCoeff()) /
                                 lengths.minCoeff() +
                             w.joint_angle;
   double start_gradient = 0.0;
+  const bool l2 = w.l2 > 0.0 || w.l2_weighted > 0.0;
+  const Eigen::VectorXd inverse_length = lengths.cwiseInverse();
   auto optimality = [&](const Points& p, const Eigen::VectorXd& grad, const Eigen::VectorXd& lag) {
     const double residual = lag.cwiseAbs().maxCoeff();
     const double extent = std::fmax(p.cwiseAbs().maxCoeff(), lengths.maxCoeff());
-    if (residual <= 64.0 * std::numeric_limits<double>::epsilon() * weight_sum * extent) {
-      return 0.0;
+    const double level = 64.0 * std::numeric_limits<double>::epsilon() * extent;
+    bool rounding = true;
+    for (int j = 1; j <= k && rounding; ++j) {
+      double kappa = weight_sum + std::fabs(lambda[j - 1]) * inverse_length[j - 1] +
+                     (j < nc ? std::fabs(lambda[j]) * inverse_length[j] : 0.0);
+      if (l2) {
+        const double r = (p.row(j) - old_points.row(j)).norm();
+        kappa += L2Weight(w, lengths, j) / std::sqrt(r * r + smoothing * smoothing);
+      }
+      for (int q = 0; q < dim; ++q) rounding &= std::fabs(lag[sink.offset[j] + q]) <= level * kappa;
     }
+    if (rounding) return 0.0;
     const double scale = std::fmax(std::fmax(grad.cwiseAbs().maxCoeff(), start_gradient),
                                    std::numeric_limits<double>::min());
     return residual / scale;

@@ -141,6 +141,7 @@ int MovingPoints(const Chain& chain, const Points& x, double still) {
 struct Tally {
   int total = 0, converged = 0, lower = 0, overall_failed = 0;
   double worst_objective = 0.0, worst_position = 0.0, worst_still = 0.0;
+  std::vector<std::string> lower_cases;  // "name / objective" where IPOPT found a lower value
 };
 
 // One case: OverallStep and IPOPT; the comparison where both converged.
@@ -182,6 +183,7 @@ void Compare(const Case& c, const std::string& objective, const ObjectiveWeights
   const double gap = report.objective - peer.objective;  // > 0: IPOPT found a lower value
   if (gap > kLowerTolerance * scale) {  // printed, counted, bounded below; never hidden
     ++tally->lower;
+    tally->lower_cases.push_back(c.name + " / " + objective);
     std::printf(
         "IPOPT found a LOWER value: %s: OverallStep %.15g (points 1..%d of %d move; %s) vs IPOPT "
         "%.15g (points 1..%d move; %s)\n",
@@ -239,7 +241,7 @@ TEST(OverallL2PeerTest, SameMinimumAsIpoptOnTheEpigraphForm) {
   Summarize("default stop", tally, SecondsSince(started));
   RecordProperty("ipopt_converged",
                  std::to_string(tally.converged) + " of " + std::to_string(tally.total));
-  // Measured: 77 of 99 (the others: Solved_To_Acceptable_Level, Search_Direction_Becomes_Too_Small,
+  // Measured: 78 of 99 (the others: Solved_To_Acceptable_Level, Search_Direction_Becomes_Too_Small,
   // restoration failures, all printed; and OverallStep's failure below, not compared).
   EXPECT_GE(tally.converged, 0.75 * tally.total);
   // Known and reported, not hidden (see the printed lines):
@@ -249,11 +251,14 @@ TEST(OverallL2PeerTest, SameMinimumAsIpoptOnTheEpigraphForm) {
   //   feasible path from OverallStep's answer towards IPOPT's the metric first rises (by 3e-7 at
   //   a hundredth of the way) and falls only past a third of it: OverallStep's answer is a local
   //   minimizer, IPOPT's another, lower one.
-  EXPECT_LE(tally.lower, 1);
-  // - random3d_8_10links / l2: OverallStep stalls ("stalled after 41 iterations", optimality
-  //   5.8e-12 against the 1e-12 asked) at 1.38463341893, all 10 points moving; IPOPT converges to
-  //   2.548 (another, higher stationary point).
-  EXPECT_LE(tally.overall_failed, 1);
+  for (const std::string& name : tally.lower_cases) {
+    EXPECT_EQ(name, "random3d_0_25links / l2") << "IPOPT found a lower value in a new case";
+  }
+  // OverallStep converges in every case. (random3d_8_10links / l2 used to stall at optimality
+  // 5.8e-12, the rounding level of a point that moved by little, whose direction of motion is
+  // known only to eps |x| / r; the optimality measure now counts that level as 0 (see
+  // src/overall_newton.cc), and OverallStep returns IPOPT's minimizer there, 2.54804198313.)
+  EXPECT_EQ(tally.overall_failed, 0);
 }
 
 // With IPOPT's error scaling off (s_max 1e20) its stopping test is absolute: where it converges
