@@ -242,7 +242,7 @@ TEST(OverallL2PeerTest, SameMinimumAsIpoptOnTheEpigraphForm) {
   RecordProperty("ipopt_converged",
                  std::to_string(tally.converged) + " of " + std::to_string(tally.total));
   // Measured: 78 of 99 (the others: Solved_To_Acceptable_Level, Search_Direction_Becomes_Too_Small,
-  // restoration failures, all printed; and OverallStep's failure below, not compared).
+  // restoration failures, all printed).
   EXPECT_GE(tally.converged, 0.75 * tally.total);
   // Known and reported, not hidden (see the printed lines):
   // - random3d_0_25links / l2 (head moved by 0.063, a twentieth of a link): OverallStep moves
