@@ -297,15 +297,35 @@ class BandedLdlt {
         double* target = column + static_cast<size_t>(k) * width;
         for (int i = k; i <= band; ++i) target[i - k] -= f * column[i];
       }
-      double largest = 1.0;
-      for (int r = 1; r <= band; ++r) {
-        column[r] *= inverse;
-        largest = std::max(largest, std::fabs(column[r]));
-      }
-      growth_ = std::max(growth_, std::fabs(pivot) * largest * largest);
+      // |D(j)| max(1, max_r |L(j + r, j)|)^2 = max(|pivot|, m^2 / |pivot|), m the largest
+      // entry below the pivot before scaling.
+      const double m = MaxBelowPivot<B>(column, band);
+      growth_ = std::max(growth_, std::max(std::fabs(pivot), m * m * std::fabs(inverse)));
+      for (int r = 1; r <= band; ++r) column[r] *= inverse;
       inverse_pivot_[j] = inverse;
     }
     return std::isfinite(growth_);
+  }
+
+  // max_{1 <= r <= band} |column[r]|, as a tree of independent comparisons for the fixed bands
+  // (a chain of max would be as long as the band).
+  template <int B>
+  static double MaxBelowPivot(const double* column, int band) {
+    auto a = [column](int r) { return std::fabs(column[r]); };
+    if constexpr (B == 5) {
+      return std::max(std::max(a(1), a(2)), std::max(std::max(a(3), a(4)), a(5)));
+    } else if constexpr (B == 7) {
+      return std::max(std::max(std::max(a(1), a(2)), std::max(a(3), a(4))),
+                      std::max(std::max(a(5), a(6)), a(7)));
+    } else {
+      double even = 0.0, odd = 0.0;
+      for (int r = 1; r + 1 <= band; r += 2) {
+        odd = std::max(odd, a(r));
+        even = std::max(even, a(r + 1));
+      }
+      if (band % 2 == 1) odd = std::max(odd, a(band));
+      return std::max(even, odd);
+    }
   }
 
   template <int B>

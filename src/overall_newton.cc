@@ -195,11 +195,15 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
   double start_gradient = 0.0;
   const bool l2 = w.l2 > 0.0 || w.l2_weighted > 0.0;
   const Eigen::VectorXd inverse_length = lengths.cwiseInverse();
+  const double max_inverse_length = inverse_length.maxCoeff();
   auto optimality = [&](const Points& p, const Eigen::VectorXd& grad, const Eigen::VectorXd& lag) {
     const double residual = lag.cwiseAbs().maxCoeff();
     const double extent = std::fmax(p.cwiseAbs().maxCoeff(), lengths.maxCoeff());
     const double level = 64.0 * std::numeric_limits<double>::epsilon() * extent;
-    bool rounding = true;
+    // Without an L2 term every kappa_j is at most weight_sum + 2 max|lambda| / L_min: above that
+    // level, no point is at its rounding level (the usual case, decided without the loop).
+    bool rounding = l2 || residual <= level * (weight_sum + 2.0 * lambda.cwiseAbs().maxCoeff() *
+                                                                 max_inverse_length);
     for (int j = 1; j <= k && rounding; ++j) {
       double kappa = weight_sum + std::fabs(lambda[j - 1]) * inverse_length[j - 1] +
                      (j < nc ? std::fabs(lambda[j]) * inverse_length[j] : 0.0);
