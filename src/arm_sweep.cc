@@ -100,16 +100,25 @@ void Sweeper::Jacobian(const SmallVec& u, const SmallVec& f, double h, SmallMat*
   }
 }
 
-SmallVec Sweeper::EvaluateWithJacobian(const SmallVec& u, double h, SmallMat* jac) {
+SmallVec Sweeper::EvaluateWithJacobian(const SmallVec& u, double h, SmallMat* jac,
+                                       const SmallVec* probe, SmallVec* f_probe) {
   if (fast_) {
     double us[kMaxLanes * 3];
     for (int c = 0; c <= dim_; ++c) {
       for (int k = 0; k < dim_; ++k) us[c * dim_ + k] = u[k] + (k + 1 == c ? h : 0.0);
     }
+    const bool probing = probe != nullptr && spare_lane();
+    if (probing) {
+      for (int k = 0; k < dim_; ++k) us[(dim_ + 1) * dim_ + k] = (*probe)[k];
+    }
     limited_ = false;
-    const SmallVec f = FastLanes(dim_ + 1, us, lanes_[0].data());
+    const SmallVec f = FastLanes(dim_ + 1 + (probing ? 1 : 0), us, lanes_[0].data());
     for (int c = 0; c < dim_; ++c) {
       for (int k = 0; k < dim_; ++k) (*jac)(k, c) = (fast_bases_[c + 1][k] - f[k]) / h;
+    }
+    if (probing) {
+      f_probe->resize(dim_);
+      for (int k = 0; k < dim_; ++k) (*f_probe)[k] = fast_bases_[dim_ + 1][k];
     }
     return f;
   }
