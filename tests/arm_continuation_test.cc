@@ -84,7 +84,8 @@ TEST(ArmContinuation, SharpCornersAndReversalsConverge) {
     state.memory = ArmSolverMemory{};
     const ArmStepReport cold = ArmStep(model, state, path.row(i).transpose(), ArmOptions{});
     EXPECT_LT((cold.state.points - t.steps[i].state.points).cwiseAbs().maxCoeff(), 1e-9) << i;
-    EXPECT_LE(t.steps[i].passes, 6) << i;
+    // A corner costs a few passes (the scalar sweeper's Jacobian takes passes of its own).
+    EXPECT_LE(t.steps[i].passes, arm_internal::HasAvx2Fma() ? 6 : 10) << i;
     state = t.steps[i].state;
   }
 }
