@@ -9,6 +9,7 @@
 #include "arm_revolute.h"
 #include "flexkin/arm.h"
 #include "flexkin/error.h"
+#include "wavefront/arm_anchor.h"
 
 namespace flexkin {
 namespace {
@@ -217,17 +218,47 @@ JointAngles JointAnglesFromPoints(const ArmModel& model, const Points& points) {
 
 namespace arm_internal {
 
+void Atan2All(const double* y, const double* x, int count, double* out, bool batched) {
+#if FLEXKIN_HAVE_WAVEFRONT
+  if (batched && HasAvx2Fma()) {
+    internal::Atan2Avx2(y, x, count, out);
+    return;
+  }
+#endif
+  for (int i = 0; i < count; ++i) out[i] = std::atan2(y[i], x[i]);
+}
+
+void SinCosAll(const double* a, int count, double* s, double* c, bool batched) {
+#if FLEXKIN_HAVE_WAVEFRONT
+  if (batched && HasAvx2Fma()) {
+    internal::SinCosAvx2(a, count, s, c);
+    return;
+  }
+#endif
+  for (int i = 0; i < count; ++i) {
+    s[i] = std::sin(a[i]);
+    c[i] = std::cos(a[i]);
+  }
+}
+
 Points ForwardUnchecked(const ArmModel& model, const JointAngles& angles) {
   const int n = model.num_links();
   Points points(n + 1, model.dim);
   points.row(0) = model.base.transpose();
   if (model.dim == 2) {
-    double heading = std::atan2(model.base_direction[1], model.base_direction[0]);
+    // The headings (sequential sums), their sines and cosines (independent: batched where the
+    // CPU allows), then the points (sequential sums).
+    Eigen::VectorXd scratch(3 * n);
+    double* heading = scratch.data();
+    double* sn = heading + n;
+    double* cs = sn + n;
+    double h = std::atan2(model.base_direction[1], model.base_direction[0]);
+    for (int j = 0; j < n; ++j) heading[j] = h += angles.angle[j];
+    SinCosAll(heading, n, sn, cs);
     for (int j = 0; j < n; ++j) {
-      heading += angles.angle[j];
       const double l = model.link_lengths[j];
-      points(j + 1, 0) = points(j, 0) + l * std::cos(heading);
-      points(j + 1, 1) = points(j, 1) + l * std::sin(heading);
+      points(j + 1, 0) = points(j, 0) + l * cs[j];
+      points(j + 1, 1) = points(j, 1) + l * sn[j];
     }
     return points;
   }
@@ -248,10 +279,20 @@ JointAngles AnglesUnchecked(const ArmModel& model, const Points& points) {
   // Each angle is measured against the frame that forward kinematics accumulates, with the same
   // operations, so FK reproduces every direction to rounding without drift along the arm.
   if (model.dim == 2) {
+    // Each link's direction (independent: batched where the CPU allows), then the angles
+    // against the accumulated heading (sequential).
+    Eigen::VectorXd scratch(2 * n);
+    double* dx = scratch.data();
+    double* dy = dx + n;
+    for (int j = 0; j < n; ++j) {
+      dx[j] = points(j + 1, 0) - points(j, 0);
+      dy[j] = points(j + 1, 1) - points(j, 1);
+    }
+    double* direction = angles.angle.data();
+    Atan2All(dy, dx, n, direction);
     double heading = std::atan2(model.base_direction[1], model.base_direction[0]);
     for (int j = 0; j < n; ++j) {
-      const double dx = points(j + 1, 0) - points(j, 0), dy = points(j + 1, 1) - points(j, 1);
-      const double theta = (dx == 0.0 && dy == 0.0) ? 0.0 : Wrap(std::atan2(dy, dx) - heading);
+      const double theta = (dx[j] == 0.0 && dy[j] == 0.0) ? 0.0 : Wrap(direction[j] - heading);
       angles.angle[j] = theta;
       heading += theta;
     }

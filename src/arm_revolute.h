@@ -47,6 +47,12 @@ class RevoluteSweeper {
   void Jacobian(const SmallVec& u, const SmallVec& f, double h, SmallMat* jac);
   // F(u) and that Jacobian; leaves the points of u in points().
   SmallVec EvaluateWithJacobian(const SmallVec& u, double h, SmallMat* jac);
+  // No lane to spare here (spare_lane() is false): the probe is not swept.
+  SmallVec EvaluateWithJacobian(const SmallVec& u, double h, SmallMat* jac, const SmallVec*,
+                                SmallVec*) {
+    return EvaluateWithJacobian(u, h, jac);
+  }
+  bool spare_lane() const { return false; }
   const Points& points() const { return points_; }
   bool limited() const { return limited_; }
   int sweeps() const { return sweeps_; }

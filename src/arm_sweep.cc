@@ -9,11 +9,10 @@
 #include "wavefront/arm_lanes.h"
 
 namespace flexkin::arm_internal {
-namespace {
 
 // Whether the AVX2 sweeps (src/wavefront/arm_lanes.h) can run here: the CPU has AVX2 and FMA,
 // and FLEXKIN_SIMD (see propagate.cc) does not ask for scalar code.
-bool Avx2Lanes() {
+bool HasAvx2Fma() {
 #if FLEXKIN_HAVE_WAVEFRONT
   static const bool ok = [] {
     __builtin_cpu_init();
@@ -27,8 +26,6 @@ bool Avx2Lanes() {
 #endif
 }
 
-}  // namespace
-
 Sweeper::Sweeper(const ArmModel& model, const Points& start, const Eigen::VectorXd& target,
                  int substeps)
     : model_(model), start_(start), target_(target), substeps_(substeps),
@@ -37,7 +34,7 @@ Sweeper::Sweeper(const ArmModel& model, const Points& start, const Eigen::Vector
   inv_lengths_.resize(n_);
   for (int j = 0; j < n_; ++j) inv_lengths_[j] = 1.0 / model.link_lengths[j];
   lanes_[0].resize(n_ + 1, dim_);
-  fast_ = !has_limits_ && Avx2Lanes();
+  fast_ = !has_limits_ && HasAvx2Fma();
 }
 
 SmallVec Sweeper::FastLanes(int lanes, const double* u, double* points0) {
@@ -100,16 +97,25 @@ void Sweeper::Jacobian(const SmallVec& u, const SmallVec& f, double h, SmallMat*
   }
 }
 
-SmallVec Sweeper::EvaluateWithJacobian(const SmallVec& u, double h, SmallMat* jac) {
+SmallVec Sweeper::EvaluateWithJacobian(const SmallVec& u, double h, SmallMat* jac,
+                                       const SmallVec* probe, SmallVec* f_probe) {
   if (fast_) {
     double us[kMaxLanes * 3];
     for (int c = 0; c <= dim_; ++c) {
       for (int k = 0; k < dim_; ++k) us[c * dim_ + k] = u[k] + (k + 1 == c ? h : 0.0);
     }
+    const bool probing = probe != nullptr && spare_lane();
+    if (probing) {
+      for (int k = 0; k < dim_; ++k) us[(dim_ + 1) * dim_ + k] = (*probe)[k];
+    }
     limited_ = false;
-    const SmallVec f = FastLanes(dim_ + 1, us, lanes_[0].data());
+    const SmallVec f = FastLanes(dim_ + 1 + (probing ? 1 : 0), us, lanes_[0].data());
     for (int c = 0; c < dim_; ++c) {
       for (int k = 0; k < dim_; ++k) (*jac)(k, c) = (fast_bases_[c + 1][k] - f[k]) / h;
+    }
+    if (probing) {
+      f_probe->resize(dim_);
+      for (int k = 0; k < dim_; ++k) (*f_probe)[k] = fast_bases_[dim_ + 1][k];
     }
     return f;
   }

@@ -33,8 +33,10 @@ class Sweeper {
   // from dim lanes swept in one pass. points() is left as it was.
   void Jacobian(const SmallVec& u, const SmallVec& f, double h, SmallMat* jac);
   // F(u) and the forward-difference Jacobian at u, (F(u + h e_k) - F(u)) / h, from dim + 1 lanes
-  // swept in one pass; leaves the points of u in points().
-  SmallVec EvaluateWithJacobian(const SmallVec& u, double h, SmallMat* jac);
+  // swept in one pass; leaves the points of u in points(). With `probe` (only where
+  // spare_lane()), F(probe) into *f_probe from one more lane of the same pass.
+  SmallVec EvaluateWithJacobian(const SmallVec& u, double h, SmallMat* jac,
+                                const SmallVec* probe = nullptr, SmallVec* f_probe = nullptr);
   // One sweep of the given points in place (the fixed-point baseline translates them itself).
   SmallVec SweepInPlace(Points* points);
 
@@ -48,6 +50,8 @@ class Sweeper {
   int passes() const { return passes_; }
   // Whether Jacobian lanes cost about one sweep (the AVX2 lanes), not dim sweeps' worth.
   bool cheap_jacobian() const { return fast_; }
+  // Whether EvaluateWithJacobian has a lane to spare for a probe at no cost (AVX2 lanes, dim 2).
+  bool spare_lane() const { return fast_ && dim_ + 2 <= kMaxLanes; }
 
  private:
   // Sweeps the K lanes' points in place (each n+1 by dim, row-major); limited[l]: whether a

@@ -126,11 +126,23 @@ struct ArmOptions {
 // What the Newton fixed-base solver learned in a step, to start the next one from (continuation
 // along a path: consecutive steps solve nearby problems). ArmStep fills it in the state it returns
 // when Newton converged, and TrackPath passes it on. It is only a hint: ArmStep works without it
-// (the first step, a state built by hand) and checks it (a remembered translation whose base
-// residual exceeds the move is dropped for u = 0), so a stale one costs a sweep, never accuracy.
+// (the first step, a state built by hand) and checks it (a start whose base residual exceeds the
+// move is dropped for u = 0), so a stale one costs a sweep, never accuracy. The next step starts
+// from the translations of the last steps extrapolated along the path (quadratically in the end
+// effector's travel), and probes F's curvature along the last prediction error to correct its
+// first Newton step (docs/robots.md, "The step"). Parts that are missing, of the wrong size or
+// not finite are ignored.
 struct ArmSolverMemory {
   // dim: the translation u that solved the last step (length unit); empty: none.
   Eigen::VectorXd translation;
+  // dim by 0 to 2: the translations that solved the steps before the last, most recent first.
+  Eigen::MatrixXd earlier_translations;
+  // 1 + earlier_translations.cols() values: the length of the end effector's move (target minus
+  // the end effector before the step; length unit) in the last step, then in the earlier ones.
+  Eigen::VectorXd move_lengths;
+  // dim: the last step's translation minus the one it was started from (length unit): where the
+  // next step probes F's curvature. Empty: none.
+  Eigen::VectorXd prediction_error;
   // Whether there is a memory of the right size (dim) with finite values; otherwise it is ignored.
   bool Usable(int dim) const;
 };

@@ -78,9 +78,10 @@ struct EstrinExpImpl {
     const T poly = Fma(z1, r8, z0);
     // k is in [-1022, 0]: (k << 52) + bits(1.0) are the bits of 2^k.
     if constexpr (std::is_same_v<T, double>) {
-      int64_t bits;
+      // Unsigned: the shift drops the high bits by design (a signed shift would overflow).
+      uint64_t bits;
       std::memcpy(&bits, &shifted, sizeof bits);
-      bits = (bits << 52) + int64_t{0x3FF0000000000000};
+      bits = (bits << 52) + uint64_t{0x3FF0000000000000};
       double scale;
       std::memcpy(&scale, &bits, sizeof scale);
       return poly * scale;
