@@ -303,13 +303,7 @@ PeerReport SolveL2WithIpopt(const Eigen::VectorXd& lengths,
     // No console journal at all, and no banner: IPOPT must stay silent in the tests.
     Ipopt::SmartPtr<Ipopt::IpoptApplication> app = new Ipopt::IpoptApplication(false);
     Ipopt::SmartPtr<Ipopt::OptionsList> o = app->Options();
-    o->SetIntegerValue("print_level", 0);
-    o->SetStringValue("sb", "yes");
-    o->SetNumericValue("tol", options.ipopt_tolerance);
-    o->SetIntegerValue("max_iter", options.max_iterations);
-    o->SetStringValue("linear_solver", "mumps");
-    o->SetStringValue("hessian_approximation", options.exact_hessian ? "exact" : "limited-memory");
-    if (options.max_seconds > 0.0) o->SetNumericValue("max_cpu_time", options.max_seconds);
+    internal::SetCommonIpoptOptions(options, GetRawPtr(o));
     // bound_relax_factor (default 1e-8) widens every bound by that much before solving, here
     // absolutely since the bounds are 0: t_j >= -1e-8 and t_j^2 - |x_j - a_j|^2 >= -1e-8, which
     // lets a point that should stay still move by up to 1e-4 for free. 0 keeps the cones exact

@@ -7,6 +7,10 @@
 #include "flexkin/chain.h"
 #include "peer_solvers.h"
 
+namespace Ipopt {
+class OptionsList;
+}
+
 namespace flexkin::peers::internal {
 
 using Clock = std::chrono::steady_clock;
@@ -19,6 +23,10 @@ double ConstraintViolation(const Eigen::VectorXd& lengths, const Points& x);
 // Throws InputError as OverallStep does: the chain, the head's size and values, the options.
 void ValidateInput(const Eigen::VectorXd& lengths, const Eigen::Ref<const Eigen::VectorXd>& head,
                    const PeerOptions& options, const Points& old_points);
+
+// The options both IPOPT adapters set from `options`: silent (no output, no banner), tol,
+// max_iter, MUMPS, exact or limited-memory Hessian, and the CPU time limit if any.
+void SetCommonIpoptOptions(const PeerOptions& options, Ipopt::OptionsList* o);
 
 // The name of an Ipopt::ApplicationReturnStatus, e.g. "Solve_Succeeded"; "unknown" for others.
 const char* IpoptStatusName(int status);

@@ -46,6 +46,16 @@ void ValidateInput(const Eigen::VectorXd& lengths, const Eigen::Ref<const Eigen:
   }
 }
 
+void SetCommonIpoptOptions(const PeerOptions& options, Ipopt::OptionsList* o) {
+  o->SetIntegerValue("print_level", 0);
+  o->SetStringValue("sb", "yes");
+  o->SetNumericValue("tol", options.ipopt_tolerance);
+  o->SetIntegerValue("max_iter", options.max_iterations);
+  o->SetStringValue("linear_solver", "mumps");
+  o->SetStringValue("hessian_approximation", options.exact_hessian ? "exact" : "limited-memory");
+  if (options.max_seconds > 0.0) o->SetNumericValue("max_cpu_time", options.max_seconds);
+}
+
 const char* IpoptStatusName(int status) {
   static const std::pair<Ipopt::ApplicationReturnStatus, const char*> kNames[] = {
       {Ipopt::Solve_Succeeded, "Solve_Succeeded"},
@@ -417,13 +427,7 @@ PeerReport SolveWithIpopt(const Eigen::VectorXd& lengths,
     // No console journal at all, and no banner: IPOPT must stay silent in the tests.
     Ipopt::SmartPtr<Ipopt::IpoptApplication> app = new Ipopt::IpoptApplication(false);
     Ipopt::SmartPtr<Ipopt::OptionsList> o = app->Options();
-    o->SetIntegerValue("print_level", 0);
-    o->SetStringValue("sb", "yes");
-    o->SetNumericValue("tol", options.ipopt_tolerance);
-    o->SetIntegerValue("max_iter", options.max_iterations);
-    o->SetStringValue("linear_solver", "mumps");
-    o->SetStringValue("hessian_approximation", options.exact_hessian ? "exact" : "limited-memory");
-    if (options.max_seconds > 0.0) o->SetNumericValue("max_cpu_time", options.max_seconds);
+    internal::SetCommonIpoptOptions(options, GetRawPtr(o));
     status = app->Initialize("");  // "": no ipopt.opt file from the working directory
     if (status == Ipopt::Solve_Succeeded) {
       Ipopt::SmartPtr<Ipopt::TNLP> nlp =
