@@ -375,13 +375,21 @@ ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
       throw InputError("state.angles", "has " + std::to_string(state.angles.angle.size()) +
                                            " finite values or fewer; expected " + std::to_string(n));
     }
-    arm_internal::RevoluteSweeper sweeper(model, state, target, options.substeps);
-    const SolveResult solved =
-        options.method == FixedBaseMethod::kNewton
-            ? SolveNewton(&sweeper, model, target - state.points.row(n).transpose(), options, tol,
-                          scale, state.memory)
-            : SolveFixedPointRevolute(&sweeper, options, tol);
-    take(solved, sweeper.sweeps(), sweeper.passes());
+    if (options.method == FixedBaseMethod::kNewton) {
+      // Weighted minimum-norm joint motion from the last angles (src/arm_revolute_solve.cc says
+      // why not the sweep); base_error is the end effector's miss, sweeps 0.
+      const arm_internal::RevoluteSolve solved =
+          arm_internal::SolveRevolute(model, state.angles.angle, target, tol, options.max_iterations);
+      points = solved.points;
+      report.base_error = solved.residual;
+      report.iterations = solved.iterations;
+      report.converged = solved.converged;
+      report.limited = solved.limited;
+      report.passes = solved.passes;
+    } else {
+      arm_internal::RevoluteSweeper sweeper(model, state, target, options.substeps);
+      take(SolveFixedPointRevolute(&sweeper, options, tol), sweeper.sweeps(), sweeper.passes());
+    }
   } else {
     Sweeper sweeper(model, state.points, target, options.substeps);
     const SolveResult solved =
