@@ -155,22 +155,4 @@ SmallVec RevoluteSweeper::Evaluate(const SmallVec& u) {
   return points_.row(n_).transpose() - target_;
 }
 
-void RevoluteSweeper::Jacobian(const SmallVec& u, const SmallVec& f, double h, SmallMat* jac) {
-  const Points kept = points_;
-  const bool kept_limited = limited_;
-  for (int k = 0; k < 3; ++k) {
-    SmallVec uk = u;
-    uk[k] += h;
-    jac->col(k) = (Evaluate(uk) - f) / h;
-  }
-  points_ = kept;
-  limited_ = kept_limited;
-}
-
-SmallVec RevoluteSweeper::EvaluateWithJacobian(const SmallVec& u, double h, SmallMat* jac) {
-  const SmallVec f = Evaluate(u);
-  Jacobian(u, f, h, jac);
-  return f;
-}
-
 }  // namespace flexkin::arm_internal

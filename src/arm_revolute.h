@@ -65,22 +65,9 @@ class RevoluteSweeper {
                   int substeps);
   // Sweeps the start translated by u; returns F(u) and leaves the rebuilt points in points().
   SmallVec Evaluate(const SmallVec& u);
-  // The forward-difference Jacobian at u, F(u) being `f`: columns (F(u + h e_k) - f) / h, one
-  // sweep after another. points() is left as it was.
-  void Jacobian(const SmallVec& u, const SmallVec& f, double h, SmallMat* jac);
-  // F(u) and that Jacobian; leaves the points of u in points().
-  SmallVec EvaluateWithJacobian(const SmallVec& u, double h, SmallMat* jac);
-  // No lane to spare here (spare_lane() is false): the probe is not swept.
-  SmallVec EvaluateWithJacobian(const SmallVec& u, double h, SmallMat* jac, const SmallVec*,
-                                SmallVec*) {
-    return EvaluateWithJacobian(u, h, jac);
-  }
-  bool spare_lane() const { return false; }
   const Points& points() const { return points_; }
   bool limited() const { return limited_; }
   int sweeps() const { return sweeps_; }
-  int passes() const { return sweeps_; }  // one sweep per pass
-  bool cheap_jacobian() const { return false; }
 
  private:
   const ArmModel& model_;

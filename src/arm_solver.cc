@@ -119,7 +119,6 @@ ArmSolverMemory Remember(const ArmSolverMemory& memory, int dim, const Vec& u, c
   return next;
 }
 
-// Sweeper: Sweeper, or arm_internal::RevoluteSweeper for revolute joints about given axes.
 // `memory`: the last step's (may be empty or unusable).
 //
 // Each iteration needs F and its Jacobian. Where the sweeper's Jacobian lanes cost about one sweep
@@ -388,7 +387,8 @@ ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
       report.passes = solved.passes;
     } else {
       arm_internal::RevoluteSweeper sweeper(model, state, target, options.substeps);
-      take(SolveFixedPointRevolute(&sweeper, options, tol), sweeper.sweeps(), sweeper.passes());
+      // (One sweep per pass.)
+      take(SolveFixedPointRevolute(&sweeper, options, tol), sweeper.sweeps(), sweeper.sweeps());
     }
   } else {
     Sweeper sweeper(model, state.points, target, options.substeps);
