@@ -59,13 +59,17 @@ double AngleAbout(const Eigen::Vector3d& axis, const Eigen::Vector3d& from, cons
   return std::atan2(axis.dot(f.cross(t)), f.dot(t));
 }
 
-Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle) {
+Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle,
+                       Eigen::MatrixXd* axes) {
   const int n = model.num_links();
   Points points(n + 1, 3);
   points.row(0) = model.base.transpose();
+  if (axes != nullptr) axes->resize(n, 3);
   Eigen::Quaterniond frame = Eigen::Quaterniond::Identity();
   for (int j = 0; j < n; ++j) {
     const Eigen::Vector3d a = model.joint_axes.row(j).transpose();
+    // A rotation about a leaves a fixed: the world axis is the frame above's image of it.
+    if (axes != nullptr) axes->row(j) = (frame * a).transpose();
     frame = (frame * Eigen::Quaterniond(Eigen::AngleAxisd(angle[j], a))).normalized();
     points.row(j + 1) = points.row(j) + model.link_lengths[j] * (frame * RestDirection(model, j)).transpose();
   }

@@ -24,7 +24,9 @@ Eigen::Vector3d RestDirection(const ArmModel& model, int k);
 double AngleAbout(const Eigen::Vector3d& axis, const Eigen::Vector3d& from, const Eigen::Vector3d& to);
 
 // Forward kinematics at `angle` (n): the n+1 points, base first.
-Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle);
+// With `axes`, also each joint's axis in the world (n by 3), as the position Jacobian needs.
+Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle,
+                       Eigen::MatrixXd* axes = nullptr);
 // The angles whose forward kinematics puts every link nearest to the points' link directions
 // (exactly, for points that FK produced).
 Eigen::VectorXd RevoluteInverse(const ArmModel& model, const Points& points);

@@ -24,27 +24,6 @@
 #include "arm_revolute.h"
 
 namespace flexkin::arm_internal {
-namespace {
-
-// Forward kinematics that also gives each joint's axis in the world (n by 3).
-void ForwardWithAxes(const ArmModel& model, const Eigen::VectorXd& angle, Points* points,
-                     Eigen::MatrixXd* axes) {
-  const int n = model.num_links();
-  points->resize(n + 1, 3);
-  axes->resize(n, 3);
-  points->row(0) = model.base.transpose();
-  Eigen::Quaterniond frame = Eigen::Quaterniond::Identity();
-  for (int j = 0; j < n; ++j) {
-    const Eigen::Vector3d a = model.joint_axes.row(j).transpose();
-    // A rotation about a leaves a fixed: the world axis is the frame above's image of it.
-    axes->row(j) = (frame * a).transpose();
-    frame = (frame * Eigen::Quaterniond(Eigen::AngleAxisd(angle[j], a))).normalized();
-    points->row(j + 1) = points->row(j) + model.link_lengths[j] * (frame * RestDirection(model, j)).transpose();
-  }
-}
-
-}  // namespace
-
 RevoluteSolve SolveRevolute(const ArmModel& model, const Eigen::VectorXd& previous,
                             const Eigen::VectorXd& target, double tol, int max_iterations) {
   const int n = model.num_links();
@@ -65,7 +44,7 @@ RevoluteSolve SolveRevolute(const ArmModel& model, const Eigen::VectorXd& previo
   for (int k = 0; k < n; ++k) q[k] = std::clamp(previous[k], lo(k), hi(k));
   Points points, trial_points;
   Eigen::MatrixXd axes, trial_axes;
-  ForwardWithAxes(model, q, &points, &axes);
+  points = RevoluteForward(model, q, &axes);
   ++out.passes;
   // Gauss-Newton toward `goal` until the miss is at most `goal_tol` (or no descent is left).
   Eigen::Vector3d r;
@@ -120,7 +99,7 @@ RevoluteSolve SolveRevolute(const ArmModel& model, const Eigen::VectorXd& previo
       double taken = 0.0;  // the step length accepted
       for (double alpha = 1.0; alpha > 1e-9 && !improved; alpha *= 0.5) {
         for (int k = 0; k < n; ++k) trial[k] = std::clamp(q[k] + alpha * dq[k], lo(k), hi(k));
-        ForwardWithAxes(model, trial, &trial_points, &trial_axes);
+        trial_points = RevoluteForward(model, trial, &trial_axes);
         ++out.passes;
         const Eigen::Vector3d r_trial = trial_points.row(n).transpose() - goal;
         if (r_trial.allFinite() && r_trial.norm() <= (1.0 - 1e-4 * alpha) * r.norm()) {

@@ -135,8 +135,7 @@ ArmSolverMemory Remember(const ArmSolverMemory& memory, int dim, const Vec& u, c
 // along d: s <- s - J^-1 q (s.d / d.d)^2, one fixed-point step on F + J s + F''(s, s) / 2 = 0
 // with F'' taken along d. The correction is kept only if it is at most half the step; the next
 // pass measures the result as always, and the line search guards it like any step.
-template <typename AnySweeper>
-SolveResult SolveNewton(AnySweeper* sweeper, const ArmModel& model, const Vec& move,
+SolveResult SolveNewton(Sweeper* sweeper, const ArmModel& model, const Vec& move,
                         const ArmOptions& options, double tol, double scale,
                         const ArmSolverMemory& memory) {
   const int dim = model.dim;
@@ -241,8 +240,8 @@ SolveResult SolveNewton(AnySweeper* sweeper, const ArmModel& model, const Vec& m
   return best;
 }
 
-SolveResult SolveFixedPoint(Sweeper* sweeper, const ArmModel& model, const Points& start,
-                            const ArmOptions& options, double tol) {
+SolveResult SolveFixedPoint(Sweeper* sweeper, const Points& start, const ArmOptions& options,
+                            double tol) {
   SolveResult result;
   result.points = start;
   Vec f = sweeper->SweepInPlace(&result.points);
@@ -256,7 +255,6 @@ SolveResult SolveFixedPoint(Sweeper* sweeper, const ArmModel& model, const Point
   result.residual = f.norm();
   result.converged = result.residual <= tol;
   result.limited = sweeper->limited();
-  (void)model;
   return result;
 }
 
@@ -379,12 +377,9 @@ ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
       // why not the sweep); base_error is the end effector's miss, sweeps 0.
       const arm_internal::RevoluteSolve solved =
           arm_internal::SolveRevolute(model, state.angles.angle, target, tol, options.max_iterations);
-      points = solved.points;
-      report.base_error = solved.residual;
-      report.iterations = solved.iterations;
-      report.converged = solved.converged;
-      report.limited = solved.limited;
-      report.passes = solved.passes;
+      take(SolveResult{solved.points, solved.residual, solved.iterations, solved.converged,
+                       solved.limited, {}},
+           0, solved.passes);
     } else {
       arm_internal::RevoluteSweeper sweeper(model, state, target, options.substeps);
       // (One sweep per pass.)
@@ -396,7 +391,7 @@ ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
         options.method == FixedBaseMethod::kNewton
             ? SolveNewton(&sweeper, model, target - state.points.row(n).transpose(), options, tol,
                           scale, state.memory)
-            : SolveFixedPoint(&sweeper, model, state.points, options, tol);
+            : SolveFixedPoint(&sweeper, state.points, options, tol);
     take(solved, sweeper.sweeps(), sweeper.passes());
   }
   // Re-anchor: rebuild the points from the joint angles at the fixed base; this also puts any

@@ -65,20 +65,6 @@ class BandMatrix {
     }
     return y;
   }
-  // max_i |(A x - b)_i| for a symmetric A, as MultiplySymmetric (without a temporary).
-  double SymmetricResidual(const Eigen::VectorXd& x, const Eigen::VectorXd& b) const {
-    assert(!lower_);
-    const double* in = x.data();
-    double worst = 0.0;
-    for (int i = 0; i < size_; ++i) {
-      const int first = std::max(0, i - band_), last = std::min(size_ - 1, i + band_);
-      const double* column = &ab_[Index(0, i)];
-      double sum = -b[i];
-      for (int j = first; j <= last; ++j) sum += column[j] * in[j];
-      worst = std::max(worst, std::fabs(sum));
-    }
-    return worst;
-  }
   // y = A x.
   Eigen::VectorXd Multiply(const Eigen::VectorXd& x) const {
     assert(!lower_);

@@ -153,7 +153,7 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
                  (2.0 * lengths[i - 1]);
     }
   };
-  // Gradient of the Lagrangian g + J^T lambda (x rows only), into `result` (no allocation: this
+  // Gradient of the Lagrangian g + J^T lambda (x rows only), into `out` (no allocation: this
   // runs three times per iteration).
   auto lagrangian_gradient_into = [&](const Points& p, const Eigen::VectorXd& grad,
                                       const Eigen::VectorXd& lam, Eigen::VectorXd* out) {
@@ -171,12 +171,6 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
       }
     }
     for (int i = 1; i <= nc; ++i) r[multiplier_row(i)] = 0.0;
-  };
-  auto lagrangian_gradient = [&](const Points& p, const Eigen::VectorXd& grad,
-                                 const Eigen::VectorXd& lam) {
-    Eigen::VectorXd result(size);
-    lagrangian_gradient_into(p, grad, lam, &result);
-    return result;
   };
   // First-order optimality: the Lagrangian's gradient relative to the objective's gradient (now
   // or at the start, whichever is larger). Where the metric is 0 at the solution (a still head,
@@ -467,7 +461,8 @@ OverallReport NewtonSolve(const Eigen::VectorXd& lengths, const Points& old_poin
     if (!stepped) {
       report.objective = value;
       report.constraint_violation = ConstraintViolation(lengths, x);
-      report.optimality = optimality(x, g, lagrangian_gradient(x, g, lambda));
+      lagrangian_gradient_into(x, g, lambda, &lag);
+      report.optimality = optimality(x, g, lag);
       const bool done = report.constraint_violation <= options.constraint_tolerance &&
                         report.optimality <= options.optimality_tolerance;
       report.status = done              ? OverallStatus::kConverged
