@@ -214,7 +214,7 @@ Points ParsePath(const json& path, const std::string& ptr, const ArmModel& model
 ArmOptions ParseSolver(const json& solver, const std::string& ptr) {
   Object(solver, ptr);
   CheckKeys(solver, ptr, {"method", "tolerance", "max_iterations", "max_fixed_point_iterations",
-                          "substeps", "edge_margin"});
+                          "substeps", "edge_margin", "restarts"});
   ArmOptions o;
   if (const json* v = Find(solver, "method")) {
     if (!v->is_string()) TypeFail(*v, ptr + "/method", "\"newton\" or \"fixed_point\"");
@@ -227,6 +227,7 @@ ArmOptions ParseSolver(const json& solver, const std::string& ptr) {
   }
   if (const json* v = Find(solver, "substeps")) o.substeps = Integer(*v, ptr + "/substeps", 1, 1000000);
   if (const json* v = Find(solver, "edge_margin")) o.edge_margin = Number(*v, ptr + "/edge_margin");
+  if (const json* v = Find(solver, "restarts")) o.restarts = Integer(*v, ptr + "/restarts", 0, 1000);
   const std::string why = o.Validate();
   if (!why.empty()) Fail(ptr + "/" + why.substr(0, why.find(':')), why.substr(why.find(':') + 2));
   return o;
@@ -360,6 +361,8 @@ int RobotCommand::Run() const {
     step["reached"] = r.reached;
     step["stretched"] = r.stretched;
     step["limited"] = r.limited;
+    step["joint_space"] = r.joint_space;
+    step["restarts"] = r.restarts;
     doc["steps"].push_back(std::move(step));
   }
   // One key per line and one step per line: readable, and diffs stay local.

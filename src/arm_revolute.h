@@ -31,30 +31,8 @@ Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle,
 // (exactly, for points that FK produced).
 Eigen::VectorXd RevoluteInverse(const ArmModel& model, const Points& points);
 
-// The step of method "newton" for these arms (src/arm_revolute_solve.cc, docs/robots.md): the
-// joint angles q, within the limits, with the end effector at `target`, reached from `previous`
-// by the smallest weighted joint motion: Gauss-Newton whose steps are minimum-norm in
-// (dq)' W (dq), W diagonal with w_k = (distance along the chain from joint k to the end
-// effector / mean link length)^2, so the motion is carried by the joints near the end effector
-// and dies out toward the base. Each iteration is O(n) (the 3 by n position Jacobian and a
-// 3 by 3 solve); a backtracking line search on the miss; an active set for the limits (a joint
-// the step would push out of its limits is held there and the step re-solved without it).
-// Never leaves the limits; where the free joints cannot reach the target it ends at the
-// nearest configuration found (no descent left, or max_iterations).
-struct RevoluteSolve {
-  Eigen::VectorXd angle;   // n joint angles (rad), within the limits
-  Points points;           // their forward kinematics (n+1 by 3, base first)
-  double residual = 0.0;   // |end effector - target| (length)
-  int iterations = 0;      // Gauss-Newton iterations
-  int passes = 0;          // forward-kinematics passes over the links (cost ~ passes * n)
-  bool converged = false;  // residual <= tol
-  bool limited = false;    // a joint ended at one of its limits
-};
-RevoluteSolve SolveRevolute(const ArmModel& model, const Eigen::VectorXd& previous,
-                            const Eigen::VectorXd& target, double tol, int max_iterations);
-
 // The sweep of one step for these arms, now only for the fixed-point baseline (method
-// "fixed_point"): method "newton" uses SolveRevolute. Each link's frame is carried from the end effector
+// "fixed_point"): method "newton" solves in joint space (src/arm_joint_space.h). Each link's frame is carried from the end effector
 // down: the end-effector link turns by the smallest rotation that the tractrix step gives it;
 // every other link's direction, proposed by the tractrix step, is put on the cone of directions
 // that its joint with the link above allows (rotation about that joint's axis, angle within its

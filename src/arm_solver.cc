@@ -18,6 +18,7 @@
 #include <string>
 
 #include "arm_internal.h"
+#include "arm_joint_space.h"
 #include "arm_revolute.h"
 #include "arm_sweep.h"
 #include "flexkin/arm.h"
@@ -325,6 +326,7 @@ std::string ArmOptions::Validate() const {
     return "max_fixed_point_iterations: value " + std::to_string(max_fixed_point_iterations) +
            " is not >= 1";
   }
+  if (restarts < 0) return "restarts: value " + std::to_string(restarts) + " is not >= 0";
   if (substeps < 1) return "substeps: value " + std::to_string(substeps) + " is not >= 1";
   if (!(edge_margin >= 0.0 && edge_margin < 0.5)) {
     return "edge_margin: value " + FormatNumber(edge_margin) + " is not valid; expected 0 <= edge_margin < 0.5";
@@ -339,68 +341,94 @@ void CheckOptions(const ArmOptions& options) {
   if (!why.empty()) throw InputError("options." + why.substr(0, why.find(':')), why.substr(why.find(':') + 2));
 }
 
+// The report of a solve: the points re-anchored (rebuilt from the joint angles at the fixed
+// base, which also puts any joint the sweep could not keep within its limits, the base link
+// between two limits, there), the error measured on them.
+ArmStepReport Report(const ArmModel& model, const Eigen::VectorXd& target, double tol,
+                     const SolveResult& solved, int sweeps, int passes) {
+  const int n = model.num_links();
+  ArmStepReport report;
+  report.base_error = solved.residual;
+  report.iterations = solved.iterations;
+  report.converged = solved.converged;
+  report.limited = solved.limited;
+  report.sweeps = sweeps;
+  report.passes = passes;
+  report.state.memory = solved.memory;
+  report.state.angles = arm_internal::AnglesUnchecked(model, solved.points);
+  report.limited |= arm_internal::ClampToLimits(model, &report.state.angles);
+  report.state.points = arm_internal::ForwardUnchecked(model, report.state.angles);
+  report.ee_error = (report.state.points.row(n).transpose() - target).norm();
+  report.reached = report.converged && report.ee_error <= 2.0 * tol + 1e-13 * model.reach();
+  return report;
+}
+
+// The joint-space solve from `state` (src/arm_joint_space.h); base_error is the end effector's
+// miss, sweeps 0.
+ArmStepReport JointSpaceStep(const ArmModel& model, const ArmState& state,
+                             const Eigen::VectorXd& target, double tol, const ArmOptions& options) {
+  const arm_internal::JointSpaceSolve solved =
+      arm_internal::SolveJointSpace(model, state, target, tol, options.max_iterations, options.restarts);
+  ArmStepReport report = Report(
+      model, target, tol,
+      SolveResult{solved.points, solved.residual, solved.iterations, solved.converged, solved.limited, {}},
+      0, solved.passes);
+  report.joint_space = true;
+  report.restarts = solved.restarts;
+  return report;
+}
+
 // ArmStep on a checked model, options, state and target.
 ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
                           const Eigen::VectorXd& target, const ArmOptions& options) {
   const int n = model.num_links();
   const double scale = model.link_lengths.mean();
   const double tol = options.tolerance * scale;
-  ArmStepReport report;
-  Points points;
   const Vec to_target = target - model.base;
-  // The solver's result into the report (`sweeps` read after the solve).
-  auto take = [&](const SolveResult& solved, int sweeps, int passes) {
-    points = solved.points;
-    report.base_error = solved.residual;
-    report.iterations = solved.iterations;
-    report.converged = solved.converged;
-    report.limited = solved.limited;
-    report.sweeps = sweeps;
-    report.passes = passes;
-    report.state.memory = solved.memory;
-  };
   if (to_target.norm() >= model.reach() * (1.0 - options.edge_margin)) {
     // Out of reach (or on its edge, where the Jacobian is singular): stretched toward the target.
-    report.stretched = true;
-    points.resize(n + 1, model.dim);
+    SolveResult stretched;
+    stretched.points.resize(n + 1, model.dim);
     const Vec dir = to_target.normalized();
-    points.row(0) = model.base.transpose();
-    for (int j = 0; j < n; ++j) points.row(j + 1) = points.row(j) + model.link_lengths[j] * dir.transpose();
-    report.converged = true;
-  } else if (model.has_axes()) {
+    stretched.points.row(0) = model.base.transpose();
+    for (int j = 0; j < n; ++j) {
+      stretched.points.row(j + 1) = stretched.points.row(j) + model.link_lengths[j] * dir.transpose();
+    }
+    stretched.converged = true;
+    ArmStepReport report = Report(model, target, tol, stretched, 0, 0);
+    report.stretched = true;
+    return report;
+  }
+  const bool newton = options.method == FixedBaseMethod::kNewton;
+  if (model.has_axes()) {
     if (state.angles.angle.size() != n || !state.angles.angle.allFinite()) {
       throw InputError("state.angles", "has " + std::to_string(state.angles.angle.size()) +
                                            " finite values or fewer; expected " + std::to_string(n));
     }
-    if (options.method == FixedBaseMethod::kNewton) {
-      // Weighted minimum-norm joint motion from the last angles (src/arm_revolute_solve.cc says
-      // why not the sweep); base_error is the end effector's miss, sweeps 0.
-      const arm_internal::RevoluteSolve solved =
-          arm_internal::SolveRevolute(model, state.angles.angle, target, tol, options.max_iterations);
-      take(SolveResult{solved.points, solved.residual, solved.iterations, solved.converged,
-                       solved.limited, {}},
-           0, solved.passes);
-    } else {
-      arm_internal::RevoluteSweeper sweeper(model, state, target, options.substeps);
-      // (One sweep per pass.)
-      take(SolveFixedPointRevolute(&sweeper, options, tol), sweeper.sweeps(), sweeper.sweeps());
-    }
-  } else {
-    Sweeper sweeper(model, state.points, target, options.substeps);
-    const SolveResult solved =
-        options.method == FixedBaseMethod::kNewton
-            ? SolveNewton(&sweeper, model, target - state.points.row(n).transpose(), options, tol,
-                          scale, state.memory)
-            : SolveFixedPoint(&sweeper, state.points, options, tol);
-    take(solved, sweeper.sweeps(), sweeper.passes());
+    // Method newton: the weighted minimum-norm joint motion from the last angles
+    // (src/arm_joint_space.cc says why not the sweep).
+    if (newton) return JointSpaceStep(model, state, target, tol, options);
+    arm_internal::RevoluteSweeper sweeper(model, state, target, options.substeps);
+    const SolveResult solved = SolveFixedPointRevolute(&sweeper, options, tol);
+    return Report(model, target, tol, solved, sweeper.sweeps(), sweeper.sweeps());  // 1 sweep a pass
   }
-  // Re-anchor: rebuild the points from the joint angles at the fixed base; this also puts any
-  // joint the sweep could not keep within its limits (the base link between two limits) there.
-  report.state.angles = arm_internal::AnglesUnchecked(model, points);
-  report.limited |= arm_internal::ClampToLimits(model, &report.state.angles);
-  report.state.points = arm_internal::ForwardUnchecked(model, report.state.angles);
-  report.ee_error = (report.state.points.row(n).transpose() - target).norm();
-  report.reached = report.converged && report.ee_error <= 2.0 * tol + 1e-13 * model.reach();
+  Sweeper sweeper(model, state.points, target, options.substeps);
+  const SolveResult solved =
+      newton ? SolveNewton(&sweeper, model, target - state.points.row(n).transpose(), options, tol,
+                           scale, state.memory)
+             : SolveFixedPoint(&sweeper, state.points, options, tol);
+  ArmStepReport report = Report(model, target, tol, solved, sweeper.sweeps(), sweeper.passes());
+  if (report.reached || !newton) return report;
+  // The sweep found no root (joint limits saturated near the end effector, where the target
+  // needs bending near the base): the joint-space solve from the last state, kept if it gets
+  // nearer. Its cost adds to the sweep's.
+  ArmStepReport fallback = JointSpaceStep(model, state, target, tol, options);
+  fallback.iterations += report.iterations;
+  fallback.sweeps = report.sweeps;
+  fallback.passes += report.passes;
+  if (fallback.reached || fallback.ee_error < report.ee_error) return fallback;
+  report.iterations = fallback.iterations;
+  report.passes = fallback.passes;
   return report;
 }
 

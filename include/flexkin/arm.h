@@ -113,6 +113,12 @@ struct ArmOptions {
   // baseline needs hundreds to thousands near the edge of the workspace.
   int max_iterations = 100;
   int max_fixed_point_iterations = 100000;
+  // Joint-space solves (ArmStepReport::joint_space) that stall short of the target are started
+  // again up to this many times: twice from the last pose with weights that spread the motion
+  // more evenly along the arm, then from random poses around it (a fixed seed). Each costs up to
+  // a full solve, so a target that the limits put out of reach costs up to restarts + 1 solves.
+  // 0: none. Typical 8.
+  int restarts = 8;
   // Sub-steps of the sweep: the end effector's move to the target is split in this many straight
   // pieces (finer = closer to the continuous tractrix motion). Typical 1.
   int substeps = 1;
@@ -167,6 +173,11 @@ struct ArmStepReport {
   bool reached = false;    // converged and ee_error within the tolerance: the target was reached
   bool stretched = false;  // out of reach: the arm was stretched straight toward the target
   bool limited = false;    // a joint limit was active
+  // The step was solved in joint space (docs/robots.md): always for revolute joints about axes
+  // with method newton; for planar and spherical arms where the sweep found no root. The state's
+  // memory is then empty.
+  bool joint_space = false;
+  int restarts = 0;        // joint-space solves after the first (ArmOptions::restarts)
   std::string BriefReport() const;
 };
 

@@ -1,0 +1,54 @@
+#pragma once
+// The fixed-base step solved in joint space (src/arm_joint_space.cc, docs/robots.md "Revolute
+// joints about given axes" and "Joint limits"): Gauss-Newton on the end effector's position whose
+// every step is the smallest joint motion in a weighted norm that favours the joints near the end
+// effector, with the joint limits as an active set.
+//
+// Method "newton" uses it for revolute joints about given axes (always), and for planar and
+// spherical arms where the tractrix sweep's Newton does not reach a target: with joint limits
+// saturated near the end effector the sweep's base residual may have no root, though the target
+// is reachable.
+
+#include <Eigen/Core>
+
+#include "flexkin/arm.h"
+
+namespace flexkin::arm_internal {
+
+// W^-1 of the weighted norm (dq)' W (dq): entry k is 1 / (d_k / mean link length)^2, d_k the
+// distance along the chain from joint k to the end effector. A joint's lever on the end effector
+// grows about as d_k, so its share of a step, w_k^-1 (J' lambda)_k, falls off about as 1 / d_k.
+Eigen::VectorXd InverseJointWeights(const ArmModel& model);
+
+struct JointSpaceSolve {
+  Points points;           // the arm at the end (n+1 by dim, base first), within the limits
+  double residual = 0.0;   // |end effector - target| (length)
+  int iterations = 0;      // Gauss-Newton iterations
+  int passes = 0;          // forward-kinematics passes over the links (cost ~ passes * n)
+  bool converged = false;  // residual <= tol
+  bool limited = false;    // a joint ended at one of its limits
+  int restarts = 0;        // solves after the first (see SolveJointSpace)
+};
+
+// From the arm at `previous` (its angles for revolute joints about axes, otherwise its points;
+// with the model's lengths and within its limits) to the end effector at `target`: every Gauss-Newton step is the smallest in
+// (dq)' W (dq) that cancels the miss to first order; a backtracking line search on the miss, with
+// Levenberg-Marquardt damping where full steps fail; far targets through intermediate goals half
+// a link apart. Each iteration is O(n). Never leaves the limits; where the target cannot be
+// reached from here it ends at the nearest configuration found (no descent left, or
+// max_iterations). The joints:
+//   revolute about given axes (model.has_axes()): dq the joint angles; a joint the step would
+//     carry past a limit is moved onto it and held, and the rest re-solved (the active set);
+//   planar: the same with every axis z;
+//   spherical: dq_j a rotation vector (3 components) turning links j+1..n about point j; the
+//     bend limit is a cone about link j, and a joint the step would carry out of its cone is
+//     turned onto the cone's nearest direction and held.
+// Gauss-Newton is local: where it stalls short of the target (held joints blocking the way), up
+// to `restarts` more solves (ArmOptions::restarts): with weights that spread the motion more
+// evenly, then from random poses around the last one. The first that converges is taken,
+// otherwise the nearest end found.
+JointSpaceSolve SolveJointSpace(const ArmModel& model, const ArmState& previous,
+                                const Eigen::VectorXd& target, double tol, int max_iterations,
+                                int restarts);
+
+}  // namespace flexkin::arm_internal
