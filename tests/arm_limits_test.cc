@@ -10,6 +10,7 @@
 #include <random>
 #include <string>
 
+#include "arm_test_util.h"
 #include "flexkin/arm.h"
 #include "flexkin/error.h"
 
@@ -33,19 +34,6 @@ ArmModel LimitedArm(int dim, int links, double limit, double turn) {
   return model;
 }
 
-// A pitch/yaw snake: joint axes alternately y and z, limits +-0.6 rad, gently curled.
-ArmModel Snake(int links) {
-  ArmModel m = StraightArm(3, links, 1.0);
-  m.initial.azimuth.resize(0);
-  m.joint_axes.resize(links, 3);
-  for (int j = 0; j < links; ++j) {
-    m.joint_axes.row(j) = j % 2 == 0 ? Eigen::RowVector3d::UnitY() : Eigen::RowVector3d::UnitZ();
-    m.initial.angle[j] = j % 2 == 0 ? 0.15 : 0.1;
-  }
-  m.joint_min = Eigen::VectorXd::Constant(links, -0.6);
-  m.joint_max = Eigen::VectorXd::Constant(links, 0.6);
-  return m;
-}
 
 // Random joint angles within the limits: revolute in [-range, range] (inside the limits),
 // spherical bends in [0, range] about random azimuths.
@@ -156,8 +144,8 @@ TEST(ArmLimits, FarTargetsAreReachedInOneStep) {
     bool needs_restarts;  // measured: some targets need restarts
   };
   const Case cases[] = {
-      {"snake 4", Snake(4), 0.6, 200, true},
-      {"snake 64", Snake(64), 0.3, 40, true},
+      {"snake 4", RevoluteSnake(4), 0.6, 200, true},
+      {"snake 64", RevoluteSnake(64), 0.3, 40, true},
       {"planar 4", LimitedArm(2, 4, 0.6, 0.12), 0.6, 200, true},
       {"planar 16", LimitedArm(2, 16, 0.6, 0.12), 0.6, 200, true},
       {"spherical 16", LimitedArm(3, 16, 0.6, 0.12), 0.6, 40, false},
@@ -185,7 +173,7 @@ TEST(ArmLimits, FarTargetsAreReachedInOneStep) {
 // Without restarts the stall is reported, not hidden: the same far targets of the 64-link snake
 // leave some unreached (measured: 80 of 200), each with finite points and limits held.
 TEST(ArmLimits, WithoutRestartsAStallIsReportedHonestly) {
-  const ArmModel model = Snake(64);
+  const ArmModel model = RevoluteSnake(64);
   ArmOptions options;
   options.restarts = 0;
   std::mt19937 rng(7);
@@ -204,7 +192,7 @@ TEST(ArmLimits, WithoutRestartsAStallIsReportedHonestly) {
 }
 
 TEST(ArmLimits, NegativeRestartsAreRefused) {
-  const ArmModel model = Snake(4);
+  const ArmModel model = RevoluteSnake(4);
   ArmOptions options;
   options.restarts = -1;
   try {

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <random>
 
+#include "arm_test_util.h"
 #include "flexkin/error.h"
 
 namespace flexkin {
@@ -309,20 +310,6 @@ TEST(ArmStep, BadInputIsRefusedWithTheField) {
 namespace flexkin {
 namespace {
 
-// A spatial snake with revolute joints about alternating pitch (y) and yaw (z) axes, limits
-// +-0.6 rad, gently curled.
-ArmModel RevoluteSnake(int links) {
-  ArmModel m = StraightArm(3, links, 1.0);
-  m.initial.azimuth.resize(0);
-  m.joint_axes.resize(links, 3);
-  for (int j = 0; j < links; ++j) {
-    m.joint_axes.row(j) = j % 2 == 0 ? Eigen::RowVector3d::UnitY() : Eigen::RowVector3d::UnitZ();
-    m.initial.angle[j] = j % 2 == 0 ? 0.15 : 0.1;
-  }
-  m.joint_min = Eigen::VectorXd::Constant(links, -0.6);
-  m.joint_max = Eigen::VectorXd::Constant(links, 0.6);
-  return m;
-}
 
 TEST(ArmRevolute, ForwardOfInverseReproducesPoints) {
   ArmModel model = RevoluteSnake(64);

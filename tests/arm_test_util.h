@@ -31,4 +31,19 @@ inline Points Circle(const ArmModel& model, double radius, int m) {
   return path;
 }
 
+// A pitch/yaw snake of unit links: joint axes alternately y and z, limits +-0.6 rad, gently
+// curled (0.15 and 0.1 rad).
+inline ArmModel RevoluteSnake(int links) {
+  ArmModel m = StraightArm(3, links, 1.0);
+  m.initial.azimuth.resize(0);
+  m.joint_axes.resize(links, 3);
+  for (int j = 0; j < links; ++j) {
+    m.joint_axes.row(j) = j % 2 == 0 ? Eigen::RowVector3d::UnitY() : Eigen::RowVector3d::UnitZ();
+    m.initial.angle[j] = j % 2 == 0 ? 0.15 : 0.1;
+  }
+  m.joint_min = Eigen::VectorXd::Constant(links, -0.6);
+  m.joint_max = Eigen::VectorXd::Constant(links, 0.6);
+  return m;
+}
+
 }  // namespace flexkin
