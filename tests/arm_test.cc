@@ -366,7 +366,7 @@ Eigen::VectorXd CheckEveryStepReached(const ArmModel& model, const ArmTrajectory
   return motion;
 }
 
-// The weighted minimum-norm step (src/arm_revolute_solve.cc) reaches every target in a few
+// The weighted minimum-norm step (src/arm_joint_space.cc) reaches every target in a few
 // Gauss-Newton iterations (measured: at most 4), the base fixed and the limits kept, and the
 // motion dies out toward the base: measured total motion 0.55 rad at the end effector's joint,
 // 0.05 in the middle, 0.10 at the base (the tractrix sweep with Newton on its translation left
@@ -403,7 +403,8 @@ TEST(ArmRevolute, ReachesTargetsWithJointsAtTheirLimits) {
 
 // Single steps from the initial pose to far targets (100 end effectors of random angles within
 // the limits, several link lengths away): all reached on the 16-link snake (measured with 200:
-// none missed; on 64 links many single jumps of tens of link lengths are not, docs/robots.md).
+// none missed, even without restarts; the 4- and 64-link snakes need them,
+// tests/arm_limits_test.cc).
 TEST(ArmRevolute, ReachesFarTargetsInOneStep) {
   const int n = 16;
   const ArmModel model = RevoluteSnake(n);
