@@ -2,7 +2,9 @@
 // pseudo-inverse (ChainIkSolverPos_NR + ChainIkSolverVel_pinv) and Levenberg-Marquardt
 // (ChainIkSolverPos_LMA), testing/kdl_peer.h, on the same arm and the same end-effector path:
 // a planar arm of 8 to 512 unit links bent into a circular arc with the end effector at 70% of
-// the reach, the end effector tracing a circle of one link radius in 64 steps, each KDL step
+// the reach, the end effector tracing a circle of one link radius in 64 steps; the same as a
+// spatial arm with spherical joints (8 to 128 links), the circle tilted out of the arc's plane
+// (KDL: three revolute joints per link, testing/kdl_peer.h). Each KDL step
 // warm-started from the previous one, tolerance 1e-10 of a link for all three.
 //   build/bench/arm_kdl_benchmark --benchmark_counters_tabular=true
 // Counters: s/step (time per step); x_flexkin (this solver's time per step over flexkin's, both
@@ -29,15 +31,31 @@ using flexkin::peers::KdlSolver;
 
 using flexkin::bench::ArcArm;
 
+// 64 targets on a circle of one link radius through the end effector's start. Planar: in the
+// plane; spatial: tilted 45 degrees out of the arc's plane, about the x axis.
 flexkin::Points CirclePath(const flexkin::ArmModel& model) {
+  const int dim = model.dim;
   const flexkin::Points start = flexkin::ForwardKinematics(model, model.initial);
-  const Eigen::Vector2d ee = start.row(model.num_links()).transpose();
-  flexkin::Points path(64, 2);
+  const Eigen::VectorXd ee = start.row(model.num_links()).transpose();
+  flexkin::Points path(64, dim);
   for (int i = 0; i < 64; ++i) {
     const double a = 2.0 * M_PI * (i + 1) / 64;
-    path.row(i) = (ee + Eigen::Vector2d(std::cos(a) - 1.0, std::sin(a))).transpose();
+    Eigen::VectorXd p = ee;
+    p[0] += std::cos(a) - 1.0;
+    if (dim == 2) {
+      p[1] += std::sin(a);
+    } else {
+      p[1] += std::sin(a) * std::sqrt(0.5);
+      p[2] += std::sin(a) * std::sqrt(0.5);
+    }
+    path.row(i) = p.transpose();
   }
   return path;
+}
+
+// The scene of a benchmark: range(0) links, range(1) the dimension.
+flexkin::ArmModel Scene(const benchmark::State& state) {
+  return ArcArm(static_cast<int>(state.range(0)), 0.7, static_cast<int>(state.range(1)));
 }
 
 // This thread's CPU time (s): the machine is shared, and Google Benchmark's s/step is CPU time too.
@@ -80,7 +98,7 @@ void SetStepCounters(benchmark::State& state, double steps, double seconds,
 }
 
 void Flexkin(benchmark::State& state) {
-  const flexkin::ArmModel model = ArcArm(static_cast<int>(state.range(0)), 0.7);
+  const flexkin::ArmModel model = Scene(state);
   const flexkin::Points path = CirclePath(model);
   const double reference = FlexkinSecondsPerStep(model, path);
   flexkin::ArmTrajectory t;
@@ -104,7 +122,7 @@ void Flexkin(benchmark::State& state) {
 }
 
 void Kdl(benchmark::State& state, KdlSolver solver) {
-  const flexkin::ArmModel model = ArcArm(static_cast<int>(state.range(0)), 0.7);
+  const flexkin::ArmModel model = Scene(state);
   const flexkin::Points path = CirclePath(model);
   const double reference = FlexkinSecondsPerStep(model, path);
   flexkin::peers::KdlTrajectory t;
@@ -129,9 +147,12 @@ void Kdl(benchmark::State& state, KdlSolver solver) {
 void KdlNrPinv(benchmark::State& state) { Kdl(state, KdlSolver::kNewtonPinv); }
 void KdlLma(benchmark::State& state) { Kdl(state, KdlSolver::kLma); }
 
+// Planar arms of 8 to 512 links; spatial (spherical joints, three KDL joints per link) of 8 to
+// 128 (KDL's pseudo-inverse at 512 spatial links takes seconds per step).
 void Sizes(benchmark::internal::Benchmark* b) {
-  for (int n : {8, 32, 128, 512}) b->Arg(n);
-  b->ArgName("links")->Unit(benchmark::kMicrosecond);
+  for (int n : {8, 32, 128, 512}) b->Args({n, 2});
+  for (int n : {8, 32, 128}) b->Args({n, 3});
+  b->ArgNames({"links", "dim"})->Unit(benchmark::kMicrosecond);
 }
 BENCHMARK(Flexkin)->Apply(Sizes);
 BENCHMARK(KdlNrPinv)->Apply(Sizes);
