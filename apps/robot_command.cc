@@ -361,6 +361,7 @@ int RobotCommand::Run() const {
     step["reached"] = r.reached;
     step["stretched"] = r.stretched;
     step["limited"] = r.limited;
+    step["legs"] = r.legs;
     step["joint_space"] = r.joint_space;
     step["restarts"] = r.restarts;
     doc["steps"].push_back(std::move(step));

@@ -28,6 +28,11 @@
 namespace flexkin {
 namespace {
 
+// Where the sweep finds no root for a far move, the move is tracked in legs of at most this many
+// mean link lengths (see StepChecked).
+constexpr double kLegLength = 0.5;
+constexpr int kFarIterations = 20;
+
 using Vec = arm_internal::SmallVec;
 using Mat = arm_internal::SmallMat;
 using arm_internal::Sweeper;
@@ -378,6 +383,19 @@ ArmStepReport JointSpaceStep(const ArmModel& model, const ArmState& state,
   return report;
 }
 
+// The tractrix sweep's step (planar and spherical arms), solved by Newton or the fixed point.
+ArmStepReport SweepStep(const ArmModel& model, const ArmState& state, const Eigen::VectorXd& target,
+                        double tol, const ArmOptions& options) {
+  const int n = model.num_links();
+  Sweeper sweeper(model, state.points, target, options.substeps);
+  const SolveResult solved =
+      options.method == FixedBaseMethod::kNewton
+          ? SolveNewton(&sweeper, model, target - state.points.row(n).transpose(), options, tol,
+                        model.link_lengths.mean(), state.memory)
+          : SolveFixedPoint(&sweeper, state.points, options, tol);
+  return Report(model, target, tol, solved, sweeper.sweeps(), sweeper.passes());
+}
+
 // ArmStep on a checked model, options, state and target.
 ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
                           const Eigen::VectorXd& target, const ArmOptions& options) {
@@ -412,22 +430,54 @@ ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
     const SolveResult solved = SolveFixedPointRevolute(&sweeper, options, tol);
     return Report(model, target, tol, solved, sweeper.sweeps(), sweeper.sweeps());  // 1 sweep a pass
   }
-  Sweeper sweeper(model, state.points, target, options.substeps);
-  const SolveResult solved =
-      newton ? SolveNewton(&sweeper, model, target - state.points.row(n).transpose(), options, tol,
-                           scale, state.memory)
-             : SolveFixedPoint(&sweeper, state.points, options, tol);
-  ArmStepReport report = Report(model, target, tol, solved, sweeper.sweeps(), sweeper.passes());
+  // A far move (more than one leg, below) gets fewer Newton iterations in one sweep: where
+  // Newton converges it does in a few (at most 10 measured on single jumps across the
+  // workspace), and the legs are the better use of the passes where it does not.
+  const Vec from = state.points.row(n).transpose();
+  const int legs = static_cast<int>(std::ceil((target - from).norm() / (kLegLength * scale)));
+  ArmOptions first = options;
+  if (legs > 1 && newton) first.max_iterations = std::min(options.max_iterations, kFarIterations);
+  ArmStepReport report = SweepStep(model, state, target, tol, first);
   if (report.reached || !newton) return report;
-  // The sweep found no root (joint limits saturated near the end effector, where the target
-  // needs bending near the base): the joint-space solve from the last state, kept if it gets
-  // nearer. Its cost adds to the sweep's.
+  // Costs of the attempts that follow add to the first's.
+  auto add_cost = [](ArmStepReport* to, const ArmStepReport& from) {
+    to->iterations += from.iterations;
+    to->sweeps += from.sweeps;
+    to->passes += from.passes;
+  };
+  // The sweep found no root. (1) A far move: the same straight line in legs, each with the base
+  // held (a short path tracked as TrackPath would).
+  if (legs > 1) {
+    ArmStepReport leg_report;
+    ArmState leg_state = state;
+    leg_state.memory = ArmSolverMemory();
+    int cost_iterations = 0, cost_sweeps = 0, cost_passes = 0;
+    for (int leg = 1; leg <= legs; ++leg) {
+      const Eigen::VectorXd goal = leg == legs ? target : Eigen::VectorXd(from + (target - from) * (double(leg) / legs));
+      leg_report = SweepStep(model, leg_state, goal, tol, options);
+      cost_iterations += leg_report.iterations;
+      cost_sweeps += leg_report.sweeps;
+      cost_passes += leg_report.passes;
+      if (!leg_report.reached) break;
+      leg_state = leg_report.state;
+    }
+    leg_report.legs = legs;
+    leg_report.iterations = cost_iterations;
+    leg_report.sweeps = cost_sweeps;
+    leg_report.passes = cost_passes;
+    add_cost(&leg_report, report);
+    if (leg_report.reached) return leg_report;
+    report.iterations = leg_report.iterations;
+    report.sweeps = leg_report.sweeps;
+    report.passes = leg_report.passes;
+  }
+  // (2) Joint limits saturated near the end effector, where the target needs bending near the
+  // base: the joint-space solve from the last state, kept if it gets nearer.
   ArmStepReport fallback = JointSpaceStep(model, state, target, tol, options);
-  fallback.iterations += report.iterations;
-  fallback.sweeps = report.sweeps;
-  fallback.passes += report.passes;
+  add_cost(&fallback, report);
   if (fallback.reached || fallback.ee_error < report.ee_error) return fallback;
   report.iterations = fallback.iterations;
+  report.sweeps = fallback.sweeps;
   report.passes = fallback.passes;
   return report;
 }

@@ -177,6 +177,10 @@ struct ArmStepReport {
   // with method newton; for planar and spherical arms where the sweep found no root. The state's
   // memory is then empty.
   bool joint_space = false;
+  // A far move on which one sweep found no root, tracked along the same straight line in this
+  // many legs of at most half a mean link, the base held after each (docs/robots.md); 0: one
+  // sweep. iterations, sweeps and passes count all of them.
+  int legs = 0;
   int restarts = 0;        // joint-space solves after the first (ArmOptions::restarts)
   std::string BriefReport() const;
 };
