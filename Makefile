@@ -35,7 +35,7 @@ test-sanitize: deps
 	  ctest --test-dir $(BUILD_SAN) --output-on-failure -j$(JOBS)
 
 bench: build
-	@for b in propagation_benchmark overall_benchmark arm_benchmark arm_kdl_benchmark; do \
+	@for b in propagation_benchmark overall_benchmark arm_benchmark arm_kdl_benchmark arm_limits_benchmark; do \
 	  $(BUILD)/bench/$$b --benchmark_repetitions=5 --benchmark_report_aggregates_only=true || exit 1; \
 	done
 

@@ -19,20 +19,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Planar (dim 2, limits +-limit) or spherical (dim 3, bend cone `limit`) unit links, every joint
-// turned by `turn` (spherical: about azimuths 0.5 j).
-ArmModel LimitedArm(int dim, int links, double limit, double turn) {
-  ArmModel model = StraightArm(dim, links, 1.0);
-  if (dim == 2) {
-    model.joint_min = Eigen::VectorXd::Constant(links, -limit);
-    model.joint_max = Eigen::VectorXd::Constant(links, limit);
-  } else {
-    model.max_bend = Eigen::VectorXd::Constant(links, limit);
-    for (int j = 0; j < links; ++j) model.initial.azimuth[j] = std::remainder(0.5 * j, 2.0 * kPi);
-  }
-  model.initial.angle.setConstant(turn);
-  return model;
-}
 
 
 // Random joint angles within the limits: revolute in [-range, range] (inside the limits),
@@ -85,29 +71,10 @@ TEST(ArmLimits, SaturatedLimitsStillReachEveryTarget) {
     const double limit = 0.2;
     const ArmModel model = LimitedArm(dim, n, limit, 0.0);
     std::mt19937 rng(3);
-    std::uniform_real_distribution<double> unit(-1.0, 1.0);
     int limited = 0, joint_space = 0;
     double ee_turn = 0.0, base_turn = 0.0;
     for (int trial = 0; trial < 5; ++trial) {
-      Eigen::VectorXd phase(n), rate(n), amplitude(n), azimuth(n);
-      for (int j = 0; j < n; ++j) {
-        phase[j] = 3.0 * unit(rng);
-        rate[j] = 1.0 + 0.5 * unit(rng);
-        amplitude[j] = 1.6 * limit * unit(rng);
-        azimuth[j] = 3.0 * unit(rng);
-      }
-      const int m = 100;
-      Points path(m, dim);
-      for (int i = 0; i < m; ++i) {
-        const double t = 0.05 * i;
-        JointAngles a = model.initial;
-        for (int j = 0; j < n; ++j) {
-          const double swing = amplitude[j] * std::sin(rate[j] * t + phase[j]);
-          a.angle[j] = dim == 2 ? std::clamp(swing, -limit, limit) : std::min(std::abs(swing), limit);
-          if (dim == 3) a.azimuth[j] = std::remainder(azimuth[j] + 0.3 * t, 2.0 * kPi);
-        }
-        path.row(i) = ForwardKinematics(model, a).row(n);
-      }
+      const Points path = SaturatingPath(model, limit, 100, &rng);
       const ArmTrajectory t = TrackPath(model, path, ArmOptions());
       EXPECT_EQ(t.unreached, 0) << dim << " trial " << trial << ": " << t.BriefReport();
       Points previous = InitialState(model).points;
