@@ -396,6 +396,39 @@ ArmStepReport SweepStep(const ArmModel& model, const ArmState& state, const Eige
   return Report(model, target, tol, solved, sweeper.sweeps(), sweeper.passes());
 }
 
+// The cost of one attempt (iterations, sweeps, passes) added to another's, or put in its place.
+void AddCost(const ArmStepReport& from, ArmStepReport* to) {
+  to->iterations += from.iterations;
+  to->sweeps += from.sweeps;
+  to->passes += from.passes;
+}
+void SetCost(const ArmStepReport& from, ArmStepReport* to) {
+  to->iterations = from.iterations;
+  to->sweeps = from.sweeps;
+  to->passes = from.passes;
+}
+
+// The move from the end effector to `target` tracked along its straight line in `legs` equal
+// legs, each a sweep step with the base held, as TrackPath would track that line. Stops at the
+// first leg not reached (reached = false; its error is then the leg's). Costs of all legs.
+ArmStepReport LegsStep(const ArmModel& model, const ArmState& state, const Eigen::VectorXd& target,
+                       int legs, double tol, const ArmOptions& options) {
+  const Eigen::VectorXd from = state.points.row(model.num_links()).transpose();
+  ArmStepReport report, cost;
+  ArmState leg_state = state;
+  leg_state.memory = ArmSolverMemory();  // the memory is of a step of another length
+  for (int leg = 1; leg <= legs; ++leg) {
+    const Eigen::VectorXd goal = leg == legs ? target : Eigen::VectorXd(from + (target - from) * (double(leg) / legs));
+    report = SweepStep(model, leg_state, goal, tol, options);
+    AddCost(report, &cost);
+    if (!report.reached) break;
+    leg_state = report.state;
+  }
+  report.legs = legs;
+  SetCost(cost, &report);
+  return report;
+}
+
 // ArmStep on a checked model, options, state and target.
 ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
                           const Eigen::VectorXd& target, const ArmOptions& options) {
@@ -439,46 +472,19 @@ ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
   if (legs > 1 && newton) first.max_iterations = std::min(options.max_iterations, kFarIterations);
   ArmStepReport report = SweepStep(model, state, target, tol, first);
   if (report.reached || !newton) return report;
-  // Costs of the attempts that follow add to the first's.
-  auto add_cost = [](ArmStepReport* to, const ArmStepReport& from) {
-    to->iterations += from.iterations;
-    to->sweeps += from.sweeps;
-    to->passes += from.passes;
-  };
-  // The sweep found no root. (1) A far move: the same straight line in legs, each with the base
-  // held (a short path tracked as TrackPath would).
+  // The sweep found no root. (1) A far move: the same straight line in legs.
   if (legs > 1) {
-    ArmStepReport leg_report;
-    ArmState leg_state = state;
-    leg_state.memory = ArmSolverMemory();
-    int cost_iterations = 0, cost_sweeps = 0, cost_passes = 0;
-    for (int leg = 1; leg <= legs; ++leg) {
-      const Eigen::VectorXd goal = leg == legs ? target : Eigen::VectorXd(from + (target - from) * (double(leg) / legs));
-      leg_report = SweepStep(model, leg_state, goal, tol, options);
-      cost_iterations += leg_report.iterations;
-      cost_sweeps += leg_report.sweeps;
-      cost_passes += leg_report.passes;
-      if (!leg_report.reached) break;
-      leg_state = leg_report.state;
-    }
-    leg_report.legs = legs;
-    leg_report.iterations = cost_iterations;
-    leg_report.sweeps = cost_sweeps;
-    leg_report.passes = cost_passes;
-    add_cost(&leg_report, report);
-    if (leg_report.reached) return leg_report;
-    report.iterations = leg_report.iterations;
-    report.sweeps = leg_report.sweeps;
-    report.passes = leg_report.passes;
+    ArmStepReport legged = LegsStep(model, state, target, legs, tol, options);
+    AddCost(report, &legged);
+    if (legged.reached) return legged;
+    SetCost(legged, &report);
   }
   // (2) Joint limits saturated near the end effector, where the target needs bending near the
   // base: the joint-space solve from the last state, kept if it gets nearer.
   ArmStepReport fallback = JointSpaceStep(model, state, target, tol, options);
-  add_cost(&fallback, report);
+  AddCost(report, &fallback);
   if (fallback.reached || fallback.ee_error < report.ee_error) return fallback;
-  report.iterations = fallback.iterations;
-  report.sweeps = fallback.sweeps;
-  report.passes = fallback.passes;
+  SetCost(fallback, &report);
   return report;
 }
 
