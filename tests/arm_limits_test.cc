@@ -112,7 +112,7 @@ TEST(ArmLimits, FarTargetsAreReachedInOneStep) {
   };
   const Case cases[] = {
       {"snake 4", RevoluteSnake(4), 0.6, 200, true},
-      {"snake 64", RevoluteSnake(64), 0.3, 40, true},
+      {"snake 64", RevoluteSnake(64), 0.3, 20, true},
       {"planar 4", LimitedArm(2, 4, 0.6, 0.12), 0.6, 200, true},
       {"planar 16", LimitedArm(2, 16, 0.6, 0.12), 0.6, 200, true},
       {"spherical 16", LimitedArm(3, 16, 0.6, 0.12), 0.6, 40, false},
