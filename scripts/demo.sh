@@ -21,10 +21,14 @@ echo "== closed form and comparisons"
 echo "== robot arm with a fixed base (docs/robots.md)"
 "$flexkin" robot examples/robot_planar_8link.json -o out/robot_planar_8link.json \
   --csv out/robot_planar_8link_joints.csv
-# The spatial snake read from a URDF (revolute joints about given axes); exit 3 = some targets
-# not reached, a known limitation of these joints (docs/robots.md), so it does not stop the demo.
+# The spatial snake read from a URDF (revolute joints about given axes). Exit 3 would mean some
+# targets not reached (reported, docs/robots.md); it does not stop the demo.
 "$flexkin" robot examples/robot_snake_urdf.json -o out/robot_snake_urdf.json \
   --csv out/robot_snake_urdf_joints.csv || [ $? -eq 3 ]
+# A spatial arm whose bend limits saturate along the path: every target is reachable and reached,
+# most through the joint-space step (docs/robots.md, "Joint limits").
+"$flexkin" robot examples/robot_spatial_limits.json -o out/robot_spatial_limits.json \
+  --csv out/robot_spatial_limits_joints.csv
 echo "== tractrix against the Jacobian pseudo-inverse (Orocos KDL), Ravi et al. 2010's arm"
 for scenario in robot_ravi_lines robot_ravi_circle; do
   "$build/examples/robot_compare" "examples/$scenario.json" "out/${scenario}_compare"
