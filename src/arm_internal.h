@@ -15,7 +15,10 @@ using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3>;
 // ForwardKinematics and JointAnglesFromPoints without their checks of the model and the input
 // (for the solver, whose input is checked once).
 Points ForwardUnchecked(const ArmModel& model, const JointAngles& angles);
-JointAngles AnglesUnchecked(const ArmModel& model, const Points& points);
+// With `rebuilt`, AnglesUnchecked also gives ForwardUnchecked of the angles it returns (the same
+// points bit for bit; for spherical joints from the frames it accumulates anyway, without a
+// second pass).
+JointAngles AnglesUnchecked(const ArmModel& model, const Points& points, Points* rebuilt = nullptr);
 
 // Whether the CPU has AVX2 and FMA and FLEXKIN_SIMD does not ask for scalar code: the AVX2
 // arm code (src/wavefront/arm_lanes.h, arm_anchor.h) may run.

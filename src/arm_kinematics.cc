@@ -272,7 +272,7 @@ Points ForwardUnchecked(const ArmModel& model, const JointAngles& angles) {
   return points;
 }
 
-JointAngles AnglesUnchecked(const ArmModel& model, const Points& points) {
+JointAngles AnglesUnchecked(const ArmModel& model, const Points& points, Points* rebuilt) {
   const int n = model.num_links();
   JointAngles angles;
   angles.angle.resize(n);
@@ -296,14 +296,20 @@ JointAngles AnglesUnchecked(const ArmModel& model, const Points& points) {
       angles.angle[j] = theta;
       heading += theta;
     }
+    if (rebuilt != nullptr) *rebuilt = ForwardUnchecked(model, angles);
     return angles;
   }
   if (model.has_axes()) {
     angles.angle = RevoluteInverse(model, points);
+    if (rebuilt != nullptr) *rebuilt = ForwardUnchecked(model, angles);
     return angles;
   }
   angles.azimuth.resize(n);
   Eigen::Quaterniond frame = BaseFrame(model);
+  if (rebuilt != nullptr) {
+    rebuilt->resize(n + 1, 3);
+    rebuilt->row(0) = model.base.transpose();
+  }
   for (int j = 0; j < n; ++j) {
     const Eigen::Vector3d d = (points.row(j + 1) - points.row(j)).transpose();
     const Eigen::Vector3d v = frame.conjugate() * d;
@@ -311,6 +317,11 @@ JointAngles AnglesUnchecked(const ArmModel& model, const Points& points) {
     angles.angle[j] = std::atan2(side, v.x());
     angles.azimuth[j] = side > 0.0 ? std::atan2(v.z(), v.y()) : 0.0;
     frame = (frame * LocalRotation(angles.angle[j], angles.azimuth[j])).normalized();
+    if (rebuilt != nullptr) {
+      // ForwardUnchecked's operations on the same frame: the same points, bit for bit.
+      const Eigen::Vector3d e = frame * Eigen::Vector3d::UnitX();
+      rebuilt->row(j + 1) = rebuilt->row(j) + model.link_lengths[j] * e.transpose();
+    }
   }
   return angles;
 }

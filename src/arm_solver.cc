@@ -360,9 +360,11 @@ ArmStepReport Report(const ArmModel& model, const Eigen::VectorXd& target, doubl
   report.sweeps = sweeps;
   report.passes = passes;
   report.state.memory = solved.memory;
-  report.state.angles = arm_internal::AnglesUnchecked(model, solved.points);
-  report.limited |= arm_internal::ClampToLimits(model, &report.state.angles);
-  report.state.points = arm_internal::ForwardUnchecked(model, report.state.angles);
+  report.state.angles = arm_internal::AnglesUnchecked(model, solved.points, &report.state.points);
+  if (arm_internal::ClampToLimits(model, &report.state.angles)) {
+    report.limited = true;
+    report.state.points = arm_internal::ForwardUnchecked(model, report.state.angles);
+  }
   report.ee_error = (report.state.points.row(n).transpose() - target).norm();
   report.reached = report.converged && report.ee_error <= 2.0 * tol + 1e-13 * model.reach();
   return report;
