@@ -15,7 +15,7 @@
 #include "flexkin/error.h"
 #include "flexkin/result_io.h"
 #include "flexkin/urdf.h"
-#include "scenario_parser.h"
+#include "io/scenario_parser.h"
 
 namespace flexkin::cli {
 namespace {

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "flexkin/propagate.h"
-#include "sweep.h"
+#include "sequential/sweep.h"
 
 namespace flexkin {
 namespace {

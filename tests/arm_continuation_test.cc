@@ -1,13 +1,13 @@
 // The Newton fixed-base step's continuation along a path (ArmSolverMemory: the extrapolated start
-// and the curvature probe, src/arm_solver.cc) and the planar arm's batched re-anchoring
-// (src/wavefront/arm_anchor.h): two passes per step on a smooth path, convergence through sharp
+// and the curvature probe, src/arm/solver.cc) and the planar arm's batched re-anchoring
+// (src/arm/anchor.h): two passes per step on a smooth path, convergence through sharp
 // corners and broken memories, and the batched atan2 / sine / cosine equal to the C library's.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
-#include "arm_internal.h"
+#include "arm/internal.h"
 #include "arm_test_util.h"
 #include "flexkin/arm.h"
 

@@ -367,7 +367,7 @@ Eigen::VectorXd CheckEveryStepReached(const ArmModel& model, const ArmTrajectory
   return motion;
 }
 
-// The weighted minimum-norm step (src/arm_joint_space.cc) reaches every target in a few
+// The weighted minimum-norm step (src/arm/joint_space.cc) reaches every target in a few
 // Gauss-Newton iterations (measured: at most 4), the base fixed and the limits kept, and the
 // motion dies out toward the base: measured total motion 0.55 rad at the end effector's joint,
 // 0.05 in the middle, 0.10 at the base (the tractrix sweep with Newton on its translation left

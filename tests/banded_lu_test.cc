@@ -2,7 +2,7 @@
 // answers to rounding) and against Eigen's dense LU, and its inertia count against the
 // eigenvalues of the same symmetric matrices.
 
-#include "banded_lu.h"
+#include "overall/banded_lu.h"
 
 #include <gtest/gtest.h>
 

@@ -16,7 +16,7 @@
 #include <type_traits>
 
 #include "flexkin/error.h"
-#include "link_rules.h"
+#include "sequential/link_rules.h"
 #include "reference_ode.h"
 
 namespace flexkin {

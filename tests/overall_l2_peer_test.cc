@@ -257,7 +257,7 @@ TEST(OverallL2PeerTest, SameMinimumAsIpoptOnTheEpigraphForm) {
   // OverallStep converges in every case. (random3d_8_10links / l2 used to stall at optimality
   // 5.8e-12, the rounding level of a point that moved by little, whose direction of motion is
   // known only to eps |x| / r; the optimality measure now counts that level as 0 (see
-  // src/overall_newton.cc), and OverallStep returns IPOPT's minimizer there, 2.54804198313.)
+  // src/overall/newton.cc), and OverallStep returns IPOPT's minimizer there, 2.54804198313.)
   EXPECT_EQ(tally.overall_failed, 0);
 }
 

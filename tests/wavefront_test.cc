@@ -12,7 +12,7 @@
 
 #include "flexkin/propagate.h"
 #include "flexkin/run.h"
-#include "sweep.h"
+#include "sequential/sweep.h"
 
 namespace flexkin {
 namespace {

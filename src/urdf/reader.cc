@@ -9,7 +9,7 @@
 #include <system_error>
 #include <vector>
 
-#include "arm_internal.h"
+#include "arm/internal.h"
 #include "flexkin/error.h"
 #include "flexkin/urdf.h"
 

@@ -3,7 +3,7 @@
 #include <cstdio>
 #include <sstream>
 
-#include "arm_revolute.h"
+#include "arm/revolute.h"
 #include "flexkin/error.h"
 #include "flexkin/urdf.h"
 

@@ -5,11 +5,11 @@
 
 #include <Eigen/Geometry>
 
-#include "arm_internal.h"
-#include "arm_revolute.h"
+#include "arm/internal.h"
+#include "arm/revolute.h"
 #include "flexkin/arm.h"
 #include "flexkin/error.h"
-#include "wavefront/arm_anchor.h"
+#include "arm/anchor.h"
 
 namespace flexkin {
 namespace {

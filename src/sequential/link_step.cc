@@ -5,7 +5,7 @@
 #include <string>
 
 #include "flexkin/error.h"
-#include "link_rules.h"
+#include "sequential/link_rules.h"
 
 namespace flexkin {
 namespace {

@@ -1,4 +1,4 @@
-// The fixed-base step solved in joint space (src/arm_joint_space.h, docs/robots.md).
+// The fixed-base step solved in joint space (src/arm/joint_space.h, docs/robots.md).
 //
 // Why revolute joints about given axes are solved here and not by the tractrix sweep: with such
 // joints the sweep's frames, carried down from the end effector, need not meet the base's, and
@@ -18,7 +18,7 @@
 // in (dq)' W (dq) that cancels r to first order. From the previous pose the first such step is
 // the weighted minimum-norm motion; the next ones only remove what curvature leaves (Gauss-Newton
 // converges quadratically: 4 to 5 iterations to 1e-10 of a link on the tests).
-#include "arm_joint_space.h"
+#include "arm/joint_space.h"
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
@@ -27,8 +27,8 @@
 #include <random>
 #include <vector>
 
-#include "arm_internal.h"
-#include "arm_revolute.h"
+#include "arm/internal.h"
+#include "arm/revolute.h"
 
 namespace flexkin::arm_internal {
 namespace {

@@ -8,7 +8,7 @@
 #include <cstdlib>
 #include <vector>
 
-#include "banded_lu.h"
+#include "overall/banded_lu.h"
 #include "flexkin/overall.h"
 
 namespace flexkin::internal {

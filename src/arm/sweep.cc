@@ -1,16 +1,16 @@
-// The sweep of the fixed-base arm's step (src/arm_sweep.h).
-#include "arm_sweep.h"
+// The sweep of the fixed-base arm's step (src/arm/sweep.h).
+#include "arm/sweep.h"
 
 #include <cstdlib>
 #include <string>
 
-#include "arm_internal.h"
-#include "link_rules.h"
-#include "wavefront/arm_lanes.h"
+#include "arm/internal.h"
+#include "sequential/link_rules.h"
+#include "arm/lanes.h"
 
 namespace flexkin::arm_internal {
 
-// Whether the AVX2 sweeps (src/wavefront/arm_lanes.h) can run here: the CPU has AVX2 and FMA,
+// Whether the AVX2 sweeps (src/arm/lanes.h) can run here: the CPU has AVX2 and FMA,
 // and FLEXKIN_SIMD (see propagate.cc) does not ask for scalar code.
 bool HasAvx2Fma() {
 #if FLEXKIN_HAVE_WAVEFRONT

@@ -21,11 +21,11 @@ Points ForwardUnchecked(const ArmModel& model, const JointAngles& angles);
 JointAngles AnglesUnchecked(const ArmModel& model, const Points& points, Points* rebuilt = nullptr);
 
 // Whether the CPU has AVX2 and FMA and FLEXKIN_SIMD does not ask for scalar code: the AVX2
-// arm code (src/wavefront/arm_lanes.h, arm_anchor.h) may run.
+// arm code (src/arm/lanes.h, arm_anchor.h) may run.
 bool HasAvx2Fma();
 
 // out[i] = atan2(y[i], x[i]) and s[i], c[i] = sin, cos(a[i]) for i < count: batched with AVX2
-// (src/wavefront/arm_anchor.h) where HasAvx2Fma() and `batched`, otherwise the C library's.
+// (src/arm/anchor.h) where HasAvx2Fma() and `batched`, otherwise the C library's.
 // Both agree to a few units in the last place.
 void Atan2All(const double* y, const double* x, int count, double* out, bool batched = true);
 void SinCosAll(const double* a, int count, double* s, double* c, bool batched = true);

@@ -7,7 +7,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "arm_internal.h"
+#include "arm/internal.h"
 #include "flexkin/arm.h"
 
 namespace flexkin::arm_internal {
@@ -32,7 +32,7 @@ Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle,
 Eigen::VectorXd RevoluteInverse(const ArmModel& model, const Points& points);
 
 // The sweep of one step for these arms, now only for the fixed-point baseline (method
-// "fixed_point"): method "newton" solves in joint space (src/arm_joint_space.h). Each link's frame is carried from the end effector
+// "fixed_point"): method "newton" solves in joint space (src/arm/joint_space.h). Each link's frame is carried from the end effector
 // down: the end-effector link turns by the smallest rotation that the tractrix step gives it;
 // every other link's direction, proposed by the tractrix step, is put on the cone of directions
 // that its joint with the link above allows (rotation about that joint's axis, angle within its

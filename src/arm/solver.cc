@@ -17,13 +17,13 @@
 #include <cstdlib>
 #include <string>
 
-#include "arm_internal.h"
-#include "arm_joint_space.h"
-#include "arm_revolute.h"
-#include "arm_sweep.h"
+#include "arm/internal.h"
+#include "arm/joint_space.h"
+#include "arm/revolute.h"
+#include "arm/sweep.h"
 #include "flexkin/arm.h"
 #include "flexkin/error.h"
-#include "link_rules.h"
+#include "sequential/link_rules.h"
 
 namespace flexkin {
 namespace {
@@ -370,7 +370,7 @@ ArmStepReport Report(const ArmModel& model, const Eigen::VectorXd& target, doubl
   return report;
 }
 
-// The joint-space solve from `state` (src/arm_joint_space.h); base_error is the end effector's
+// The joint-space solve from `state` (src/arm/joint_space.h); base_error is the end effector's
 // miss, sweeps 0.
 ArmStepReport JointSpaceStep(const ArmModel& model, const ArmState& state,
                              const Eigen::VectorXd& target, double tol, const ArmOptions& options) {
@@ -459,7 +459,7 @@ ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
                                            " finite values or fewer; expected " + std::to_string(n));
     }
     // Method newton: the weighted minimum-norm joint motion from the last angles
-    // (src/arm_joint_space.cc says why not the sweep).
+    // (src/arm/joint_space.cc says why not the sweep).
     if (newton) return JointSpaceStep(model, state, target, tol, options);
     arm_internal::RevoluteSweeper sweeper(model, state, target, options.substeps);
     const SolveResult solved = SolveFixedPointRevolute(&sweeper, options, tol);

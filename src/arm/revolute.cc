@@ -1,12 +1,12 @@
-// Spatial arms with revolute joints about given axes (src/arm_revolute.h, docs/robots.md).
-#include "arm_revolute.h"
+// Spatial arms with revolute joints about given axes (src/arm/revolute.h, docs/robots.md).
+#include "arm/revolute.h"
 
 #include <cmath>
 #include <string>
 
-#include "arm_internal.h"
+#include "arm/internal.h"
 #include "flexkin/error.h"
-#include "link_rules.h"
+#include "sequential/link_rules.h"
 
 namespace flexkin::arm_internal {
 namespace {

@@ -1,5 +1,5 @@
 #pragma once
-// The sweep of the fixed-base arm's step (src/arm_solver.cc, docs/robots.md), for planar arms and
+// The sweep of the fixed-base arm's step (src/arm/solver.cc, docs/robots.md), for planar arms and
 // spatial arms with spherical joints: translate the arm by u, move the end effector in a straight
 // line to the target and let every link follow by the tractrix step, from the end effector down
 // to the base, putting each link back into its joint's limits as soon as it is placed. F(u) is
@@ -15,7 +15,7 @@
 
 #include <Eigen/Core>
 
-#include "arm_internal.h"
+#include "arm/internal.h"
 #include "flexkin/arm.h"
 
 namespace flexkin::arm_internal {
@@ -71,7 +71,7 @@ class Sweeper {
   const Eigen::VectorXd target_;
   const int substeps_, n_, dim_;
   const bool has_limits_;
-  bool fast_ = false;  // no limits and the CPU has AVX2 + FMA: src/wavefront/arm_lanes.h
+  bool fast_ = false;  // no limits and the CPU has AVX2 + FMA: src/arm/lanes.h
   double fast_bases_[kMaxLanes][3];  // the lanes' F after FastLanes
   Eigen::VectorXd base_direction_;
   std::vector<double> inv_lengths_;

@@ -1,7 +1,7 @@
 // The wavefront engine compiled for one instruction set. CMakeLists.txt builds this file once per
 // instruction set with its flags and FLEXKIN_ISA set to 2 (AVX2+FMA) or 3 (AVX-512);
 // propagate.cc calls the entry point only after checking at run time that the CPU has it.
-#include "wavefront.h"
+#include "sequential/wavefront.h"
 
 namespace flexkin::internal {
 

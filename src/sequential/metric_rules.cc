@@ -11,8 +11,8 @@
 
 #include <Eigen/Geometry>
 
-#include "link_rules.h"
-#include "sweep.h"
+#include "sequential/link_rules.h"
+#include "sequential/sweep.h"
 
 namespace flexkin::internal {
 

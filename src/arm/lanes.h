@@ -1,5 +1,5 @@
 #pragma once
-// The fixed-base arm's sweeps (src/arm_sweep.h) compiled for AVX2 + FMA (arm_lanes.cc, chosen at
+// The fixed-base arm's sweeps (src/arm/sweep.h) compiled for AVX2 + FMA (arm_lanes.cc, chosen at
 // run time by arm_sweep.cc): one translation swept with a scalar loop whose exp has a short
 // dependency chain, or up to 4 translations swept together, one per lane of an AVX2 register.
 // Arms without joint limits only (the limits' projections stay in the generic loop).

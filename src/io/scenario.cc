@@ -6,7 +6,7 @@
 
 #include "flexkin/error.h"
 #include "flexkin/result_io.h"
-#include "scenario_parser.h"
+#include "io/scenario_parser.h"
 
 namespace flexkin {
 namespace scenario_internal {

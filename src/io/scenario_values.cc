@@ -9,7 +9,7 @@
 #include "flexkin/error.h"
 #include "flexkin/leader.h"
 #include "flexkin/propagate.h"
-#include "scenario_parser.h"
+#include "io/scenario_parser.h"
 
 namespace flexkin::scenario_internal {
 

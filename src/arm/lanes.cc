@@ -1,5 +1,5 @@
 // The fixed-base arm's sweeps for AVX2 + FMA (arm_lanes.h). CMakeLists.txt compiles this file
-// with -mavx2 -mfma; src/arm_sweep.cc calls it only after checking that the CPU has both.
+// with -mavx2 -mfma; src/arm/sweep.cc calls it only after checking that the CPU has both.
 //
 // A sweep is latency-bound: each link waits for the one before it, through a sqrt, an exp and a
 // division. Two things shorten or fill that wait here, without touching the link rule
@@ -7,7 +7,7 @@
 // operations instead of Horner's 14), and the point just placed stays in registers for the next
 // link instead of going through memory. Several translations (the finite-difference lanes of a
 // Jacobian) share one register, so they cost about one sweep.
-#include "arm_lanes.h"
+#include "arm/lanes.h"
 
 #include <algorithm>
 #include <cmath>
@@ -17,7 +17,7 @@
 #include <vector>
 #include <xsimd/xsimd.hpp>
 
-#include "../link_rules.h"
+#include "sequential/link_rules.h"
 
 namespace flexkin::internal {
 namespace {

@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "flexkin/error.h"
-#include "link_rules.h"
-#include "sweep.h"
+#include "sequential/link_rules.h"
+#include "sequential/sweep.h"
 
 namespace flexkin {
 namespace {

@@ -1,5 +1,5 @@
 #pragma once
-// The fixed-base step solved in joint space (src/arm_joint_space.cc, docs/robots.md "Revolute
+// The fixed-base step solved in joint space (src/arm/joint_space.cc, docs/robots.md "Revolute
 // joints about given axes" and "Joint limits"): Gauss-Newton on the end effector's position whose
 // every step is the smallest joint motion in a weighted norm that favours the joints near the end
 // effector, with the joint limits as an active set.

@@ -1,7 +1,7 @@
 // Batched atan2 and sine/cosine for the planar arm's re-anchoring (arm_anchor.h), AVX2 + FMA.
 // Only the two functions of the header have external linkage; nothing here instantiates a
 // template that another translation unit could share (checked with nm -C for weak symbols).
-#include "arm_anchor.h"
+#include "arm/anchor.h"
 
 #include <cmath>
 #include <cstdint>

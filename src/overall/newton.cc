@@ -1,4 +1,4 @@
-#include "overall_newton.h"
+#include "overall/newton.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,8 +6,8 @@
 #include <optional>
 #include <vector>
 
-#include "banded_lu.h"
-#include "overall_objective.h"
+#include "overall/banded_lu.h"
+#include "overall/objective.h"
 
 namespace flexkin::internal {
 namespace {

@@ -1,4 +1,4 @@
-#include "overall_objective.h"
+#include "overall/objective.h"
 
 #include <cmath>
 #include <cstdio>

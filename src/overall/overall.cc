@@ -11,8 +11,8 @@
 
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
-#include "overall_newton.h"
-#include "overall_objective.h"
+#include "overall/newton.h"
+#include "overall/objective.h"
 
 namespace flexkin {
 namespace {

@@ -9,8 +9,8 @@
 #include <vector>
 #include <xsimd/xsimd.hpp>
 
-#include "../link_rules.h"
-#include "../sweep.h"
+#include "sequential/link_rules.h"
+#include "sequential/sweep.h"
 #include "flexkin/propagate.h"
 
 namespace flexkin::internal {

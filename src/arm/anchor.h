@@ -1,6 +1,6 @@
 #pragma once
 // The planar arm's re-anchoring (joint angles from points and points from joint angles,
-// src/arm_kinematics.cc) needs one atan2 per joint and one sine and cosine per link. They are
+// src/arm/kinematics.cc) needs one atan2 per joint and one sine and cosine per link. They are
 // independent of each other (only the cheap sums along the arm are sequential), so here they are
 // evaluated four at a time with AVX2 + FMA (arm_anchor.cc, compiled with -mavx2 -mfma; called
 // only after the CPU was checked to have both). xsimd's functions agree with the C library's to
