@@ -65,16 +65,19 @@ void SetCounters(benchmark::State& state, int points, int iterations, double obj
 }
 
 // Each solve starts from the same old configuration: copying it is part of the timed loop, and
-// costs a negligible O(n).
+// costs a negligible O(n). The solves share one workspace, as the steps of a run do, unless
+// `reuse_workspace` is false (each solve then sizes a workspace of its own).
 void RunOverall(benchmark::State& state, const Problem& p,
-                const ObjectiveWeights& weights = ObjectiveWeights{}) {
+                const ObjectiveWeights& weights = ObjectiveWeights{}, bool reuse_workspace = true) {
   OverallOptions options;  // squared objective by default
   options.weights = weights;
   OverallReport report;
+  OverallWorkspace workspace;
+  Chain chain = p.chain;
   for (auto _ : state) {
-    Points points = p.chain.points;
-    report = OverallStep(p.chain.lengths, p.head, options, &points);
-    benchmark::DoNotOptimize(points.data());
+    chain.points = p.chain.points;
+    report = OverallStep(p.head, options, &chain, reuse_workspace ? &workspace : nullptr);
+    benchmark::DoNotOptimize(chain.points.data());
   }
   SetCounters(state, static_cast<int>(p.chain.points.rows()), report.iterations, report.objective,
               report.converged());
@@ -99,6 +102,10 @@ void RunPeer(benchmark::State& state, const Problem& p, PeerSolve solve) {
 
 // Question 1.
 void BM_Parabola_Overall(benchmark::State& state) { RunOverall(state, Parabola()); }
+// The same without a workspace kept from solve to solve: what reusing one saves.
+void BM_Parabola_OverallNoWorkspace(benchmark::State& state) {
+  RunOverall(state, Parabola(), ObjectiveWeights{}, false);
+}
 void BM_Parabola_Slsqp(benchmark::State& state) {
   RunPeer(state, Parabola(), peers::SolveWithSlsqp);
 }
@@ -137,6 +144,7 @@ void BM_Parabola_IpoptL2(benchmark::State& state) {
   state.counters["moving_points"] = moving;
 }
 BENCHMARK(BM_Parabola_Overall)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_Parabola_OverallNoWorkspace)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(BM_Parabola_OverallL2)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(BM_Parabola_IpoptL2)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(BM_Parabola_Slsqp)->Unit(benchmark::kMicrosecond)->UseRealTime();

@@ -152,8 +152,9 @@ void Compare(const Case& c, const std::string& objective, const ObjectiveWeights
   const int n = c.chain.num_links();
   OverallOptions options;
   options.weights = weights;
-  Points overall = c.chain.points;
-  const OverallReport report = OverallStep(c.chain.lengths, c.head, options, &overall);
+  Chain moved = c.chain;
+  const Points& overall = moved.points;
+  const OverallReport report = OverallStep(c.head, options, &moved);
   PeerOptions peer_options;
   peer_options.weights = weights;
   peer_options.max_iterations = max_iterations;
@@ -292,8 +293,9 @@ TEST(OverallL2PeerTest, StartsWhereToldAndRejectsBadInput) {
   options.weights = L2Weights(1, 0, 0);
   OverallOptions overall_options;
   overall_options.weights = options.weights;
-  Points overall = chain.points;
-  const OverallReport report = OverallStep(chain.lengths, head, overall_options, &overall);
+  Chain moved = chain;
+  const Points& overall = moved.points;
+  const OverallReport report = OverallStep(head, overall_options, &moved);
   ASSERT_TRUE(report.converged()) << report.BriefReport();
 
   peers::EpigraphOptions start;

@@ -77,8 +77,9 @@ Points SolveAndCheck(const ObjectiveWeights& w, const Eigen::VectorXd& lengths,
   const int n = static_cast<int>(lengths.size());
   OverallOptions options;
   options.weights = w;
-  Points x = old_points;
-  const OverallReport report = OverallStep(lengths, head, options, &x);
+  Chain moved{old_points, lengths};
+  const Points& x = moved.points;
+  const OverallReport report = OverallStep(head, options, &moved);
   if (report_out != nullptr) *report_out = report;
   EXPECT_TRUE(report.converged()) << report.BriefReport();
   EXPECT_EQ(x.row(0), head.transpose());
@@ -198,8 +199,9 @@ TEST(OverallL2Test, MinimizerIsSparse) {
     SolveAndCheck(L2Weights(1, 0, 0, 0), lengths, p, head, &rng, &report);
     EXPECT_LE(report.moving_points, 3) << "pull " << pull;
     OverallOptions squared;
-    Points x = p;
-    const OverallReport dense = OverallStep(lengths, head, squared, &x);
+    Chain moved{p, lengths};
+    const Points& x = moved.points;
+    const OverallReport dense = OverallStep(head, squared, &moved);
     EXPECT_EQ(dense.moving_points, 20);
     for (int j = 1; j <= 20; ++j) EXPECT_NE(x.row(j), p.row(j)) << "squared metric, point " << j;
   }
@@ -213,7 +215,9 @@ TEST(OverallL2Test, OneLinkIsTheNearestPointOfTheCircle) {
   const Eigen::Vector2d head(-0.3, 0.4);
   OverallOptions options;
   options.weights = L2Weights(1, 0, 0, 0);
-  ASSERT_TRUE(OverallStep(lengths, head, options, &p).converged());
+  Chain moved{p, lengths};
+  ASSERT_TRUE(OverallStep(head, options, &moved).converged());
+  p = moved.points;
   const Eigen::Vector2d expected = head + (Eigen::Vector2d(1.0, 0.0) - head).normalized();
   EXPECT_NEAR((p.row(1).transpose() - expected).norm(), 0.0, 1e-15);
 }
@@ -227,8 +231,9 @@ TEST(OverallL2Test, StraightPullTranslatesTheChain) {
   const Eigen::Vector3d head(-0.2, 0.0, 0.0);
   OverallOptions options;
   options.weights = L2Weights(1, 0, 0, 0);
-  Points x = p;
-  const OverallReport report = OverallStep(lengths, head, options, &x);
+  Chain moved{p, lengths};
+  const Points& x = moved.points;
+  const OverallReport report = OverallStep(head, options, &moved);
   ASSERT_TRUE(report.converged()) << report.BriefReport();
   EXPECT_EQ(report.moving_points, 5);
   for (int i = 1; i <= 5; ++i) EXPECT_NEAR(x(i, 0), 0.5 * i - 0.2, 1e-14);
@@ -281,8 +286,9 @@ TEST(OverallL2Test, StillHeadLeavesTheChainInPlace) {
   const Points p = CurvedPoints(3, 4, 1.0, 0.4);
   OverallOptions options;
   options.weights = L2Weights(1, 0, 0, 0);
-  Points x = p;
-  const OverallReport report = OverallStep(LengthsOf(p), p.row(0).transpose(), options, &x);
+  Chain moved{p, LengthsOf(p)};
+  const Points& x = moved.points;
+  const OverallReport report = OverallStep(p.row(0).transpose(), options, &moved);
   EXPECT_TRUE(report.converged());
   EXPECT_EQ(report.moving_points, 0);
   EXPECT_EQ(x, p);
@@ -293,11 +299,11 @@ TEST(OverallL2Test, RejectsTheCombinationWithTheJointAngleTerm) {
   OverallOptions options;
   options.weights = L2Weights(1, 0, 0, 0);
   options.weights.joint_angle = 1.0;
-  Points x = p;
-  ExpectInputError([&] { OverallStep(LengthsOf(p), Eigen::Vector2d(1.1, 0.1), options, &x); },
+  Chain x{p, LengthsOf(p)};
+  ExpectInputError([&] { OverallStep(Eigen::Vector2d(1.1, 0.1), options, &x); },
                    "weights.joint_angle", "cannot be combined with the L2 metric");
   options.weights = L2Weights(-1, 0, 0, 0);
-  ExpectInputError([&] { OverallStep(LengthsOf(p), Eigen::Vector2d(1.1, 0.1), options, &x); },
+  ExpectInputError([&] { OverallStep(Eigen::Vector2d(1.1, 0.1), options, &x); },
                    "weights.l2", "must be a finite number >= 0");
 }
 

@@ -130,8 +130,9 @@ TEST_P(OverallPeersTest, SameMinimumAsSlsqpAndIpopt) {
 
   OverallOptions options;
   options.weights = c.weights;
-  Points overall = c.chain.points;
-  const OverallReport report = OverallStep(c.chain.lengths, c.head, options, &overall);
+  Chain moved = c.chain;
+  const Points& overall = moved.points;
+  const OverallReport report = OverallStep(c.head, options, &moved);
   ASSERT_TRUE(report.converged()) << report.BriefReport() << peer_results;
   EXPECT_LT(report.constraint_violation, 1e-12) << report.BriefReport();
   EXPECT_NEAR(report.objective,

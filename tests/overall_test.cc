@@ -133,8 +133,9 @@ TEST(OverallStepTest, ReturnsAStrictLocalMinimizerThatKeepsEveryLength) {
                        std::to_string(w.joint_angle));
           OverallOptions options;
           options.weights = w;
-          Points x = old_points;
-          const OverallReport report = OverallStep(lengths, head, options, &x);
+          Chain moved{old_points, lengths};
+          const Points& x = moved.points;
+          const OverallReport report = OverallStep(head, options, &moved);
           ASSERT_TRUE(report.converged()) << report.BriefReport();
           EXPECT_EQ(x.row(0), head.transpose());
           Chain chain{x, lengths};
@@ -168,8 +169,9 @@ TEST(OverallStepTest, OneLinkSquaredIsTheFollowTheLeaderStep) {
     p.row(1) = tail.transpose();
     const Eigen::VectorXd lengths = LengthsOf(p);
     OverallOptions options;
-    Points x = p;
-    const OverallReport report = OverallStep(lengths, head_new, options, &x);
+    Chain moved{p, lengths};
+    const Points& x = moved.points;
+    const OverallReport report = OverallStep(head_new, options, &moved);
     ASSERT_TRUE(report.converged()) << report.BriefReport();
     const Eigen::Vector3d expected = FollowTheLeaderStep(head_old, head_new, tail, lengths[0]);
     // The projection is ill-conditioned when the old tail is near the new head (its direction
@@ -190,9 +192,10 @@ TEST(OverallStepTest, RotationAloneTranslatesTheChain) {
     shift[1] = 0.2;
     OverallOptions options;
     options.weights = {0, 0, 1, 0};
-    Points x = old_points;
+    Chain moved{old_points, lengths};
+    const Points& x = moved.points;
     const OverallReport report =
-        OverallStep(lengths, old_points.row(0).transpose() + shift, options, &x);
+        OverallStep(old_points.row(0).transpose() + shift, options, &moved);
     ASSERT_TRUE(report.converged()) << report.BriefReport();
     EXPECT_LE((x - (old_points.rowwise() + shift.transpose())).cwiseAbs().maxCoeff(), 1e-12);
     EXPECT_LE(report.objective, 1e-24);
@@ -207,8 +210,9 @@ TEST(OverallStepTest, StillHeadLeavesTheChainInPlace) {
     for (const ObjectiveWeights& w : Mixes(dim)) {
       OverallOptions options;
       options.weights = w;
-      Points x = old_points;
-      const OverallReport report = OverallStep(lengths, old_points.row(0).transpose(), options, &x);
+      Chain moved{old_points, lengths};
+      const Points& x = moved.points;
+      const OverallReport report = OverallStep(old_points.row(0).transpose(), options, &moved);
       ASSERT_TRUE(report.converged()) << report.BriefReport();
       EXPECT_LE((x - old_points).cwiseAbs().maxCoeff(), 1e-14);
     }
@@ -224,10 +228,10 @@ TEST(OverallStepTest, WeightedMetricMovesContinuouslyBetweenItsLimits) {
   auto solve = [&](double squared, double rotation) {
     OverallOptions options;
     options.weights = {squared, 0, rotation, 0};
-    Points x = old_points;
-    const OverallReport report = OverallStep(lengths, head, options, &x);
+    Chain moved{old_points, lengths};
+    const OverallReport report = OverallStep(head, options, &moved);
     EXPECT_TRUE(report.converged()) << report.BriefReport();
-    return x;
+    return moved.points;
   };
   const Points rope = solve(1, 0);
   const Points rod = old_points.rowwise() + (head - old_points.row(0).transpose()).transpose();
@@ -254,9 +258,10 @@ TEST(OverallStepTest, ReportsInsteadOfFailingSilently) {
   const Eigen::VectorXd lengths = LengthsOf(old_points);
   OverallOptions options;
   options.max_iterations = 1;
-  Points x = old_points;
+  Chain moved{old_points, lengths};
+  const Points& x = moved.points;
   const OverallReport report =
-      OverallStep(lengths, old_points.row(0).transpose() + Eigen::Vector2d(-2.0, 1.0), options, &x);
+      OverallStep(old_points.row(0).transpose() + Eigen::Vector2d(-2.0, 1.0), options, &moved);
   EXPECT_EQ(report.status, OverallStatus::kMaxIterations);
   EXPECT_FALSE(report.converged());
   EXPECT_NE(report.BriefReport().find("max_iterations"), std::string::npos);
@@ -269,8 +274,8 @@ TEST(OverallStepTest, RejectsInvalidInputNamingTheField) {
   const Eigen::VectorXd lengths = LengthsOf(p2);
   OverallOptions options;
   auto step = [&](const Points& p, const Eigen::VectorXd& head, const OverallOptions& o) {
-    Points x = p;
-    OverallStep(LengthsOf(p), head, o, &x);
+    Chain x{p, LengthsOf(p)};
+    OverallStep(head, o, &x);
   };
   ExpectInputError([&] { step(p2, Eigen::Vector3d(0, 0, 0), options); }, "head");
   ExpectInputError([&] { step(p2, Eigen::Vector2d(NAN, 0), options); }, "head[0]");
@@ -285,10 +290,8 @@ TEST(OverallStepTest, RejectsInvalidInputNamingTheField) {
   bad = options;
   bad.weights = {1, 0, 0, 1};
   ExpectInputError([&] { step(p3, Eigen::Vector3d(0, 0, 0), bad); }, "weights.joint_angle");
-  Points x = p2;
-  ExpectInputError(
-      [&] { OverallStep(Eigen::VectorXd::Ones(2), Eigen::Vector2d(0, 0), options, &x); },
-      "points.lengths");
+  Chain x{p2, Eigen::VectorXd::Ones(2)};
+  ExpectInputError([&] { OverallStep(Eigen::Vector2d(0, 0), options, &x); }, "points.lengths");
 }
 
 }  // namespace

@@ -4,11 +4,15 @@
 // minimizes a metric of the motion subject to every link keeping its length.
 
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 
 #include "flexkin/chain.h"
 
 namespace flexkin {
+namespace internal {
+struct OverallBuffers;
+}  // namespace internal
 
 // The metric of one step, from the old configuration a_0..a_n to the new one x_0..x_n, as a
 // weighted sum of these terms. Link vectors: D_i = x_i - x_{i-1}, D_i^old = a_i - a_{i-1}.
@@ -91,14 +95,35 @@ struct OverallReport {
   std::string BriefReport() const;
 };
 
-// One step: moves point 0 of `points` (the old configuration, (n+1) by dim) to `head` and the
-// other points to the minimizer of `options.weights` subject to |x_i - x_{i-1}| = lengths[i-1].
-// `points` is updated in place (to the best configuration found, even when not converged: check
-// the report). Throws InputError on invalid input (shapes, non-finite values, options; the
+// Everything the overall solver stores while it works (the banded KKT matrix and its factors,
+// gradients, multipliers, trial configurations, the L2 metric's friction bounds ...), kept from
+// one step to the next by a caller that makes many: sized for the chain on first use (for the
+// largest problem it poses), then reused, so that a step allocates nothing once the workspace is
+// warm. (The LU fallback's storage, rarely needed, is sized when first needed.) Opaque; one per
+// thread; a chain of another size or dimension simply resizes it. Costs O(n) memory.
+class OverallWorkspace {
+ public:
+  OverallWorkspace();
+  ~OverallWorkspace();
+  OverallWorkspace(OverallWorkspace&&) noexcept;
+  OverallWorkspace& operator=(OverallWorkspace&&) noexcept;
+
+  internal::OverallBuffers& buffers() { return *buffers_; }  // the solver's own
+
+ private:
+  std::unique_ptr<internal::OverallBuffers> buffers_;
+};
+
+// One step: moves point 0 of `chain->points` (the old configuration, (n+1) by dim) to `head` and
+// the other points to the minimizer of `options.weights` subject to |x_i - x_{i-1}| = L_i
+// (`chain->lengths`, unchanged). `chain->points` is updated in place (to the best configuration
+// found, even when not converged: check the report). `workspace`: the buffers to reuse (see
+// OverallWorkspace); without one, a temporary one is made. Throws InputError on invalid input
+// (the chain, whose field is named "points"; the head's size and values; the options; the
 // joint-angle term in 3D).
-OverallReport OverallStep(const Eigen::VectorXd& lengths,
-                          const Eigen::Ref<const Eigen::VectorXd>& head,
-                          const OverallOptions& options, Points* points);
+OverallReport OverallStep(const Eigen::Ref<const Eigen::VectorXd>& head,
+                          const OverallOptions& options, Chain* chain,
+                          OverallWorkspace* workspace = nullptr);
 
 // The value, gradient (n dim) and, if `hessian` is not null, the Hessian (n dim square, dense:
 // for tests and small problems) of the step metric as a function of x_1..x_n (point 0 fixed at

@@ -27,15 +27,31 @@ namespace flexkin::internal {
 class BandMatrix {
  public:
   enum class Layout { kGeneral, kWithFill, kLowerSymmetric };
-  BandMatrix(int size, int band, Layout layout = Layout::kGeneral)
-      : size_(size),
-        band_(band),
-        ldab_(layout == Layout::kWithFill ? 3 * band + 1
-              : layout == Layout::kGeneral ? 2 * band + 1
-                                           : band + 1),
-        offset_(layout == Layout::kWithFill ? 2 * band : layout == Layout::kGeneral ? band : 0),
-        lower_(layout == Layout::kLowerSymmetric),
-        ab_(static_cast<size_t>(ldab_) * (size + (lower_ ? band : 0))) {}
+  BandMatrix() = default;  // 0 by 0: Resize before use
+  BandMatrix(int size, int band, Layout layout = Layout::kGeneral) { Resize(size, band, layout); }
+
+  // Makes this a zero matrix of the given shape, reusing the storage (no allocation when it is
+  // no larger than before: the overall solver's size changes with its active set).
+  void Resize(int size, int band, Layout layout = Layout::kGeneral) {
+    size_ = size;
+    band_ = band;
+    ldab_ = layout == Layout::kWithFill  ? 3 * band + 1
+            : layout == Layout::kGeneral ? 2 * band + 1
+                                         : band + 1;
+    offset_ = layout == Layout::kWithFill ? 2 * band : layout == Layout::kGeneral ? band : 0;
+    lower_ = layout == Layout::kLowerSymmetric;
+    ab_.assign(static_cast<size_t>(ldab_) * (size + (lower_ ? band : 0)), 0.0);
+  }
+
+  // Makes room for a matrix of that shape without changing this one (the next Resize to it or
+  // smaller then allocates nothing).
+  void Reserve(int size, int band, Layout layout = Layout::kGeneral) {
+    const int ldab = layout == Layout::kWithFill  ? 3 * band + 1
+                     : layout == Layout::kGeneral ? 2 * band + 1
+                                                  : band + 1;
+    ab_.reserve(static_cast<size_t>(ldab) *
+                (size + (layout == Layout::kLowerSymmetric ? band : 0)));
+  }
 
   int size() const { return size_; }
   int band() const { return band_; }
@@ -87,16 +103,28 @@ class BandMatrix {
     return static_cast<size_t>(j) * ldab_ + (offset_ + i - j);
   }
 
-  int size_, band_, ldab_, offset_;
-  bool lower_;
+  int size_ = 0, band_ = 0, ldab_ = 1, offset_ = 0;
+  bool lower_ = false;
   std::vector<double> ab_;
 };
 
 // LU factorization with partial pivoting of a BandMatrix. Cost O(size band^2).
 class BandedLu {
  public:
-  explicit BandedLu(const BandMatrix& shape)
-      : lu_(shape.size(), shape.band(), BandMatrix::Layout::kWithFill), ipiv_(shape.size()) {}
+  BandedLu() = default;  // Resize before use
+  explicit BandedLu(const BandMatrix& shape) { Resize(shape); }
+
+  // Takes the shape of `shape`, reusing the storage.
+  void Resize(const BandMatrix& shape) {
+    lu_.Resize(shape.size(), shape.band(), BandMatrix::Layout::kWithFill);
+    ipiv_.assign(shape.size(), 0);
+    factorized_ = false;
+  }
+  // Makes room for factors of that shape without changing these.
+  void Reserve(int size, int band) {
+    lu_.Reserve(size, band, BandMatrix::Layout::kWithFill);
+    ipiv_.reserve(size);
+  }
 
   // Factors a copy of `a` (of the shape given at construction). False if it is singular.
   bool Factorize(const BandMatrix& a) {
@@ -149,9 +177,16 @@ class BandedLu {
  public:
   // Solves A x = rhs with the last factorization.
   Eigen::VectorXd Solve(const Eigen::VectorXd& rhs) const {
-    assert(factorized_);
+    Eigen::VectorXd solution(rhs.size());
+    SolveInto(rhs, solution);
+    return solution;
+  }
+  // The same into `solution` (of the matrix's size; no allocation).
+  void SolveInto(const Eigen::Ref<const Eigen::VectorXd>& rhs,
+                 Eigen::Ref<Eigen::VectorXd> solution) const {
+    assert(factorized_ && rhs.size() == lu_.size_ && solution.size() == lu_.size_);
     const int n = lu_.size_, kl = lu_.band_, kv = 2 * lu_.band_;
-    Eigen::VectorXd solution = rhs;
+    solution = rhs;
     double* b = solution.data();
     for (int j = 0; j < n; ++j) {  // L, with the row interchanges in order
       if (ipiv_[j] != j) std::swap(b[j], b[ipiv_[j]]);
@@ -166,7 +201,6 @@ class BandedLu {
       b[j] = bj;
       for (int i = std::max(0, j - kv); i < j; ++i) b[i] -= column[i - j] * bj;
     }
-    return solution;
   }
   bool factorized() const { return factorized_; }
 
@@ -193,13 +227,27 @@ class BandedLu {
 // these small systems are solved at every Newton iteration.
 class BandedLdlt {
  public:
-  BandedLdlt(int size, int band)
-      : size_(size),
-        band_(band),
-        a_(size, band, BandMatrix::Layout::kLowerSymmetric),
-        inverse_pivot_(size),
-        work_(size + band) {}
+  BandedLdlt() = default;  // Resize before use
+  BandedLdlt(int size, int band) { Resize(size, band); }
   explicit BandedLdlt(const BandMatrix& shape) : BandedLdlt(shape.size(), shape.band()) {}
+
+  // Takes the shape (size, band), reusing the storage; matrix() is then zero.
+  void Resize(int size, int band) {
+    size_ = size;
+    band_ = band;
+    a_.Resize(size, band, BandMatrix::Layout::kLowerSymmetric);
+    inverse_pivot_.assign(size, 0.0);
+    work_.assign(size + band, 0.0);
+    growth_ = 0.0;
+    negative_ = 0;
+    factorized_ = false;
+  }
+  // Makes room for that shape without changing this factorization.
+  void Reserve(int size, int band) {
+    a_.Reserve(size, band, BandMatrix::Layout::kLowerSymmetric);
+    inverse_pivot_.reserve(size);
+    work_.reserve(size + band);
+  }
 
   // Where to assemble the matrix to factor (call SetZero first); the factors replace it.
   BandMatrix& matrix() { return a_; }
@@ -245,12 +293,13 @@ class BandedLdlt {
   bool factorized() const { return factorized_; }
 
   Eigen::VectorXd Solve(const Eigen::VectorXd& rhs) const {
-    Eigen::VectorXd solution;
-    SolveInto(rhs, &solution);
+    Eigen::VectorXd solution(size_);
+    SolveInto(rhs, solution);
     return solution;
   }
-  // Solve into `solution` (resized if needed; no allocation when it has the right size).
-  void SolveInto(const Eigen::VectorXd& rhs, Eigen::VectorXd* solution) const {
+  // Solve into `solution` (of the matrix's size; no allocation).
+  void SolveInto(const Eigen::Ref<const Eigen::VectorXd>& rhs,
+                 Eigen::Ref<Eigen::VectorXd> solution) const {
     assert(factorized_);
     switch (band_) {
       case 5:
@@ -315,7 +364,8 @@ class BandedLdlt {
   }
 
   template <int B>
-  void SolveFixed(const Eigen::VectorXd& rhs, Eigen::VectorXd* solution) const {
+  void SolveFixed(const Eigen::Ref<const Eigen::VectorXd>& rhs,
+                  Eigen::Ref<Eigen::VectorXd> solution) const {
     const int n = size_, band = B > 0 ? B : band_, width = band + 1;
     const double* l = a_.ab_.data();
     double* y = work_.data();
@@ -339,11 +389,11 @@ class BandedLdlt {
         y[j] = (y[j] - others) - column[1] * y[j + 1];
       }
     }
-    solution->resize(n);
-    for (int i = 0; i < n; ++i) (*solution)[i] = y[i];
+    assert(solution.size() == n);
+    for (int i = 0; i < n; ++i) solution[i] = y[i];
   }
 
-  int size_, band_;
+  int size_ = 0, band_ = 0;
   BandMatrix a_;                       // the matrix, then its factors (lower symmetric layout)
   std::vector<double> inverse_pivot_;  // 1 / D(j)
   mutable std::vector<double> work_;   // the solve's right-hand side, padded

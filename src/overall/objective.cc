@@ -192,7 +192,7 @@ double OverallObjective(const ObjectiveWeights& weights, const Eigen::VectorXd& 
   for (int j = 1; j <= n; ++j) sink.offset[j] = (j - 1) * dim;
   if (gradient != nullptr) {
     gradient->setZero(n * dim);
-    sink.gradient = gradient;
+    sink.gradient = gradient->data();
   }
   internal::Triplets triplets;
   if (hessian != nullptr) sink.hessian = &triplets;

@@ -1,6 +1,6 @@
 #pragma once
 // The step metrics of the overall optimization and their derivatives, shared by the solver
-// (overall.cc) and OverallObjective (overall_objective.cc).
+// (kkt.cc, active_set.cc) and OverallObjective (objective.cc).
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -20,7 +20,7 @@ using Triplets = std::vector<Eigen::Triplet<double>>;
 // `offset[j]` is the first row of point j's coordinates in the unknowns, or -1 for a fixed point.
 struct Sink {
   int dim = 0;
-  Eigen::VectorXd* gradient = nullptr;  // may be null
+  double* gradient = nullptr;  // indexed like the unknowns; may be null
   // The Hessian goes to `band` if set (the solver), else into the quadratic form
   // `*form` += v' H v with v = `form_vector` (indexed like the unknowns) if set, else to
   // `hessian` if set.
@@ -39,7 +39,7 @@ struct Sink {
   bool WantsHessian() const { return band != nullptr || form != nullptr || hessian != nullptr; }
   void Gradient(int j, const double* g, double scale) const {
     if (gradient == nullptr || offset[j] < 0) return;
-    for (int k = 0; k < dim; ++k) (*gradient)[offset[j] + k] += scale * g[k];
+    for (int k = 0; k < dim; ++k) gradient[offset[j] + k] += scale * g[k];
   }
   // Adds scale * block (dim by dim, row-major in `b`) at (point p, point q).
   void Block(int p, int q, const double* b, double scale) const {

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "flexkin/error.h"
+#include "overall/step.h"
 
 namespace flexkin {
 namespace {
@@ -162,8 +163,15 @@ RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& 
 
   const bool overall = options.method == Method::kOverall;
   std::optional<Stepper> stepper;
+  // The overall method: one workspace and one report for all the run's sub-steps, so that they
+  // allocate nothing. The chain, the leader steps and the options are checked above, and the
+  // options against the chain here, once: the sub-steps skip OverallStep's checks.
+  std::optional<OverallWorkspace> workspace;
+  OverallReport overall_report;
   if (overall) {
-    result.weights = options.overall.weights;  // OverallStep checks them against the chain
+    result.weights = options.overall.weights;
+    internal::CheckOverallOptionsForChain(options.overall, chain.dim());
+    workspace.emplace();
   } else {
     stepper = MakeStepper(options.method, chain);
   }
@@ -202,8 +210,9 @@ RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& 
                              : Eigen::VectorXd(start + (double(j) / substeps) * (target - start));
       before = points;
       if (overall) {
-        const OverallReport report = OverallStep(chain.lengths, head, options.overall, &points);
-        Record(report, s + 1, j, &result.overall);
+        internal::OverallStepUnchecked(chain.lengths, head, options.overall, &points,
+                                       &*workspace, &overall_report);
+        Record(overall_report, s + 1, j, &result.overall);
       } else {
         MoveLeader(*stepper, head, 1, &points);
       }
