@@ -99,21 +99,28 @@ void ApplyOverrides(const RunArgs& args, flexkin::RunOptions* options) {
   } else if (*args.substeps_opt && options->max_substeps < options->substeps) {
     options->max_substeps = options->substeps;  // a large --substeps raises the default cap
   }
-  const std::string why = options->Validate();
-  if (why.empty()) return;
-  const std::string field = why.substr(0, why.find(':'));
-  const std::string reason = why.substr(why.find(':') + 2);
-  const bool from_cli = (field == "substeps" && *args.substeps_opt) ||
-                        (field == "record_every" && *args.record_every_opt) ||
-                        (field == "tolerance" && *args.tolerance_opt) ||
-                        (field == "max_substeps" && *args.max_substeps_opt);
-  std::string flag = field;
-  for (char& c : flag) c = c == '_' ? '-' : c;
-  const std::string pointer = field == "substeps"       ? "/leader/substeps"
-                              : field == "record_every" ? "/record/every"
-                              : field == "tolerance"    ? "/accuracy/tolerance"
-                                                        : "/accuracy/max_substeps";
-  throw flexkin::InputError(from_cli ? "--" + flag : args.scenario + ": " + pointer, reason);
+  const flexkin::Problems problems = options->Validate();
+  if (problems.empty()) return;
+  // A value from the command line is named by its option, one from the file by its JSON pointer.
+  const flexkin::Problem& p = problems.front();
+  const flexkin::OptionLocation* location = flexkin::FindOptionLocation(p.field);
+  const bool from_cli = location != nullptr && *location->flag != '\0' &&
+                        ((location->flag == std::string("--substeps") && *args.substeps_opt) ||
+                         (location->flag == std::string("--record-every") && *args.record_every_opt) ||
+                         (location->flag == std::string("--tolerance") && *args.tolerance_opt) ||
+                         (location->flag == std::string("--max-substeps") && *args.max_substeps_opt));
+  flexkin::Problem located = flexkin::InScenarioFile(p);
+  located.field = from_cli ? location->flag : args.scenario + ": " + located.field;
+  throw flexkin::InputError(located);
+}
+
+// The --method help, from the library's vocabulary: every method with its one-line summary.
+std::string MethodHelp() {
+  std::string help = "Overrides the scenario's method:";
+  for (const auto& entry : flexkin::Vocabulary<flexkin::Method>::kEntries) {
+    help += std::string("\n  ") + entry.name + ": " + entry.summary;
+  }
+  return help;
 }
 
 int RunCommand(const RunArgs& args) {
@@ -166,10 +173,10 @@ int ValidateCommand(const std::string& path) {
     std::cout << path << ": " << e.what() << "\n";
     return kExitInvalidInput;
   }
-  const std::vector<flexkin::ScenarioProblem> problems = flexkin::ValidateScenario(json);
+  const flexkin::Problems problems = flexkin::ValidateScenario(json);
   if (!problems.empty()) {
     for (const auto& p : problems) {
-      std::cout << path << ": " << (p.pointer.empty() ? "" : p.pointer + ": ") << p.message << "\n";
+      std::cout << path << ": " << p.Text() << "\n";
     }
     return kExitInvalidInput;
   }
@@ -192,7 +199,7 @@ int Main(int argc, char** argv) {
       ->required();
   run->add_option("-o,--output", args.output, "Result file to write (JSON)")->required();
   run->add_option("--csv", args.csv, "Also write the recorded frames as CSV");
-  args.method_opt = run->add_option("--method", args.method, "tractrix, ftl or overall");
+  args.method_opt = run->add_option("--method", args.method, MethodHelp());
   args.substeps_opt =
       run->add_option("--substeps", args.substeps, "Sub-steps per leader step (>= 1)");
   args.tolerance_opt = run->add_option(

@@ -37,13 +37,13 @@ void Figure(const RenderJob& job, const char* extension) {
 
 void Plots(const RenderJob& job) {
   const bool have_angles = job.file->result.frames.front().link_angles.size() > 0;
-  for (PlotKind kind : kAllPlotKinds) {
+  for (const auto& [kind, name, summary] : Vocabulary<PlotKind>::kEntries) {
     if (kind == PlotKind::kLinkAngles && !have_angles) {
       std::cerr << "flexkin: note: no link_angles plot: the leading end never moves\n";
       continue;
     }
     for (const char* extension : {".svg", ".png"}) {
-      const std::string path = job.base + "_" + PlotKindName(kind) + extension;
+      const std::string path = job.base + "_" + name + extension;
       WritePlot(*job.file, kind, job.plot, path);
       job.written->push_back(path);
     }
@@ -72,64 +72,63 @@ void Gltf(const RenderJob& job, const char* extension) {
   job.written->push_back(path);
 }
 
-struct OutputFormat {
-  const char* name;
-  const char* files;  // what it writes, for --help
+// The writer of each output format (flexkin/render.h names them), in the order they are written.
+// Add a format with one line here and one in the vocabulary.
+struct FormatWriter {
+  OutputFormat format;
   void (*write)(const RenderJob& job);
 };
-
-// The formats, in the order they are written. Add a format with one line here.
-const OutputFormat kFormats[] = {
-    {"svg", "<stem>.svg", [](const RenderJob& j) { Figure(j, ".svg"); }},
-    {"png", "<stem>.png", [](const RenderJob& j) { Figure(j, ".png"); }},
-    {"pdf", "<stem>.pdf", [](const RenderJob& j) { Figure(j, ".pdf"); }},
-    {"plots", "<stem>_{path_length,link_angles,length_error}.{svg,png}", Plots},
-    {"mp4", "<stem>.mp4", [](const RenderJob& j) { Animation(j, ".mp4"); }},
-    {"gif", "<stem>.gif", [](const RenderJob& j) { Animation(j, ".gif"); }},
-    {"html", "<stem>.html", Viewer},
-    {"gltf", "<stem>.gltf", [](const RenderJob& j) { Gltf(j, ".gltf"); }},
-    {"glb", "<stem>.glb", [](const RenderJob& j) { Gltf(j, ".glb"); }},
+const FormatWriter kWriters[] = {
+    {OutputFormat::kSvg, [](const RenderJob& j) { Figure(j, ".svg"); }},
+    {OutputFormat::kPng, [](const RenderJob& j) { Figure(j, ".png"); }},
+    {OutputFormat::kPdf, [](const RenderJob& j) { Figure(j, ".pdf"); }},
+    {OutputFormat::kPlots, Plots},
+    {OutputFormat::kMp4, [](const RenderJob& j) { Animation(j, ".mp4"); }},
+    {OutputFormat::kGif, [](const RenderJob& j) { Animation(j, ".gif"); }},
+    {OutputFormat::kHtml, Viewer},
+    {OutputFormat::kGltf, [](const RenderJob& j) { Gltf(j, ".gltf"); }},
+    {OutputFormat::kGlb, [](const RenderJob& j) { Gltf(j, ".glb"); }},
 };
+static_assert(std::size(kWriters) == std::size(Vocabulary<OutputFormat>::kEntries),
+              "every output format has a writer");
 
-std::string FormatNames() {
-  std::string names;
-  for (const OutputFormat& f : kFormats) names += std::string(names.empty() ? "" : ", ") + f.name;
-  return names;
-}
-
-// "svg,png,plots" -> the table's entries, in table order, each once.
-std::vector<const OutputFormat*> ParseFormats(const std::string& list) {
-  std::vector<bool> chosen(std::size(kFormats), false);
+// "svg,png,plots" -> the writers, in table order, each once.
+std::vector<const FormatWriter*> ParseFormats(const std::string& list) {
+  std::vector<bool> chosen(std::size(kWriters), false);
   size_t start = 0;
   while (start <= list.size()) {
     size_t end = list.find(',', start);
     if (end == std::string::npos) end = list.size();
     const std::string name = list.substr(start, end - start);
     start = end + 1;
+    const NamedValue<OutputFormat>* entry = FindName<OutputFormat>(name);
     size_t i = 0;
-    while (i < std::size(kFormats) && name != kFormats[i].name) ++i;
-    if (i < std::size(kFormats)) {
+    while (entry != nullptr && i < std::size(kWriters) && kWriters[i].format != entry->value) ++i;
+    if (entry != nullptr && i < std::size(kWriters)) {
       chosen[i] = true;
       continue;
     }
+    std::string names;
+    for (const std::string& n : NamesOf<OutputFormat>()) names += (names.empty() ? "" : ", ") + n;
     throw InputError("--formats", "unknown format \"" + name +
-                                      "\"; expected a comma-separated list of " + FormatNames());
+                                      "\"; expected a comma-separated list of " + names);
   }
-  std::vector<const OutputFormat*> formats;
+  std::vector<const FormatWriter*> writers;
   for (size_t i = 0; i < chosen.size(); ++i) {
-    if (chosen[i]) formats.push_back(&kFormats[i]);
+    if (chosen[i]) writers.push_back(&kWriters[i]);
   }
-  return formats;
+  return writers;
 }
 
-// A Validate() message "every_k: ..." as an InputError naming the command-line option.
-void CheckOptions(const std::string& why) {
-  if (why.empty()) return;
-  const size_t colon = why.find(": ");
-  std::string field = why.substr(0, colon);
-  if (field == "every_k") field = "every";
-  for (char& c : field) c = c == '_' ? '-' : c;
-  throw InputError("--" + field, why.substr(colon + 2));
+// The first problem of render options, named by the command-line option that set the member
+// ("every_k" -> "--every", "max_frames" -> "--max-frames").
+void CheckOptions(const Problems& problems) {
+  if (problems.empty()) return;
+  Problem p = problems.front();
+  std::string flag = p.field == "every_k" ? "every" : p.field;
+  for (char& c : flag) c = c == '_' ? '-' : c;
+  p.field = "--" + flag;
+  throw InputError(p);
 }
 
 // OUTDIR/<stem>: <stem> is the result file's name without ".json".
@@ -154,8 +153,8 @@ RenderCommand::RenderCommand(CLI::App* app, const std::string& footer) {
   command_->add_option("-o,--output-dir", args_.output_dir,
                        "Directory for the outputs, created if missing (default: the result's)");
   std::string formats_help = "Comma-separated outputs (default svg,png,plots):";
-  for (const OutputFormat& f : kFormats)
-    formats_help += std::string("\n  ") + f.name + ": " + f.files;
+  for (const auto& entry : Vocabulary<OutputFormat>::kEntries)
+    formats_help += std::string("\n  ") + entry.name + ": " + entry.summary;
   command_->add_option("--formats", args_.formats, formats_help);
   command_->add_option("--every", args_.every,
                        "Figures: draw every K-th recorded frame (default: about 16 frames)");
@@ -179,7 +178,7 @@ RenderCommand::RenderCommand(CLI::App* app, const std::string& footer) {
 }
 
 int RenderCommand::Run() const {
-  const std::vector<const OutputFormat*> formats = ParseFormats(args_.formats);
+  const std::vector<const FormatWriter*> formats = ParseFormats(args_.formats);
   RenderJob job;
   job.figure.every_k = args_.every;
   job.figure.title = job.animation.title = args_.title;
@@ -213,7 +212,7 @@ int RenderCommand::Run() const {
   std::vector<std::string> written;
   job.written = &written;
   try {
-    for (const OutputFormat* format : formats) format->write(job);
+    for (const FormatWriter* format : formats) format->write(job);
   } catch (const InputError& e) {
     throw InputError(args_.result + (e.field().empty() ? "" : ": " + e.field()),
                      std::string(e.what()).substr(e.field().empty() ? 0 : e.field().size() + 2));

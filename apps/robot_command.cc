@@ -46,7 +46,7 @@ void CheckKeys(const json& obj, const std::string& ptr, const std::vector<std::s
     }
     if (!known) {
       Fail(ptr + "/" + scenario_internal::EscapePointerToken(item.key()),
-           "unknown key" + (nearest.empty() ? "; expected one of " + scenario_internal::Quoted(allowed)
+           "unknown key" + (nearest.empty() ? "; expected one of " + QuotedList(allowed)
                                             : "; did you mean \"" + nearest + "\"?"));
     }
   }
@@ -149,13 +149,16 @@ ArmModel ParseArm(const json& arm, const std::string& ptr) {
     Fail(ptr + "/initial_azimuths", "planar arms (dim 2) have no azimuths");
   }
   // What is left (ranges of the limits and the initial angles) is the model's own check.
-  const std::string why = m.Validate();
-  if (!why.empty()) {
-    std::string field = why.substr(0, why.find(':'));
-    if (field.rfind("initial.angle", 0) == 0) field = "initial_angles" + field.substr(13);
-    if (field.rfind("initial.azimuth", 0) == 0) field = "initial_azimuths" + field.substr(15);
-    if (field.rfind("max_bend", 0) == 0) field = "joint_limits/max_bend" + field.substr(8);
-    Fail(ptr + scenario_internal::FieldToPointer(field), why.substr(why.find(':') + 2));
+  if (const std::optional<Problem> problem = m.FirstProblem()) {
+    // The model's members as the robot file names them.
+    std::string field = problem->field;
+    const std::pair<const char*, const char*> keys[] = {{"initial.angle", "initial_angles"},
+                                                        {"initial.azimuth", "initial_azimuths"},
+                                                        {"max_bend", "joint_limits/max_bend"}};
+    for (const auto& [member, key] : keys) {
+      if (field.rfind(member, 0) == 0) field = key + field.substr(std::string(member).size());
+    }
+    Fail(ptr + scenario_internal::FieldToPointer(field), problem->message);
   }
   return m;
 }
@@ -228,8 +231,9 @@ ArmOptions ParseSolver(const json& solver, const std::string& ptr) {
   if (const json* v = Find(solver, "substeps")) o.substeps = Integer(*v, ptr + "/substeps", 1, 1000000);
   if (const json* v = Find(solver, "edge_margin")) o.edge_margin = Number(*v, ptr + "/edge_margin");
   if (const json* v = Find(solver, "restarts")) o.restarts = Integer(*v, ptr + "/restarts", 0, 1000);
-  const std::string why = o.Validate();
-  if (!why.empty()) Fail(ptr + "/" + why.substr(0, why.find(':')), why.substr(why.find(':') + 2));
+  if (const Problems problems = o.Validate(); !problems.empty()) {
+    Fail(ptr + "/" + problems.front().field, problems.front().message);  // the keys are the members
+  }
   return o;
 }
 

@@ -36,7 +36,9 @@ KDL::Vector ToKdl(const Eigen::VectorXd& v) {
 }
 
 void CheckModel(const ArmModel& model) {
-  if (const std::string why = model.Validate(); !why.empty()) throw InputError("arm", why);
+  Problems problems;
+  AppendNested("arm", model.Validate(), &problems);
+  ThrowIfAny(problems);
   if (model.has_limits()) {
     throw InputError("arm.joint_limits",
                      "KDL's NR and LMA solvers have no joint limits; remove the limits to compare");
@@ -49,16 +51,21 @@ const char* KdlSolverName(KdlSolver solver) {
   return solver == KdlSolver::kNewtonPinv ? "kdl_nr_pinv" : "kdl_lma";
 }
 
-std::string KdlOptions::Validate() const {
+Problems KdlOptions::Validate() const {
+  Problems problems;
   if (!(tolerance > 0.0 && tolerance < 1.0)) {
-    return "tolerance: " + std::to_string(tolerance) + " is not in (0, 1)";
+    problems.push_back(Problem::Invalid("tolerance", FormatNumber(tolerance), "in (0, 1)"));
   }
-  if (max_iterations < 1) return "max_iterations: " + std::to_string(max_iterations) + " is not >= 1";
-  if (!(pinv_eps > 0.0)) return "pinv_eps: " + std::to_string(pinv_eps) + " is not > 0";
+  if (max_iterations < 1) {
+    problems.push_back(Problem::Invalid("max_iterations", std::to_string(max_iterations), ">= 1"));
+  }
+  if (!(pinv_eps > 0.0)) {
+    problems.push_back(Problem::Invalid("pinv_eps", FormatNumber(pinv_eps), "> 0"));
+  }
   if (!(lma_eps_joints > 0.0)) {
-    return "lma_eps_joints: " + std::to_string(lma_eps_joints) + " is not > 0";
+    problems.push_back(Problem::Invalid("lma_eps_joints", FormatNumber(lma_eps_joints), "> 0"));
   }
-  return "";
+  return problems;
 }
 
 int KdlJointsPerLink(const ArmModel& model) { return model.dim == 2 ? 1 : 3; }
@@ -125,7 +132,9 @@ Points KdlPoints(const ArmModel& model, const KDL::Chain& chain, const KDL::JntA
 KdlTrajectory TrackPathWithKdl(const ArmModel& model, const Points& path, KdlSolver solver,
                                const KdlOptions& options) {
   const KDL::Chain chain = KdlChain(model);
-  if (const std::string why = options.Validate(); !why.empty()) throw InputError("options", why);
+  Problems problems;
+  AppendNested("options", options.Validate(), &problems);
+  ThrowIfAny(problems);
   if (path.rows() < 1 || path.cols() != model.dim || !path.allFinite()) {
     throw InputError("path", "must be at least one row of " + std::to_string(model.dim) +
                                  " finite coordinates");

@@ -51,8 +51,8 @@ struct KdlOptions {
   double pinv_eps = 1e-5;
   // ChainIkSolverPos_LMA: stop when the joint increments are below this (KDL's default 1e-15).
   double lma_eps_joints = 1e-15;
-  // "" if valid, else "field: reason".
-  std::string Validate() const;
+  // Every problem (empty if valid), each naming its member.
+  Problems Validate() const;
 };
 
 // Joints per link in the KDL chain: 1 (planar) or 3 (spatial).

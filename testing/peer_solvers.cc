@@ -40,7 +40,9 @@ void ValidateInput(const Eigen::VectorXd& lengths, const Eigen::Ref<const Eigen:
     throw InputError("head", "must be " + std::to_string(old_points.cols()) +
                                  " finite coordinates, like the chain's points");
   }
-  if (const std::string why = options.Validate(); !why.empty()) throw InputError("options", why);
+  Problems problems;
+  AppendNested("options", options.Validate(), &problems);
+  ThrowIfAny(problems);
   if (options.weights.joint_angle > 0.0 && old_points.cols() != 2) {
     throw InputError("weights.joint_angle", "is defined for planar (2D) chains only; set it to 0");
   }
@@ -356,16 +358,21 @@ class IpoptStep : public Ipopt::TNLP {
 
 }  // namespace
 
-std::string PeerOptions::Validate() const {
-  if (const std::string why = weights.Validate(); !why.empty()) return why;
+Problems PeerOptions::Validate() const {
+  Problems problems;
+  AppendNested("weights", weights.Validate(), &problems);
   auto positive = [](double v) { return v > 0.0 && std::isfinite(v); };
-  if (!positive(constraint_tolerance)) return "constraint_tolerance: must be a finite number > 0";
-  if (!(xtol_rel >= 0.0) || !(ftol_rel >= 0.0)) return "xtol_rel, ftol_rel: must be >= 0";
-  if (max_evaluations < 1) return "max_evaluations: must be >= 1";
-  if (!positive(ipopt_tolerance)) return "ipopt_tolerance: must be a finite number > 0";
-  if (max_iterations < 0) return "max_iterations: must be >= 0";
-  if (!(max_seconds >= 0.0)) return "max_seconds: must be >= 0 (0 for no limit)";
-  return "";
+  const auto check = [&](bool ok, const char* field, const char* expected) {
+    if (!ok) problems.emplace_back(field, std::string("must be ") + expected, "", expected);
+  };
+  check(positive(constraint_tolerance), "constraint_tolerance", "a finite number > 0");
+  check(xtol_rel >= 0.0, "xtol_rel", ">= 0");
+  check(ftol_rel >= 0.0, "ftol_rel", ">= 0");
+  check(max_evaluations >= 1, "max_evaluations", ">= 1");
+  check(positive(ipopt_tolerance), "ipopt_tolerance", "a finite number > 0");
+  check(max_iterations >= 0, "max_iterations", ">= 0");
+  check(max_seconds >= 0.0, "max_seconds", ">= 0 (0 for no limit)");
+  return problems;
 }
 
 std::string PeerReport::BriefReport() const {

@@ -42,8 +42,8 @@ struct PeerOptions {
   // Both: time limit in seconds (SLSQP: wall clock; IPOPT: CPU time); 0 for none.
   double max_seconds = 0.0;
 
-  // Empty if valid, else the reason naming the field.
-  std::string Validate() const;
+  // Every problem (empty if valid), each naming its member.
+  Problems Validate() const;
 };
 
 // What a peer did. The solver's own verdict is kept as it is: a peer that stops early is

@@ -222,11 +222,11 @@ TEST(CurveErrorTest, ProblemsListsEveryBadField) {
   def.radius = NAN;
   def.links = -3;
   def.link_length = 0.0;
-  const std::vector<InputError> problems = CurveProblems(def);
+  const Problems problems = CurveProblems(def);
   ASSERT_EQ(problems.size(), 3u);
-  EXPECT_EQ(problems[0].field(), "radius");
-  EXPECT_EQ(problems[1].field(), "links");
-  EXPECT_EQ(problems[2].field(), "link_length");
+  EXPECT_EQ(problems[0].field, "radius");
+  EXPECT_EQ(problems[1].field, "links");
+  EXPECT_EQ(problems[2].field, "link_length");
   EXPECT_TRUE(CurveProblems(ArcDef{}).empty());
   EXPECT_TRUE(CurveProblems(HelixDef{}).empty());
   EXPECT_TRUE(CurveProblems(ParabolaDef{}).empty());

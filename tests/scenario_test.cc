@@ -319,9 +319,9 @@ TEST_P(BadScenarioTest, InputErrorNamesTheField) {
   } catch (const InputError&) {
     return;
   }
-  const std::vector<ScenarioProblem> problems = ValidateScenario(doc);
+  const Problems problems = ValidateScenario(doc);
   ASSERT_FALSE(problems.empty());
-  EXPECT_EQ(problems.front().pointer, c.pointer);
+  EXPECT_EQ(problems.front().field, c.pointer);
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenario, BadScenarioTest, testing::ValuesIn(kBadCases),
@@ -337,7 +337,7 @@ TEST(ScenarioValidateTest, ListsEveryProblemNotJustTheFirst) {
     "leader": {"pull": [1, 0], "steps": 0},
     "method": "fast", "record": {"every": 0}})");
   std::vector<std::string> pointers;
-  for (const ScenarioProblem& p : ValidateScenario(doc)) pointers.push_back(p.pointer);
+  for (const Problem& p : ValidateScenario(doc)) pointers.push_back(p.field);
   for (const char* expected :
        {"/curve/colour", "/curve/radius", "/curve/links", "/method", "/record/every"}) {
     EXPECT_NE(std::find(pointers.begin(), pointers.end(), expected), pointers.end()) << expected;
@@ -378,8 +378,8 @@ TEST(ScenarioLoadTest, MissingFileIsASystemErrorNamingThePath) {
 // The keys the parser accepts at `pointer` of `doc`, read from its unknown-key message.
 std::set<std::string> AcceptedKeys(json doc, const std::string& pointer) {
   doc[json::json_pointer(pointer)]["zzz_unknown"] = 1;
-  for (const ScenarioProblem& p : ValidateScenario(doc)) {
-    if (p.pointer != pointer + "/zzz_unknown") continue;
+  for (const Problem& p : ValidateScenario(doc)) {
+    if (p.field != pointer + "/zzz_unknown") continue;
     std::set<std::string> keys;
     const std::string list = p.message.substr(p.message.find("valid keys here are"));
     for (size_t open = list.find('"'); open != std::string::npos;

@@ -51,7 +51,7 @@ TEST(Urdf, RoundTripKeepsLengthsAxesLimitsBaseAndKinematics) {
     arm.joint_max[k] = 0.25 + 0.2 * k;
   }
   arm.base_direction = arm.link_directions.row(0).transpose();
-  ASSERT_EQ(arm.Validate(), "");
+  ASSERT_TRUE(arm.Validate().empty()) << arm.Validate().front().Text();
   const std::string text = UrdfFromArm(arm, "snake");
   const ArmModel back = ArmFromUrdf(text);
   ASSERT_EQ(back.dim, 3);

@@ -13,8 +13,11 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <optional>
 
 #include "flexkin/chain.h"
+#include "flexkin/error.h"
+#include "flexkin/vocabulary.h"
 
 namespace flexkin {
 
@@ -44,6 +47,16 @@ enum class ArmJoint {
   kSpherical,  // "spherical": spatial arms, bend angle and azimuth per joint
 };
 
+template <>
+struct Vocabulary<ArmJoint> {
+  static constexpr const char* kKind = "joint kind";
+  static constexpr NamedValue<ArmJoint> kEntries[] = {
+      {ArmJoint::kRevolute, "revolute",
+       "one angle per joint: planar arms, or spatial arms with joint_axes"},
+      {ArmJoint::kSpherical, "spherical", "spatial arms: bend angle and azimuth per joint"},
+  };
+};
+
 struct ArmModel {
   int dim = 2;                                // 2 (revolute) or 3 (spherical, or revolute with axes)
   Eigen::VectorXd link_lengths;               // n >= 1 positive lengths, base link first
@@ -71,8 +84,10 @@ struct ArmModel {
   int num_links() const { return static_cast<int>(link_lengths.size()); }
   bool has_limits() const { return joint_min.size() > 0 || max_bend.size() > 0; }
   double reach() const { return link_lengths.sum(); }
-  // "" if the model is usable, otherwise "field: reason" (the field as named above).
-  std::string Validate() const;
+  // The first problem that makes the model unusable (none if it is usable), its field the member
+  // as named above ("joint_min[2]", "initial.angle[0]").
+  Problems Validate() const;
+  std::optional<Problem> FirstProblem() const;
 };
 
 // A straight arm of `links` links of length `link_length` from the origin along +x (all joint
@@ -101,9 +116,22 @@ enum class FixedBaseMethod {
   // again from where it is, until the base stays within the tolerance. Converges linearly.
   kFixedPoint,
 };
-const char* FixedBaseMethodName(FixedBaseMethod method);
-// Parses "newton" or "fixed_point"; throws InputError naming `field` otherwise.
-FixedBaseMethod ParseFixedBaseMethod(std::string_view name, const std::string& field = "method");
+
+template <>
+struct Vocabulary<FixedBaseMethod> {
+  static constexpr const char* kKind = "fixed-base method";
+  static constexpr NamedValue<FixedBaseMethod> kEntries[] = {
+      {FixedBaseMethod::kNewton, "newton",
+       "Newton's method on the base translation before one sweep (the default)"},
+      {FixedBaseMethod::kFixedPoint, "fixed_point",
+       "translate back to the base and sweep again until the base stays (linear convergence)"},
+  };
+};
+inline const char* FixedBaseMethodName(FixedBaseMethod method) { return NameOf(method); }
+inline FixedBaseMethod ParseFixedBaseMethod(std::string_view name,
+                                            const std::string& field = "method") {
+  return ParseName<FixedBaseMethod>(name, field);
+}
 
 struct ArmOptions {
   FixedBaseMethod method = FixedBaseMethod::kNewton;  // see FixedBaseMethod
@@ -125,8 +153,8 @@ struct ArmOptions {
   // Targets farther from the base than (1 - edge_margin) times the reach are treated as out of
   // reach: the arm is stretched straight toward them. Typical 1e-9.
   double edge_margin = 1e-9;
-  // "" if valid, otherwise "field: reason".
-  std::string Validate() const;
+  // Every problem (empty if valid), each naming its member ("max_iterations").
+  Problems Validate() const;
 };
 
 // What the Newton fixed-base solver learned in a step, to start the next one from (continuation

@@ -65,10 +65,10 @@ struct HelixDef {
 
 // Every problem with a definition, each an InputError whose field is the member's name
 // ("radius", "links", ...) and whose message gives the value and the valid range. Empty if valid.
-std::vector<InputError> CurveProblems(const LineDef& def);
-std::vector<InputError> CurveProblems(const ParabolaDef& def);
-std::vector<InputError> CurveProblems(const ArcDef& def);
-std::vector<InputError> CurveProblems(const HelixDef& def);
+Problems CurveProblems(const LineDef& def);
+Problems CurveProblems(const ParabolaDef& def);
+Problems CurveProblems(const ArcDef& def);
+Problems CurveProblems(const HelixDef& def);
 
 // The points, (links + 1) by dim (dim = start.size() for a line, 2 for a parabola or arc, 3 for
 // a helix). Throw the first of CurveProblems(def) if there is one.

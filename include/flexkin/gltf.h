@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "flexkin/chain.h"
+#include "flexkin/vocabulary.h"
 #include "flexkin/result_io.h"
 
 namespace flexkin {
@@ -33,10 +34,22 @@ enum class GltfUpAxis {
   kZ,     // flexkin (x, y, z) -> glTF (x, z, -y): z-up data, as Blender shows it after import
 };
 
-// "auto", "y", "z": the names used by the command line and in the file's extras.
-const char* GltfUpAxisName(GltfUpAxis axis);
-// The inverse of GltfUpAxisName; throws InputError naming `field` for anything else.
-GltfUpAxis ParseGltfUpAxis(const std::string& name, const std::string& field = "up_axis");
+// The names used by the command line and in the file's extras.
+template <>
+struct Vocabulary<GltfUpAxis> {
+  static constexpr const char* kKind = "up axis";
+  static constexpr NamedValue<GltfUpAxis> kEntries[] = {
+      {GltfUpAxis::kAuto, "auto", "y for 2D results, z for 3D results"},
+      {GltfUpAxis::kY, "y", "flexkin's y points up: no rotation"},
+      {GltfUpAxis::kZ, "z", "flexkin's z points up, as Blender shows z-up data"},
+  };
+};
+inline const char* GltfUpAxisName(GltfUpAxis axis) { return NameOf(axis); }
+// Throws InputError naming `field` and listing the names.
+inline GltfUpAxis ParseGltfUpAxis(const std::string& name,
+                                  const std::string& field = "up_axis") {
+  return ParseName<GltfUpAxis>(name, field);
+}
 
 struct GltfOptions {
   // Playback speed: one leader step lasts 1 / steps_per_second seconds, so frame f's keyframe is
@@ -56,8 +69,8 @@ struct GltfOptions {
   // Which flexkin axis points up in glTF; see GltfUpAxis.
   GltfUpAxis up_axis = GltfUpAxis::kAuto;
 
-  // Empty if the options are valid, otherwise the reason, naming the field.
-  std::string Validate() const;
+  // Every problem (empty if valid), each naming its member ("tube_sides").
+  Problems Validate() const;
 };
 
 // Writes `result`'s frames to `path` as glTF 2.0: binary (.glb) or JSON with the buffer embedded

@@ -8,11 +8,32 @@
 #include <string>
 
 #include "flexkin/chain.h"
+#include "flexkin/error.h"
+#include "flexkin/vocabulary.h"
 
 namespace flexkin {
 namespace internal {
 struct OverallBuffers;
 }  // namespace internal
+
+// The terms of the step metric (the members of ObjectiveWeights below).
+enum class ObjectiveTerm { kL2, kL2Weighted, kSquared, kSquaredWeighted, kRotation, kJointAngle };
+
+template <>
+struct Vocabulary<ObjectiveTerm> {
+  static constexpr const char* kKind = "objective term";
+  static constexpr NamedValue<ObjectiveTerm> kEntries[] = {
+      {ObjectiveTerm::kL2, "l2", "sum of the distances the points move (the paper's L2 metric)"},
+      {ObjectiveTerm::kL2Weighted, "l2_weighted", "the same weighted by arc length (eq. 6)"},
+      {ObjectiveTerm::kSquared, "squared", "sum of the squared distances the points move"},
+      {ObjectiveTerm::kSquaredWeighted, "squared_weighted",
+       "the same weighted by arc length (the squared form of eq. 6)"},
+      {ObjectiveTerm::kRotation, "rotation",
+       "body rotation: sum over links of |D_i - D_i_old|^2 / L_i (Sec. 4.1)"},
+      {ObjectiveTerm::kJointAngle, "joint_angle",
+       "joint-angle change, planar chains only: sum of L_mean (psi_i - psi_i_old)^2 (Sec. 4.2)"},
+  };
+};
 
 // The metric of one step, from the old configuration a_0..a_n to the new one x_0..x_n, as a
 // weighted sum of these terms. Link vectors: D_i = x_i - x_{i-1}, D_i^old = a_i - a_{i-1}.
@@ -43,8 +64,13 @@ struct ObjectiveWeights {
   // end): the discrete form of eq. (6).
   double l2_weighted = 0.0;
 
-  // Empty if valid (every weight finite and >= 0, at least one > 0), else the reason.
-  std::string Validate() const;
+  // The weight of `term` (one of the members above).
+  double& operator[](ObjectiveTerm term);
+  double operator[](ObjectiveTerm term) const;
+
+  // Every problem (empty if valid: every weight finite and >= 0, at least one > 0, no L2 term
+  // with the joint-angle term), each naming its member ("l2").
+  Problems Validate() const;
 };
 
 // Options of the overall solver (an SQP/Newton method on the KKT system, whose linear algebra is
@@ -62,8 +88,8 @@ struct OverallOptions {
   // Newton iterations at most. Typical: 50.
   int max_iterations = 50;
 
-  // Empty if valid, else the reason naming the field.
-  std::string Validate() const;
+  // Every problem (empty if valid), each naming its member ("max_iterations", "weights.l2").
+  Problems Validate() const;
 };
 
 enum class OverallStatus {

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 
 #include "flexkin/chain.h"
+#include "flexkin/vocabulary.h"
 
 namespace flexkin {
 
@@ -25,16 +26,33 @@ enum class Method {
   kOverall,
 };
 
-// The one vocabulary for method names, shared by the CLI, files and messages.
-const char* MethodName(Method method);
-// Parses a method name ("tractrix", "ftl", "min_rotation", "min_joint_angle", "overall"); throws
-// InputError naming `field` and listing them.
-Method ParseMethod(std::string_view name, const std::string& field = "method");
+// The method names, defined once (flexkin/vocabulary.h).
+template <>
+struct Vocabulary<Method> {
+  static constexpr const char* kKind = "method";
+  static constexpr NamedValue<Method> kEntries[] = {
+      {Method::kTractrix, "tractrix",
+       "closed-form tractrix step, each point's velocity along its link (sequential)"},
+      {Method::kFollowTheLeader, "ftl",
+       "follow-the-leader: nearest point on the sphere around the new leading end"},
+      {Method::kMinRotation, "min_rotation",
+       "sequential minimum body rotation: each link translates (Sec. 4.1)"},
+      {Method::kMinJointAngle, "min_joint_angle",
+       "sequential minimum joint-angle change: the chain behind the first link moves rigidly "
+       "(Sec. 4.2)"},
+      {Method::kOverall, "overall",
+       "all points at once, minimizing the objective under the length constraints (Sec. 3, 4)"},
+  };
+};
+
+inline const char* MethodName(Method method) { return NameOf(method); }
+// Throws InputError naming `field` and listing the names.
+inline Method ParseMethod(std::string_view name, const std::string& field = "method") {
+  return ParseName<Method>(name, field);
+}
 // Convergence order of the multi-step method to the continuous motion (2 for tractrix, 1 for ftl;
 // 0 where it is not established: accuracy control is then not offered).
 int MethodOrder(Method method);
-// All method names, quoted and listed for messages: "tractrix", "ftl", ... or "overall".
-std::string MethodNames();
 
 // Data precomputed once per chain and reused by every move (the reciprocal link lengths).
 struct Stepper {

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "flexkin/result_io.h"
+#include "flexkin/vocabulary.h"
 
 namespace flexkin {
 
@@ -30,6 +31,26 @@ enum class ImageFormat {
 // for any other extension.
 ImageFormat ImageFormatFromPath(const std::string& path, const std::string& field = "path");
 
+// What `flexkin render --formats` can write, one entry per format.
+enum class OutputFormat { kSvg, kPng, kPdf, kPlots, kMp4, kGif, kHtml, kGltf, kGlb };
+
+template <>
+struct Vocabulary<OutputFormat> {
+  static constexpr const char* kKind = "format";
+  // The summary says which files a format writes.
+  static constexpr NamedValue<OutputFormat> kEntries[] = {
+      {OutputFormat::kSvg, "svg", "<stem>.svg"},
+      {OutputFormat::kPng, "png", "<stem>.png"},
+      {OutputFormat::kPdf, "pdf", "<stem>.pdf"},
+      {OutputFormat::kPlots, "plots", "<stem>_{path_length,link_angles,length_error}.{svg,png}"},
+      {OutputFormat::kMp4, "mp4", "<stem>.mp4"},
+      {OutputFormat::kGif, "gif", "<stem>.gif"},
+      {OutputFormat::kHtml, "html", "<stem>.html"},
+      {OutputFormat::kGltf, "gltf", "<stem>.gltf"},
+      {OutputFormat::kGlb, "glb", "<stem>.glb"},
+  };
+};
+
 // The snapshot figure: the chain every k-th recorded frame, overlaid, in the style of the paper's
 // Figs. 6 to 12.
 struct FigureOptions {
@@ -53,8 +74,8 @@ struct FigureOptions {
   // Draw the legend (in the corner of the plot that covers the fewest drawn points).
   bool show_legend = true;
 
-  // Empty if valid, otherwise the reason, starting with the field's name.
-  std::string Validate() const;
+  // Every problem (empty if valid), each naming its member ("width").
+  Problems Validate() const;
 };
 
 // The recorded frames a figure draws: 0, k, 2k, ... and the last one (indices into frames).
@@ -74,12 +95,20 @@ enum class PlotKind {
   kLengthError,  // "length_error": largest relative link-length error of each recorded frame
                  // against the leader step, log scale (FrameLengthErrors)
 };
-inline constexpr PlotKind kAllPlotKinds[] = {PlotKind::kPathLength, PlotKind::kLinkAngles,
-                                             PlotKind::kLengthError};
-// "path_length", "link_angles", "length_error".
-const char* PlotKindName(PlotKind kind);
-// The inverse of PlotKindName; throws InputError naming `field` and listing the names.
-PlotKind ParsePlotKind(const std::string& name, const std::string& field = "plot");
+template <>
+struct Vocabulary<PlotKind> {
+  static constexpr const char* kKind = "plot";
+  static constexpr NamedValue<PlotKind> kEntries[] = {
+      {PlotKind::kPathLength, "path_length", "distance travelled by each point against its index"},
+      {PlotKind::kLinkAngles, "link_angles", "each link's angle to the pull against the step"},
+      {PlotKind::kLengthError, "length_error", "largest relative link-length error per frame"},
+  };
+};
+inline const char* PlotKindName(PlotKind kind) { return NameOf(kind); }
+// Throws InputError naming `field` and listing the names.
+inline PlotKind ParsePlotKind(const std::string& name, const std::string& field = "plot") {
+  return ParseName<PlotKind>(name, field);
+}
 
 struct PlotOptions {
   // Size in pixels (SVG px; PDF points). 64 to 8192. Typical: 800 x 500.
@@ -88,8 +117,8 @@ struct PlotOptions {
   // The title; "" = what is plotted and the scenario's name.
   std::string title;
 
-  // Empty if valid, otherwise the reason, starting with the field's name.
-  std::string Validate() const;
+  // Every problem (empty if valid), each naming its member ("width").
+  Problems Validate() const;
 };
 
 // Writes one plot of `file` to `path` (.svg, .png or .pdf). kLinkAngles needs link angles
@@ -130,8 +159,8 @@ struct AnimationOptions {
   // Typical: 20.
   int crf = 20;
 
-  // Empty if valid, otherwise the reason, starting with the field's name.
-  std::string Validate() const;
+  // Every problem (empty if valid), each naming its member ("width").
+  Problems Validate() const;
 };
 
 // Writes the animation of `file` to `path`: ".mp4" (H.264, yuv420p) or ".gif" (palette made from

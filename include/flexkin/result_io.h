@@ -54,6 +54,13 @@ void WriteResultJson(const RunResult& result, const std::string& path,
 void WriteFramesCsv(const RunResult& result, std::ostream& out);
 void WriteFramesCsv(const RunResult& result, const std::string& path);
 
+// The one check of a result, shared by every reader and writer of results (render, viewer and
+// glTF add only their own): dim 2 or 3, at least one link, positive finite link lengths, at least
+// one frame, every frame (n+1) by dim, link angles one per link or none, and every number finite.
+// Stops at the first problem; its field is the member path ("frames[3].points[2][1]",
+// "link_lengths[0]", "metrics.l2_total").
+Problems ValidateResult(const RunResult& result, int dim);
+
 // A result file read back.
 struct ResultFile {
   RunResult result;           // method, lengths, num_steps, frames, metrics, accuracy, seconds

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "flexkin/chain.h"
+#include "flexkin/error.h"
 #include "flexkin/overall.h"
 #include "flexkin/propagate.h"
 
@@ -35,8 +36,9 @@ struct RunOptions {
   // Called with (leader steps done, total) about every 0.1 s of work; may be empty.
   std::function<void(int64_t done, int64_t total)> progress;
 
-  // Empty if the options are valid, otherwise the reason, naming the field.
-  std::string Validate() const;
+  // Every problem with the options (empty if valid), each naming its member ("substeps",
+  // "overall.weights.l2").
+  Problems Validate() const;
 };
 
 // One recorded configuration.

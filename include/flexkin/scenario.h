@@ -22,12 +22,6 @@ struct Scenario {
   RunOptions options;   // "method", "leader/substeps", "record/every", "accuracy/..."
 };
 
-// One problem in a scenario document.
-struct ScenarioProblem {
-  std::string pointer;  // JSON pointer to the offending value ("/leader/steps"); "" = whole file
-  std::string message;  // the value and what would be valid, without the pointer
-};
-
 // Checks `json` and builds the scenario. Throws InputError whose field() is the JSON pointer of
 // the first problem and whose what() is "pointer: message", e.g.
 //   "/leader/steps: value 0 is not valid; expected an integer >= 1".
@@ -36,7 +30,24 @@ Scenario ParseScenario(const nlohmann::json& json);
 // Every problem found in `json` (unknown keys, wrong types, values out of range, inconsistent
 // dimensions, curves that cannot be generated, ...), in the order checked (the keys of an
 // object alphabetically); empty if and only if ParseScenario would succeed.
-std::vector<ScenarioProblem> ValidateScenario(const nlohmann::json& json);
+// Each problem's field is the JSON pointer of the offending value ("/leader/steps"; "" for the
+// whole document).
+Problems ValidateScenario(const nlohmann::json& json);
+
+// Where a RunOptions member is set: in a scenario file and on the command line. The one map from
+// the fields of RunOptions::Validate's problems to the places a user wrote them.
+struct OptionLocation {
+  const char* field;    // the member ("substeps"); ending in '.', every member below it
+  const char* pointer;  // the scenario file's JSON pointer ("/leader/substeps"); for a prefix, the
+                        // members below it are appended as keys ("overall.weights.l2" ->
+                        // "/objective/l2")
+  const char* flag;     // the `flexkin run` option ("--substeps"); "" if there is none
+};
+const std::vector<OptionLocation>& RunOptionLocations();
+// The entry whose field is `field` or a prefix of it; null if none.
+const OptionLocation* FindOptionLocation(const std::string& field);
+// A problem of RunOptions::Validate with its field as the scenario file's JSON pointer.
+Problem InScenarioFile(Problem problem);
 
 // ReadJsonFile (result_io.h) + ParseScenario. Messages do not repeat the path; callers add it.
 // Throws std::system_error if the file cannot be read, InputError if it is not valid JSON (the

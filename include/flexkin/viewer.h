@@ -38,8 +38,8 @@ struct ViewerOptions {
   // the drawing's extent, far below a pixel, at about 13 bytes per coordinate; 17 is exact.
   int digits = 9;
 
-  // Empty if the options are valid, otherwise the reason, naming the field.
-  std::string Validate() const;
+  // Every problem (empty if valid), each naming its member ("digits").
+  Problems Validate() const;
 };
 
 // Writes the viewer page for `result` to `path`, atomically (WriteFileAtomically: written whole or

@@ -1,6 +1,7 @@
 // Joint angles <-> link points of a fixed-base arm (include/flexkin/arm.h), the model's checks
 // and the joint-limit projections the solver uses.
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -25,17 +26,17 @@ double Wrap(double x) {
 
 std::string Indexed(const char* field, int i) { return std::string(field) + "[" + std::to_string(i) + "]"; }
 
-std::string CheckVector(const Eigen::VectorXd& v, const char* field, int size) {
+std::optional<Problem> CheckVector(const Eigen::VectorXd& v, const char* field, int size) {
   if (v.size() != size) {
-    return std::string(field) + ": has " + std::to_string(v.size()) + " values; expected " +
-           std::to_string(size);
+    return Problem(field, "has " + std::to_string(v.size()) + " values; expected " +
+                              std::to_string(size));
   }
   for (int i = 0; i < v.size(); ++i) {
     if (!std::isfinite(v[i])) {
-      return Indexed(field, i) + ": value " + FormatNumber(v[i]) + " is not a finite number";
+      return Problem::Invalid(Indexed(field, i), FormatNumber(v[i]), "a finite number");
     }
   }
-  return "";
+  return std::nullopt;
 }
 
 // The base frame: the smallest rotation taking the world x axis to the base direction.
@@ -54,23 +55,23 @@ Eigen::Quaterniond LocalRotation(double bend, double azimuth) {
 void CheckAngles(const ArmModel& model, const JointAngles& angles, const char* field) {
   const int n = model.num_links();
   const bool spherical = model.joint() == ArmJoint::kSpherical;
-  std::string why = CheckVector(angles.angle, "angle", n);
-  if (why.empty() && spherical) why = CheckVector(angles.azimuth, "azimuth", n);
-  if (why.empty() && !spherical && angles.azimuth.size() != 0) {
-    why = "azimuth: revolute joints have no azimuths; expected none";
+  std::optional<Problem> why = CheckVector(angles.angle, "angle", n);
+  if (!why && spherical) why = CheckVector(angles.azimuth, "azimuth", n);
+  if (!why && !spherical && angles.azimuth.size() != 0) {
+    why = Problem("azimuth", "revolute joints have no azimuths; expected none");
   }
-  if (!why.empty()) throw InputError(std::string(field) + "." + why.substr(0, why.find(':')),
-                                     why.substr(why.find(':') + 2));
+  if (why) {
+    Problems problems;
+    AppendNested(field, {*why}, &problems);
+    ThrowIfAny(problems);
+  }
 }
 
 }  // namespace
 
 namespace arm_internal {
 
-void CheckModel(const ArmModel& model) {
-  const std::string why = model.Validate();
-  if (!why.empty()) throw InputError(why.substr(0, why.find(':')), why.substr(why.find(':') + 2));
-}
+void CheckModel(const ArmModel& model) { ThrowIfAny(model.Validate()); }
 
 double ClampCircular(double theta, double lo, double hi) {
   if (theta >= lo && theta <= hi) return theta;
@@ -118,73 +119,99 @@ bool ClampDirection(int dim, const double* reference, double lo, double hi, doub
 
 }  // namespace arm_internal
 
-std::string ArmModel::Validate() const {
-  if (dim != 2 && dim != 3) return "dim: value " + std::to_string(dim) + " is not 2 or 3";
+Problems ArmModel::Validate() const {
+  if (const std::optional<Problem> problem = FirstProblem(); problem) return {*problem};
+  return {};
+}
+
+std::optional<Problem> ArmModel::FirstProblem() const {
+  if (dim != 2 && dim != 3) {
+    return Problem("dim", "value " + std::to_string(dim) + " is not 2 or 3", std::to_string(dim),
+                   "2 or 3");
+  }
   const int n = num_links();
-  if (n < 1) return "link_lengths: the arm has no links; expected at least 1";
+  if (n < 1) return Problem("link_lengths", "the arm has no links; expected at least 1");
   for (int i = 0; i < n; ++i) {
     if (!(link_lengths[i] > 0.0) || !std::isfinite(link_lengths[i])) {
-      return Indexed("link_lengths", i) + ": value " + FormatNumber(link_lengths[i]) +
-             " is not a positive finite number";
+      return Problem(Indexed("link_lengths", i),
+                     "value " + FormatNumber(link_lengths[i]) + " is not a positive finite number",
+                     FormatNumber(link_lengths[i]), "a positive finite number");
     }
   }
-  std::string why = CheckVector(base, "base", dim);
-  if (why.empty()) why = CheckVector(base_direction, "base_direction", dim);
-  if (!why.empty()) return why;
-  if (!(base_direction.squaredNorm() > 0.0)) return "base_direction: is zero; expected a non-zero vector";
+  std::optional<Problem> why = CheckVector(base, "base", dim);
+  if (!why) why = CheckVector(base_direction, "base_direction", dim);
+  if (why) return why;
+  if (!(base_direction.squaredNorm() > 0.0)) {
+    return Problem("base_direction", "is zero; expected a non-zero vector");
+  }
   if (has_axes() || link_directions.size() != 0) {
-    if (!has_axes()) return "link_directions: only arms with joint_axes have link directions";
-    if (!(why = arm_internal::ValidateAxes(*this)).empty()) return why;
+    if (!has_axes()) {
+      return Problem("link_directions", "only arms with joint_axes have link directions");
+    }
+    if ((why = arm_internal::ValidateAxes(*this))) return why;
   }
   const bool revolute = joint() == ArmJoint::kRevolute;
   if (revolute) {
-    if (max_bend.size() != 0) return "max_bend: revolute joints have joint_min and joint_max instead";
-    if (joint_min.size() != joint_max.size()) return "joint_max: joint_min and joint_max differ in size";
+    if (max_bend.size() != 0) {
+      return Problem("max_bend", "revolute joints have joint_min and joint_max instead");
+    }
+    if (joint_min.size() != joint_max.size()) {
+      return Problem("joint_max", "joint_min and joint_max differ in size");
+    }
     if (joint_min.size() != 0) {
-      if (!(why = CheckVector(joint_min, "joint_min", n)).empty()) return why;
-      if (!(why = CheckVector(joint_max, "joint_max", n)).empty()) return why;
+      if ((why = CheckVector(joint_min, "joint_min", n))) return why;
+      if ((why = CheckVector(joint_max, "joint_max", n))) return why;
       for (int j = 0; j < n; ++j) {
         if (!(joint_min[j] >= -kPi && joint_min[j] <= joint_max[j] && joint_max[j] <= kPi)) {
-          return Indexed("joint_min", j) + ": limits [" + FormatNumber(joint_min[j]) + ", " +
-                 FormatNumber(joint_max[j]) + "] rad are not valid; expected -pi <= min <= max <= pi";
+          return Problem(Indexed("joint_min", j),
+                         "limits [" + FormatNumber(joint_min[j]) + ", " +
+                             FormatNumber(joint_max[j]) +
+                             "] rad are not valid; expected -pi <= min <= max <= pi");
         }
       }
     }
   } else {
     if (joint_min.size() != 0 || joint_max.size() != 0) {
-      return "joint_min: spherical joints have max_bend instead";
+      return Problem("joint_min", "spherical joints have max_bend instead");
     }
     if (max_bend.size() != 0) {
-      if (!(why = CheckVector(max_bend, "max_bend", n)).empty()) return why;
+      if ((why = CheckVector(max_bend, "max_bend", n))) return why;
       for (int j = 0; j < n; ++j) {
         if (!(max_bend[j] > 0.0 && max_bend[j] <= kPi)) {
-          return Indexed("max_bend", j) + ": value " + FormatNumber(max_bend[j]) +
-                 " rad is not valid; expected 0 < max_bend <= pi";
+          return Problem(Indexed("max_bend", j),
+                         "value " + FormatNumber(max_bend[j]) +
+                             " rad is not valid; expected 0 < max_bend <= pi",
+                         FormatNumber(max_bend[j]), "0 < max_bend <= pi");
         }
       }
     }
   }
   why = CheckVector(initial.angle, "initial.angle", n);
-  if (why.empty() && !revolute) why = CheckVector(initial.azimuth, "initial.azimuth", n);
-  if (why.empty() && revolute && initial.azimuth.size() != 0) {
-    why = "initial.azimuth: revolute joints have no azimuths; expected none";
+  if (!why && !revolute) why = CheckVector(initial.azimuth, "initial.azimuth", n);
+  if (!why && revolute && initial.azimuth.size() != 0) {
+    why = Problem("initial.azimuth", "revolute joints have no azimuths; expected none");
   }
-  if (!why.empty()) return why;
+  if (why) return why;
   for (int j = 0; j < n; ++j) {
     const double a = initial.angle[j];
     const bool ok = revolute ? a >= -kPi && a <= kPi : a >= 0.0 && a <= kPi;
     if (!ok) {
-      return Indexed("initial.angle", j) + ": value " + FormatNumber(a) + " rad is not valid; expected " +
-             (revolute ? "-pi <= angle <= pi" : "0 <= bend angle <= pi");
+      const char* expected = revolute ? "-pi <= angle <= pi" : "0 <= bend angle <= pi";
+      return Problem(Indexed("initial.angle", j),
+                     "value " + FormatNumber(a) + " rad is not valid; expected " + expected,
+                     FormatNumber(a), expected);
     }
     const bool inside = revolute ? joint_min.size() == 0 || (a >= joint_min[j] && a <= joint_max[j])
                                  : max_bend.size() == 0 || a <= max_bend[j];
     if (!inside) {
-      return Indexed("initial.angle", j) + ": value " + FormatNumber(a) +
-             " rad is outside the joint's limits; the initial angles must be within them";
+      return Problem(Indexed("initial.angle", j),
+                     "value " + FormatNumber(a) +
+                         " rad is outside the joint's limits; the initial angles must be within "
+                         "them",
+                     FormatNumber(a), "within the joint's limits");
     }
   }
-  return "";
+  return std::nullopt;
 }
 
 ArmModel StraightArm(int dim, int links, double link_length) {

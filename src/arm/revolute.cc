@@ -2,6 +2,7 @@
 #include "arm/revolute.h"
 
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "arm/internal.h"
@@ -13,39 +14,43 @@ namespace {
 
 std::string Row(const char* field, int i) { return std::string(field) + "[" + std::to_string(i) + "]"; }
 
-std::string CheckUnitRows(const Eigen::MatrixXd& m, const char* field, int n) {
+std::optional<Problem> CheckUnitRows(const Eigen::MatrixXd& m, const char* field, int n) {
   if (m.rows() != n || m.cols() != 3) {
-    return std::string(field) + ": shape " + std::to_string(m.rows()) + " by " +
-           std::to_string(m.cols()) + " is not valid; expected " + std::to_string(n) + " by 3";
+    return Problem(field, "shape " + std::to_string(m.rows()) + " by " + std::to_string(m.cols()) +
+                              " is not valid; expected " + std::to_string(n) + " by 3");
   }
   for (int i = 0; i < n; ++i) {
     if (!m.row(i).allFinite() || std::abs(m.row(i).norm() - 1.0) > 1e-9) {
-      return Row(field, i) + ": is not a finite unit vector (norm " + FormatNumber(m.row(i).norm()) +
-             "); expected norm 1";
+      return Problem(Row(field, i), "is not a finite unit vector (norm " +
+                                        FormatNumber(m.row(i).norm()) + "); expected norm 1");
     }
   }
-  return "";
+  return std::nullopt;
 }
 
 }  // namespace
 
-std::string ValidateAxes(const ArmModel& model) {
+std::optional<Problem> ValidateAxes(const ArmModel& model) {
   const int n = model.num_links();
-  if (model.dim != 3) return "joint_axes: only spatial arms (dim 3) have joint axes";
-  if (model.max_bend.size() != 0) return "max_bend: revolute joints have joint_min and joint_max instead";
-  std::string why = CheckUnitRows(model.joint_axes, "joint_axes", n);
-  if (why.empty() && model.link_directions.size() != 0) {
+  if (model.dim != 3) return Problem("joint_axes", "only spatial arms (dim 3) have joint axes");
+  if (model.max_bend.size() != 0) {
+    return Problem("max_bend", "revolute joints have joint_min and joint_max instead");
+  }
+  std::optional<Problem> why = CheckUnitRows(model.joint_axes, "joint_axes", n);
+  if (!why && model.link_directions.size() != 0) {
     why = CheckUnitRows(model.link_directions, "link_directions", n);
   }
-  if (!why.empty()) return why;
+  if (why) return why;
   for (int j = 0; j < n; ++j) {
     const Eigen::Vector3d a = model.joint_axes.row(j).transpose();
     if (a.cross(RestDirection(model, j)).norm() < 1e-6) {
-      return Row("joint_axes", j) + ": lies along link " + std::to_string(j + 1) +
-             ", which the joint turns; a joint that only twists its link is not supported";
+      return Problem(Row("joint_axes", j),
+                     "lies along link " + std::to_string(j + 1) +
+                         ", which the joint turns; a joint that only twists its link is not "
+                         "supported");
     }
   }
-  return "";
+  return std::nullopt;
 }
 
 Eigen::Vector3d RestDirection(const ArmModel& model, int k) {

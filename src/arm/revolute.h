@@ -1,4 +1,6 @@
 #pragma once
+
+#include <optional>
 // Spatial arms with revolute joints about given axes (ArmModel::joint_axes, docs/robots.md):
 // kinematics and the sweep that keeps every link on the circle of directions its joint allows.
 
@@ -9,11 +11,12 @@
 
 #include "arm/internal.h"
 #include "flexkin/arm.h"
+#include "flexkin/error.h"
 
 namespace flexkin::arm_internal {
 
 // The checks of ArmModel::Validate for joint_axes and link_directions: "" or "field: reason".
-std::string ValidateAxes(const ArmModel& model);
+std::optional<Problem> ValidateAxes(const ArmModel& model);
 
 // Unit direction of link k+1 (0-based k) in its own frame.
 Eigen::Vector3d RestDirection(const ArmModel& model, int k);

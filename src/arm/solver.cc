@@ -311,39 +311,40 @@ bool ArmSolverMemory::Usable(int dim) const {
   return translation.size() == dim && translation.allFinite();
 }
 
-const char* FixedBaseMethodName(FixedBaseMethod method) {
-  return method == FixedBaseMethod::kNewton ? "newton" : "fixed_point";
-}
-
-FixedBaseMethod ParseFixedBaseMethod(std::string_view name, const std::string& field) {
-  if (name == "newton") return FixedBaseMethod::kNewton;
-  if (name == "fixed_point") return FixedBaseMethod::kFixedPoint;
-  throw InputError(field, "value \"" + std::string(name) +
-                              "\" is not a fixed-base method; expected \"newton\" or \"fixed_point\"");
-}
-
-std::string ArmOptions::Validate() const {
+Problems ArmOptions::Validate() const {
+  Problems problems;
   if (!(tolerance > 0.0 && tolerance < 1.0)) {
-    return "tolerance: value " + FormatNumber(tolerance) + " is not valid; expected 0 < tolerance < 1";
+    problems.push_back(Problem::Invalid("tolerance", FormatNumber(tolerance), "0 < tolerance < 1"));
   }
-  if (max_iterations < 1) return "max_iterations: value " + std::to_string(max_iterations) + " is not >= 1";
-  if (max_fixed_point_iterations < 1) {
-    return "max_fixed_point_iterations: value " + std::to_string(max_fixed_point_iterations) +
-           " is not >= 1";
+  struct Count {
+    const char* name;
+    int value, least;
+  };
+  const Count counts[] = {{"max_iterations", max_iterations, 1},
+                          {"max_fixed_point_iterations", max_fixed_point_iterations, 1},
+                          {"restarts", restarts, 0},
+                          {"substeps", substeps, 1}};
+  for (const auto& [name, value, least] : counts) {
+    if (value < least) {
+      problems.emplace_back(name,
+                            "value " + std::to_string(value) + " is not >= " +
+                                std::to_string(least),
+                            std::to_string(value), ">= " + std::to_string(least));
+    }
   }
-  if (restarts < 0) return "restarts: value " + std::to_string(restarts) + " is not >= 0";
-  if (substeps < 1) return "substeps: value " + std::to_string(substeps) + " is not >= 1";
   if (!(edge_margin >= 0.0 && edge_margin < 0.5)) {
-    return "edge_margin: value " + FormatNumber(edge_margin) + " is not valid; expected 0 <= edge_margin < 0.5";
+    problems.push_back(
+        Problem::Invalid("edge_margin", FormatNumber(edge_margin), "0 <= edge_margin < 0.5"));
   }
-  return "";
+  return problems;
 }
 
 namespace {
 
 void CheckOptions(const ArmOptions& options) {
-  const std::string why = options.Validate();
-  if (!why.empty()) throw InputError("options." + why.substr(0, why.find(':')), why.substr(why.find(':') + 2));
+  Problems problems;
+  AppendNested("options", options.Validate(), &problems);
+  ThrowIfAny(problems);
 }
 
 // The report of a solve: the points re-anchored (rebuilt from the joint angles at the fixed

@@ -13,7 +13,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-void CheckLinks(int links, std::vector<InputError>* problems) {
+void CheckLinks(int links, Problems* problems) {
   if (links < 1 || links > kMaxGeneratedLinks) {
     problems->emplace_back("links", "value " + std::to_string(links) +
                                         " is not valid; expected an integer from 1 to " +
@@ -21,21 +21,21 @@ void CheckLinks(int links, std::vector<InputError>* problems) {
   }
 }
 
-void CheckLinkLength(double link_length, std::vector<InputError>* problems) {
+void CheckLinkLength(double link_length, Problems* problems) {
   if (!(link_length > 0.0) || !std::isfinite(link_length)) {
     problems->emplace_back("link_length", "value " + FormatNumber(link_length) +
                                               " is not valid; expected a finite number > 0");
   }
 }
 
-void CheckFinite(const char* field, double value, std::vector<InputError>* problems) {
+void CheckFinite(const char* field, double value, Problems* problems) {
   if (!std::isfinite(value)) {
     problems->emplace_back(field, "value " + FormatNumber(value) + " is not a finite number");
   }
 }
 
 void CheckFiniteVector(const char* field, const Eigen::Ref<const Eigen::VectorXd>& v,
-                       std::vector<InputError>* problems) {
+                       Problems* problems) {
   for (Eigen::Index k = 0; k < v.size(); ++k) {
     if (!std::isfinite(v[k])) {
       problems->emplace_back(std::string(field) + "[" + std::to_string(k) + "]",
@@ -44,7 +44,7 @@ void CheckFiniteVector(const char* field, const Eigen::Ref<const Eigen::VectorXd
   }
 }
 
-void CheckRadius(double radius, std::vector<InputError>* problems) {
+void CheckRadius(double radius, Problems* problems) {
   if (!(radius > 0.0) || !std::isfinite(radius)) {
     problems->emplace_back(
         "radius", "value " + FormatNumber(radius) + " is not valid; expected a finite number > 0");
@@ -53,8 +53,7 @@ void CheckRadius(double radius, std::vector<InputError>* problems) {
 
 template <typename Def>
 void ThrowFirstProblem(const Def& def) {
-  const std::vector<InputError> problems = CurveProblems(def);
-  if (!problems.empty()) throw problems.front();
+  ThrowIfAny(CurveProblems(def));
 }
 
 // Chord length of the parabola y = a x^2 between x0 >= 0 and x0 + u, u >= 0:
@@ -99,8 +98,8 @@ double HelixChord(double radius, double rise_per_radian, double dt) {
 
 }  // namespace
 
-std::vector<InputError> CurveProblems(const LineDef& def) {
-  std::vector<InputError> problems;
+Problems CurveProblems(const LineDef& def) {
+  Problems problems;
   if (def.start.size() != 2 && def.start.size() != 3) {
     problems.emplace_back("start", "has " + std::to_string(def.start.size()) +
                                        " coordinates; expected 2 (planar) or 3 (spatial)");
@@ -122,8 +121,8 @@ std::vector<InputError> CurveProblems(const LineDef& def) {
   return problems;
 }
 
-std::vector<InputError> CurveProblems(const ParabolaDef& def) {
-  std::vector<InputError> problems;
+Problems CurveProblems(const ParabolaDef& def) {
+  Problems problems;
   CheckFinite("a", def.a, &problems);
   if (def.side != 1 && def.side != -1) {
     problems.emplace_back("side", "value " + std::to_string(def.side) +
@@ -134,8 +133,8 @@ std::vector<InputError> CurveProblems(const ParabolaDef& def) {
   return problems;
 }
 
-std::vector<InputError> CurveProblems(const ArcDef& def) {
-  std::vector<InputError> problems;
+Problems CurveProblems(const ArcDef& def) {
+  Problems problems;
   CheckRadius(def.radius, &problems);
   CheckFiniteVector("center", def.center, &problems);
   CheckFinite("start_angle", def.start_angle, &problems);
@@ -151,8 +150,8 @@ std::vector<InputError> CurveProblems(const ArcDef& def) {
   return problems;
 }
 
-std::vector<InputError> CurveProblems(const HelixDef& def) {
-  std::vector<InputError> problems;
+Problems CurveProblems(const HelixDef& def) {
+  Problems problems;
   CheckRadius(def.radius, &problems);
   CheckFinite("pitch", def.pitch, &problems);
   CheckFiniteVector("center", def.center, &problems);

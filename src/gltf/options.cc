@@ -1,4 +1,4 @@
-// GltfOptions::Validate and the names of GltfUpAxis.
+// GltfOptions::Validate.
 #include <cmath>
 #include <string>
 
@@ -7,45 +7,36 @@
 
 namespace flexkin {
 
-const char* GltfUpAxisName(GltfUpAxis axis) {
-  switch (axis) {
-    case GltfUpAxis::kAuto:
-      return "auto";
-    case GltfUpAxis::kY:
-      return "y";
-    case GltfUpAxis::kZ:
-      return "z";
-  }
-  return "?";
-}
-
-GltfUpAxis ParseGltfUpAxis(const std::string& name, const std::string& field) {
-  for (const GltfUpAxis axis : {GltfUpAxis::kAuto, GltfUpAxis::kY, GltfUpAxis::kZ}) {
-    if (name == GltfUpAxisName(axis)) return axis;
-  }
-  throw InputError(field, "\"" + name + "\" is not valid; expected \"auto\", \"y\" or \"z\"");
-}
-
-std::string GltfOptions::Validate() const {
+Problems GltfOptions::Validate() const {
+  Problems problems;
   if (!(steps_per_second > 0.0) || !std::isfinite(steps_per_second)) {
-    return "steps_per_second: " + FormatNumber(steps_per_second) +
-           " is not valid; must be a finite number > 0";
+    problems.emplace_back("steps_per_second",
+                          FormatNumber(steps_per_second) +
+                              " is not valid; must be a finite number > 0",
+                          FormatNumber(steps_per_second), "a finite number > 0");
   }
   if (!(tube_radius >= 0.0) || !std::isfinite(tube_radius)) {
-    return "tube_radius: " + FormatNumber(tube_radius) +
-           " is not valid; must be a finite number >= 0 (0 picks one from the link lengths)";
+    problems.emplace_back("tube_radius",
+                          FormatNumber(tube_radius) +
+                              " is not valid; must be a finite number >= 0 (0 picks one from the "
+                              "link lengths)",
+                          FormatNumber(tube_radius), "a finite number >= 0");
   }
   if (tube_sides < 3 || tube_sides > 64) {
-    return "tube_sides: " + std::to_string(tube_sides) + " is not valid; must be 3 to 64";
+    problems.emplace_back("tube_sides", std::to_string(tube_sides) + " is not valid; must be 3 to 64",
+                          std::to_string(tube_sides), "3 to 64");
   }
   if (!(scale > 0.0) || !std::isfinite(scale)) {
-    return "scale: " + FormatNumber(scale) + " is not valid; must be a finite number > 0";
+    problems.emplace_back("scale", FormatNumber(scale) + " is not valid; must be a finite number > 0",
+                          FormatNumber(scale), "a finite number > 0");
   }
-  if (up_axis != GltfUpAxis::kAuto && up_axis != GltfUpAxis::kY && up_axis != GltfUpAxis::kZ) {
-    return "up_axis: " + std::to_string(static_cast<int>(up_axis)) +
-           " is not valid; must be auto, y or z";
+  if (FindName<GltfUpAxis>(NameOf(up_axis)) == nullptr) {
+    problems.emplace_back("up_axis",
+                          std::to_string(static_cast<int>(up_axis)) + " is not valid; must be " +
+                              QuotedNames<GltfUpAxis>(),
+                          std::to_string(static_cast<int>(up_axis)), QuotedNames<GltfUpAxis>());
   }
-  return "";
+  return problems;
 }
 
 }  // namespace flexkin

@@ -29,61 +29,37 @@ std::string Index(const std::string& name, size_t i) {
   return name + "[" + std::to_string(i) + "]";
 }
 
-// Checks that `result` can be exported; throws InputError naming the field otherwise.
+// Checks that `result` can be exported: the library's check of results, then glTF's own limits
+// (16-bit joint indices, float32 coordinates, a direction for every link); throws InputError
+// naming the field otherwise.
 void CheckResult(const ResultFile& file, double scale) {
+  ThrowIfAny(ValidateResult(file.result, file.dim));
   const RunResult& result = file.result;
-  if (file.dim != 2 && file.dim != 3) {
-    throw InputError("dim", std::to_string(file.dim) + " is not valid; expected 2 or 3");
-  }
   const Eigen::Index n = result.lengths.size();
-  if (n < 1) throw InputError("link_lengths", "the result has no links; expected at least one");
   if (n + 1 > kMaxJoints) {
     throw InputError("link_lengths", std::to_string(n) +
                                          " links is too many; glTF joint indices "
                                          "(16 bits) allow at most " +
                                          std::to_string(kMaxJoints - 1));
   }
-  for (Eigen::Index i = 0; i < n; ++i) {
-    if (!(result.lengths[i] > 0.0) || !std::isfinite(result.lengths[i])) {
-      throw InputError(
-          Index("link_lengths", i),
-          FormatNumber(result.lengths[i]) + " is not valid; link lengths must be finite and > 0");
-    }
-  }
-  if (result.frames.empty()) {
-    throw InputError("frames", "the result has no frames; expected at least one");
-  }
   // float32 overflows near 3.4e38; refuse long before.
   const double largest = 1e30 / scale;
   for (size_t f = 0; f < result.frames.size(); ++f) {
-    const Frame& frame = result.frames[f];
-    const std::string field = Index("frames", f);
-    if (frame.points.rows() != n + 1 || frame.points.cols() != file.dim) {
-      throw InputError(field + ".points", "is " + std::to_string(frame.points.rows()) + " by " +
-                                              std::to_string(frame.points.cols()) + "; expected " +
-                                              std::to_string(n + 1) + " by " +
-                                              std::to_string(file.dim) +
-                                              " (one row per point, n+1 for n links)");
-    }
+    const Points& p = result.frames[f].points;
+    const std::string field = Index("frames", f) + ".points";
     for (Eigen::Index i = 0; i <= n; ++i) {
       for (int k = 0; k < file.dim; ++k) {
-        const double v = frame.points(i, k);
-        if (!std::isfinite(v) || std::abs(v) > largest) {
-          throw InputError(
-              Index(Index(field + ".points", i), k),
-              FormatNumber(v) + " is not valid; coordinates must be finite (and fit in float32)");
+        if (std::abs(p(i, k)) > largest) {
+          throw InputError(Index(Index(field, i), k),
+                           FormatNumber(p(i, k)) +
+                               " is not valid; coordinates must fit in float32 (|x| <= " +
+                               FormatNumber(largest) + " at this scale)");
         }
       }
-      if (i > 0 && frame.points.row(i) == frame.points.row(i - 1)) {
-        throw InputError(
-            Index(field + ".points", i),
-            "coincides with point " + std::to_string(i - 1) + "; a link needs a direction");
+      if (i > 0 && p.row(i) == p.row(i - 1)) {
+        throw InputError(Index(field, i), "coincides with point " + std::to_string(i - 1) +
+                                              "; a link needs a direction");
       }
-    }
-    if (frame.step < 0 || (f > 0 && frame.step <= result.frames[f - 1].step)) {
-      throw InputError(field + ".step",
-                       std::to_string(frame.step) +
-                           " is not valid; steps must be >= 0 and increase from frame to frame");
     }
   }
 }
@@ -262,10 +238,7 @@ void AddMesh(const ResultFile& file, const GltfOptions& options, const Eigen::Ma
 }  // namespace
 
 void WriteGltf(const ResultFile& file, const GltfOptions& options, const std::string& path) {
-  if (const std::string why = options.Validate(); !why.empty()) {
-    const auto colon = why.find(':');
-    throw InputError(why.substr(0, colon), why.substr(colon + 2));
-  }
+  ThrowIfAny(options.Validate());
   const bool binary = IsBinaryPath(path);
   CheckResult(file, options.scale);
   const RunResult& result = file.result;

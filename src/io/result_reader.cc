@@ -96,9 +96,6 @@ ResultFile ResultFromJson(const json& j) {
     throw InputError("/dim", "value " + std::to_string(file.dim) + " is not 2 or 3");
   r.lengths = ReadVector(Member(j, "", "link_lengths"), "/link_lengths", -1);
   const Eigen::Index n = r.lengths.size();
-  if (n < 1 || !(r.lengths.minCoeff() > 0.0)) {
-    throw InputError("/link_lengths", "is not valid; expected at least one positive length");
-  }
   r.num_steps = ReadInteger(Member(j, "", "num_steps"), "/num_steps", 0);
 
   const json& accuracy = Member(j, "", "accuracy");
@@ -117,21 +114,16 @@ ResultFile ResultFromJson(const json& j) {
   if (const auto it = j.find("overall"); it != j.end()) {
     const json& o = *it;
     const json& w = Member(o, "/overall", "objective");
-    // (The L2 terms are optional: files written before they existed lack them.)
-    for (const auto& [name, weight] : {std::pair<const char*, double*>{"l2", &r.weights.l2},
-                                       {"l2_weighted", &r.weights.l2_weighted}}) {
-      if (const auto term = w.find(name); term != w.end()) {
-        *weight = ReadNumber(*term, std::string("/overall/objective/") + name);
+    for (const auto& [term, name, summary] : Vocabulary<ObjectiveTerm>::kEntries) {
+      const std::string pointer = std::string("/overall/objective/") + name;
+      // The L2 terms are optional: files written before they existed lack them.
+      const bool optional = term == ObjectiveTerm::kL2 || term == ObjectiveTerm::kL2Weighted;
+      if (const auto it = w.find(name); it != w.end()) {
+        r.weights[term] = ReadNumber(*it, pointer);
+      } else if (!optional) {
+        Member(w, "/overall/objective", name);  // throws: a required term is missing
       }
     }
-    r.weights.squared =
-        ReadNumber(Member(w, "/overall/objective", "squared"), "/overall/objective/squared");
-    r.weights.squared_weighted = ReadNumber(Member(w, "/overall/objective", "squared_weighted"),
-                                            "/overall/objective/squared_weighted");
-    r.weights.rotation =
-        ReadNumber(Member(w, "/overall/objective", "rotation"), "/overall/objective/rotation");
-    r.weights.joint_angle = ReadNumber(Member(w, "/overall/objective", "joint_angle"),
-                                       "/overall/objective/joint_angle");
     r.overall.solves = ReadInteger(Member(o, "/overall", "solves"), "/overall/solves", 0);
     r.overall.failures = ReadInteger(Member(o, "/overall", "failures"), "/overall/failures", 0);
     r.overall.iterations =
@@ -171,6 +163,12 @@ ResultFile ResultFromJson(const json& j) {
     const json& angles = Member(frames[f], ptr, "link_angles");
     frame.link_angles = ReadVector(angles, ptr + "/link_angles", angles.empty() ? 0 : n);
     r.frames.push_back(std::move(frame));
+  }
+  // What the shapes read above do not say (positive lengths, increasing steps, ...): the one check
+  // of results, its member path made the file's JSON pointer.
+  if (Problems problems = ValidateResult(r, file.dim); !problems.empty()) {
+    problems.front().field = MemberPathToPointer(problems.front().field);
+    ThrowIfAny(problems);
   }
   return file;
 }

@@ -37,48 +37,14 @@ void AppendVector(const Eigen::VectorXd& v, std::string* out) {
   out->push_back(']');
 }
 
-void CheckFinite(const Eigen::Ref<const Eigen::VectorXd>& v, const std::string& field) {
-  for (Eigen::Index i = 0; i < v.size(); ++i) {
-    if (!std::isfinite(v[i])) {
-      char value[32];
-      std::snprintf(value, sizeof value, "%g", v[i]);
-      throw InputError(field + "[" + std::to_string(i) + "]",
-                       std::string("value ") + value +
-                           " is not finite; a result file holds finite numbers only, so nothing "
-                           "was written");
-    }
-  }
-}
-
-// Checks what the writers rely on: consistent shapes and finite numbers everywhere.
+// The result's dimension, after the one check of results (ValidateResult): consistent shapes and
+// finite numbers everywhere, which JSON needs.
 int CheckResult(const RunResult& r) {
-  if (r.frames.empty()) throw InputError("frames", "is empty; expected at least the initial frame");
-  const int dim = static_cast<int>(r.frames[0].points.cols());
-  const Eigen::Index n = r.lengths.size();
-  CheckFinite(r.lengths, "lengths");
-  for (size_t f = 0; f < r.frames.size(); ++f) {
-    const Frame& frame = r.frames[f];
-    const std::string field = "frames[" + std::to_string(f) + "]";
-    if (frame.points.rows() != n + 1 || frame.points.cols() != dim || (dim != 2 && dim != 3)) {
-      throw InputError(field + ".points", "is " + std::to_string(frame.points.rows()) + " by " +
-                                              std::to_string(frame.points.cols()) +
-                                              "; expected (links + 1) by dim = " +
-                                              std::to_string(n + 1) + " by 2 or 3, as frame 0");
-    }
-    for (Eigen::Index i = 0; i <= n; ++i) {
-      CheckFinite(frame.points.row(i).transpose(), field + ".points[" + std::to_string(i) + "]");
-    }
-    CheckFinite(frame.link_angles, field + ".link_angles");
+  const int dim = r.frames.empty() ? 0 : static_cast<int>(r.frames[0].points.cols());
+  if (Problems problems = ValidateResult(r, dim); !problems.empty()) {
+    problems.front().message += "; nothing was written";
+    ThrowIfAny(problems);
   }
-  const Metrics& m = r.metrics;
-  CheckFinite(m.l2_per_step, "metrics.l2_per_step");
-  CheckFinite(m.l2_weighted_per_step, "metrics.l2_weighted_per_step");
-  CheckFinite(m.path_length, "metrics.path_length");
-  Eigen::Vector4d scalars(m.l2_total, m.l2_weighted_total, m.max_relative_length_error,
-                          r.accuracy.estimated_error);
-  CheckFinite(scalars,
-              "metrics (l2_total, l2_weighted_total, max_relative_length_error, "
-              "estimated_error)");
   return dim;
 }
 
@@ -137,18 +103,11 @@ void WriteResultJson(const RunResult& result, std::ostream& out, const std::stri
   if (result.method == Method::kOverall) {
     const OverallSummary& o = result.overall;
     const ObjectiveWeights& w = result.weights;
-    t += "\"overall\": {\"objective\": {\"l2\": ";
-    AppendDouble(w.l2, &t);
-    t += ", \"l2_weighted\": ";
-    AppendDouble(w.l2_weighted, &t);
-    t += ", \"squared\": ";
-    AppendDouble(w.squared, &t);
-    t += ", \"squared_weighted\": ";
-    AppendDouble(w.squared_weighted, &t);
-    t += ", \"rotation\": ";
-    AppendDouble(w.rotation, &t);
-    t += ", \"joint_angle\": ";
-    AppendDouble(w.joint_angle, &t);
+    t += "\"overall\": {\"objective\": {";
+    for (const auto& [term, name, summary] : Vocabulary<ObjectiveTerm>::kEntries) {
+      t += std::string(term == ObjectiveTerm::kL2 ? "" : ", ") + "\"" + name + "\": ";
+      AppendDouble(w[term], &t);
+    }
     t += "}, \"solves\": " + std::to_string(o.solves) +
          ", \"failures\": " + std::to_string(o.failures) +
          ", \"iterations\": " + std::to_string(o.iterations) +

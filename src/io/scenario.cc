@@ -42,17 +42,8 @@ Scenario Parser::Parse(const json& root) {
   if (!max_substeps_given)
     s.options.max_substeps = std::max(s.options.max_substeps, s.options.substeps);
   if (!problems.empty()) return s;
-  if (const std::string why = s.options.Validate(); !why.empty()) {
-    const std::string field = why.substr(0, why.find(':'));
-    const std::string pointer = field == "substeps"                      ? "/leader/substeps"
-                                : field == "record_every"                ? "/record/every"
-                                : field == "tolerance"                   ? "/accuracy/tolerance"
-                                : field.rfind("overall.weights.", 0) == 0
-                                    ? "/objective/" + field.substr(16)
-                                : field == "overall.weights"             ? "/objective"
-                                : field.rfind("overall.", 0) == 0        ? "/solver"
-                                                                         : "/accuracy/max_substeps";
-    Add(pointer, why.substr(why.find(':') + 2));
+  if (const Problems option_problems = s.options.Validate(); !option_problems.empty()) {
+    for (const Problem& p : option_problems) problems.push_back(InScenarioFile(p));
     return s;
   }
   s.chain = std::move(*chain);
@@ -64,16 +55,51 @@ Scenario Parser::Parse(const json& root) {
 
 using scenario_internal::Parser;
 
+const std::vector<OptionLocation>& RunOptionLocations() {
+  static const std::vector<OptionLocation> locations = {
+      {"method", "/method", "--method"},
+      {"substeps", "/leader/substeps", "--substeps"},
+      {"record_every", "/record/every", "--record-every"},
+      {"tolerance", "/accuracy/tolerance", "--tolerance"},
+      {"max_substeps", "/accuracy/max_substeps", "--max-substeps"},
+      {"overall.weights.", "/objective", ""},
+      {"overall.weights", "/objective", ""},
+      {"overall.", "/solver", ""},
+  };
+  return locations;
+}
+
+const OptionLocation* FindOptionLocation(const std::string& field) {
+  for (const OptionLocation& l : RunOptionLocations()) {
+    const std::string f = l.field;
+    if (field == f || (f.back() == '.' && field.rfind(f, 0) == 0)) return &l;
+  }
+  return nullptr;
+}
+
+Problem InScenarioFile(Problem problem) {
+  if (const OptionLocation* l = FindOptionLocation(problem.field)) {
+    const std::string f = l->field;
+    std::string pointer = l->pointer;
+    if (f.back() == '.') {
+      for (char c : problem.field.substr(f.size())) pointer += c == '.' ? '/' : c;
+      pointer.insert(std::string(l->pointer).size(), "/");
+    }
+    problem.field = pointer;
+  }
+  return problem;
+}
+
 Scenario ParseScenario(const nlohmann::json& json) {
   Parser parser;
   Scenario scenario = parser.Parse(json);
   if (!parser.problems.empty()) {
-    throw InputError(parser.problems.front().pointer, parser.problems.front().message);
+    throw InputError(parser.problems.front());
   }
   return scenario;
 }
 
-std::vector<ScenarioProblem> ValidateScenario(const nlohmann::json& json) {
+Problems ValidateScenario(const nlohmann::json& json) {
   Parser parser;
   parser.Parse(json);
   return std::move(parser.problems);

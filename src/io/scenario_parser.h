@@ -14,6 +14,7 @@
 #include "flexkin/curves.h"
 #include "flexkin/error.h"
 #include "flexkin/scenario.h"
+#include "flexkin/vocabulary.h"
 
 namespace flexkin::scenario_internal {
 
@@ -77,48 +78,11 @@ inline std::string EscapePointerToken(const std::string& key) {
   return out;
 }
 
-// The part of an InputError's message after "field: ".
-inline std::string Reason(const InputError& e) {
-  const std::string what = e.what();
-  return e.field().empty() ? what : what.substr(e.field().size() + 2);
-}
-
 // "center[1]" -> "/center/1": C++ field names of the curve definitions to JSON pointers.
-inline std::string FieldToPointer(const std::string& field) {
-  std::string out = "/";
-  for (char c : field) {
-    if (c == '[') {
-      out += '/';
-    } else if (c != ']') {
-      out += c;
-    }
-  }
-  return out;
-}
+inline std::string FieldToPointer(const std::string& field) { return MemberPathToPointer(field); }
 
-// Levenshtein distance, to suggest the intended key for a typo.
-inline size_t EditDistance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1] ? 1 : 0)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
-
-inline std::string Quoted(const std::vector<std::string>& names) {
-  std::string out;
-  for (size_t i = 0; i < names.size(); ++i) {
-    out += (i == 0 ? "\"" : (i + 1 == names.size() ? "\" or \"" : "\", \"")) + names[i];
-  }
-  return out + "\"";
-}
+// The library's (flexkin/vocabulary.h).
+using flexkin::EditDistance;
 
 // Collects every problem of a scenario document while building the Scenario. Each Parse* method
 // returns nullopt (or false) when its part is unusable, so later checks that depend on it (the
@@ -126,11 +90,11 @@ inline std::string Quoted(const std::vector<std::string>& names) {
 class Parser {
  public:
   Scenario Parse(const json& root);
-  std::vector<ScenarioProblem> problems;
+  Problems problems;
 
  private:
   void Add(const std::string& pointer, std::string message) {
-    problems.push_back({pointer, std::move(message)});
+    problems.emplace_back(pointer, std::move(message));
   }
   void TypeProblem(const json& v, const std::string& ptr, const std::string& expected) {
     Add(ptr,
@@ -175,8 +139,11 @@ class Parser {
     if (problems.size() != problems_before) return std::nullopt;
     def.links = links;
     def.link_length = link_length;
-    const std::vector<InputError> curve_problems = CurveProblems(def);
-    for (const InputError& e : curve_problems) Add(ptr + FieldToPointer(e.field()), Reason(e));
+    const Problems curve_problems = CurveProblems(def);
+    for (Problem p : curve_problems) {
+      p.field = ptr + FieldToPointer(p.field);
+      problems.push_back(std::move(p));
+    }
     if (!curve_problems.empty()) return std::nullopt;
     return make(def);
   }

@@ -177,7 +177,9 @@ std::optional<Points> Parser::ParseLeader(const json& v, const std::string& ptr,
     try {
       steps = ResamplePath(chain->points.row(0).transpose(), *path, *max_step);
     } catch (const InputError& e) {  // too many steps
-      Add(ptr + FieldToPointer(e.field()), Reason(e));
+      Problem p = e.problem();
+      p.field = ptr + FieldToPointer(p.field);
+      problems.push_back(std::move(p));
       return std::nullopt;
     }
     if (steps.rows() == 0) {
@@ -194,10 +196,10 @@ std::optional<Points> Parser::ParseLeader(const json& v, const std::string& ptr,
 void Parser::ParseOptions(const json& root, RunOptions* options) {
   if (const json* m = Find(root, "method")) {
     if (const auto name = String(*m, "/method")) {
-      try {
-        options->method = ParseMethod(*name, "/method");
-      } catch (const InputError& e) {
-        Add(e.field(), "value " + ShowJson(*m) + " is not valid; expected " + MethodNames());
+      if (const NamedValue<Method>* entry = FindName<Method>(*name)) {
+        options->method = entry->value;
+      } else {
+        problems.push_back(Problem::Invalid("/method", ShowJson(*m), QuotedNames<Method>()));
       }
     }
   }
@@ -212,23 +214,14 @@ void Parser::ParseOptions(const json& root, RunOptions* options) {
     if (ExpectObject(*o, "/objective",
                      "an object of term weights, e.g. {\"squared\": 1, \"rotation\": 0.5}")) {
       ObjectiveWeights& w = options->overall.weights;
-      const std::pair<const char*, double*> terms[] = {
-          {"l2", &w.l2},
-          {"l2_weighted", &w.l2_weighted},
-          {"squared", &w.squared},
-          {"squared_weighted", &w.squared_weighted},
-          {"rotation", &w.rotation},
-          {"joint_angle", &w.joint_angle}};
-      std::vector<std::string> names;
-      for (const auto& [name, weight] : terms) names.push_back(name);
-      CheckKeys(*o, "/objective", names);
+      CheckKeys(*o, "/objective", NamesOf<ObjectiveTerm>());
       // Only the terms listed count: {"rotation": 1} is the rotation metric alone.
-      for (const auto& [name, weight] : terms) {
-        *weight = 0.0;
+      for (const auto& [term, name, summary] : Vocabulary<ObjectiveTerm>::kEntries) {
+        w[term] = 0.0;
         Optional(
             *o, "/objective", name,
             [&](const json& v, const std::string& p) { return Number(v, p, Range::kNonNegative); },
-            weight);
+            &w[term]);
       }
     }
   }

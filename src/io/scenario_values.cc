@@ -24,7 +24,7 @@ void Parser::CheckKeys(const json& obj, const std::string& ptr,
   for (const auto& item : obj.items()) {
     const std::string& key = item.key();
     if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
-    std::string message = "unknown key \"" + key + "\"; valid keys here are " + Quoted(allowed);
+    std::string message = "unknown key \"" + key + "\"; valid keys here are " + QuotedList(allowed);
     for (const std::string& name : allowed) {
       if (EditDistance(key, name) <= 2) {
         message += " (did you mean \"" + name + "\"?)";
@@ -85,7 +85,7 @@ std::optional<std::string> Parser::String(const json& v, const std::string& ptr)
 
 std::optional<std::string> Parser::Choice(const json& v, const std::string& ptr,
                                           const std::vector<std::string>& choices) {
-  const std::string expected = "one of " + Quoted(choices);
+  const std::string expected = "one of " + QuotedList(choices);
   if (!v.is_string()) {
     TypeProblem(v, ptr, expected);
     return std::nullopt;

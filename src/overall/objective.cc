@@ -153,31 +153,59 @@ double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const
 
 }  // namespace internal
 
-std::string ObjectiveWeights::Validate() const {
-  const std::pair<const char*, double> terms[] = {{"l2", l2},
-                                                  {"l2_weighted", l2_weighted},
-                                                  {"squared", squared},
-                                                  {"squared_weighted", squared_weighted},
-                                                  {"rotation", rotation},
-                                                  {"joint_angle", joint_angle}};
+double& ObjectiveWeights::operator[](ObjectiveTerm term) {
+  switch (term) {
+    case ObjectiveTerm::kL2:
+      return l2;
+    case ObjectiveTerm::kL2Weighted:
+      return l2_weighted;
+    case ObjectiveTerm::kSquared:
+      return squared;
+    case ObjectiveTerm::kSquaredWeighted:
+      return squared_weighted;
+    case ObjectiveTerm::kRotation:
+      return rotation;
+    case ObjectiveTerm::kJointAngle:
+      break;
+  }
+  return joint_angle;
+}
+
+double ObjectiveWeights::operator[](ObjectiveTerm term) const {
+  return (*const_cast<ObjectiveWeights*>(this))[term];
+}
+
+Problems ObjectiveWeights::Validate() const {
+  Problems problems;
   double total = 0.0;
-  for (const auto& [name, value] : terms) {
+  for (const auto& entry : Vocabulary<ObjectiveTerm>::kEntries) {
+    const double value = (*this)[entry.value];
     if (!(value >= 0.0) || !std::isfinite(value)) {
-      return std::string("weights.") + name + ": " + FormatNumber(value) +
-             " is not valid; each weight must be a finite number >= 0";
+      problems.emplace_back(entry.name,
+                            FormatNumber(value) +
+                                " is not valid; each weight must be a finite number >= 0",
+                            FormatNumber(value), "a finite number >= 0");
     }
     total += value;
   }
+  if (!problems.empty()) return problems;
   if ((l2 > 0.0 || l2_weighted > 0.0) && joint_angle > 0.0) {
-    return "weights.joint_angle: " + FormatNumber(joint_angle) +
-           " cannot be combined with the L2 metric (l2, l2_weighted): that combination is not "
-           "supported; set joint_angle or both L2 weights to 0";
+    problems.emplace_back("joint_angle",
+                          FormatNumber(joint_angle) +
+                              " cannot be combined with the L2 metric (l2, l2_weighted): that "
+                              "combination is not supported; set joint_angle or both L2 weights "
+                              "to 0",
+                          FormatNumber(joint_angle), "0 with an L2 term");
   }
   if (!(total > 0.0)) {
-    return "weights: all weights are 0; give at least one term (l2, l2_weighted, squared, "
-           "squared_weighted, rotation, joint_angle) a positive weight";
+    std::string names;
+    for (const std::string& name : NamesOf<ObjectiveTerm>()) {
+      names += (names.empty() ? "" : ", ") + name;
+    }
+    problems.emplace_back("", "all weights are 0; give at least one term (" + names +
+                                  ") a positive weight");
   }
-  return "";
+  return problems;
 }
 
 double OverallObjective(const ObjectiveWeights& weights, const Eigen::VectorXd& lengths,

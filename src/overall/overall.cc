@@ -34,29 +34,33 @@ void ValidateInput(const Eigen::Ref<const Eigen::VectorXd>& head, const OverallO
                        "value " + FormatNumber(head[k]) + " is not a finite number");
     }
   }
-  if (const std::string why = options.Validate(); !why.empty()) {
-    const auto colon = why.find(':');
-    throw InputError(why.substr(0, colon), why.substr(colon + 2));
-  }
+  ThrowIfAny(options.Validate());
   internal::CheckOverallOptionsForChain(options, chain.dim());
 }
 
 }  // namespace
 
-std::string OverallOptions::Validate() const {
-  if (const std::string why = weights.Validate(); !why.empty()) return why;
+Problems OverallOptions::Validate() const {
+  Problems problems;
+  AppendNested("weights", weights.Validate(), &problems);
   if (!(constraint_tolerance > 0.0) || !std::isfinite(constraint_tolerance)) {
-    return "constraint_tolerance: " + FormatNumber(constraint_tolerance) +
-           " is not valid; must be a finite number > 0 (typical 1e-14)";
+    problems.emplace_back("constraint_tolerance",
+                          FormatNumber(constraint_tolerance) +
+                              " is not valid; must be a finite number > 0 (typical 1e-14)",
+                          FormatNumber(constraint_tolerance), "a finite number > 0");
   }
   if (!(optimality_tolerance > 0.0) || !std::isfinite(optimality_tolerance)) {
-    return "optimality_tolerance: " + FormatNumber(optimality_tolerance) +
-           " is not valid; must be a finite number > 0 (typical 1e-10)";
+    problems.emplace_back("optimality_tolerance",
+                          FormatNumber(optimality_tolerance) +
+                              " is not valid; must be a finite number > 0 (typical 1e-10)",
+                          FormatNumber(optimality_tolerance), "a finite number > 0");
   }
   if (max_iterations < 1) {
-    return "max_iterations: " + std::to_string(max_iterations) + " is not valid; must be >= 1";
+    problems.emplace_back("max_iterations",
+                          std::to_string(max_iterations) + " is not valid; must be >= 1",
+                          std::to_string(max_iterations), ">= 1");
   }
-  return "";
+  return problems;
 }
 
 const char* OverallStatusName(OverallStatus status) {

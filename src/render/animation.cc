@@ -169,7 +169,7 @@ void DrawMoment(render::Canvas* canvas, const ChainScene& scene, const ResultFil
 
 void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
                     const std::string& path) {
-  render::ThrowIfInvalid(options.Validate());
+  ThrowIfAny(options.Validate());
   const VideoFormat format = VideoFormatFromPath(path);
   render::CheckDrawable(file);
   const int width = options.width + options.width % 2;

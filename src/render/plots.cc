@@ -201,7 +201,7 @@ void LengthErrorPlot(render::Canvas* canvas, const ResultFile& file) {
 
 void WritePlot(const ResultFile& file, PlotKind kind, const PlotOptions& options,
                const std::string& path) {
-  render::ThrowIfInvalid(options.Validate());
+  ThrowIfAny(options.Validate());
   const ImageFormat format = ImageFormatFromPath(path);
   render::CheckDrawable(file);
   render::Canvas canvas(format, options.width, options.height);

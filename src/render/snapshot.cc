@@ -69,7 +69,7 @@ void DrawPathArrow(cairo_t* cr, const ChainScene& scene, const std::vector<doubl
 void WriteSnapshotFigure(const ResultFile& file, const FigureOptions& options,
                          const std::string& path) {
   using namespace render;
-  ThrowIfInvalid(options.Validate());
+  ThrowIfAny(options.Validate());
   const ImageFormat format = ImageFormatFromPath(path);
   CheckDrawable(file);
 

@@ -114,42 +114,50 @@ std::string Format(const char* fmt, double x) {
 
 }  // namespace
 
-std::string RunOptions::Validate() const {
-  if (substeps < 1) return "substeps: " + std::to_string(substeps) + " is not valid; must be >= 1";
+Problems RunOptions::Validate() const {
+  Problems problems;
+  if (substeps < 1) {
+    problems.emplace_back("substeps", std::to_string(substeps) + " is not valid; must be >= 1",
+                          std::to_string(substeps), ">= 1");
+  }
   if (record_every < 1) {
-    return "record_every: " + std::to_string(record_every) + " is not valid; must be >= 1";
+    problems.emplace_back("record_every",
+                          std::to_string(record_every) + " is not valid; must be >= 1",
+                          std::to_string(record_every), ">= 1");
   }
   if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) {
-    return "tolerance: " + FormatNumber(tolerance) +
-           " is not valid; must be a finite number >= 0 (0 turns accuracy control off)";
+    problems.emplace_back("tolerance",
+                          FormatNumber(tolerance) +
+                              " is not valid; must be a finite number >= 0 (0 turns accuracy "
+                              "control off)",
+                          FormatNumber(tolerance), "a finite number >= 0");
+  } else if (tolerance > 0.0 && MethodOrder(method) == 0) {
+    problems.emplace_back("tolerance",
+                          std::string("accuracy control is available for the tractrix and ftl "
+                                      "methods; with \"") +
+                              MethodName(method) + "\" set it to 0 and choose the sub-steps",
+                          FormatNumber(tolerance), "0 with this method");
   }
   if (tolerance > 0.0 && max_substeps < 2) {
-    return "max_substeps: " + std::to_string(max_substeps) +
-           " is not valid; accuracy control compares two runs and needs max_substeps >= 2";
+    problems.emplace_back("max_substeps",
+                          std::to_string(max_substeps) +
+                              " is not valid; accuracy control compares two runs and needs "
+                              "max_substeps >= 2",
+                          std::to_string(max_substeps), ">= 2");
+  } else if (max_substeps < substeps && substeps >= 1) {
+    problems.emplace_back("max_substeps",
+                          std::to_string(max_substeps) + " is not valid; must be >= substeps (" +
+                              std::to_string(substeps) + ")",
+                          std::to_string(max_substeps), ">= substeps");
   }
-  if (tolerance > 0.0 && MethodOrder(method) == 0) {
-    return std::string(
-               "tolerance: accuracy control is available for the tractrix and ftl methods; "
-               "with \"") +
-           MethodName(method) + "\" set it to 0 and choose the sub-steps";
-  }
-  if (method == Method::kOverall) {
-    if (const std::string why = overall.Validate(); !why.empty()) return "overall." + why;
-  }
-  if (max_substeps < substeps) {
-    return "max_substeps: " + std::to_string(max_substeps) +
-           " is not valid; must be >= substeps (" + std::to_string(substeps) + ")";
-  }
-  return "";
+  if (method == Method::kOverall) AppendNested("overall", overall.Validate(), &problems);
+  return problems;
 }
 
 RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& options) {
   ValidateChain(chain);
   ValidateLeaderSteps(leader_steps, chain.dim());
-  if (const std::string why = options.Validate(); !why.empty()) {
-    const auto colon = why.find(':');
-    throw InputError(why.substr(0, colon), why.substr(colon + 2));
-  }
+  ThrowIfAny(options.Validate());
   const auto start_time = Clock::now();
 
   RunResult result;

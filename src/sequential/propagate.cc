@@ -120,35 +120,6 @@ int WavefrontLanes() {
 
 }  // namespace internal
 
-const char* MethodName(Method method) {
-  switch (method) {
-    case Method::kTractrix:
-      return "tractrix";
-    case Method::kFollowTheLeader:
-      return "ftl";
-    case Method::kMinRotation:
-      return "min_rotation";
-    case Method::kMinJointAngle:
-      return "min_joint_angle";
-    case Method::kOverall:
-      return "overall";
-  }
-  return "unknown";
-}
-
-Method ParseMethod(std::string_view name, const std::string& field) {
-  for (const Method m : {Method::kTractrix, Method::kFollowTheLeader, Method::kMinRotation,
-                         Method::kMinJointAngle, Method::kOverall}) {
-    if (name == MethodName(m)) return m;
-  }
-  throw InputError(
-      field, "unknown method \"" + std::string(name) + "\"; valid methods are " + MethodNames());
-}
-
-std::string MethodNames() {
-  return "\"tractrix\", \"ftl\", \"min_rotation\", \"min_joint_angle\" or \"overall\"";
-}
-
 int MethodOrder(Method method) {
   switch (method) {
     case Method::kTractrix:

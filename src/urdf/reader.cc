@@ -152,8 +152,10 @@ ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
     model.joint_axes.resize(0, 0);
     model.link_directions.resize(0, 0);
   }
-  const std::string why = model.Validate();
-  if (!why.empty()) throw InputError("urdf", why);
+  // The model built from the file: its problem is the file's, named "urdf" with the member.
+  if (const Problems problems = model.Validate(); !problems.empty()) {
+    throw InputError("urdf", problems.front().Text());
+  }
   return model;
 }
 

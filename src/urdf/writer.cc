@@ -38,8 +38,9 @@ std::string XmlEscape(const std::string& s) {
 }  // namespace
 
 std::string UrdfFromArm(const ArmModel& model, const std::string& robot_name) {
-  const std::string why = model.Validate();
-  if (!why.empty()) throw InputError("model." + why.substr(0, why.find(':')), why.substr(why.find(':') + 2));
+  Problems problems;
+  AppendNested("model", model.Validate(), &problems);
+  ThrowIfAny(problems);
   if (model.joint() == ArmJoint::kSpherical) {
     throw InputError("model.joint_axes", "is empty: spherical joints have no URDF form; expected revolute joints "
                                          "(a planar arm, or joint_axes)");

@@ -31,36 +31,46 @@ std::string_view WriteReplacing(std::ostream& out, std::string_view page, std::s
 
 }  // namespace
 
-std::string ViewerOptions::Validate() const {
+Problems ViewerOptions::Validate() const {
+  Problems problems;
   if (!(playback_seconds > 0.0 && playback_seconds <= 86400.0)) {
-    return "playback_seconds: " + FormatNumber(playback_seconds) +
-           " is not valid; must be > 0 and <= 86400 (seconds for all frames at 1x)";
+    problems.emplace_back("playback_seconds",
+                          FormatNumber(playback_seconds) +
+                              " is not valid; must be > 0 and <= 86400 (seconds for all frames "
+                              "at 1x)",
+                          FormatNumber(playback_seconds), "> 0 and <= 86400");
   }
   for (size_t i = 0; i < trail_points.size(); ++i) {
     if (trail_points[i] < 0) {
-      return "trail_points[" + std::to_string(i) + "]: " + std::to_string(trail_points[i]) +
-             " is not valid; must be a point index >= 0 (0 is the leading end)";
+      problems.emplace_back("trail_points[" + std::to_string(i) + "]",
+                            std::to_string(trail_points[i]) +
+                                " is not valid; must be a point index >= 0 (0 is the leading end)",
+                            std::to_string(trail_points[i]), "a point index >= 0");
     }
   }
   if (!std::isfinite(azimuth_deg)) {
-    return "azimuth_deg: " + FormatNumber(azimuth_deg) + " is not valid; must be finite (degrees)";
+    problems.emplace_back("azimuth_deg",
+                          FormatNumber(azimuth_deg) + " is not valid; must be finite (degrees)",
+                          FormatNumber(azimuth_deg), "a finite number of degrees");
   }
   if (!(elevation_deg >= -90.0 && elevation_deg <= 90.0)) {
-    return "elevation_deg: " + FormatNumber(elevation_deg) +
-           " is not valid; must be in [-90, 90] (degrees)";
+    problems.emplace_back("elevation_deg",
+                          FormatNumber(elevation_deg) +
+                              " is not valid; must be in [-90, 90] (degrees)",
+                          FormatNumber(elevation_deg), "in [-90, 90]");
   }
   if (digits < 6 || digits > 17) {
-    return "digits: " + std::to_string(digits) + " is not valid; must be in [6, 17]";
+    problems.emplace_back("digits", std::to_string(digits) + " is not valid; must be in [6, 17]",
+                          std::to_string(digits), "in [6, 17]");
   }
-  return "";
+  return problems;
 }
 
 void WriteViewerHtml(const ResultFile& result, const ViewerOptions& options,
                      const std::string& path) {
-  if (const std::string why = options.Validate(); !why.empty()) {
-    const size_t colon = why.find(':');
-    throw InputError("options." + why.substr(0, colon), why.substr(colon + 2));
-  }
+  Problems problems;
+  AppendNested("options", options.Validate(), &problems);
+  ThrowIfAny(problems);
   // All checks happen here, before the file is touched.
   const std::string data = viewer_internal::ViewerDataJson(result, options);
 

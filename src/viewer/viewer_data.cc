@@ -12,57 +12,11 @@
 namespace flexkin::viewer_internal {
 namespace {
 
-void RequireFinite(double x, const std::string& field) {
-  if (!std::isfinite(x)) {
-    throw InputError(field, FormatNumber(x) + " is not a finite number; the viewer cannot show it");
-  }
-}
-
-void RequireFinite(const Eigen::VectorXd& v, const std::string& field) {
-  for (Eigen::Index i = 0; i < v.size(); ++i) {
-    RequireFinite(v[i], field + "[" + std::to_string(i) + "]");
-  }
-}
-
-// Everything the page would show must be a finite number and every frame (n+1) by dim.
+// Everything the page would show must be a finite number and every frame (n+1) by dim (the
+// library's check of results); the trail points must be points of the chain.
 void CheckResult(const ResultFile& file, const ViewerOptions& options) {
-  const RunResult& r = file.result;
-  if (file.dim != 2 && file.dim != 3) {
-    throw InputError("dim", std::to_string(file.dim) + " is not valid; must be 2 or 3");
-  }
-  const Eigen::Index n = r.lengths.size();
-  if (n < 1) throw InputError("link_lengths", "is empty; a chain has at least one link");
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const std::string field = "link_lengths[" + std::to_string(i) + "]";
-    RequireFinite(r.lengths[i], field);
-    if (!(r.lengths[i] > 0.0)) {
-      throw InputError(field, FormatNumber(r.lengths[i]) + " is not valid; must be > 0");
-    }
-  }
-  if (r.frames.empty()) throw InputError("frames", "is empty; the viewer needs at least one frame");
-  for (size_t f = 0; f < r.frames.size(); ++f) {
-    const Points& p = r.frames[f].points;
-    const std::string field = "frames[" + std::to_string(f) + "].points";
-    if (p.rows() != n + 1 || p.cols() != file.dim) {
-      throw InputError(field, std::to_string(p.rows()) + " by " + std::to_string(p.cols()) +
-                                  " is not valid; expected " + std::to_string(n + 1) + " by " +
-                                  std::to_string(file.dim) + " (n+1 points of dim coordinates)");
-    }
-    for (Eigen::Index i = 0; i < p.rows(); ++i) {
-      for (Eigen::Index k = 0; k < p.cols(); ++k) {
-        RequireFinite(p(i, k), field + "[" + std::to_string(i) + "][" + std::to_string(k) + "]");
-      }
-    }
-  }
-  const Metrics& m = r.metrics;
-  RequireFinite(m.l2_total, "metrics.l2_total");
-  RequireFinite(m.l2_weighted_total, "metrics.l2_weighted_total");
-  RequireFinite(m.max_relative_length_error, "metrics.max_relative_length_error");
-  RequireFinite(m.path_length, "metrics.path_length");
-  RequireFinite(m.l2_per_step, "metrics.l2_per_step");
-  RequireFinite(r.accuracy.tolerance, "accuracy.tolerance");
-  RequireFinite(r.accuracy.estimated_error, "accuracy.estimated_error");
-  RequireFinite(r.seconds, "seconds");
+  ThrowIfAny(ValidateResult(file.result, file.dim));
+  const Eigen::Index n = file.result.lengths.size();
   for (size_t i = 0; i < options.trail_points.size(); ++i) {
     if (options.trail_points[i] > n) {
       throw InputError("trail_points[" + std::to_string(i) + "]",

@@ -1,0 +1,97 @@
+// The one check of a result: what every reader and writer of results relies on (result_io.h).
+#include <cmath>
+#include <optional>
+#include <string>
+
+#include "flexkin/error.h"
+#include "flexkin/result_io.h"
+
+namespace flexkin {
+namespace {
+
+std::string Index(const std::string& field, Eigen::Index i) {
+  return field + "[" + std::to_string(i) + "]";
+}
+
+std::optional<Problem> NonFinite(const Eigen::Ref<const Eigen::VectorXd>& v,
+                                 const std::string& field) {
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    if (!std::isfinite(v[i])) {
+      return Problem::Invalid(Index(field, i), FormatNumber(v[i]), "a finite number");
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<Problem> FirstProblem(const RunResult& r, int dim) {
+  if (dim != 2 && dim != 3) return Problem::Invalid("dim", std::to_string(dim), "2 or 3");
+  const Eigen::Index n = r.lengths.size();
+  if (n < 1) return Problem("link_lengths", "the result has no links; expected at least one");
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!(r.lengths[i] > 0.0) || !std::isfinite(r.lengths[i])) {
+      return Problem::Invalid(Index("link_lengths", i), FormatNumber(r.lengths[i]),
+                              "a positive finite number");
+    }
+  }
+  if (r.frames.empty()) {
+    return Problem("frames", "the result has no frames; expected at least the initial frame");
+  }
+  for (size_t f = 0; f < r.frames.size(); ++f) {
+    const Frame& frame = r.frames[f];
+    const std::string field = Index("frames", static_cast<Eigen::Index>(f));
+    const Points& p = frame.points;
+    if (p.rows() != n + 1 || p.cols() != dim) {
+      return Problem(field + ".points",
+                     "is " + std::to_string(p.rows()) + " by " + std::to_string(p.cols()) +
+                         "; expected " + std::to_string(n + 1) + " by " + std::to_string(dim) +
+                         " (one row per point, n+1 for n links)");
+    }
+    for (Eigen::Index i = 0; i <= n; ++i) {
+      if (auto problem = NonFinite(p.row(i).transpose(), Index(field + ".points", i))) {
+        return problem;
+      }
+    }
+    if (frame.link_angles.size() != 0 && frame.link_angles.size() != n) {
+      return Problem(field + ".link_angles", "has " + std::to_string(frame.link_angles.size()) +
+                                                 " values; expected one per link (" +
+                                                 std::to_string(n) + ") or none");
+    }
+    if (auto problem = NonFinite(frame.link_angles, field + ".link_angles")) return problem;
+    if (frame.step < 0 || (f > 0 && frame.step <= r.frames[f - 1].step)) {
+      return Problem(field + ".step",
+                     std::to_string(frame.step) +
+                         " is not valid; steps must be >= 0 and increase from frame to frame",
+                     std::to_string(frame.step), ">= 0 and above the previous frame's");
+    }
+  }
+  const Metrics& m = r.metrics;
+  const std::pair<const char*, const Eigen::VectorXd*> vectors[] = {
+      {"metrics.l2_per_step", &m.l2_per_step},
+      {"metrics.l2_weighted_per_step", &m.l2_weighted_per_step},
+      {"metrics.path_length", &m.path_length}};
+  for (const auto& [name, v] : vectors) {
+    if (auto problem = NonFinite(*v, name)) return problem;
+  }
+  const std::pair<const char*, double> numbers[] = {
+      {"metrics.l2_total", m.l2_total},
+      {"metrics.l2_weighted_total", m.l2_weighted_total},
+      {"metrics.max_relative_length_error", m.max_relative_length_error},
+      {"accuracy.tolerance", r.accuracy.tolerance},
+      {"accuracy.estimated_error", r.accuracy.estimated_error},
+      {"overall.constraint_violation", r.overall.constraint_violation},
+      {"overall.optimality", r.overall.optimality},
+      {"seconds", r.seconds}};
+  for (const auto& [name, x] : numbers) {
+    if (!std::isfinite(x)) return Problem::Invalid(name, FormatNumber(x), "a finite number");
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+Problems ValidateResult(const RunResult& result, int dim) {
+  if (std::optional<Problem> problem = FirstProblem(result, dim)) return {*problem};
+  return {};
+}
+
+}  // namespace flexkin
