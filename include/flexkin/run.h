@@ -109,9 +109,31 @@ struct RunResult {
   std::string FullReport() const;
 };
 
+// Receives a run's recorded configurations as they are produced (frame 0 first, then every
+// `record_every`-th leader step and the last), so that a caller can stream them to a file or
+// keep only what it needs: the run itself holds one configuration, not the frames.
+class FrameSink {
+ public:
+  virtual ~FrameSink() = default;
+  // `points` is (n+1) by dim; `link_angles` as Frame::link_angles. Both are valid only during the
+  // call. May throw: the run stops and the exception propagates.
+  virtual void Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) = 0;
+};
+
+// The sink of Run's plain form: keeps every frame in memory, in `frames`.
+class FrameRecorder : public FrameSink {
+ public:
+  void Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) override;
+  std::vector<Frame> frames;
+};
+
 // Runs `chain` with its leading end moved in straight lines through the rows of `leader_steps`
-// (m by dim, the successive targets, not including the start). Throws InputError on invalid
-// input (chain, targets, options).
+// (m by dim, the successive targets, not including the start). The recorded frames go to `sink`
+// (RunResult::frames stays empty). Throws InputError on invalid input (chain, targets, options)
+// before any frame is produced.
+RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& options,
+              FrameSink* sink);
+// The same with the frames kept in RunResult::frames.
 RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& options);
 
 }  // namespace flexkin

@@ -9,6 +9,8 @@
 // Jacobian) share one register, so they cost about one sweep.
 #include "arm/lanes.h"
 
+#include "chain/substep.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -105,11 +107,10 @@ void SweepOne(const double* target, int substeps, const double* lengths, const d
   double from[Dim];
   for (int k = 0; k < Dim; ++k) from[k] = p[n * Dim + k];
   for (int s = 1; s <= substeps; ++s) {
-    const double fraction = double(s) / substeps;
     double head_old[Dim], head[Dim];
     for (int k = 0; k < Dim; ++k) {
       head_old[k] = p[n * Dim + k];
-      head[k] = s == substeps ? target[k] : from[k] + (target[k] - from[k]) * fraction;
+      head[k] = internal::SubstepHead(from[k], target[k], s, substeps);
       p[n * Dim + k] = head[k];
     }
     for (int j = n; j >= 1; --j) {

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "arm/internal.h"
+#include "chain/substep.h"
 #include "flexkin/error.h"
 #include "sequential/link_rules.h"
 
@@ -121,8 +122,8 @@ SmallVec RevoluteSweeper::Evaluate(const SmallVec& u) {
   double head_old[3], tail_old[3];
   for (int s = 1; s <= substeps_; ++s) {
     for (int k = 0; k < 3; ++k) head_old[k] = p(n_, k);
-    const Eigen::Vector3d head =
-        s == substeps_ ? Eigen::Vector3d(target_) : Eigen::Vector3d(from + (target_ - from) * (double(s) / substeps_));
+    Eigen::Vector3d head;
+    for (int k = 0; k < 3; ++k) head[k] = internal::SubstepHead(from[k], target_[k], s, substeps_);
     p.row(n_) = head.transpose();
     for (int j = n_; j >= 1; --j) {
       const double length = model_.link_lengths[j - 1];

@@ -5,22 +5,17 @@
 #include <string>
 
 #include "arm/internal.h"
+#include "chain/simd.h"
+#include "chain/substep.h"
 #include "sequential/link_rules.h"
 #include "arm/lanes.h"
 
 namespace flexkin::arm_internal {
 
-// Whether the AVX2 sweeps (src/arm/lanes.h) can run here: the CPU has AVX2 and FMA,
-// and FLEXKIN_SIMD (see propagate.cc) does not ask for scalar code.
+// Whether the AVX2 sweeps (src/arm/lanes.h) can run here: AllowedSimd() (src/chain/simd.h).
 bool HasAvx2Fma() {
 #if FLEXKIN_HAVE_WAVEFRONT
-  static const bool ok = [] {
-    __builtin_cpu_init();
-    const char* cap = std::getenv("FLEXKIN_SIMD");
-    if (cap != nullptr && std::string(cap) == "scalar") return false;
-    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  }();
-  return ok;
+  return internal::AllowedSimd().avx2_fma;
 #else
   return false;
 #endif
@@ -175,12 +170,11 @@ void Sweeper::Run(double* const* lanes, bool* limited_out) {
     for (int k = 0; k < Dim; ++k) from[l][k] = lanes[l][n * Dim + k];
   }
   for (int s = 1; s <= substeps_; ++s) {
-    const double fraction = double(s) / substeps_;
     for (int l = 0; l < K; ++l) {
       double* head = lanes[l] + n * Dim;
       for (int k = 0; k < Dim; ++k) {
         head_old[l][k] = head[k];
-        head[k] = s == substeps_ ? target_[k] : from[l][k] + (target_[k] - from[l][k]) * fraction;
+        head[k] = internal::SubstepHead(from[l][k], target_[k], s, substeps_);
       }
     }
     for (int j = n; j >= 1; --j) {

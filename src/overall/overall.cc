@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "chain/substep.h"
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
 #include "overall/active_set.h"
@@ -167,10 +168,8 @@ OverallReport Continue(const Eigen::VectorXd& lengths,
   OverallReport report;
   int iterations = 0;
   for (int s = 1; s <= sub_steps; ++s) {
-    if (s == sub_steps) {
-      b->target = head;
-    } else {
-      b->target = b->from + (static_cast<double>(s) / sub_steps) * (head - b->from);
+    for (Eigen::Index k = 0; k < head.size(); ++k) {
+      b->target[k] = internal::SubstepHead(b->from[k], head[k], s, sub_steps);
     }
     if (l2) {
       report = SolveActiveSet(lengths, b->old_points, options, b->target, &moving, points,

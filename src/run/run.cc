@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "flexkin/error.h"
+#include "chain/substep.h"
 #include "overall/step.h"
 
 namespace flexkin {
@@ -154,7 +155,96 @@ Problems RunOptions::Validate() const {
   return problems;
 }
 
-RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& options) {
+namespace {
+
+// Moves the chain by one sub-step with the run's method: the sequential link rule of a stepper, or
+// the overall solve in a workspace reused by every sub-step (the chain, the head and the options
+// are checked once, before the run).
+class ChainMover {
+ public:
+  ChainMover(const Chain& chain, const RunOptions& options, RunResult* result)
+      : lengths_(chain.lengths), options_(options), result_(result) {
+    if (options.method == Method::kOverall) {
+      internal::CheckOverallOptionsForChain(options.overall, chain.dim());
+      workspace_.emplace();
+    } else {
+      stepper_ = MakeStepper(options.method, chain);
+    }
+  }
+  void Step(const Eigen::VectorXd& head, int64_t step, int substep, Points* points) {
+    if (!stepper_) {
+      internal::OverallStepUnchecked(lengths_, head, options_.overall, points, &*workspace_,
+                                     &report_);
+      Record(report_, step, substep, &result_->overall);
+    } else {
+      MoveLeader(*stepper_, head, 1, points);
+    }
+  }
+
+ private:
+  const Eigen::VectorXd& lengths_;
+  const RunOptions& options_;
+  RunResult* result_;
+  std::optional<Stepper> stepper_;
+  std::optional<OverallWorkspace> workspace_;
+  OverallReport report_;
+};
+
+// The metrics of a run (paper eq. 6 and Sec. 3.2), accumulated sub-step by sub-step.
+class MetricsAccumulator {
+ public:
+  MetricsAccumulator(const Eigen::VectorXd& lengths, int64_t num_steps, Metrics* m)
+      : lengths_(lengths), weights_(ArcLengthWeights(lengths)), m_(m) {
+    m->l2_per_step.resize(num_steps);
+    m->l2_weighted_per_step.resize(num_steps);
+    m->path_length = Eigen::VectorXd::Zero(lengths.size() + 1);
+    moved_.resize(lengths.size() + 1);
+  }
+  void BeginStep() { moved_.setZero(); }
+  void AddSubstep(const Points& before, const Points& after) {
+    moved_ += (after - before).rowwise().norm();
+  }
+  void EndStep(int64_t s, const Points& points) {
+    m_->path_length += moved_;
+    m_->l2_per_step[s] = moved_.sum();
+    m_->l2_weighted_per_step[s] = moved_.dot(weights_);
+    for (Eigen::Index i = 1; i <= lengths_.size(); ++i) {
+      const double length = (points.row(i) - points.row(i - 1)).norm();
+      m_->max_relative_length_error = std::fmax(m_->max_relative_length_error,
+                                                std::fabs(length - lengths_[i - 1]) / lengths_[i - 1]);
+    }
+  }
+  void Finish() {
+    m_->l2_total = m_->l2_per_step.sum();
+    m_->l2_weighted_total = m_->l2_weighted_per_step.sum();
+  }
+
+ private:
+  const Eigen::VectorXd& lengths_;
+  const Eigen::VectorXd weights_;
+  Metrics* m_;
+  Eigen::VectorXd moved_;
+};
+
+// The direction of the first leader step that moves: that of frame 0's link angles.
+Eigen::VectorXd FirstDirection(const Points& start, const Points& leader_steps) {
+  Eigen::VectorXd from = start.row(0).transpose();
+  for (Eigen::Index s = 0; s < leader_steps.rows(); ++s) {
+    const Eigen::VectorXd d = leader_steps.row(s).transpose() - from;
+    if (d.norm() > 0.0) return d.normalized();
+    from = leader_steps.row(s).transpose();
+  }
+  return {};
+}
+
+}  // namespace
+
+void FrameRecorder::Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) {
+  frames.push_back({step, points, link_angles});
+}
+
+RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& options,
+              FrameSink* sink) {
   ValidateChain(chain);
   ValidateLeaderSteps(leader_steps, chain.dim());
   ThrowIfAny(options.Validate());
@@ -166,78 +256,36 @@ RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& 
   result.num_steps = leader_steps.rows();
   result.accuracy.order = MethodOrder(options.method);
   result.accuracy.substeps = options.substeps;
+  if (options.method == Method::kOverall) result.weights = options.overall.weights;
+  ChainMover mover(chain, options, &result);
   if (options.tolerance > 0.0) result.accuracy = ChooseSubsteps(chain, leader_steps, options);
   const int substeps = result.accuracy.substeps;
+  MetricsAccumulator metrics(chain.lengths, result.num_steps, &result.metrics);
 
-  const bool overall = options.method == Method::kOverall;
-  std::optional<Stepper> stepper;
-  // The overall method: one workspace and one report for all the run's sub-steps, so that they
-  // allocate nothing. The chain, the leader steps and the options are checked above, and the
-  // options against the chain here, once: the sub-steps skip OverallStep's checks.
-  std::optional<OverallWorkspace> workspace;
-  OverallReport overall_report;
-  if (overall) {
-    result.weights = options.overall.weights;
-    internal::CheckOverallOptionsForChain(options.overall, chain.dim());
-    workspace.emplace();
-  } else {
-    stepper = MakeStepper(options.method, chain);
-  }
-  const Eigen::Index n = chain.num_links();
-  const Eigen::VectorXd weights = ArcLengthWeights(chain.lengths);
-  Metrics& m = result.metrics;
-  m.l2_per_step.resize(result.num_steps);
-  m.l2_weighted_per_step.resize(result.num_steps);
-  m.path_length = Eigen::VectorXd::Zero(n + 1);
-
-  // The direction for frame 0 is that of the first leader step that moves.
-  Eigen::VectorXd direction;
-  {
-    Eigen::VectorXd from = chain.points.row(0).transpose();
-    for (Eigen::Index s = 0; s < leader_steps.rows() && direction.size() == 0; ++s) {
-      const Eigen::VectorXd d = leader_steps.row(s).transpose() - from;
-      if (d.norm() > 0.0) direction = d.normalized();
-      from = leader_steps.row(s).transpose();
-    }
-  }
-  Points points = chain.points;
-  result.frames.push_back({0, points, LinkAngles(points, direction)});
-
+  Eigen::VectorXd direction = FirstDirection(chain.points, leader_steps);
+  Points points = chain.points, before;
+  sink->Add(0, points, LinkAngles(points, direction));
   auto last_report = Clock::now();
-  Points before;
-  Eigen::VectorXd moved(n + 1), head(chain.dim());
+  Eigen::VectorXd head(chain.dim());
   for (int64_t s = 0; s < result.num_steps; ++s) {
     const Eigen::VectorXd start = points.row(0).transpose();
     const Eigen::VectorXd target = leader_steps.row(s).transpose();
     if ((target - start).norm() > 0.0) direction = (target - start).normalized();
     // One sub-step at a time (the heads MoveLeader would use), so that the metrics see the
     // motion at the resolution it is computed.
-    moved.setZero();
+    metrics.BeginStep();
     for (int j = 1; j <= substeps; ++j) {
-      head = (j == substeps) ? target
-                             : Eigen::VectorXd(start + (double(j) / substeps) * (target - start));
-      before = points;
-      if (overall) {
-        internal::OverallStepUnchecked(chain.lengths, head, options.overall, &points,
-                                       &*workspace, &overall_report);
-        Record(overall_report, s + 1, j, &result.overall);
-      } else {
-        MoveLeader(*stepper, head, 1, &points);
+      for (int k = 0; k < chain.dim(); ++k) {
+        head[k] = internal::SubstepHead(start[k], target[k], j, substeps);
       }
-      moved += (points - before).rowwise().norm();
+      before = points;
+      mover.Step(head, s + 1, j, &points);
+      metrics.AddSubstep(before, points);
     }
-    m.path_length += moved;
-    m.l2_per_step[s] = moved.sum();
-    m.l2_weighted_per_step[s] = moved.dot(weights);
-    for (Eigen::Index i = 1; i <= n; ++i) {
-      const double length = (points.row(i) - points.row(i - 1)).norm();
-      m.max_relative_length_error =
-          std::fmax(m.max_relative_length_error,
-                    std::fabs(length - chain.lengths[i - 1]) / chain.lengths[i - 1]);
-    }
+    metrics.EndStep(s, points);
     const int64_t done = s + 1;
     if (done % options.record_every == 0 || done == result.num_steps) {
-      result.frames.push_back({done, points, LinkAngles(points, direction)});
+      sink->Add(done, points, LinkAngles(points, direction));
     }
     if (options.progress && Clock::now() - last_report > std::chrono::milliseconds(100)) {
       options.progress(done, result.num_steps);
@@ -245,9 +293,15 @@ RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& 
     }
   }
   if (options.progress) options.progress(result.num_steps, result.num_steps);
-  m.l2_total = m.l2_per_step.sum();
-  m.l2_weighted_total = m.l2_weighted_per_step.sum();
+  metrics.Finish();
   result.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
+  return result;
+}
+
+RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& options) {
+  FrameRecorder recorder;
+  RunResult result = Run(chain, leader_steps, options, &recorder);
+  result.frames = std::move(recorder.frames);
   return result;
 }
 

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "chain/simd.h"
+#include "chain/substep.h"
 #include "flexkin/error.h"
 #include "sequential/link_rules.h"
 #include "sequential/sweep.h"
@@ -48,21 +50,11 @@ struct WavefrontChoice {
   SweepsFn fn;
   int lanes;
 };
-// FLEXKIN_SIMD=scalar|avx2|avx512 in the environment caps the instruction set (to compare them,
-// or to test every engine on one machine); the CPU's support is still checked. Without AVX2 and
-// FMA there is no wavefront (lanes = 1) and every move takes the one-pass loop.
+// The widest engine AllowedSimd() permits (src/chain/simd.h). Without AVX2 and FMA there is no
+// wavefront (lanes = 1) and every move takes the one-pass loop.
 WavefrontChoice ChooseWavefront() {
-  __builtin_cpu_init();
-  const char* cap_env = std::getenv("FLEXKIN_SIMD");
-  const std::string cap = cap_env ? cap_env : "avx512";
-  if (cap == "scalar") return {nullptr, 1};
-  if (cap == "avx512" && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
-      __builtin_cpu_supports("avx512cd")) {
-    return {SweepsWavefrontAvx512, 8};
-  }
-  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
-    return {SweepsWavefrontAvx2, 4};
-  }
+  if (AllowedSimd().avx512) return {SweepsWavefrontAvx512, 8};
+  if (AllowedSimd().avx2_fma) return {SweepsWavefrontAvx2, 4};
   return {nullptr, 1};
 }
 const WavefrontChoice& Wavefront() {
@@ -98,14 +90,8 @@ void SweepsWavefront(Method method, int dim, const double* heads, int64_t num_sw
 std::vector<WavefrontEngine> AvailableWavefronts() {
   std::vector<WavefrontEngine> engines;
 #if FLEXKIN_HAVE_WAVEFRONT
-  __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
-    engines.push_back({"avx2", SweepsWavefrontAvx2, 4});
-  }
-  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
-      __builtin_cpu_supports("avx512cd")) {
-    engines.push_back({"avx512", SweepsWavefrontAvx512, 8});
-  }
+  if (CpuSimd().avx2_fma) engines.push_back({"avx2", SweepsWavefrontAvx2, 4});
+  if (CpuSimd().avx512) engines.push_back({"avx512", SweepsWavefrontAvx512, 8});
 #endif
   return engines;
 }
@@ -174,10 +160,8 @@ void MoveLeader(const Stepper& stepper, const Eigen::Ref<const Eigen::VectorXd>&
   const int dim = stepper.dim;
   std::vector<double> heads(static_cast<size_t>(substeps) * dim);
   for (int j = 1; j <= substeps; ++j) {
-    const double t = static_cast<double>(j) / substeps;
     for (int k = 0; k < dim; ++k) {
-      const double start = (*points)(0, k);
-      heads[(j - 1) * dim + k] = (j == substeps) ? target[k] : start + t * (target[k] - start);
+      heads[(j - 1) * dim + k] = internal::SubstepHead((*points)(0, k), target[k], j, substeps);
     }
   }
   const int n = static_cast<int>(stepper.lengths.size());
