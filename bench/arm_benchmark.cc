@@ -5,27 +5,20 @@
 //   build/bench/arm_benchmark --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
 
-#include <cmath>
-
 #include "flexkin/arm.h"
-#include "arm_scenes.h"
+#include "scenes/scenes.h"
 
 namespace {
 
-using flexkin::bench::ArcArm;
+namespace scenes = flexkin::scenes;
 
 void Track(benchmark::State& state, flexkin::FixedBaseMethod method) {
   const int links = static_cast<int>(state.range(0));
   const double fraction = state.range(1) / 1000.0;
-  const flexkin::ArmModel model = ArcArm(links, fraction);
+  const flexkin::ArmModel model =
+      scenes::ArcArm(2, links, scenes::ArcTurnForReach(links, fraction));
   // A small circle (radius: one link) traced by the end effector in 64 steps.
-  const flexkin::ArmState start = flexkin::InitialState(model);
-  const Eigen::Vector2d ee = start.points.row(links).transpose();
-  flexkin::Points path(64, 2);
-  for (int i = 0; i < 64; ++i) {
-    const double a = 2.0 * M_PI * (i + 1) / 64;
-    path.row(i) = (ee + Eigen::Vector2d(std::cos(a) - 1.0, std::sin(a))).transpose();
-  }
+  const flexkin::Points path = scenes::CircleOfTargets(model, 1.0, 64);
   flexkin::ArmOptions options;
   options.method = method;
   long long steps = 0, iterations = 0, sweeps = 0, passes = 0, unreached = 0;

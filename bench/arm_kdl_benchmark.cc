@@ -22,40 +22,25 @@
 
 #include "arm_metrics.h"
 #include "flexkin/arm.h"
-#include "arm_scenes.h"
 #include "kdl_peer.h"
+#include "scenes/scenes.h"
 
 namespace {
 
 using flexkin::peers::KdlSolver;
-
-using flexkin::bench::ArcArm;
+namespace scenes = flexkin::scenes;
 
 // 64 targets on a circle of one link radius through the end effector's start. Planar: in the
 // plane; spatial: tilted 45 degrees out of the arc's plane, about the x axis.
 flexkin::Points CirclePath(const flexkin::ArmModel& model) {
-  const int dim = model.dim;
-  const flexkin::Points start = flexkin::ForwardKinematics(model, model.initial);
-  const Eigen::VectorXd ee = start.row(model.num_links()).transpose();
-  flexkin::Points path(64, dim);
-  for (int i = 0; i < 64; ++i) {
-    const double a = 2.0 * M_PI * (i + 1) / 64;
-    Eigen::VectorXd p = ee;
-    p[0] += std::cos(a) - 1.0;
-    if (dim == 2) {
-      p[1] += std::sin(a);
-    } else {
-      p[1] += std::sin(a) * std::sqrt(0.5);
-      p[2] += std::sin(a) * std::sqrt(0.5);
-    }
-    path.row(i) = p.transpose();
-  }
-  return path;
+  return scenes::CircleOfTargets(model, 1.0, 64, scenes::CircleTilt::kTilted45);
 }
 
 // The scene of a benchmark: range(0) links, range(1) the dimension.
 flexkin::ArmModel Scene(const benchmark::State& state) {
-  return ArcArm(static_cast<int>(state.range(0)), 0.7, static_cast<int>(state.range(1)));
+  const int links = static_cast<int>(state.range(0));
+  return scenes::ArcArm(static_cast<int>(state.range(1)), links,
+                        scenes::ArcTurnForReach(links, 0.7));
 }
 
 // This thread's CPU time (s): the machine is shared, and Google Benchmark's s/step is CPU time too.

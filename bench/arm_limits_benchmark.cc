@@ -2,7 +2,7 @@
 // reaching every target when the sweep finds no root and the step goes to joint space, against
 // the predecessors' fixed-point scheme (method fixed_point, no fallback) on the same paths.
 // Planar and spherical arms of 16 and 64 unit links, limits 0.2 rad (16) and 0.08 rad (64),
-// 5 paths of 100 steps whose joints swing beyond the limits (tests/arm_test_util.h,
+// 5 paths of 100 steps whose joints swing beyond the limits (scenes/scenes.h,
 // SaturatingPath). Counters per step: CPU time (s/step), passes over the links, the share of
 // steps solved in joint space, and the steps not reached (of 500).
 //   build/bench/arm_limits_benchmark --benchmark_counters_tabular=true
@@ -11,18 +11,20 @@
 #include <random>
 #include <vector>
 
-#include "arm_test_util.h"
 #include "flexkin/arm.h"
+#include "scenes/scenes.h"
 
 namespace {
 
 void Track(benchmark::State& state, flexkin::FixedBaseMethod method) {
   const int links = static_cast<int>(state.range(0)), dim = static_cast<int>(state.range(1));
   const double limit = links <= 16 ? 0.2 : 0.08;
-  const flexkin::ArmModel model = flexkin::LimitedArm(dim, links, limit, 0.0);
+  const flexkin::ArmModel model = flexkin::scenes::LimitedArm(dim, links, limit, 0.0);
   std::mt19937 rng(3);
   std::vector<flexkin::Points> paths;
-  for (int p = 0; p < 5; ++p) paths.push_back(flexkin::SaturatingPath(model, limit, 100, &rng));
+  for (int p = 0; p < 5; ++p) {
+    paths.push_back(flexkin::scenes::SaturatingPath(model, limit, 100, &rng));
+  }
   flexkin::ArmOptions options;
   options.method = method;
   double steps = 0, passes = 0, joint_space = 0, unreached = 0;

@@ -20,10 +20,10 @@
 #include <cmath>
 #include <string>
 
-#include "flexkin/curves.h"
 #include "flexkin/overall.h"
 #include "l2_peer.h"
 #include "peer_solvers.h"
+#include "scenes/scenes.h"
 
 namespace flexkin {
 namespace {
@@ -35,21 +35,15 @@ struct Problem {
 
 // Paper Sec. 5.1: vertex leading, the chain on the +x branch, pulled by (0.7/sqrt 2, 0.7/sqrt 2).
 Problem Parabola() {
-  const ParabolaDef def;
-  Problem p{MakeEqualLinkChain(MakeParabola(def), def.link_length), Eigen::Vector2d::Zero()};
-  p.head = p.chain.points.row(0).transpose() + Eigen::Vector2d(0.7, 0.7) / std::sqrt(2.0);
+  Problem p{scenes::PaperParabola(), Eigen::Vector2d::Zero()};
+  p.head = p.chain.points.row(0).transpose() + scenes::PaperPull();
   return p;
 }
 
 // A helix of `n` links of 0.25 (about 25 links per turn, rising 0.5 per turn); the leading end
 // moves by about half a link, so the motion spreads over the first few turns.
 Problem Helix(int n) {
-  HelixDef def;
-  def.radius = 1.0;
-  def.pitch = 0.5;
-  def.links = n;
-  def.link_length = 0.25;
-  Problem p{MakeEqualLinkChain(MakeHelix(def), def.link_length), Eigen::Vector3d::Zero()};
+  Problem p{scenes::Helix(n), Eigen::Vector3d::Zero()};
   p.head = p.chain.points.row(0).transpose() + Eigen::Vector3d(0.1, 0.05, 0.05);
   return p;
 }

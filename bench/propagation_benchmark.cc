@@ -13,19 +13,15 @@
 #include <cmath>
 #include <vector>
 
+#include "flexkin/curves.h"
 #include "flexkin/propagate.h"
+#include "scenes/scenes.h"
 #include "sequential/sweep.h"
 
 namespace flexkin {
 namespace {
 
-// A 3D helix-like chain; the leader wanders on a smooth curve so every link keeps moving.
-Chain Helix(int n) {
-  Points p(n + 1, 3);
-  for (int i = 0; i <= n; ++i) p.row(i) << std::cos(0.3 * i), std::sin(0.3 * i), 0.05 * i;
-  return MakeChain(p);
-}
-
+// The wandering leader of the coil (scenes::Coil): a smooth curve, so every link keeps moving.
 Eigen::Vector3d LeaderTarget(const Eigen::Vector3d& from, int j) {
   return from + Eigen::Vector3d(0.2 * std::cos(0.05 * j), 0.2 * std::sin(0.05 * j), 0.05);
 }
@@ -36,11 +32,11 @@ void SetRate(benchmark::State& state, double link_steps_per_iteration) {
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
-// A straight chain along -x pulled along +x: every link keeps moving, however long the chain.
+// A straight chain along -x, links of 0.3, pulled along +x: every link keeps moving, however
+// long the chain. (Its leading point is (-0.0, 0, 0), as the chain has always started.)
 Chain StraightLine(int n) {
-  Points p(n + 1, 3);
-  for (int i = 0; i <= n; ++i) p.row(i) << -0.3 * i, 0.0, 0.0;
-  return MakeChain(p);
+  const LineDef line{Eigen::Vector3d(-0.0, 0.0, 0.0), -Eigen::Vector3d::UnitX(), n, 0.3};
+  return MakeChain(MakeLine(line));
 }
 
 // Question 1: one move of the leader split into `kSubsteps` sweeps. Two scenes: `wander` (the
@@ -50,7 +46,7 @@ constexpr int kSubsteps = 64;
 
 void BM_MultiStep(benchmark::State& state, Method method, bool wavefront, bool wander) {
   const int n = static_cast<int>(state.range(0));
-  Chain chain = wander ? Helix(n) : StraightLine(n);
+  Chain chain = wander ? scenes::Coil(n) : StraightLine(n);
   const Stepper stepper = MakeStepper(method, chain);
   std::vector<double> heads(3 * kSubsteps);
   int j = 0;
@@ -86,7 +82,7 @@ BENCHMARK_CAPTURE(BM_MultiStep, wander_ftl_wavefront, Method::kFollowTheLeader, 
 // Question 2: single-step moves, one MoveLeader call (one sweep) each.
 void BM_SingleStep(benchmark::State& state, Method method) {
   const int n = static_cast<int>(state.range(0));
-  Chain chain = Helix(n);
+  Chain chain = scenes::Coil(n);
   const Stepper stepper = MakeStepper(method, chain);
   int j = 0;
   for (auto _ : state) {
@@ -99,8 +95,8 @@ void BM_SingleStep(benchmark::State& state, Method method) {
 BENCHMARK_CAPTURE(BM_SingleStep, tractrix, Method::kTractrix)->RangeMultiplier(10)->Range(10, 100000);
 BENCHMARK_CAPTURE(BM_SingleStep, ftl, Method::kFollowTheLeader)->RangeMultiplier(10)->Range(10, 100000);
 
-// Question 3: the paper's parabola y = x^2 in 20 links of 0.25 and a 100-link helix, each pulled
-// along a bent path (3 straight moves of about 1.5 chain lengths in all).
+// Question 3: the coil (scenes::Coil) of 20 and of 100 links, each pulled along a bent path (3
+// straight moves of about 1.5 chain lengths in all).
 struct AccuracyProblem {
   Chain chain;
   Points moves;
@@ -108,7 +104,7 @@ struct AccuracyProblem {
 
 AccuracyProblem MakeProblem(int n) {
   AccuracyProblem problem;
-  problem.chain = Helix(n);
+  problem.chain = scenes::Coil(n);
   const double scale = problem.chain.lengths.sum() / 3.0;
   const Eigen::Vector3d start = problem.chain.points.row(0).transpose();
   problem.moves.resize(3, 3);

@@ -8,11 +8,14 @@
 #include <random>
 
 #include "arm/internal.h"
-#include "arm_test_util.h"
 #include "flexkin/arm.h"
+#include "scenes/scenes.h"
 
 namespace flexkin {
 namespace {
+
+using scenes::ArcArm;
+using scenes::CircleOfTargets;
 
 // Every step's reported base residual is a measured one within the tolerance.
 void ExpectConverged(const ArmModel& model, const ArmTrajectory& t) {
@@ -27,8 +30,8 @@ void ExpectConverged(const ArmModel& model, const ArmTrajectory& t) {
 TEST(ArmContinuation, SmoothPathTakesTwoPassesPerStep) {
   // The KDL benchmark's scene, 64 links: an arc with the end effector at ~70% of the reach
   // (turn 2.0 / 64 per joint), a circle of one link in 64 steps.
-  const ArmModel model = Arc(64, 0.0315);
-  const Points path = Circle(model, 1.0, 64);
+  const ArmModel model = ArcArm(2, 64, 0.0315);
+  const Points path = CircleOfTargets(model, 1.0, 64);
   const ArmTrajectory t = TrackPath(model, path, ArmOptions{});
   ExpectConverged(model, t);
   int two = 0;
@@ -45,7 +48,7 @@ TEST(ArmContinuation, SmoothPathTakesTwoPassesPerStep) {
 }
 
 TEST(ArmContinuation, SharpCornersAndReversalsConverge) {
-  const ArmModel model = Arc(32, 0.06);
+  const ArmModel model = ArcArm(2, 32, 0.06);
   const Eigen::Vector2d ee = ForwardKinematics(model, model.initial).row(32).transpose();
   // A square (corners of 90 degrees) traced in steps of 0.1, then back along its last side.
   std::vector<Eigen::Vector2d> targets;
@@ -72,13 +75,13 @@ TEST(ArmContinuation, SharpCornersAndReversalsConverge) {
 }
 
 TEST(ArmContinuation, BrokenHistoryIsIgnored) {
-  const ArmModel model = Arc(32, 0.05);
-  const ArmTrajectory t = TrackPath(model, Circle(model, 0.5, 8), ArmOptions{});
+  const ArmModel model = ArcArm(2, 32, 0.05);
+  const ArmTrajectory t = TrackPath(model, CircleOfTargets(model, 0.5, 8), ArmOptions{});
   ASSERT_EQ(t.unreached, 0);
   const ArmState& good = t.steps[6].state;
   ASSERT_EQ(good.memory.earlier_translations.cols(), 2);
   ASSERT_EQ(good.memory.move_lengths.size(), 3);
-  const Eigen::VectorXd target = Circle(model, 0.5, 8).row(7).transpose();
+  const Eigen::VectorXd target = CircleOfTargets(model, 0.5, 8).row(7).transpose();
   const ArmStepReport reference = ArmStep(model, good, target, ArmOptions{});
   ASSERT_TRUE(reference.reached);
   std::vector<ArmSolverMemory> broken(6, good.memory);

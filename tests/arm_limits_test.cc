@@ -10,12 +10,17 @@
 #include <random>
 #include <string>
 
-#include "arm_test_util.h"
 #include "flexkin/arm.h"
 #include "flexkin/error.h"
+#include "scenes/scenes.h"
 
 namespace flexkin {
 namespace {
+
+using scenes::ArcArm;
+using scenes::LimitedArm;
+using scenes::RevoluteSnake;
+using scenes::SaturatingPath;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -145,8 +150,7 @@ TEST(ArmLimits, FarTargetsAreReachedInOneStep) {
 TEST(ArmLimits, FarJumpsWithoutLimitsAreTrackedInLegs) {
   for (int dim : {2, 3}) {
     for (int n : {4, 8, 32}) {
-      ArmModel model = StraightArm(dim, n, 1.0);
-      model.initial.angle.setConstant(0.3 / std::sqrt(n));
+      const ArmModel model = ArcArm(dim, n, 0.3 / std::sqrt(n));
       std::mt19937 rng(5);
       std::uniform_real_distribution<double> unit(-1.0, 1.0);
       int legs = 0, joint_space = 0;

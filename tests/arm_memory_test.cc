@@ -5,16 +5,19 @@
 
 #include <cmath>
 
-#include "arm_test_util.h"
 #include "flexkin/arm.h"
+#include "scenes/scenes.h"
 
 namespace flexkin {
 namespace {
 
+using scenes::ArcArm;
+using scenes::CircleOfTargets;
+
 TEST(ArmMemory, WithAndWithoutMemoryReachTheSameConfiguration) {
   for (int links : {8, 64}) {
-    const ArmModel model = Arc(links, 2.0 / links);
-    const Points path = Circle(model, 0.5, 16);
+    const ArmModel model = ArcArm(2, links, 2.0 / links);
+    const Points path = CircleOfTargets(model, 0.5, 16);
     const ArmTrajectory t = TrackPath(model, path, ArmOptions{});
     ASSERT_EQ(t.unreached, 0);
     for (int i = 1; i < path.rows(); ++i) {
@@ -32,7 +35,7 @@ TEST(ArmMemory, WithAndWithoutMemoryReachTheSameConfiguration) {
 }
 
 TEST(ArmMemory, StaleOrWrongMemoryStillConverges) {
-  const ArmModel model = Arc(32, 0.05);
+  const ArmModel model = ArcArm(2, 32, 0.05);
   const ArmState start = InitialState(model);
   const Eigen::VectorXd target =
       start.points.row(32).transpose() + Eigen::Vector2d(-0.3, 0.4);
@@ -61,13 +64,8 @@ TEST(ArmMemory, StaleOrWrongMemoryStillConverges) {
 
 TEST(ArmMemory, MemorySavesPassesOnAPath) {
   for (int dim : {2, 3}) {
-    ArmModel model = Arc(64, 0.03);
-    if (dim == 3) {
-      model = StraightArm(3, 64, 1.0);
-      model.initial.angle.setConstant(0.03);
-      model.initial.azimuth.setConstant(0.5);
-    }
-    const Points path = Circle(model, 1.0, 48);
+    const ArmModel model = ArcArm(dim, 64, 0.03, 0.5);
+    const Points path = CircleOfTargets(model, 1.0, 48);
     const ArmTrajectory warm = TrackPath(model, path, ArmOptions{});
     ASSERT_EQ(warm.unreached, 0) << dim;
     // The same steps, each started from the state without its memory.
@@ -88,7 +86,7 @@ TEST(ArmMemory, MemorySavesPassesOnAPath) {
 }
 
 TEST(ArmMemory, FixedPointAndStretchedStepsLeaveNoMemory) {
-  const ArmModel model = Arc(16, 0.1);
+  const ArmModel model = ArcArm(2, 16, 0.1);
   const ArmState start = InitialState(model);
   ArmOptions fixed;
   fixed.method = FixedBaseMethod::kFixedPoint;

@@ -9,24 +9,18 @@
 #include <cstdio>
 #include <random>
 
-#include "arm_test_util.h"
 #include "flexkin/error.h"
+#include "scenes/scenes.h"
 
 namespace flexkin {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using scenes::CircleOfTargets;
+using scenes::CircleTilt;
+using scenes::CurledArm;
+using scenes::RevoluteSnake;
 
-// A gently curled arm: every joint turned by `turn` (planar) or bent by `turn` about a slowly
-// turning azimuth (spatial).
-ArmModel CurledArm(int dim, int links, double turn) {
-  ArmModel model = StraightArm(dim, links, 1.0);
-  model.initial.angle.setConstant(dim == 2 ? turn : std::abs(turn));
-  if (dim == 3) {
-    for (int j = 0; j < links; ++j) model.initial.azimuth[j] = 0.3 * j - kPi * std::floor(0.3 * j / kPi);
-  }
-  return model;
-}
+constexpr double kPi = 3.14159265358979323846;
 
 double MaxLengthError(const ArmModel& model, const Points& p) {
   double worst = 0.0;
@@ -92,23 +86,6 @@ TEST(ArmKinematics, PlanarAnglesAreCounterClockwise) {
   EXPECT_NEAR(p(2, 1), 1.0, 1e-15);
 }
 
-// A circle of `steps` targets of radius `radius` through the end effector's start (planar, or
-// tilted out of the plane in 3D).
-Points CirclePath(const ArmModel& model, double radius, int steps, int turns = 1) {
-  const Points start = ForwardKinematics(model, model.initial);
-  const Eigen::VectorXd ee = start.row(model.num_links()).transpose();
-  Points path(steps, model.dim);
-  for (int i = 0; i < steps; ++i) {
-    const double a = 2.0 * kPi * turns * (i + 1) / steps;
-    Eigen::VectorXd p = ee;
-    p[0] += radius * (std::cos(a) - 1.0);
-    p[1] += radius * std::sin(a);
-    if (model.dim == 3) p[2] += 0.5 * radius * std::sin(a);
-    path.row(i) = p.transpose();
-  }
-  return path;
-}
-
 void ExpectStepInvariants(const ArmModel& model, const ArmStepReport& r, int step) {
   ASSERT_TRUE(r.state.points.allFinite()) << step;
   EXPECT_LT((r.state.points.row(0).transpose() - model.base).norm(), 1e-12) << step;
@@ -123,7 +100,7 @@ void ExpectStepInvariants(const ArmModel& model, const ArmStepReport& r, int ste
 TEST(ArmStep, FixedBaseHeldAndTargetsReachedOverALongPath) {
   for (int dim : {2, 3}) {
     const ArmModel model = CurledArm(dim, 32, 0.05);
-    const Points path = CirclePath(model, 3.0, 1000, 2);
+    const Points path = CircleOfTargets(model, 3.0, 1000, CircleTilt::kRising, 2);
     const ArmTrajectory t = TrackPath(model, path, ArmOptions{});
     ASSERT_EQ(t.steps.size(), 1000u);
     EXPECT_EQ(t.unreached, 0) << dim;
@@ -142,7 +119,7 @@ TEST(ArmStep, NewtonNeedsAFewIterationsWhereTheFixedPointNeedsMany) {
   // Near the edge of the workspace (end effector at 0.98 of the reach), where the base's reply
   // to a move of the end effector is nearly a translation.
   ArmModel model = CurledArm(2, 128, 0.005);
-  const Points path = CirclePath(model, 1.0, 40);
+  const Points path = CircleOfTargets(model, 1.0, 40, CircleTilt::kRising);
   ArmOptions newton, fixed;
   fixed.method = FixedBaseMethod::kFixedPoint;
   const ArmTrajectory a = TrackPath(model, path, newton);
@@ -161,7 +138,8 @@ TEST(ArmStep, MotionDiesOutTowardTheBase) {
   for (int dim : {2, 3}) {
     const int n = 24;
     const ArmModel model = CurledArm(dim, n, 0.06);
-    const ArmTrajectory t = TrackPath(model, CirclePath(model, 2.0, 200), ArmOptions{});
+    const Points path = CircleOfTargets(model, 2.0, 200, CircleTilt::kRising);
+    const ArmTrajectory t = TrackPath(model, path, ArmOptions{});
     EXPECT_EQ(t.unreached, 0);
     // Total motion of each joint: its point's path length (angles of spherical joints have an
     // azimuth that is ill-defined near zero bend, so use the points).
@@ -200,7 +178,8 @@ TEST(ArmStep, JointLimitsAreNeverViolated) {
     // tests/arm_limits_test.cc; here none keeps the test short.
     ArmOptions options;
     options.restarts = 0;
-    const ArmTrajectory t = TrackPath(model, CirclePath(model, 4.0, 300), options);
+    const Points path = CircleOfTargets(model, 4.0, 300, CircleTilt::kRising);
+    const ArmTrajectory t = TrackPath(model, path, options);
     bool any_limited = false, any_reached = false;
     for (size_t i = 0; i < t.steps.size(); ++i) {
       ExpectStepInvariants(model, t.steps[i], static_cast<int>(i));
@@ -255,7 +234,8 @@ TEST(ArmStep, FixedPointBaselineKeepsTheSameInvariants) {
   const ArmModel model = CurledArm(3, 16, 0.08);
   ArmOptions options;
   options.method = FixedBaseMethod::kFixedPoint;
-  const ArmTrajectory t = TrackPath(model, CirclePath(model, 2.0, 100), options);
+  const Points path = CircleOfTargets(model, 2.0, 100, CircleTilt::kRising);
+  const ArmTrajectory t = TrackPath(model, path, options);
   EXPECT_EQ(t.unreached, 0);
   for (size_t i = 0; i < t.steps.size(); ++i) ExpectStepInvariants(model, t.steps[i], int(i));
 }

@@ -23,6 +23,7 @@
 #include "flexkin/scenario.h"
 #include "gltf/rig.h"
 #include "gltf/tube.h"
+#include "scenes/scenes.h"
 #include "test_util.h"
 
 namespace flexkin {
@@ -62,7 +63,7 @@ std::string ReadAll(const std::string& path) {
 // A result of `Run` on a curved chain of `n` links whose leading end follows a wavy path of
 // `steps` leader steps (3D: a helix-like path), recorded every `record_every` steps.
 ResultFile MakeResult(int dim, int n, int steps, int record_every = 1) {
-  const Chain chain = MakeChain(test_util::CurvedPoints(dim, n, 1.0, 0.35));
+  const Chain chain = scenes::CurvedChain(dim, n, 1.0, 0.35);
   Points leader(steps, dim);
   for (int s = 0; s < steps; ++s) {
     const double u = (s + 1) * 0.05;

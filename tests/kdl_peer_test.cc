@@ -11,6 +11,7 @@
 
 #include "arm_metrics.h"
 #include "flexkin/error.h"
+#include "scenes/scenes.h"
 
 namespace flexkin::peers {
 namespace {
@@ -50,9 +51,7 @@ TEST(KdlPeer, ForwardKinematicsMatchesFlexkinPlanarAndSpatial) {
 // A 6-link arm curled into an arc, the end effector moving 0.05 of a link per step on a short
 // straight path: both KDL trackers reach every target, warm-started.
 void ExpectTracksShortPath(int dim) {
-  ArmModel model = StraightArm(dim, 6, 1.0);
-  model.initial.angle.setConstant(0.4);
-  if (dim == 3) model.initial.azimuth.setConstant(0.2);
+  const ArmModel model = scenes::ArcArm(dim, 6, 0.4, 0.2);
   const Points start = ForwardKinematics(model, model.initial);
   Points path(10, dim);
   for (int i = 0; i < 10; ++i) {
@@ -130,8 +129,7 @@ TEST(ArmMetrics, TotalJointMotionSpatialByHand) {
 // The flexkin side of the comparison: AnglesOf keeps the order of the steps, and the total
 // motion of a flexkin trajectory equals the sum of its steps' motions.
 TEST(ArmMetrics, AnglesOfFlexkinTrajectory) {
-  ArmModel model = StraightArm(2, 5, 1.0);
-  model.initial.angle.setConstant(0.3);
+  const ArmModel model = scenes::ArcArm(2, 5, 0.3);
   const Points start = ForwardKinematics(model, model.initial);
   Points path(3, 2);
   for (int i = 0; i < 3; ++i) path.row(i) = start.row(5) + Eigen::RowVector2d(-0.1 * (i + 1), 0.0);

@@ -9,12 +9,12 @@
 #include "flexkin/link_step.h"
 #include "flexkin/propagate.h"
 #include "flexkin/run.h"
-#include "test_util.h"
+#include "scenes/scenes.h"
 
 namespace flexkin {
 namespace {
 
-using test_util::CurvedPoints;
+using scenes::CurvedChain;
 
 Eigen::VectorXd RandomMove(int dim, std::mt19937& rng) {
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
@@ -29,7 +29,7 @@ TEST(MinRotationTest, TheChainTranslates) {
   std::mt19937 rng(4);
   for (const int dim : {2, 3}) {
     for (const int substeps : {1, 7}) {
-      Chain chain = MakeChain(CurvedPoints(dim, 12, 1.0, 0.5));
+      Chain chain = CurvedChain(dim, 12, 1.0, 0.5);
       const Points start = chain.points;
       const Eigen::VectorXd shift = 3.0 * RandomMove(dim, rng);
       MoveLeader(Method::kMinRotation, start.row(0).transpose() + shift, substeps, &chain);
@@ -46,7 +46,7 @@ TEST(MinJointAngleTest, FirstLinkIsTractrixAndTheRestMovesRigidly) {
   std::mt19937 rng(8);
   for (const int dim : {2, 3}) {
     for (int trial = 0; trial < 10; ++trial) {
-      Chain chain = MakeChain(CurvedPoints(dim, 9, 1.0, 0.3 + 0.05 * trial));
+      Chain chain = CurvedChain(dim, 9, 1.0, 0.3 + 0.05 * trial);
       const Points start = chain.points;
       const Eigen::VectorXd head = start.row(0).transpose() + RandomMove(dim, rng);
       MoveLeader(Method::kMinJointAngle, head, 1, &chain);
@@ -83,7 +83,7 @@ TEST(MinJointAngleTest, FirstLinkIsTractrixAndTheRestMovesRigidly) {
 
 // In 2D the signed joint angles are kept too (no reflection), over many sub-steps.
 TEST(MinJointAngleTest, PlanarSignedAnglesAreKeptOverManySteps) {
-  Chain chain = MakeChain(CurvedPoints(2, 6, 1.0, 0.4));
+  Chain chain = CurvedChain(2, 6, 1.0, 0.4);
   const Points start = chain.points;
   for (int s = 0; s < 200; ++s) {
     const Eigen::Vector2d target =

@@ -20,6 +20,7 @@
 #include "flexkin/error.h"
 #include "flexkin/overall.h"
 #include "l2_peer.h"
+#include "scenes/scenes.h"
 #include "test_util.h"
 
 namespace flexkin {
@@ -51,53 +52,30 @@ const std::vector<std::pair<std::string, ObjectiveWeights>>& Objectives() {
   return list;
 }
 
-// A random smooth chain: link lengths in [0.5, 1.5], each link turned from the previous one by
-// up to about 30 degrees, so that the chain is curved but never folds back on itself.
-Chain RandomChain(int dim, int links, std::mt19937* rng) {
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  Chain chain;
-  chain.points.resize(links + 1, dim);
-  chain.points.row(0).setZero();
-  chain.lengths.resize(links);
-  Eigen::VectorXd direction = Eigen::VectorXd::Zero(dim);
-  direction[0] = 1.0;
-  for (int i = 1; i <= links; ++i) {
-    Eigen::VectorXd turn(dim);
-    for (int k = 0; k < dim; ++k) turn[k] = unit(*rng);
-    turn -= turn.dot(direction) * direction;
-    direction = (direction + 0.5 * turn).normalized();
-    chain.lengths[i - 1] = 1.0 + 0.5 * unit(*rng);
-    chain.points.row(i) = chain.points.row(i - 1) + chain.lengths[i - 1] * direction.transpose();
-  }
-  return chain;
-}
-
 std::vector<Case> Cases() {
   std::vector<Case> cases;
   // Paper Sec. 5.1: y = x^2 in 20 links of 0.25, vertex leading, pulled 0.7 at 45 degrees.
-  const ParabolaDef parabola;
-  const Chain paper = MakeEqualLinkChain(MakeParabola(parabola), parabola.link_length);
-  cases.push_back({"parabola", paper,
-                   paper.points.row(0).transpose() + Eigen::Vector2d(0.7, 0.7) / std::sqrt(2.0)});
+  const Chain paper = scenes::PaperParabola();
+  cases.push_back({"parabola", paper, paper.points.row(0).transpose() + scenes::PaperPull()});
   // A straight chain of 12 links of 0.5 along +x from the origin, its head pulled by 0.6 at
   // `angle` from the -x axis (0: straight away from the chain, all points translate; 90: across;
   // 170: nearly into the chain, which is singular at exactly 180).
-  Chain straight;
-  straight.points.resize(13, 2);
-  straight.lengths = Eigen::VectorXd::Constant(12, 0.5);
-  for (int i = 0; i <= 12; ++i) straight.points.row(i) << 0.5 * i, 0.0;
+  const Chain straight = MakeEqualLinkChain(
+      MakeLine({Eigen::Vector2d::Zero(), Eigen::Vector2d::UnitX(), 12, 0.5}), 0.5);
   for (const int degrees : {0, 20, 45, 70, 90, 120, 150, 170}) {
     const double a = degrees * M_PI / 180.0;
     cases.push_back({"straight_" + std::to_string(degrees) + "deg", straight,
                      Eigen::Vector2d(-0.6 * std::cos(a), 0.6 * std::sin(a))});
   }
-  // Random chains of 2 to 30 links, the head moved by 0.05 to 1 mean link in a random direction.
+  // Random smooth chains of 2 to 30 links (link lengths in [0.5, 1.5], each link turned from the
+  // previous one by at most atan(0.5 sqrt(dim)): 35 degrees in 2D, 41 in 3D), the head moved by
+  // 0.05 to 1 mean link in a random direction.
   std::mt19937 rng(20240817);
   std::uniform_int_distribution<int> links(2, 30);
   std::uniform_real_distribution<double> unit(-1.0, 1.0), size(0.05, 1.0);
   for (const int dim : {2, 3}) {
     for (int k = 0; k < 12; ++k) {
-      Chain chain = RandomChain(dim, links(rng), &rng);
+      Chain chain = scenes::RandomSmoothChain(dim, links(rng), 0.5, &rng);
       Eigen::VectorXd move(dim);
       for (int c = 0; c < dim; ++c) move[c] = unit(rng);
       move *= size(rng) * chain.lengths.mean() / move.norm();
@@ -286,8 +264,7 @@ TEST(OverallL2PeerTest, StrictStopAgreesToRounding) {
 // The caller's start is used (from OverallStep's own answer IPOPT stays there), the report is
 // complete, and bad input throws InputError naming the field.
 TEST(OverallL2PeerTest, StartsWhereToldAndRejectsBadInput) {
-  const ParabolaDef parabola;
-  const Chain chain = MakeEqualLinkChain(MakeParabola(parabola), parabola.link_length);
+  const Chain chain = scenes::PaperParabola();
   const Eigen::Vector2d head = chain.points.row(0).transpose() + Eigen::Vector2d(0.3, 0.4);
   PeerOptions options;
   options.weights = L2Weights(1, 0, 0);

@@ -11,13 +11,15 @@
 #include <random>
 #include <vector>
 
+#include "flexkin/curves.h"
 #include "flexkin/overall.h"
+#include "scenes/scenes.h"
 #include "test_util.h"
 
 namespace flexkin {
 namespace {
 
-using test_util::CurvedPoints;
+using scenes::CurvedPoints;
 using test_util::ExpectInputError;
 using test_util::LengthsOf;
 
@@ -182,19 +184,10 @@ TEST(OverallL2Test, NoFeasiblePerturbationImprovesTheReturnedConfiguration) {
 // metric few points move and the rest stay exactly still; under the squared metric all move.
 TEST(OverallL2Test, MinimizerIsSparse) {
   std::mt19937 rng(5);
-  Points p(21, 2);
-  p.row(0) << 0.0, 0.0;
-  for (int i = 1; i <= 20; ++i) {  // next point on the parabola at distance 0.25 (bisection)
-    double lo = p(i - 1, 0), hi = lo + 0.25;
-    for (int it = 0; it < 200; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      (std::hypot(mid - p(i - 1, 0), mid * mid - p(i - 1, 1)) < 0.25 ? lo : hi) = mid;
-    }
-    p.row(i) << lo, lo * lo;
-  }
+  const Points p = scenes::PaperParabolaByBisection();
   const Eigen::VectorXd lengths = LengthsOf(p);
   for (const double pull : {0.14, 0.7}) {
-    const Eigen::Vector2d head(pull / std::sqrt(2.0), pull / std::sqrt(2.0));
+    const Eigen::Vector2d head = scenes::PaperPull(pull);  // from the vertex, at the origin
     OverallReport report;
     SolveAndCheck(L2Weights(1, 0, 0, 0), lengths, p, head, &rng, &report);
     EXPECT_LE(report.moving_points, 3) << "pull " << pull;
@@ -225,8 +218,7 @@ TEST(OverallL2Test, OneLinkIsTheNearestPointOfTheCircle) {
 // A straight chain pulled away along its axis: no point can stay (each still point would have to
 // be farther from the head than the links before it reach), so all translate.
 TEST(OverallL2Test, StraightPullTranslatesTheChain) {
-  Points p(6, 3);
-  for (int i = 0; i <= 5; ++i) p.row(i) << 0.5 * i, 0.0, 0.0;
+  const Points p = MakeLine({Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), 5, 0.5});
   const Eigen::VectorXd lengths = LengthsOf(p);
   const Eigen::Vector3d head(-0.2, 0.0, 0.0);
   OverallOptions options;

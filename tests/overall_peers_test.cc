@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "flexkin/curves.h"
 #include "flexkin/overall.h"
 #include "peer_solvers.h"
+#include "scenes/scenes.h"
 
 namespace flexkin {
 namespace {
@@ -49,34 +49,18 @@ std::vector<std::pair<std::string, ObjectiveWeights>> Objectives(int dim) {
   return list;
 }
 
-// A random chain: link lengths in [0.5, 1.5], each link turned from the previous one by up to
-// 60 degrees, so that the chain is curved but never folds back on itself.
+// A random chain: link lengths in [0.5, 1.5], each link turned from the previous one by at most
+// atan(0.6 sqrt(dim)) (40 degrees in 2D, 46 in 3D), so that the chain is curved but never folds
+// back on itself.
 Chain RandomChain(int dim, int links, std::mt19937* rng) {
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  Points p(links + 1, dim);
-  p.row(0).setZero();
-  Eigen::VectorXd direction = Eigen::VectorXd::Zero(dim);
-  direction[0] = 1.0;
-  Chain chain;
-  chain.lengths.resize(links);
-  for (int i = 1; i <= links; ++i) {
-    Eigen::VectorXd turn(dim);
-    for (int k = 0; k < dim; ++k) turn[k] = unit(*rng);
-    turn -= turn.dot(direction) * direction;
-    direction = (direction + 0.6 * turn).normalized();
-    chain.lengths[i - 1] = 1.0 + 0.5 * unit(*rng);
-    p.row(i) = p.row(i - 1) + chain.lengths[i - 1] * direction.transpose();
-  }
-  chain.points = p;
-  return chain;
+  return scenes::RandomSmoothChain(dim, links, 0.6, rng);
 }
 
 std::vector<Case> Cases() {
   std::vector<Case> cases;
   // Paper Sec. 5.1: y = x^2 in 20 links of 0.25, vertex leading, pulled 0.7 at 45 degrees.
-  ParabolaDef parabola;
-  const Chain paper = MakeEqualLinkChain(MakeParabola(parabola), parabola.link_length);
-  const Eigen::Vector2d pull(0.7 / std::sqrt(2.0), 0.7 / std::sqrt(2.0));
+  const Chain paper = scenes::PaperParabola();
+  const Eigen::Vector2d pull = scenes::PaperPull();
   for (const auto& [objective, weights] : Objectives(2)) {
     cases.push_back(
         {"parabola_" + objective, paper, paper.points.row(0).transpose() + pull, weights});
@@ -152,8 +136,7 @@ INSTANTIATE_TEST_SUITE_P(Problems, OverallPeersTest, testing::ValuesIn(Cases()),
 
 // IPOPT with its quasi-Newton Hessian instead of the exact one reaches the same minimum.
 TEST(OverallPeers, IpoptLimitedMemoryAgrees) {
-  ParabolaDef parabola;
-  const Chain chain = MakeEqualLinkChain(MakeParabola(parabola), parabola.link_length);
+  const Chain chain = scenes::PaperParabola();
   const Eigen::Vector2d head = chain.points.row(0).transpose() + Eigen::Vector2d(0.49, 0.49);
   PeerOptions options;
   options.exact_hessian = false;

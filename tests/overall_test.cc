@@ -12,12 +12,13 @@
 #include <vector>
 
 #include "flexkin/link_step.h"
+#include "scenes/scenes.h"
 #include "test_util.h"
 
 namespace flexkin {
 namespace {
 
-using test_util::CurvedPoints;
+using scenes::CurvedPoints;
 using test_util::ExpectInputError;
 using test_util::LengthsOf;
 

@@ -20,13 +20,15 @@
 #include "flexkin/error.h"
 #include "flexkin/link_step.h"
 #include "reference_ode.h"
+#include "scenes/scenes.h"
 
 namespace flexkin {
 namespace {
 
 using test_util::Str;
 using test_util::ExpectInputError;
-using test_util::CurvedPoints;
+using scenes::CurvedChain;
+using scenes::CurvedPoints;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
@@ -90,7 +92,7 @@ TEST(MakeChainTest, RejectsDegenerateInputNamingTheField) {
 }
 
 TEST(MakeChainTest, ValidateChainNamesTheField) {
-  Chain chain = MakeChain(CurvedPoints(2, 4, 1.0, 0.3));
+  Chain chain = CurvedChain(2, 4, 1.0, 0.3);
   EXPECT_NO_THROW(ValidateChain(chain));
   Chain short_lengths = chain;
   short_lengths.lengths.conservativeResize(3);
@@ -104,7 +106,7 @@ TEST(MakeChainTest, ValidateChainNamesTheField) {
 }
 
 TEST(MoveLeaderTest, RejectsInvalidInputNamingTheField) {
-  const Chain chain = MakeChain(CurvedPoints(3, 4, 1.0, 0.3));
+  const Chain chain = CurvedChain(3, 4, 1.0, 0.3);
   const Stepper stepper = MakeStepper(Method::kTractrix, chain);
   Points points = chain.points;
   ExpectInputError([&] { MoveLeader(stepper, Eigen::Vector2d(1, 2), 1, &points); }, "target");
@@ -175,7 +177,7 @@ Points LinkRuleSweeps(Method method, const Chain& chain, const Eigen::Vector3d& 
 // Short chains and few sub-steps take the scalar sweep: bit-identical to the link rules.
 TEST(MoveLeaderTest, SweepAppliesTheLinkRuleDownTheChain) {
   for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {
-    const Chain chain = MakeChain(CurvedPoints(3, 6, 1.0, 0.4));
+    const Chain chain = CurvedChain(3, 6, 1.0, 0.4);
     const Eigen::Vector3d target(0.3, 1.7, -0.4);
     Chain moved = chain;
     MoveLeader(method, target, 5, &moved);
@@ -191,7 +193,7 @@ TEST(MoveLeaderTest, ManySubstepsOnALongChainAgreeWithTheLinkRules) {
   double worst = 0.0;
   for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {
     for (const int substeps : {16, 64, 67, 1024}) {
-      const Chain chain = MakeChain(CurvedPoints(3, 40, 1.0, 0.2));
+      const Chain chain = CurvedChain(3, 40, 1.0, 0.2);
       const Eigen::Vector3d target(-0.4, 2.2, 0.5);
       Chain moved = chain;
       MoveLeader(method, target, substeps, &moved);
@@ -215,7 +217,7 @@ TEST(MoveLeaderTest, ManySubstepsOnALongChainAgreeWithTheLinkRules) {
 TEST(MoveLeaderInvariantTest, ExpensiveOneMillionStepsKeepEveryLinkLength) {
   constexpr int kLinks = 100;
   constexpr int kSteps = 1000000;
-  Chain chain = MakeChain(CurvedPoints(3, kLinks, 1.0, 0.15));
+  Chain chain = CurvedChain(3, kLinks, 1.0, 0.15);
   const Stepper stepper = MakeStepper(Method::kTractrix, chain);
   const Eigen::Vector3d origin = chain.points.row(0).transpose();
   const auto start = std::chrono::steady_clock::now();
@@ -247,7 +249,7 @@ TEST(MoveLeaderInvariantTest, ExpensiveOneMillionStepsKeepEveryLinkLength) {
 // steps of 32 sub-steps.
 TEST(MoveLeaderInvariantTest, ManySubstepsKeepEveryLinkLength) {
   for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {
-    Chain chain = MakeChain(CurvedPoints(3, 100, 1.0, 0.15));
+    Chain chain = CurvedChain(3, 100, 1.0, 0.15);
     const Stepper stepper = MakeStepper(method, chain);
     const Eigen::Vector3d origin = chain.points.row(0).transpose();
     for (int s = 1; s <= 2000; ++s) {
@@ -298,7 +300,7 @@ TEST(MoveLeaderInvariantTest, NoPointMovesFartherThanThePointAheadOfIt) {
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
   for (const int dim : {2, 3}) {
     for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {
-      Chain chain = MakeChain(CurvedPoints(dim, 20, 1.0, 0.35));
+      Chain chain = CurvedChain(dim, 20, 1.0, 0.35);
       const Stepper stepper = MakeStepper(method, chain);
       int violations = 0;
       std::string example;
@@ -332,7 +334,7 @@ TEST(MoveLeaderInvariantTest, NoPointMovesFartherThanThePointAheadOfIt) {
 TEST(MoveLeaderInvariantTest, PathLengthDoesNotIncreaseAlongTheChain) {
   for (const int dim : {2, 3}) {
     for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {
-      Chain chain = MakeChain(CurvedPoints(dim, 30, 1.0, 0.2));
+      Chain chain = CurvedChain(dim, 30, 1.0, 0.2);
       const Stepper stepper = MakeStepper(method, chain);
       const Eigen::VectorXd start = chain.points.row(0).transpose();
       Eigen::VectorXd path = Eigen::VectorXd::Zero(chain.num_links() + 1);
@@ -363,17 +365,17 @@ TEST(MoveLeaderInvariantTest, PathLengthDoesNotIncreaseAlongTheChain) {
 TEST(MoveLeaderInvariantTest, LongStraightPullAlignsEveryLink) {
   for (const int dim : {2, 3}) {
     for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {
-      Chain chain = MakeChain(CurvedPoints(dim, 12, 1.0, 0.45));
+      Chain chain = CurvedChain(dim, 12, 1.0, 0.45);
       const double chain_length = chain.lengths.sum();
       const Stepper stepper = MakeStepper(method, chain);
       Eigen::VectorXd dir(dim);
       dir.setConstant(1.0);
       dir[0] = -2.0;  // a pull direction that is not along the chain's start
       dir.normalize();
-      const int steps = 1000;
-      const Eigen::VectorXd start = chain.points.row(0).transpose();
-      for (int s = 1; s <= steps; ++s) {
-        MoveLeader(stepper, start + (50.0 * chain_length * s / steps) * dir, 1, &chain.points);
+      const Points pull =
+          scenes::StraightPull(chain.points.row(0).transpose(), dir, 50.0 * chain_length, 1000);
+      for (Eigen::Index s = 0; s < pull.rows(); ++s) {
+        MoveLeader(stepper, pull.row(s).transpose(), 1, &chain.points);
       }
       for (int i = 1; i <= chain.num_links(); ++i) {
         const Eigen::VectorXd link = (chain.points.row(i - 1) - chain.points.row(i)).transpose();
@@ -432,7 +434,7 @@ TEST(ConvergenceTest, FollowTheLeaderSubstepsConvergeToTheTractrixStepWithOrderO
 // (the ODE reference of the whole chain); tractrix with order 2, follow-the-leader with order 1.
 TEST(ConvergenceTest, ChainConvergesToTheContinuousMotion) {
   for (const int dim : {2, 3}) {
-    const Chain chain = MakeChain(CurvedPoints(dim, 10, 0.5, 0.3));
+    const Chain chain = CurvedChain(dim, 10, 0.5, 0.3);
     const double chain_length = chain.lengths.sum();
     // Three straight pieces, total ~1.1 chain lengths, turning left then right.
     Points targets(3, dim);

@@ -20,6 +20,7 @@
 #include "flexkin/chain.h"
 #include "flexkin/result_io.h"
 #include "flexkin/run.h"
+#include "scenes/scenes.h"
 #include "test_util.h"
 
 namespace flexkin::render_test {
@@ -28,7 +29,7 @@ namespace flexkin::render_test {
 // pulled up and sideways. No three consecutive points are collinear, so that every point is a
 // vertex of the drawn polyline (cairo merges collinear segments).
 inline ResultFile SmallScene(int dim) {
-  const Chain chain = MakeChain(test_util::CurvedPoints(dim, 5, 1.0, 0.55));
+  const Chain chain = scenes::CurvedChain(dim, 5, 1.0, 0.55);
   Points steps(6, dim);
   for (int k = 1; k <= 6; ++k) {
     steps(k - 1, 0) = 1.0 - 0.32 * k;

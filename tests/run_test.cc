@@ -18,17 +18,14 @@
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
 #include "reference_ode.h"
+#include "scenes/scenes.h"
 
 namespace flexkin {
 namespace {
 
+using scenes::CurvedChain;
 using test_util::Str;
 using test_util::ExpectInputError;
-
-// A curved chain of `n` links on a circle (2D) or helix (3D), point 0 first.
-Chain CurvedChain(int dim, int n, double radius, double turn) {
-  return MakeChain(test_util::CurvedPoints(dim, n, radius, turn));
-}
 
 // `count` leader targets along a smooth curve starting at the chain's leading end, about
 // `step` apart.
@@ -235,12 +232,8 @@ TEST(RunTest, PathLengthDoesNotIncreaseAlongAChainPulledStraight) {
     Eigen::VectorXd dir = Eigen::VectorXd::Zero(dim);
     dir[0] = 0.6;
     dir[1] = -0.8;
-    constexpr int kSteps = 400;
-    Points targets(kSteps, dim);
-    const Eigen::VectorXd start = chain.points.row(0).transpose();
-    for (int s = 1; s <= kSteps; ++s) {
-      targets.row(s - 1) = (start + (20.0 * chain_length * s / kSteps) * dir).transpose();
-    }
+    const Points targets =
+        scenes::StraightPull(chain.points.row(0).transpose(), dir, 20.0 * chain_length, 400);
     RunOptions options;
     options.substeps = 2;
     options.record_every = 100;

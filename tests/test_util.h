@@ -1,5 +1,5 @@
 #pragma once
-// Helpers shared by the test programs.
+// Helpers shared by the test programs (their scenes are in scenes/scenes.h).
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -40,20 +40,6 @@ void ExpectInputError(Make make, const std::string& field, const std::string& te
 template <typename Make>
 void ExpectInputError(Make make, const std::string& field) {
   ExpectInputError(make, field, field);
-}
-
-// A curved chain of `n` links: points on a helix (a circle of radius `radius` in 2D), point 0
-// first. Link lengths are about radius * turn (slightly different per link in 3D: the pitch
-// varies) so that the lengths are not all equal.
-inline Points CurvedPoints(int dim, int n, double radius, double turn) {
-  Points p(n + 1, dim);
-  for (int i = 0; i <= n; ++i) {
-    const double a = turn * i;
-    p(i, 0) = radius * std::cos(a);
-    p(i, 1) = radius * std::sin(a);
-    if (dim == 3) p(i, 2) = 0.02 * radius * i + 0.01 * radius * std::sin(3.0 * a);
-  }
-  return p;
 }
 
 // The link lengths of a chain of points, (n+1) by dim -> n.

@@ -24,6 +24,7 @@
 #include "flexkin/error.h"
 #include "flexkin/result_io.h"
 #include "flexkin/run.h"
+#include "scenes/scenes.h"
 
 namespace flexkin {
 namespace {
@@ -34,7 +35,7 @@ using test_util::ExpectInputError;
 // A run of a curved chain of `links` links whose leading end follows a smooth wavy path of
 // `steps` leader steps of about `step` each.
 ResultFile MakeResult(int dim, int links, int steps, double step, const std::string& name) {
-  const Chain chain = MakeChain(test_util::CurvedPoints(dim, links, 1.0, 2.5 / links));
+  const Chain chain = scenes::CurvedChain(dim, links, 1.0, 2.5 / links);
   Points targets(steps, dim);
   for (int s = 1; s <= steps; ++s) {
     const double t = step * s;
