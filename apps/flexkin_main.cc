@@ -1,9 +1,12 @@
 // The flexkin command line: runs and checks scenario files.
 //
-//   flexkin run SCENARIO.json -o RESULT.json [--csv FRAMES.csv] [--method tractrix|ftl|overall]
+//   flexkin run SCENARIO.json -o RESULT.json [--csv FRAMES.csv] [--method METHOD]
 //       [--substeps N] [--tolerance T] [--max-substeps N] [--record-every N]
 //       [--report brief|full] [--quiet]
 //   flexkin validate SCENARIO.json
+//   flexkin render RESULT.json ...   (render_command.h)
+//   flexkin robot SCENARIO.json ...  (robot_command.h)
+//   flexkin vocabulary               (vocabulary_command.h: every enumerated name)
 //   flexkin --version
 //
 // Exit codes are listed in kExitCodesHelp and in docs/scenario-format.md.
@@ -20,7 +23,6 @@
 #include <system_error>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
@@ -29,6 +31,7 @@
 #include "flexkin/scenario.h"
 #include "render_command.h"
 #include "robot_command.h"
+#include "vocabulary_command.h"
 
 namespace {
 
@@ -166,21 +169,15 @@ int RunCommand(const RunArgs& args) {
 }
 
 int ValidateCommand(const std::string& path) {
-  nlohmann::json json;
-  try {
-    json = flexkin::ReadJsonFile(path);
-  } catch (const flexkin::InputError& e) {
-    std::cout << path << ": " << e.what() << "\n";
-    return kExitInvalidInput;
-  }
-  const flexkin::Problems problems = flexkin::ValidateScenario(json);
+  // Text that is not JSON is one problem, like any other.
+  const flexkin::Problems problems = flexkin::ValidateScenarioFile(path);
   if (!problems.empty()) {
     for (const auto& p : problems) {
       std::cout << path << ": " << p.Text() << "\n";
     }
     return kExitInvalidInput;
   }
-  std::cout << "ok: " << flexkin::ScenarioSummary(flexkin::ParseScenario(json)) << "\n";
+  std::cout << "ok: " << flexkin::ScenarioSummary(flexkin::LoadScenarioFile(path)) << "\n";
   return kExitOk;
 }
 
@@ -221,6 +218,7 @@ int Main(int argc, char** argv) {
 
   const flexkin::cli::RenderCommand render(&app, kExitCodesHelp);
   const flexkin::cli::RobotCommand robot(&app, kExitCodesHelp);
+  const flexkin::cli::VocabularyCommand vocabulary(&app, kExitCodesHelp);
 
   try {
     app.parse(argc, argv);
@@ -231,6 +229,7 @@ int Main(int argc, char** argv) {
     if (*run) return RunCommand(args);
     if (render.Parsed()) return render.Run();
     if (robot.Parsed()) return robot.Run();
+    if (vocabulary.Parsed()) return vocabulary.Run();
     return ValidateCommand(validate_path);
   } catch (const flexkin::InputError& e) {
     PrintError(e.what());

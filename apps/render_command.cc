@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "flexkin/error.h"
-#include "flexkin/gltf.h"
+#include "gltf/gltf.h"
 #include "flexkin/result_io.h"
-#include "flexkin/viewer.h"
+#include "viewer/viewer.h"
 
 namespace flexkin::cli {
 namespace {
@@ -72,7 +72,7 @@ void Gltf(const RenderJob& job, const char* extension) {
   job.written->push_back(path);
 }
 
-// The writer of each output format (flexkin/render.h names them), in the order they are written.
+// The writer of each output format (src/render/render.h names them), in the order they are written.
 // Add a format with one line here and one in the vocabulary.
 struct FormatWriter {
   OutputFormat format;

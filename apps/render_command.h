@@ -5,7 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "flexkin/render.h"
+#include "render/render.h"
 
 namespace flexkin::cli {
 

@@ -1,29 +1,14 @@
 #pragma once
 // `flexkin robot SCENARIO.json -o TRAJECTORY.json [--csv JOINTS.csv]`: joint trajectories of a
 // fixed-base hyper-redundant arm whose end effector follows a path (docs/robot-format.md,
-// docs/robots.md). Kept apart from flexkin_main.cc, which only registers it.
+// docs/robots.md). The scenario reader and the trajectory writers are the library's
+// (flexkin/robot_scenario.h); this is the command line around them. Kept apart from
+// flexkin_main.cc, which only registers it.
 
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include <nlohmann/json_fwd.hpp>
-
-#include "flexkin/arm.h"
-
 namespace flexkin::cli {
-
-// A robot scenario file read in.
-struct RobotScenario {
-  std::string name;
-  ArmModel model;
-  Points path;  // m by dim end-effector targets
-  ArmOptions options;
-};
-
-// Reads a robot scenario document (docs/robot-format.md). Throws InputError whose field is the
-// JSON pointer of the first problem ("/arm/link_lengths/2"). A relative "urdf" file name is
-// taken relative to `scenario_dir` ("" = the working directory).
-RobotScenario ParseRobotScenario(const nlohmann::json& json, const std::string& scenario_dir = "");
 
 class RobotCommand {
  public:

@@ -14,13 +14,12 @@
 
 #include "arm_metrics.h"
 #include "flexkin/error.h"
-#include <nlohmann/json.hpp>
-
-#include "flexkin/result_io.h"
+#include "flexkin/robot_scenario.h"
+#include "flexkin/urdf.h"
+#include "io/atomic_file.h"
 #include "kdl_peer.h"
 #include "render/axes.h"
 #include "render/canvas.h"
-#include "robot_command.h"
 
 namespace {
 
@@ -188,8 +187,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   try {
-    const flexkin::cli::RobotScenario s =
-        flexkin::cli::ParseRobotScenario(flexkin::ReadJsonFile(argv[1]));
+    const flexkin::RobotScenario s =
+        flexkin::LoadRobotScenarioFile(argv[1], flexkin::UrdfRobotScenarioOptions());
     if (s.model.dim != 2) {
       throw flexkin::InputError("/arm/dim", "robot_compare draws planar arms only (dim 2)");
     }

@@ -421,12 +421,15 @@ TEST(ArmRevolute, UnreachableTargetIsReportedWithoutNaN) {
 TEST(ArmRevolute, BadAxesAreRefusedWithTheField) {
   ArmModel model = RevoluteSnake(4);
   model.joint_axes.row(2) = Eigen::RowVector3d(1.0, 0.0, 0.0);  // along the link: a twist
-  EXPECT_NE(model.Validate().find("joint_axes[2]"), std::string::npos);
+  ASSERT_EQ(model.Validate().size(), 1u);
+  EXPECT_EQ(model.Validate().front().field, "joint_axes[2]");
   model.joint_axes.row(2) = Eigen::RowVector3d(0.0, 2.0, 0.0);  // not unit
-  EXPECT_NE(model.Validate().find("joint_axes[2]"), std::string::npos);
+  ASSERT_EQ(model.Validate().size(), 1u);
+  EXPECT_EQ(model.Validate().front().field, "joint_axes[2]");
   model = RevoluteSnake(4);
   model.joint_axes.resize(3, 3);
-  EXPECT_NE(model.Validate().find("joint_axes"), std::string::npos);
+  ASSERT_EQ(model.Validate().size(), 1u);
+  EXPECT_EQ(model.Validate().front().field, "joint_axes");
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
-// glTF export (include/flexkin/gltf.h): positions read back from .gltf and .glb files, the rig and
+// glTF export (src/gltf/gltf.h): positions read back from .gltf and .glb files, the rig and
 // the tube, the Khronos glTF validator on written files, and bad input.
-#include "flexkin/gltf.h"
+#include "gltf/gltf.h"
 
 #include <dirent.h>
 #include <gtest/gtest.h>
@@ -23,6 +23,7 @@
 #include "flexkin/scenario.h"
 #include "gltf/rig.h"
 #include "gltf/tube.h"
+#include "io/json_file.h"  // ReadJsonFile, WriteFileAtomically
 #include "scenes/scenes.h"
 #include "test_util.h"
 

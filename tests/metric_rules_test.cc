@@ -108,7 +108,10 @@ TEST(MetricRulesTest, NamesParseAndAccuracyControlIsRefused) {
   RunOptions options;
   options.method = Method::kMinRotation;
   options.tolerance = 1e-6;
-  EXPECT_NE(options.Validate().find("tractrix and ftl"), std::string::npos);
+  const Problems problems = options.Validate();
+  ASSERT_FALSE(problems.empty());
+  EXPECT_EQ(problems.front().field, "tolerance");
+  EXPECT_NE(problems.front().message.find("tractrix and ftl"), std::string::npos);
 }
 
 }  // namespace

@@ -27,6 +27,9 @@
 #include "flexkin/error.h"
 #include "flexkin/run.h"
 #include "flexkin/scenario.h"
+#include "io/atomic_file.h"  // WriteFileAtomically
+#include "io/json_file.h"    // ParseJsonText
+#include "io/result_json.h"  // ResultFromJson of a parsed document
 
 namespace flexkin {
 namespace {
@@ -397,6 +400,30 @@ TEST(ResultReadTest, RefusesOtherFormatsAndVersions) {
     EXPECT_EQ(e.field(), "/frames/1/points/0");
   }
   EXPECT_THROW(ReadResultJson(dir / "missing.json"), std::system_error);
+}
+
+// The reader of text gives what the reader of the file gives; text that is not JSON is refused
+// with its line and column.
+TEST(ResultReadTest, FromTextAsFromTheFile) {
+  TempDir dir;
+  WriteResultJson(AwkwardResult(3, 20), dir / "r.json", "named");
+  const ResultFile from_file = ReadResultJson(dir / "r.json");
+  const ResultFile from_text = ResultFromText(ReadFile(dir / "r.json"));
+  EXPECT_EQ(from_text.scenario_name, "named");
+  EXPECT_EQ(from_text.dim, from_file.dim);
+  ExpectSameBits(from_text.result.lengths, from_file.result.lengths, "lengths");
+  ASSERT_EQ(from_text.result.frames.size(), from_file.result.frames.size());
+  for (size_t f = 0; f < from_text.result.frames.size(); ++f) {
+    EXPECT_EQ(from_text.result.frames[f].step, from_file.result.frames[f].step);
+    EXPECT_EQ(from_text.result.frames[f].points, from_file.result.frames[f].points);
+  }
+  try {
+    ResultFromText("{\"format\": ");
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "");
+    EXPECT_EQ(std::string(e.what()).rfind("line 1, column ", 0), 0u) << e.what();
+  }
 }
 
 }  // namespace

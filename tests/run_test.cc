@@ -61,7 +61,7 @@ std::vector<Points> DirectRun(const Chain& chain, const Points& targets, Method 
 TEST(RunTest, RejectsInvalidInputNamingTheField) {
   const Chain chain = CurvedChain(2, 4, 1.0, 0.3);
   const Points targets = CurvedLeaderPath(chain, 5, 0.1);
-  EXPECT_EQ(RunOptions().Validate(), "");
+  EXPECT_TRUE(RunOptions().Validate().empty());
   const auto with = [](auto change) {
     RunOptions o;
     change(o);
@@ -84,7 +84,10 @@ TEST(RunTest, RejectsInvalidInputNamingTheField) {
                o.max_substeps = 4;
              }),
              "max_substeps"}}) {
-    EXPECT_NE(c.options.Validate().find(c.field), std::string::npos) << c.options.Validate();
+    const Problems problems = c.options.Validate();
+    ASSERT_FALSE(problems.empty()) << c.field;
+    EXPECT_EQ(problems.front().field, c.field) << problems.front().Text();
+    EXPECT_NE(problems.front().Text().find(c.field), std::string::npos) << problems.front().Text();
     ExpectInputError([&] { flexkin::Run(chain, targets, c.options); }, c.field);
   }
   ExpectInputError([&] { flexkin::Run(chain, Points(0, 2), RunOptions()); }, "leader_steps");

@@ -15,8 +15,9 @@
 #include <nlohmann/json.hpp>
 
 #include "flexkin/error.h"
-#include "flexkin/result_io.h"
 #include "flexkin/run.h"
+#include "io/json_file.h"      // ParseJsonText, ReadJsonFile
+#include "io/scenario_json.h"  // ParseScenario, ValidateScenario of a parsed document
 
 namespace flexkin {
 namespace {
@@ -179,8 +180,8 @@ struct BadCase {
 
 const BadCase kBadCases[] = {
     {"root not an object", "[1, 2]", "", "expected an object"},
-    {"missing curve", "{" LEADER "}", "/curve", "is missing"},
-    {"missing leader", "{" CURVE "}", "/leader", "is missing"},
+    {"missing curve", "{" LEADER "}", "/curve", "missing; expected"},
+    {"missing leader", "{" CURVE "}", "/leader", "missing; expected"},
     {"unknown top-level key", "{" CURVE "," LEADER R"(, "methd": "ftl"})", "/methd",
      "did you mean \"method\""},
     {"unknown curve key", R"({"curve": {"points": [[0, 0], [1, 0]], "closed": true},)" LEADER "}",
@@ -217,7 +218,7 @@ const BadCase kBadCases[] = {
      R"({"curve": {"shape": "line", "links": 1e12, "link_length": 1},)" LEADER "}", "/curve/links",
      "expected an integer from 1 to 10000000"},
     {"missing link_length", R"({"curve": {"shape": "line", "links": 3},)" LEADER "}",
-     "/curve/link_length", "is missing"},
+     "/curve/link_length", "missing; expected"},
     {"zero link_length", R"({"curve": {"shape": "line", "links": 3, "link_length": 0},)" LEADER "}",
      "/curve/link_length", "value 0 is not valid; expected a finite number > 0"},
     {"arc radius too small",
@@ -225,7 +226,7 @@ const BadCase kBadCases[] = {
      "/curve/radius", "expected radius >= 0.5"},
     {"helix without pitch",
      R"({"curve": {"shape": "helix", "radius": 1, "links": 3, "link_length": 1},)" LEADER "}",
-     "/curve/pitch", "is missing"},
+     "/curve/pitch", "missing; expected"},
     {"parabola key on an arc",
      R"({"curve": {"shape": "arc", "radius": 1, "a": 1, "links": 3, "link_length": 1},)" LEADER "}",
      "/curve/a", "unknown key"},
@@ -373,6 +374,43 @@ TEST(ScenarioLoadTest, MissingFileIsASystemErrorNamingThePath) {
     EXPECT_EQ(e.code(), std::errc::no_such_file_or_directory);
     EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
   }
+}
+
+// The public functions take text and paths: the same scenario and the same problems as the parsed
+// document, and text that is not JSON is one problem, the one ParseScenarioText throws.
+TEST(ScenarioTextTest, TextAndFileFunctionsAgreeWithTheDocument) {
+  const std::string path = Example("fig10_planar_curve.json");
+  const std::string text = ReadTextFile(path);
+  const Scenario from_text = ParseScenarioText(text), from_file = LoadScenarioFile(path);
+  const Scenario from_json = ParseScenario(ParseJsonText(text));
+  EXPECT_EQ(from_text.chain.points, from_json.chain.points);
+  EXPECT_EQ(from_file.chain.points, from_json.chain.points);
+  EXPECT_EQ(from_text.leader_steps, from_json.leader_steps);
+  EXPECT_EQ(from_file.leader_steps, from_json.leader_steps);
+  EXPECT_TRUE(ValidateScenarioText(text).empty());
+  EXPECT_TRUE(ValidateScenarioFile(path).empty());
+
+  const std::string bad = R"({"curve": {"shape": "arc", "radius": -1, "links": 0,
+    "link_length": 0.1}, "leader": {"pull": [1, 0], "steps": 0}, "method": "fast"})";
+  const Problems from_doc = ValidateScenario(ParseJsonText(bad));
+  const Problems listed = ValidateScenarioText(bad);
+  ASSERT_EQ(listed.size(), from_doc.size());
+  ASSERT_GE(listed.size(), 3u);
+  for (size_t i = 0; i < listed.size(); ++i) EXPECT_EQ(listed[i].Text(), from_doc[i].Text());
+
+  const std::string not_json = "{\"curve\": [1,";
+  const Problems syntax = ValidateScenarioText(not_json);
+  ASSERT_EQ(syntax.size(), 1u);
+  EXPECT_EQ(syntax[0].field, "");
+  EXPECT_EQ(syntax[0].message.rfind("line 1, column ", 0), 0u) << syntax[0].message;
+  EXPECT_NE(syntax[0].message.find("invalid JSON"), std::string::npos) << syntax[0].message;
+  try {
+    ParseScenarioText(not_json);
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problem().Text(), syntax[0].Text());
+  }
+  EXPECT_THROW(ValidateScenarioFile("/nonexistent-dir/scenario.json"), std::system_error);
 }
 
 // The keys the parser accepts at `pointer` of `doc`, read from its unknown-key message.

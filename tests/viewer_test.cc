@@ -3,7 +3,7 @@
 // works in a real browser (headless Chromium driven by tests/viewer/browser_check.mjs) for a small
 // 2D run and the two large runs it must play smoothly: 20 links in 3D over 2650 steps and 80
 // links in 2D over 250 steps.
-#include "flexkin/viewer.h"
+#include "viewer/viewer.h"
 #include "test_util.h"
 
 #include <gtest/gtest.h>
@@ -134,7 +134,7 @@ TEST_F(ViewerTest, PageIsSelfContainedAndCarriesTheResult) {
 }
 
 TEST_F(ViewerTest, OptionsAreValidatedNamingTheField) {
-  EXPECT_EQ(ViewerOptions().Validate(), "");
+  EXPECT_TRUE(ViewerOptions().Validate().empty());
   const ResultFile file = MakeResult(3, 4, 5, 0.1, "");
   const auto expect = [&](auto change, const std::string& field) {
     ViewerOptions options;
@@ -147,8 +147,8 @@ TEST_F(ViewerTest, OptionsAreValidatedNamingTheField) {
   expect([&](ViewerOptions& o) { o.playback_seconds = nan; }, "options.playback_seconds");
   expect([](ViewerOptions& o) { o.trail_points = {1, -1}; }, "options.trail_points[1]");
   expect([](ViewerOptions& o) { o.trail_points = {5}; }, "trail_points[0]");  // 4 links: 0..4
-  expect([](ViewerOptions& o) { o.elevation_deg = 91; }, "options.elevation_deg");
-  expect([&](ViewerOptions& o) { o.azimuth_deg = nan; }, "options.azimuth_deg");
+  expect([](ViewerOptions& o) { o.elevation = 91; }, "options.elevation");
+  expect([&](ViewerOptions& o) { o.azimuth = nan; }, "options.azimuth");
   expect([](ViewerOptions& o) { o.digits = 5; }, "options.digits");
   ViewerOptions ok;
   ok.trail_points = {0, 4};

@@ -1,17 +1,14 @@
 #pragma once
 
-#include <functional>
 #include <iosfwd>
 #include <string>
-
-#include <nlohmann/json_fwd.hpp>
 
 #include "flexkin/run.h"
 
 namespace flexkin {
 
-// Files in and out: result files (docs/result-format.md, docs/schema/result.schema.json), frame
-// CSV files, and the JSON reading and atomic writing they and scenario files share.
+// Files in and out: result files (docs/result-format.md, docs/schema/result.schema.json) and frame
+// CSV files.
 //
 // Errors: std::system_error for a file that cannot be read or written (the message has the path
 // and the system's reason, e.g. "No such file or directory"); InputError for content that is not
@@ -23,20 +20,6 @@ namespace flexkin {
 // The identification and version of result files, written and checked by the functions below.
 inline constexpr const char* kResultFormat = "flexkin-result";
 inline constexpr int kResultVersion = 1;
-
-// Parses JSON text. Throws InputError: for a syntax error with an empty field and a message that
-// starts "line L, column C: " and gives the reason; for a number too large for a double (1e999)
-// with the JSON pointer of the value as field.
-nlohmann::json ParseJsonText(const std::string& text);
-
-// Reads and parses the file at `path`; throws std::system_error if it cannot be read and
-// InputError as ParseJsonText.
-nlohmann::json ReadJsonFile(const std::string& path);
-
-// Creates or replaces the file at `path` with what `write` puts into the stream, atomically (see
-// above). If `write` throws, the exception propagates after the clean-up. A new file gets the
-// usual mode (0666 less the process umask); a replaced file keeps its mode.
-void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
 // Writes `result` as a result JSON document (format "flexkin-result", version 1). Doubles are
 // written with 17 significant digits, so reading them back gives the same bits. Frames are
@@ -72,7 +55,8 @@ struct ResultFile {
 // (every frame (n+1) by dim with n = the number of link lengths). Throws std::system_error if it
 // cannot be read, InputError (field: JSON pointer) if it is not a valid result file.
 ResultFile ReadResultJson(const std::string& path);
-// The same from a parsed document.
-ResultFile ResultFromJson(const nlohmann::json& json);
+// The same from the text of a result file. Throws InputError as ReadResultJson; for text that is
+// not JSON, with an empty field and a message "line L, column C: invalid JSON: <reason>".
+ResultFile ResultFromText(const std::string& json_text);
 
 }  // namespace flexkin

@@ -82,7 +82,7 @@ struct AccuracyReport {
 };
 
 // What the overall solver did over a run (method "overall" only).
-struct OverallSummary {
+struct OverallRunReport {
   int64_t solves = 0;                 // sub-steps solved
   int64_t failures = 0;               // sub-steps whose solve did not converge
   int64_t iterations = 0;             // Newton iterations in all
@@ -99,7 +99,7 @@ struct RunResult {
   std::vector<Frame> frames;
   Metrics metrics;
   AccuracyReport accuracy;
-  OverallSummary overall;    // method "overall" only
+  OverallRunReport overall;    // method "overall" only
   ObjectiveWeights weights;  // the overall method's metric (method "overall" only)
   double seconds = 0.0;      // wall time of the computation
 

@@ -3,8 +3,6 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json_fwd.hpp>
-
 #include "flexkin/chain.h"
 #include "flexkin/run.h"
 
@@ -22,17 +20,24 @@ struct Scenario {
   RunOptions options;   // "method", "leader/substeps", "record/every", "accuracy/..."
 };
 
-// Checks `json` and builds the scenario. Throws InputError whose field() is the JSON pointer of
-// the first problem and whose what() is "pointer: message", e.g.
-//   "/leader/steps: value 0 is not valid; expected an integer >= 1".
-Scenario ParseScenario(const nlohmann::json& json);
+// Checks the JSON text of a scenario and builds the scenario. Throws InputError whose field() is
+// the JSON pointer of the first problem and whose what() is "pointer: message", e.g.
+//   "/leader/steps: value 0 is not valid; expected an integer >= 1";
+// for text that is not JSON, the field is empty and the message "line L, column C: invalid JSON:
+// <reason>" (a number too large for a double is named by its pointer).
+Scenario ParseScenarioText(const std::string& json_text);
 
-// Every problem found in `json` (unknown keys, wrong types, values out of range, inconsistent
-// dimensions, curves that cannot be generated, ...), in the order checked (the keys of an
-// object alphabetically); empty if and only if ParseScenario would succeed.
+// Every problem found in the JSON text of a scenario (unknown keys, wrong types, values out of
+// range, inconsistent dimensions, curves that cannot be generated, ...), in the order checked
+// (the keys of an object alphabetically); empty if and only if ParseScenarioText would succeed.
 // Each problem's field is the JSON pointer of the offending value ("/leader/steps"; "" for the
-// whole document).
-Problems ValidateScenario(const nlohmann::json& json);
+// whole document). Text that is not JSON is one problem, the one ParseScenarioText throws.
+Problems ValidateScenarioText(const std::string& json_text);
+
+// The same for the file at `path`. Messages do not repeat the path; callers add it. Throw
+// std::system_error if the file cannot be read.
+Scenario LoadScenarioFile(const std::string& path);
+Problems ValidateScenarioFile(const std::string& path);
 
 // Where a RunOptions member is set: in a scenario file and on the command line. The one map from
 // the fields of RunOptions::Validate's problems to the places a user wrote them.
@@ -48,11 +53,6 @@ const std::vector<OptionLocation>& RunOptionLocations();
 const OptionLocation* FindOptionLocation(const std::string& field);
 // A problem of RunOptions::Validate with its field as the scenario file's JSON pointer.
 Problem InScenarioFile(Problem problem);
-
-// ReadJsonFile (result_io.h) + ParseScenario. Messages do not repeat the path; callers add it.
-// Throws std::system_error if the file cannot be read, InputError if it is not valid JSON (the
-// message gives line and column) or not a valid scenario.
-Scenario LoadScenarioFile(const std::string& path);
 
 // One line: "2D, 20 links (total length 5), 5 leader steps, method tractrix, 1 sub-step".
 std::string ScenarioSummary(const Scenario& scenario);

@@ -14,13 +14,9 @@
 #include <string>
 
 #include "flexkin/arm.h"
+#include "flexkin/robot_scenario.h"  // UrdfChain, RobotScenarioOptions
 
 namespace flexkin {
-
-struct UrdfChain {
-  std::string base_link;  // the link the arm is bolted to; "" = the URDF's root link
-  std::string tip_link;   // the end effector's link; "" = the one leaf below base_link
-};
 
 // Reads the chain from URDF text / a URDF file. Limits: a revolute joint's [lower, upper] (rad)
 // is cut to [-pi, pi]; continuous joints get [-pi, pi] when any other joint has limits. The
@@ -36,5 +32,10 @@ ArmModel ArmFromUrdfFile(const std::string& path, const UrdfChain& chain = {});
 // of it gives the same arm back. Planar arms are written with z axes in the z = 0 plane.
 // Throws InputError for spherical joints (URDF has none) or an invalid model.
 std::string UrdfFromArm(const ArmModel& model, const std::string& robot_name = "flexkin_arm");
+
+// Options of the robot scenario reader (flexkin/robot_scenario.h) that read "urdf" arms with
+// ArmFromUrdfFile: LoadRobotScenarioFile(path, UrdfRobotScenarioOptions()). The core library has
+// no URDF parser; this is how the front ends that link flexkin_urdf plug it in.
+RobotScenarioOptions UrdfRobotScenarioOptions();
 
 }  // namespace flexkin

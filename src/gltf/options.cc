@@ -3,7 +3,7 @@
 #include <string>
 
 #include "flexkin/error.h"
-#include "flexkin/gltf.h"
+#include "gltf/gltf.h"
 
 namespace flexkin {
 

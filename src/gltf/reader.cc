@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "flexkin/error.h"
-#include "flexkin/gltf.h"
+#include "gltf/gltf.h"
 #include "gltf/rig.h"
 
 namespace flexkin {

@@ -11,10 +11,11 @@
 #include <vector>
 
 #include "flexkin/error.h"
-#include "flexkin/gltf.h"
+#include "gltf/gltf.h"
 #include "flexkin/propagate.h"
 #include "gltf/rig.h"
 #include "gltf/tube.h"
+#include "io/atomic_file.h"
 
 namespace flexkin {
 namespace {

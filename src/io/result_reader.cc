@@ -4,6 +4,8 @@
 
 #include "flexkin/error.h"
 #include "flexkin/result_io.h"
+#include "io/json_file.h"
+#include "io/result_json.h"
 
 // Result files in (docs/result-format.md): the first problem is thrown, naming its JSON pointer.
 
@@ -174,5 +176,9 @@ ResultFile ResultFromJson(const json& j) {
 }
 
 ResultFile ReadResultJson(const std::string& path) { return ResultFromJson(ReadJsonFile(path)); }
+
+ResultFile ResultFromText(const std::string& json_text) {
+  return ResultFromJson(ParseJsonText(json_text));
+}
 
 }  // namespace flexkin

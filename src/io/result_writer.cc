@@ -8,6 +8,7 @@
 
 #include "flexkin/error.h"
 #include "flexkin/result_io.h"
+#include "io/atomic_file.h"
 
 // Result files and frame CSV files out (docs/result-format.md).
 
@@ -101,7 +102,7 @@ void WriteResultJson(const RunResult& result, std::ostream& out, const std::stri
   AppendDouble(a.estimated_error, &t);
   t += ", \"met\": " + std::string(a.met ? "true" : "false") + "},\n";
   if (result.method == Method::kOverall) {
-    const OverallSummary& o = result.overall;
+    const OverallRunReport& o = result.overall;
     const ObjectiveWeights& w = result.weights;
     t += "\"overall\": {\"objective\": {";
     for (const auto& [term, name, summary] : Vocabulary<ObjectiveTerm>::kEntries) {

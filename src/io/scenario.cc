@@ -1,11 +1,13 @@
 #include "flexkin/scenario.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <string>
 #include <vector>
 
 #include "flexkin/error.h"
-#include "flexkin/result_io.h"
+#include "io/json_file.h"
+#include "io/scenario_json.h"
 #include "io/scenario_parser.h"
 
 namespace flexkin {
@@ -93,9 +95,7 @@ Problem InScenarioFile(Problem problem) {
 Scenario ParseScenario(const nlohmann::json& json) {
   Parser parser;
   Scenario scenario = parser.Parse(json);
-  if (!parser.problems.empty()) {
-    throw InputError(parser.problems.front());
-  }
+  ThrowIfAny(parser.problems);
   return scenario;
 }
 
@@ -105,7 +105,25 @@ Problems ValidateScenario(const nlohmann::json& json) {
   return std::move(parser.problems);
 }
 
+Scenario ParseScenarioText(const std::string& json_text) {
+  return ParseScenario(ParseJsonText(json_text));
+}
+
+Problems ValidateScenarioText(const std::string& json_text) {
+  nlohmann::json json;
+  try {
+    json = ParseJsonText(json_text);
+  } catch (const InputError& e) {
+    return {e.problem()};
+  }
+  return ValidateScenario(json);
+}
+
 Scenario LoadScenarioFile(const std::string& path) { return ParseScenario(ReadJsonFile(path)); }
+
+Problems ValidateScenarioFile(const std::string& path) {
+  return ValidateScenarioText(ReadTextFile(path));
+}
 
 std::string ScenarioSummary(const Scenario& scenario) {
   const Chain& c = scenario.chain;

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "flexkin/error.h"
-#include "flexkin/render.h"
+#include "render/render.h"
 #include "render/canvas.h"
 #include "render/checks.h"
 #include "render/ffmpeg_pipe.h"

@@ -8,7 +8,7 @@
 #include <ostream>
 #include <stdexcept>
 
-#include "flexkin/result_io.h"
+#include "io/atomic_file.h"
 
 namespace flexkin::render {
 namespace {

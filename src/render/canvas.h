@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "flexkin/render.h"
+#include "render/render.h"
 #include "render/style.h"
 
 namespace flexkin::render {

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "flexkin/error.h"
-#include "flexkin/render.h"
+#include "render/render.h"
 #include "render/axes.h"
 #include "render/canvas.h"
 #include "render/checks.h"

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include "flexkin/render.h"
+#include "render/render.h"
 #include "render/canvas.h"
 #include "render/checks.h"
 

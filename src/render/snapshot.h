@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "flexkin/render.h"
+#include "render/render.h"
 #include "render/axes.h"
 #include "render/legend.h"
 #include "render/scene.h"

@@ -91,7 +91,7 @@ AccuracyReport ChooseSubsteps(const Chain& chain, const Points& leader_steps,
 }
 
 // Adds one overall solve to the run's summary.
-void Record(const OverallReport& report, int64_t step, int substep, OverallSummary* summary) {
+void Record(const OverallReport& report, int64_t step, int substep, OverallRunReport* summary) {
   ++summary->solves;
   summary->iterations += report.iterations;
   summary->max_iterations = std::max(summary->max_iterations, report.iterations);
@@ -266,10 +266,11 @@ RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& 
   Points points = chain.points, before;
   sink->Add(0, points, LinkAngles(points, direction));
   auto last_report = Clock::now();
-  Eigen::VectorXd head(chain.dim());
+  // Buffers of the loop, sized once: a leader step allocates nothing but its recorded frame.
+  Eigen::VectorXd head(chain.dim()), start(chain.dim()), target(chain.dim());
   for (int64_t s = 0; s < result.num_steps; ++s) {
-    const Eigen::VectorXd start = points.row(0).transpose();
-    const Eigen::VectorXd target = leader_steps.row(s).transpose();
+    start = points.row(0).transpose();
+    target = leader_steps.row(s).transpose();
     if ((target - start).norm() > 0.0) direction = (target - start).normalized();
     // One sub-step at a time (the heads MoveLeader would use), so that the metrics see the
     // motion at the resolution it is computed.

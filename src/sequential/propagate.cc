@@ -157,8 +157,14 @@ void MoveLeader(const Stepper& stepper, const Eigen::Ref<const Eigen::VectorXd>&
   }
   // Head positions of the sub-steps, interpolated from the start of the move so that the last
   // one is exactly the target.
+  // (On the stack for a few sub-steps, so that a run stepping one sub-step at a time allocates
+  // nothing.)
   const int dim = stepper.dim;
-  std::vector<double> heads(static_cast<size_t>(substeps) * dim);
+  const size_t count = static_cast<size_t>(substeps) * dim;
+  constexpr size_t kStackHeads = 48;
+  double stack_heads[kStackHeads];
+  std::vector<double> heap_heads(count > kStackHeads ? count : 0);
+  double* heads = count > kStackHeads ? heap_heads.data() : stack_heads;
   for (int j = 1; j <= substeps; ++j) {
     for (int k = 0; k < dim; ++k) {
       heads[(j - 1) * dim + k] = internal::SubstepHead((*points)(0, k), target[k], j, substeps);
@@ -167,18 +173,18 @@ void MoveLeader(const Stepper& stepper, const Eigen::Ref<const Eigen::VectorXd>&
   const int n = static_cast<int>(stepper.lengths.size());
   // The wavefront pays for a copy of the chain; it wins once several sweeps share it.
   if (stepper.method == Method::kMinRotation) {
-    internal::SweepsMinRotation(dim, heads.data(), substeps, n, points->data());
+    internal::SweepsMinRotation(dim, heads, substeps, n, points->data());
     return;
   }
   if (stepper.method == Method::kMinJointAngle) {
-    internal::SweepsMinJointAngle(dim, heads.data(), substeps, stepper.lengths.data(),
+    internal::SweepsMinJointAngle(dim, heads, substeps, stepper.lengths.data(),
                                   stepper.inv_lengths.data(), n, points->data());
     return;
   }
   const int lanes = internal::WavefrontLanes();
   const bool wavefront = lanes > 1 && substeps >= 2 * lanes && n >= 8;
   (wavefront ? internal::SweepsWavefront : internal::SweepsScalar)(
-      stepper.method, dim, heads.data(), substeps, stepper.lengths.data(),
+      stepper.method, dim, heads, substeps, stepper.lengths.data(),
       stepper.inv_lengths.data(), n, points->data());
 }
 

@@ -53,8 +53,8 @@
   const view = {
     scale: 1,              // CSS pixels per length unit
     panX: 0, panY: 0,      // CSS pixels
-    azimuth: options.azimuth_deg * Math.PI / 180,
-    elevation: options.elevation_deg * Math.PI / 180,
+    azimuth: options.azimuth * Math.PI / 180,
+    elevation: options.elevation * Math.PI / 180,
     perspective: options.perspective,
   };
   // Camera basis for 3D: right, up and towards the viewer, 3 numbers each.
@@ -580,8 +580,8 @@
   }
 
   function resetView() {
-    view.azimuth = options.azimuth_deg * Math.PI / 180;
-    view.elevation = options.elevation_deg * Math.PI / 180;
+    view.azimuth = options.azimuth * Math.PI / 180;
+    view.elevation = options.elevation * Math.PI / 180;
     fitView();
     state.backgroundDirty = true;
     state.dirty = true;

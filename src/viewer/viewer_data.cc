@@ -186,10 +186,10 @@ std::string ViewerDataJson(const ResultFile& file, const ViewerOptions& options)
     out += std::to_string(options.trail_points[i]);
   }
   out.push_back(']');
-  AppendKey("azimuth_deg", &out);
-  AppendExact(options.azimuth_deg, &out);
-  AppendKey("elevation_deg", &out);
-  AppendExact(options.elevation_deg, &out);
+  AppendKey("azimuth", &out);
+  AppendExact(options.azimuth, &out);
+  AppendKey("elevation", &out);
+  AppendExact(options.elevation, &out);
   AppendKey("perspective", &out);
   out += options.perspective ? "true" : "false";
   out.push_back('}');

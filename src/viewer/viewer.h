@@ -30,8 +30,8 @@ struct ViewerOptions {
   std::vector<int> trail_points;
   // Initial 3D view: azimuth of the viewing direction about the z axis from the x axis, degrees
   // (any finite value), and elevation above the x-y plane, degrees in [-90, 90]. Unused in 2D.
-  double azimuth_deg = -60.0;
-  double elevation_deg = 25.0;
+  double azimuth = -60.0;
+  double elevation = 25.0;
   // Initial 3D projection: perspective if true, orthographic otherwise; the page has a toggle.
   bool perspective = false;
   // Significant digits of the embedded coordinates, in [6, 17]. 9 keeps a point to about 1e-9 of

@@ -1,0 +1,101 @@
+#pragma once
+// Robot scenario files (docs/robot-format.md, docs/schema/robot.schema.json) in and robot
+// trajectories out: the one reader and writer that every front end (the `flexkin robot` command,
+// the examples, the Python module) shares.
+//
+//   RobotScenarioOptions options = UrdfRobotScenarioOptions();  // flexkin/urdf.h, or {}
+//   const RobotScenario s = LoadRobotScenarioFile("arm.json", options);
+//   const ArmTrajectory t = TrackPath(s.model, s.path, s.options);
+//   WriteRobotTrajectoryJson(s, t, "trajectory.json");
+//
+// Errors as everywhere in flexkin: InputError for content that is not valid (its field the JSON
+// pointer of the value, "/arm/link_lengths/2"), std::system_error for a file that cannot be read
+// or written (the message has the path and the system's reason).
+
+#include <functional>
+#include <iosfwd>
+#include <string>
+
+#include "flexkin/arm.h"
+#include "flexkin/chain.h"
+#include "flexkin/error.h"
+
+namespace flexkin {
+
+// Which part of a URDF (Unified Robot Description Format) model is the arm.
+struct UrdfChain {
+  std::string base_link;  // the link the arm is bolted to; "" = the URDF's root link
+  std::string tip_link;   // the end effector's link; "" = the one leaf below base_link
+};
+
+// Reads the arm of the URDF file at `path` (flexkin/urdf.h: ArmFromUrdfFile). Throws InputError
+// naming the element ("base_link", "tip_link", "joint \"elbow\"") for a URDF that is not a
+// valid arm, std::system_error for a file that cannot be read.
+using UrdfArmLoader = std::function<ArmModel(const std::string& path, const UrdfChain& chain)>;
+
+struct RobotScenarioOptions {
+  // Reads the arm of a scenario that names a URDF file ("urdf"). Empty (the default): such
+  // scenarios are refused with an InputError at "/urdf". The URDF component (flexkin_urdf,
+  // flexkin/urdf.h) provides UrdfRobotScenarioOptions(), which sets it to ArmFromUrdfFile; the
+  // core library does not depend on a URDF parser.
+  UrdfArmLoader urdf_loader;
+  // The directory that a relative "urdf" file name is taken relative to. "": the scenario file's
+  // directory for LoadRobotScenarioFile and ValidateRobotScenarioFile, the working directory for
+  // the *Text functions.
+  std::string directory;
+};
+
+// A robot scenario file read in.
+struct RobotScenario {
+  std::string name;    // "name", "" if absent
+  ArmModel model;      // from "arm", or from the URDF file named by "urdf"
+  Points path;         // m by dim, m >= 1: the end effector's targets from "path", one per step
+  ArmOptions options;  // "solver"; the defaults where it is absent
+};
+
+// Checks the JSON text of a robot scenario and builds it. Throws InputError for the first
+// problem (as listed by ValidateRobotScenarioText); for text that is not JSON, the field is empty
+// and the message "line L, column C: invalid JSON: <reason>". A URDF file that cannot be read
+// throws std::system_error.
+RobotScenario ParseRobotScenarioText(const std::string& json_text,
+                                     const RobotScenarioOptions& options = {});
+
+// Every problem found in the JSON text of a robot scenario (unknown keys with a suggestion for a
+// typo, wrong types, values out of range, sizes that do not match the number of links, an arm
+// the model refuses, ...), in the order checked; empty if and only if ParseRobotScenarioText
+// would succeed. Each problem's field is the JSON pointer of the offending value
+// ("/arm/joint_limits/max_bend/0"; "" for the whole document). Numbers are read as in scenario
+// files: an integer may be written 5.0, not 5.5. A URDF arm is read with options.urdf_loader, so
+// its problems are listed too; a URDF file that cannot be read throws std::system_error.
+Problems ValidateRobotScenarioText(const std::string& json_text,
+                                   const RobotScenarioOptions& options = {});
+
+// The same for the file at `path`. Messages do not repeat the path; callers add it. Throw
+// std::system_error if the file cannot be read.
+RobotScenario LoadRobotScenarioFile(const std::string& path,
+                                    const RobotScenarioOptions& options = {});
+Problems ValidateRobotScenarioFile(const std::string& path,
+                                   const RobotScenarioOptions& options = {});
+
+// The identification and version of robot trajectory files.
+inline constexpr const char* kRobotTrajectoryFormat = "flexkin-robot-trajectory";
+inline constexpr int kRobotTrajectoryVersion = 1;
+
+// Writes the trajectory of `scenario` (TrackPath of its model, path and options) as a trajectory
+// JSON document (docs/robot-format.md, "Outputs"): the arm, the method, a summary, the initial
+// state and one step per line. The path version writes atomically (a temporary file renamed over
+// `path`; on any error nothing is written) and throws std::system_error if it cannot.
+void WriteRobotTrajectoryJson(const RobotScenario& scenario, const ArmTrajectory& trajectory,
+                              std::ostream& out);
+void WriteRobotTrajectoryJson(const RobotScenario& scenario, const ArmTrajectory& trajectory,
+                              const std::string& path);
+
+// Writes the joint angles as CSV: a header "step,joint_0,...,joint_{n-1}" (spatial arms with
+// spherical joints: then "azimuth_0,..."), row 0 the initial angles, then one row per step, 17
+// significant digits. The path version writes atomically, as above.
+void WriteRobotJointsCsv(const RobotScenario& scenario, const ArmTrajectory& trajectory,
+                         std::ostream& out);
+void WriteRobotJointsCsv(const RobotScenario& scenario, const ArmTrajectory& trajectory,
+                         const std::string& path);
+
+}  // namespace flexkin
