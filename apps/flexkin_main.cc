@@ -14,6 +14,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdint>
 #include <cstdio>
 #include <exception>
@@ -21,8 +22,6 @@
 #include <new>
 #include <string>
 #include <system_error>
-
-#include <CLI/CLI.hpp>
 
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
@@ -107,11 +106,12 @@ void ApplyOverrides(const RunArgs& args, flexkin::RunOptions* options) {
   // A value from the command line is named by its option, one from the file by its JSON pointer.
   const flexkin::Problem& p = problems.front();
   const flexkin::OptionLocation* location = flexkin::FindOptionLocation(p.field);
-  const bool from_cli = location != nullptr && *location->flag != '\0' &&
-                        ((location->flag == std::string("--substeps") && *args.substeps_opt) ||
-                         (location->flag == std::string("--record-every") && *args.record_every_opt) ||
-                         (location->flag == std::string("--tolerance") && *args.tolerance_opt) ||
-                         (location->flag == std::string("--max-substeps") && *args.max_substeps_opt));
+  const bool from_cli =
+      location != nullptr && *location->flag != '\0' &&
+      ((location->flag == std::string("--substeps") && *args.substeps_opt) ||
+       (location->flag == std::string("--record-every") && *args.record_every_opt) ||
+       (location->flag == std::string("--tolerance") && *args.tolerance_opt) ||
+       (location->flag == std::string("--max-substeps") && *args.max_substeps_opt));
   flexkin::Problem located = flexkin::InScenarioFile(p);
   located.field = from_cli ? location->flag : args.scenario + ": " + located.field;
   throw flexkin::InputError(located);

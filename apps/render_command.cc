@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "flexkin/error.h"
-#include "gltf/gltf.h"
 #include "flexkin/result_io.h"
+#include "gltf/gltf.h"
 #include "viewer/viewer.h"
 
 namespace flexkin::cli {

@@ -3,11 +3,11 @@
 #include <iostream>
 
 #include "flexkin/arm.h"
-#include "gltf/gltf.h"
 #include "flexkin/overall.h"
 #include "flexkin/propagate.h"
-#include "render/render.h"
 #include "flexkin/vocabulary.h"
+#include "gltf/gltf.h"
+#include "render/render.h"
 
 namespace flexkin::cli {
 namespace {

@@ -25,7 +25,8 @@ void Track(benchmark::State& state, flexkin::FixedBaseMethod method) {
   for (auto _ : state) {
     const flexkin::ArmTrajectory t = flexkin::TrackPath(model, path, options);
     benchmark::DoNotOptimize(t.steps.back().state.points.data());
-    for (const auto& s : t.steps) iterations += s.iterations, sweeps += s.sweeps, passes += s.passes;
+    for (const auto& s : t.steps)
+      iterations += s.iterations, sweeps += s.sweeps, passes += s.passes;
     steps += t.steps.size();
     unreached += t.unreached;
   }

@@ -8,11 +8,11 @@
 // warm-started from the previous one, tolerance 1e-10 of a link for all three.
 //   build/bench/arm_kdl_benchmark --benchmark_counters_tabular=true
 // Counters: s/step (time per step); x_flexkin (this solver's time per step over flexkin's, both
-// measured in this run as CPU time: flexkin's before the timed loop, the median of 5 runs); max_err (largest
-// end-effector error, link lengths); unreached; motion of the joint nearest the end effector
-// (m_ee), at the middle (m_mid) and nearest the base (m_base), total |dtheta| along the path
-// (rad), and their sum over all joints (m_sum); iters/step; flexkin's passes over the links per step
-// (passes/step).
+// measured in this run as CPU time: flexkin's before the timed loop, the median of 5 runs); max_err
+// (largest end-effector error, link lengths); unreached; motion of the joint nearest the end
+// effector (m_ee), at the middle (m_mid) and nearest the base (m_base), total |dtheta| along the
+// path (rad), and their sum over all joints (m_sum); iters/step; flexkin's passes over the links
+// per step (passes/step).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -102,8 +102,8 @@ void Flexkin(benchmark::State& state) {
   state.counters["passes/step"] = passes / steps;  // passes over the links (cost ~ passes * n)
   state.counters["max_err"] = t.max_ee_error;
   state.counters["unreached"] = t.unreached;
-  SetMotionCounters(state,
-                    flexkin::peers::TotalJointMotion(model, model.initial, flexkin::peers::AnglesOf(t)));
+  SetMotionCounters(
+      state, flexkin::peers::TotalJointMotion(model, model.initial, flexkin::peers::AnglesOf(t)));
 }
 
 void Kdl(benchmark::State& state, KdlSolver solver) {

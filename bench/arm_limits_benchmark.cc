@@ -39,7 +39,8 @@ void Track(benchmark::State& state, flexkin::FixedBaseMethod method) {
       unreached += t.unreached;
     }
   }
-  state.counters["s/step"] = benchmark::Counter(steps, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["s/step"] =
+      benchmark::Counter(steps, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   state.counters["passes/step"] = passes / steps;
   state.counters["joint_space"] = joint_space / steps;  // share of the steps
   state.counters["unreached"] = unreached;              // of the 500 steps of one iteration

@@ -67,17 +67,23 @@ void BM_MultiStep(benchmark::State& state, Method method, bool wavefront, bool w
   state.counters["lanes"] = wavefront ? internal::WavefrontLanes() : 1;
 }
 BENCHMARK_CAPTURE(BM_MultiStep, pull_tractrix_wavefront, Method::kTractrix, true, false)
-    ->RangeMultiplier(10)->Range(10, 100000);
+    ->RangeMultiplier(10)
+    ->Range(10, 100000);
 BENCHMARK_CAPTURE(BM_MultiStep, pull_ftl_wavefront, Method::kFollowTheLeader, true, false)
-    ->RangeMultiplier(10)->Range(10, 100000);
+    ->RangeMultiplier(10)
+    ->Range(10, 100000);
 BENCHMARK_CAPTURE(BM_MultiStep, pull_tractrix_one_pass, Method::kTractrix, false, false)
-    ->RangeMultiplier(10)->Range(10, 100000);
+    ->RangeMultiplier(10)
+    ->Range(10, 100000);
 BENCHMARK_CAPTURE(BM_MultiStep, pull_ftl_one_pass, Method::kFollowTheLeader, false, false)
-    ->RangeMultiplier(10)->Range(10, 100000);
+    ->RangeMultiplier(10)
+    ->Range(10, 100000);
 BENCHMARK_CAPTURE(BM_MultiStep, wander_tractrix_wavefront, Method::kTractrix, true, true)
-    ->RangeMultiplier(10)->Range(10, 100000);
+    ->RangeMultiplier(10)
+    ->Range(10, 100000);
 BENCHMARK_CAPTURE(BM_MultiStep, wander_ftl_wavefront, Method::kFollowTheLeader, true, true)
-    ->RangeMultiplier(10)->Range(10, 100000);
+    ->RangeMultiplier(10)
+    ->Range(10, 100000);
 
 // Question 2: single-step moves, one MoveLeader call (one sweep) each.
 void BM_SingleStep(benchmark::State& state, Method method) {
@@ -92,8 +98,12 @@ void BM_SingleStep(benchmark::State& state, Method method) {
   }
   SetRate(state, n);
 }
-BENCHMARK_CAPTURE(BM_SingleStep, tractrix, Method::kTractrix)->RangeMultiplier(10)->Range(10, 100000);
-BENCHMARK_CAPTURE(BM_SingleStep, ftl, Method::kFollowTheLeader)->RangeMultiplier(10)->Range(10, 100000);
+BENCHMARK_CAPTURE(BM_SingleStep, tractrix, Method::kTractrix)
+    ->RangeMultiplier(10)
+    ->Range(10, 100000);
+BENCHMARK_CAPTURE(BM_SingleStep, ftl, Method::kFollowTheLeader)
+    ->RangeMultiplier(10)
+    ->Range(10, 100000);
 
 // Question 3: the coil (scenes::Coil) of 20 and of 100 links, each pulled along a bent path (3
 // straight moves of about 1.5 chain lengths in all).
@@ -150,8 +160,14 @@ void BM_ToAccuracy(benchmark::State& state, Method method) {
   state.counters["substeps"] = substeps;
   state.counters["max_error"] = error;
 }
-BENCHMARK_CAPTURE(BM_ToAccuracy, tractrix, Method::kTractrix)->Arg(20)->Arg(100)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_ToAccuracy, ftl, Method::kFollowTheLeader)->Arg(20)->Arg(100)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ToAccuracy, tractrix, Method::kTractrix)
+    ->Arg(20)
+    ->Arg(100)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ToAccuracy, ftl, Method::kFollowTheLeader)
+    ->Arg(20)
+    ->Arg(100)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace flexkin

@@ -42,10 +42,11 @@ int main(int argc, char** argv) {
         const double right = j < other.lengths.size() ? other.lengths[j] : 0.0;
         weighted += 0.5 * (left + right) * gap[j];
       }
-      std::printf("  %s (%s): distance from the reference: sum over points %.6f, arc-length "
-                  "weighted %.6f, largest %.6f; L2 metric of the motion %.6f\n",
-                  argv[a], flexkin::MethodName(other.method), gap.sum(), weighted,
-                  gap.maxCoeff(), other.metrics.l2_total);
+      std::printf(
+          "  %s (%s): distance from the reference: sum over points %.6f, arc-length "
+          "weighted %.6f, largest %.6f; L2 metric of the motion %.6f\n",
+          argv[a], flexkin::MethodName(other.method), gap.sum(), weighted, gap.maxCoeff(),
+          other.metrics.l2_total);
     }
     return 0;
   } catch (const std::exception& e) {

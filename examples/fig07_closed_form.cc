@@ -39,9 +39,10 @@ int main(int argc, char** argv) {
           head0 + (p - length * std::tanh(p / length)) * u + length / std::cosh(p / length) * w;
       worst = std::fmax(worst, (frame.points.row(1).transpose() - expected).norm() / length);
     }
-    std::printf("Fig. 7 (eq. 23): %zu frames, pull %.6g link lengths; largest distance of the "
-                "trailing end from the closed form: %.3g link lengths; %s\n",
-                result.frames.size(), pull.norm() / length, worst, result.BriefReport().c_str());
+    std::printf(
+        "Fig. 7 (eq. 23): %zu frames, pull %.6g link lengths; largest distance of the "
+        "trailing end from the closed form: %.3g link lengths; %s\n",
+        result.frames.size(), pull.norm() / length, worst, result.BriefReport().c_str());
     return worst < 1e-12 ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s: %s\n", path, e.what());

@@ -103,8 +103,8 @@ void DrawMotion(cairo_t* cr, double ui, const Rect& area, const Series& a, const
     flexkin::render::SetColor(cr, colors[m]);
     cairo_rectangle(cr, area.right() - 150 * ui, y - 5 * ui, 12 * ui, 10 * ui);
     cairo_fill(cr);
-    flexkin::render::DrawText(cr, area.right() - 132 * ui, y, m == 0 ? "tractrix" : "pseudo-inverse",
-                              key);
+    flexkin::render::DrawText(cr, area.right() - 132 * ui, y,
+                              m == 0 ? "tractrix" : "pseudo-inverse", key);
   }
   TextStyle title;
   title.size = 14 * ui;
@@ -114,8 +114,8 @@ void DrawMotion(cairo_t* cr, double ui, const Rect& area, const Series& a, const
                             title);
 }
 
-void DrawFigure(flexkin::ImageFormat format, const std::string& path,
-                const std::string& name, Series a, Series b) {
+void DrawFigure(flexkin::ImageFormat format, const std::string& path, const std::string& name,
+                Series a, Series b) {
   a.angles = Unwrapped(a.angles);
   b.angles = Unwrapped(b.angles);
   Canvas canvas(format, 1500, 560);
@@ -144,7 +144,8 @@ void DrawFigure(flexkin::ImageFormat format, const std::string& path,
   note.size = 11.5 * ui;
   note.color = flexkin::render::kMuted;
   flexkin::render::DrawText(cr, 70 * ui, 560 - 14 * ui,
-                            "lines: joint 0 (base, dark) to joint n-1 (end effector, yellow)", note);
+                            "lines: joint 0 (base, dark) to joint n-1 (end effector, yellow)",
+                            note);
   flexkin::render::SaveCanvas(&canvas, path);
 }
 
@@ -164,7 +165,8 @@ void WriteCsv(const std::string& path, const flexkin::Points& targets, const Ser
         if (i == 0) {
           out << ",";
         } else {
-          std::snprintf(buffer, sizeof buffer, ",%.9g", targets(static_cast<Eigen::Index>(i) - 1, c));
+          std::snprintf(buffer, sizeof buffer, ",%.9g",
+                        targets(static_cast<Eigen::Index>(i) - 1, c));
           out << buffer;
         }
       }
@@ -183,7 +185,8 @@ void WriteCsv(const std::string& path, const flexkin::Points& targets, const Ser
 
 int main(int argc, char** argv) {
   if (argc != 3) {
-    std::cerr << "usage: robot_compare SCENARIO.json OUT_PREFIX (writes OUT_PREFIX.svg, .png, .csv)\n";
+    std::cerr
+        << "usage: robot_compare SCENARIO.json OUT_PREFIX (writes OUT_PREFIX.svg, .png, .csv)\n";
     return 1;
   }
   try {

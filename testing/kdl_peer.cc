@@ -74,7 +74,8 @@ KDL::Chain KdlChain(const ArmModel& model) {
   CheckModel(model);
   KDL::Rotation base_rotation;
   if (model.dim == 2) {
-    base_rotation = KDL::Rotation::RotZ(std::atan2(model.base_direction[1], model.base_direction[0]));
+    base_rotation =
+        KDL::Rotation::RotZ(std::atan2(model.base_direction[1], model.base_direction[0]));
   } else {
     // As flexkin's base frame: the smallest rotation taking x to the base direction.
     const Eigen::Quaterniond q = Eigen::Quaterniond::FromTwoVectors(
@@ -82,8 +83,8 @@ KDL::Chain KdlChain(const ArmModel& model) {
     base_rotation = KDL::Rotation::Quaternion(q.x(), q.y(), q.z(), q.w());
   }
   KDL::Chain chain;
-  chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::None),
-                                KDL::Frame(base_rotation, ToKdl(model.base))));
+  chain.addSegment(
+      KDL::Segment(KDL::Joint(KDL::Joint::None), KDL::Frame(base_rotation, ToKdl(model.base))));
   for (int k = 0; k < model.num_links(); ++k) {
     const KDL::Frame link(KDL::Vector(model.link_lengths[k], 0.0, 0.0));
     if (model.dim == 2) {
@@ -100,8 +101,8 @@ KDL::Chain KdlChain(const ArmModel& model) {
 KDL::JntArray KdlJoints(const ArmModel& model, const JointAngles& angles) {
   const int n = model.num_links();
   if (angles.angle.size() != n || (model.dim == 3 && angles.azimuth.size() != n)) {
-    throw InputError("angles", "must have one angle (and in 3D one azimuth) per link, " +
-                                   std::to_string(n));
+    throw InputError("angles",
+                     "must have one angle (and in 3D one azimuth) per link, " + std::to_string(n));
   }
   KDL::JntArray q(static_cast<unsigned>(n * KdlJointsPerLink(model)));
   for (int j = 0; j < n; ++j) {
@@ -136,8 +137,8 @@ KdlTrajectory TrackPathWithKdl(const ArmModel& model, const Points& path, KdlSol
   AppendNested("options", options.Validate(), &problems);
   ThrowIfAny(problems);
   if (path.rows() < 1 || path.cols() != model.dim || !path.allFinite()) {
-    throw InputError("path", "must be at least one row of " + std::to_string(model.dim) +
-                                 " finite coordinates");
+    throw InputError(
+        "path", "must be at least one row of " + std::to_string(model.dim) + " finite coordinates");
   }
   const double scale = model.reach() / model.num_links();  // mean link length
   const double tolerance = options.tolerance * scale;

@@ -65,15 +65,15 @@ KDL::JntArray KdlJoints(const ArmModel& model, const JointAngles& angles);
 Points KdlPoints(const ArmModel& model, const KDL::Chain& chain, const KDL::JntArray& q);
 
 struct KdlStepReport {
-  JointAngles angles;      // flexkin's convention, read from `points` (JointAnglesFromPoints)
-  Points points;           // (n+1) by dim, KDL's FK of `q`
-  KDL::JntArray q;         // KDL's joints
-  double ee_error = 0.0;   // |end effector - target| (length unit)
-  int iterations = 0;      // NR: FK evaluations - 1; LMA: lastNrOfIter
-  double seconds = 0.0;    // wall time of the solver's CartToJnt
-  int status = 0;          // the solver's return code (>= 0: KDL counts it as a solution)
-  std::string status_name; // KDL's strError of `status`
-  bool reached = false;    // status >= 0 and ee_error <= 2 x tolerance x mean link length
+  JointAngles angles;       // flexkin's convention, read from `points` (JointAnglesFromPoints)
+  Points points;            // (n+1) by dim, KDL's FK of `q`
+  KDL::JntArray q;          // KDL's joints
+  double ee_error = 0.0;    // |end effector - target| (length unit)
+  int iterations = 0;       // NR: FK evaluations - 1; LMA: lastNrOfIter
+  double seconds = 0.0;     // wall time of the solver's CartToJnt
+  int status = 0;           // the solver's return code (>= 0: KDL counts it as a solution)
+  std::string status_name;  // KDL's strError of `status`
+  bool reached = false;     // status >= 0 and ee_error <= 2 x tolerance x mean link length
 };
 
 struct KdlTrajectory {
@@ -81,7 +81,7 @@ struct KdlTrajectory {
   double max_ee_error = 0.0;
   int unreached = 0;
   double max_iterations = 0, mean_iterations = 0;
-  double seconds = 0.0;              // sum of the steps' solver times
+  double seconds = 0.0;  // sum of the steps' solver times
 };
 
 // Tracks `path` (m by dim) from the model's initial angles, one warm-started IK per row.

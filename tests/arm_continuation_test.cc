@@ -108,8 +108,8 @@ TEST(ArmAnchor, BatchedAtan2AndSinCosEqualTheCLibrary) {
   std::vector<double> x(count), y(count), a(count);
   for (int i = 0; i < count; ++i) x[i] = coordinate(rng), y[i] = coordinate(rng), a[i] = angle(rng);
   // Edge cases: axes, signed zeros, half turns, large and huge angles (the C library's range).
-  const double edges[][2] = {{0.0, 1.0}, {0.0, -1.0}, {1.0, 0.0}, {-1.0, 0.0}, {-0.0, -1.0},
-                             {1e-300, 1.0}, {1.0, 1e-300}, {-1e-300, -1.0}};
+  const double edges[][2] = {{0.0, 1.0},   {0.0, -1.0},   {1.0, 0.0},    {-1.0, 0.0},
+                             {-0.0, -1.0}, {1e-300, 1.0}, {1.0, 1e-300}, {-1e-300, -1.0}};
   for (int i = 0; i < 8; ++i) y[i] = edges[i][0], x[i] = edges[i][1];
   const double big[] = {M_PI, -M_PI, M_PI / 2, 0.785398163397448, 1.5e6, -2e6, 1e9, 0.0};
   for (int i = 0; i < 8; ++i) a[i] = big[i];
@@ -157,7 +157,8 @@ TEST(ArmAnchor, ReanchoringEqualsTheScalarFormulas) {
     heading = std::atan2(0.9, -0.4);
     for (int j = 0; j < links; ++j) {
       const double theta = std::remainder(
-          std::atan2(reference(j + 1, 1) - reference(j, 1), reference(j + 1, 0) - reference(j, 0)) - heading,
+          std::atan2(reference(j + 1, 1) - reference(j, 1), reference(j + 1, 0) - reference(j, 0)) -
+              heading,
           2.0 * M_PI);
       scalar[j] = theta;
       heading += theta;

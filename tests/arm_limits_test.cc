@@ -24,8 +24,6 @@ using scenes::SaturatingPath;
 
 constexpr double kPi = 3.14159265358979323846;
 
-
-
 // Random joint angles within the limits: revolute in [-range, range] (inside the limits),
 // spherical bends in [0, range] about random azimuths.
 JointAngles RandomAngles(const ArmModel& model, double range, std::mt19937* rng) {
@@ -53,15 +51,18 @@ void ExpectInvariants(const ArmModel& model, const ArmStepReport& r, const std::
     EXPECT_LT(std::abs(l - model.link_lengths[k]), 1e-13) << what;
   }
   EXPECT_TRUE(WithinLimits(model, r.state.angles, 1e-12)) << what;
-  EXPECT_LT((ForwardKinematics(model, r.state.angles) - r.state.points).cwiseAbs().maxCoeff(), 1e-12)
+  EXPECT_LT((ForwardKinematics(model, r.state.angles) - r.state.points).cwiseAbs().maxCoeff(),
+            1e-12)
       << what;
 }
 
 // Angle (rad) between the directions of link k (1-based) in two poses.
 double LinkTurn(const Points& a, const Points& b, int k) {
-  const Eigen::VectorXd u = (a.row(k) - a.row(k - 1)).transpose(), v = (b.row(k) - b.row(k - 1)).transpose();
+  const Eigen::VectorXd u = (a.row(k) - a.row(k - 1)).transpose(),
+                        v = (b.row(k) - b.row(k - 1)).transpose();
   const double dot = u.dot(v);
-  const double cross = u.size() == 2 ? u[0] * v[1] - u[1] * v[0] : Eigen::Vector3d(u).cross(Eigen::Vector3d(v)).norm();
+  const double cross = u.size() == 2 ? u[0] * v[1] - u[1] * v[0]
+                                     : Eigen::Vector3d(u).cross(Eigen::Vector3d(v)).norm();
   return std::abs(std::atan2(cross, dot));
 }
 
@@ -97,9 +98,10 @@ TEST(ArmLimits, SaturatedLimitsStillReachEveryTarget) {
     EXPECT_GT(limited, 100) << dim;
     EXPECT_GT(joint_space, 10) << dim << ": the fallback was exercised";
     EXPECT_GT(ee_turn, 1.5 * base_turn) << dim << ": the motion dies out toward the base";
-    std::printf("dim %d, 500 steps with saturated limits: %d limited, %d solved in joint space; "
-                "end-effector link turned %.2f rad, base link %.2f rad\n",
-                dim, limited, joint_space, ee_turn, base_turn);
+    std::printf(
+        "dim %d, 500 steps with saturated limits: %d limited, %d solved in joint space; "
+        "end-effector link turned %.2f rad, base link %.2f rad\n",
+        dim, limited, joint_space, ee_turn, base_turn);
   }
 }
 
@@ -127,7 +129,8 @@ TEST(ArmLimits, FarTargetsAreReachedInOneStep) {
     const int n = c.model.num_links();
     int restarted = 0, max_restarts = 0;
     for (int trial = 0; trial < c.trials; ++trial) {
-      const Eigen::VectorXd target = ForwardKinematics(c.model, RandomAngles(c.model, c.range, &rng)).row(n).transpose();
+      const Eigen::VectorXd target =
+          ForwardKinematics(c.model, RandomAngles(c.model, c.range, &rng)).row(n).transpose();
       const ArmStepReport r = ArmStep(c.model, InitialState(c.model), target, ArmOptions());
       const std::string what = std::string(c.name) + " trial " + std::to_string(trial);
       EXPECT_TRUE(r.reached) << what << ": " << r.BriefReport();
@@ -160,7 +163,8 @@ TEST(ArmLimits, FarJumpsWithoutLimitsAreTrackedInLegs) {
           for (int k = 0; k < dim; ++k) target[k] = n * unit(rng);
         } while (target.norm() > 0.999 * n);
         const ArmStepReport r = ArmStep(model, InitialState(model), target, ArmOptions());
-        const std::string what = "dim " + std::to_string(dim) + " n " + std::to_string(n) + " trial " + std::to_string(trial);
+        const std::string what = "dim " + std::to_string(dim) + " n " + std::to_string(n) +
+                                 " trial " + std::to_string(trial);
         EXPECT_TRUE(r.reached) << what << ": " << r.BriefReport();
         ExpectInvariants(model, r, what);
         if (r.legs > 0) {
@@ -170,7 +174,8 @@ TEST(ArmLimits, FarJumpsWithoutLimitsAreTrackedInLegs) {
         joint_space += r.joint_space ? 1 : 0;
       }
       EXPECT_LE(joint_space, 5) << dim << " " << n;
-      std::printf("dim %d, %d links: 100 far jumps reached, %d through legs, %d in joint space\n", dim, n, legs, joint_space);
+      std::printf("dim %d, %d links: 100 far jumps reached, %d through legs, %d in joint space\n",
+                  dim, n, legs, joint_space);
     }
   }
 }
@@ -184,7 +189,8 @@ TEST(ArmLimits, WithoutRestartsAStallIsReportedHonestly) {
   std::mt19937 rng(7);
   int missed = 0;
   for (int trial = 0; trial < 20; ++trial) {
-    const Eigen::VectorXd target = ForwardKinematics(model, RandomAngles(model, 0.3, &rng)).row(64).transpose();
+    const Eigen::VectorXd target =
+        ForwardKinematics(model, RandomAngles(model, 0.3, &rng)).row(64).transpose();
     const ArmStepReport r = ArmStep(model, InitialState(model), target, options);
     ExpectInvariants(model, r, "trial " + std::to_string(trial));
     EXPECT_EQ(r.restarts, 0);

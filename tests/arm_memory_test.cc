@@ -28,7 +28,8 @@ TEST(ArmMemory, WithAndWithoutMemoryReachTheSameConfiguration) {
       const ArmStepReport cold = ArmStep(model, bare, path.row(i).transpose(), ArmOptions{});
       const ArmStepReport& warm = t.steps[i];
       ASSERT_TRUE(cold.reached && warm.reached) << i;
-      EXPECT_LT((cold.state.points - warm.state.points).cwiseAbs().maxCoeff(), 1e-9) << links << " " << i;
+      EXPECT_LT((cold.state.points - warm.state.points).cwiseAbs().maxCoeff(), 1e-9)
+          << links << " " << i;
       EXPECT_LT((cold.state.angles.angle - warm.state.angles.angle).cwiseAbs().maxCoeff(), 1e-9);
     }
   }
@@ -37,8 +38,7 @@ TEST(ArmMemory, WithAndWithoutMemoryReachTheSameConfiguration) {
 TEST(ArmMemory, StaleOrWrongMemoryStillConverges) {
   const ArmModel model = ArcArm(2, 32, 0.05);
   const ArmState start = InitialState(model);
-  const Eigen::VectorXd target =
-      start.points.row(32).transpose() + Eigen::Vector2d(-0.3, 0.4);
+  const Eigen::VectorXd target = start.points.row(32).transpose() + Eigen::Vector2d(-0.3, 0.4);
   const ArmStepReport fresh = ArmStep(model, start, target, ArmOptions{});
   ASSERT_TRUE(fresh.reached);
   for (const Eigen::Vector2d& remembered :

@@ -129,8 +129,10 @@ TEST(ArmStep, NewtonNeedsAFewIterationsWhereTheFixedPointNeedsMany) {
   EXPECT_LE(a.max_iterations, 10);
   EXPECT_LE(a.total_passes, 10 * 40);  // passes over the links: the cost
   EXPECT_GT(b.total_passes, 5 * a.total_passes) << a.total_passes << " " << b.total_passes;
-  std::printf("128 links, 40 steps near the edge: newton %lld passes (max %d iterations a step), "
-              "fixed point %lld passes\n", a.total_passes, a.max_iterations, b.total_passes);
+  std::printf(
+      "128 links, 40 steps near the edge: newton %lld passes (max %d iterations a step), "
+      "fixed point %lld passes\n",
+      a.total_passes, a.max_iterations, b.total_passes);
   for (const ArmStepReport& r : b.steps) EXPECT_LE(r.ee_error, 2.1e-10);
 }
 
@@ -257,7 +259,8 @@ TEST(ArmStep, BadInputIsRefusedWithTheField) {
   const Eigen::Vector2d target(3.0, 1.0);
   ArmModel bad = model;
   bad.link_lengths[2] = 0.0;
-  EXPECT_NE(ErrorOf([&] { ArmStep(bad, start, target, {}); }).find("link_lengths[2]"), std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ArmStep(bad, start, target, {}); }).find("link_lengths[2]"),
+            std::string::npos);
   bad = model;
   bad.dim = 4;
   EXPECT_NE(ErrorOf([&] { InitialState(bad); }).find("dim"), std::string::npos);
@@ -270,10 +273,12 @@ TEST(ArmStep, BadInputIsRefusedWithTheField) {
   EXPECT_NE(ErrorOf([&] { InitialState(bad); }).find("initial.angle[0]"), std::string::npos);
   bad.joint_max[1] = 0.0;
   EXPECT_NE(ErrorOf([&] { InitialState(bad); }).find("joint_min[1]"), std::string::npos);
-  EXPECT_NE(ErrorOf([&] { ArmStep(model, start, Eigen::Vector2d(1.0, NAN), {}); }).find("target[1]"),
-            std::string::npos);
-  EXPECT_NE(ErrorOf([&] { ArmStep(model, start, Eigen::Vector3d(1.0, 0.0, 0.0), {}); }).find("target"),
-            std::string::npos);
+  EXPECT_NE(
+      ErrorOf([&] { ArmStep(model, start, Eigen::Vector2d(1.0, NAN), {}); }).find("target[1]"),
+      std::string::npos);
+  EXPECT_NE(
+      ErrorOf([&] { ArmStep(model, start, Eigen::Vector3d(1.0, 0.0, 0.0), {}); }).find("target"),
+      std::string::npos);
   ArmOptions options;
   options.tolerance = 0.0;
   EXPECT_NE(ErrorOf([&] { ArmStep(model, start, target, options); }).find("options.tolerance"),
@@ -290,7 +295,6 @@ TEST(ArmStep, BadInputIsRefusedWithTheField) {
 
 namespace flexkin {
 namespace {
-
 
 TEST(ArmRevolute, ForwardOfInverseReproducesPoints) {
   ArmModel model = RevoluteSnake(64);
@@ -320,7 +324,8 @@ Points ReachablePath(const ArmModel& model, int steps, double amplitude) {
     JointAngles a = model.initial;
     const double t = 2.0 * kPi * (i + 1) / steps;
     for (int j = 0; j < n; ++j) a.angle[j] += amplitude * std::sin(t + 0.4 * j) * (j + 1) / n;
-    for (int j = 0; j < n; ++j) a.angle[j] = std::clamp(a.angle[j], model.joint_min[j], model.joint_max[j]);
+    for (int j = 0; j < n; ++j)
+      a.angle[j] = std::clamp(a.angle[j], model.joint_min[j], model.joint_max[j]);
     path.row(i) = ForwardKinematics(model, a).row(n);
   }
   return path;
@@ -340,7 +345,9 @@ Eigen::VectorXd CheckEveryStepReached(const ArmModel& model, const ArmTrajectory
     EXPECT_EQ((step.state.points.row(0).transpose() - model.base).norm(), 0.0);
     EXPECT_TRUE(WithinLimits(model, step.state.angles, 1e-12));
     EXPECT_LT(MaxLengthError(model, step.state.points), 1e-13);
-    EXPECT_LT((ForwardKinematics(model, step.state.angles) - step.state.points).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_LT(
+        (ForwardKinematics(model, step.state.angles) - step.state.points).cwiseAbs().maxCoeff(),
+        1e-12);
     motion += (step.state.angles.angle - previous.angle).cwiseAbs();
     previous = step.state.angles;
   }
@@ -359,10 +366,11 @@ TEST(ArmRevolute, TracksAReachablePathWithTheBaseFixedAndLimitsKept) {
   const Eigen::VectorXd motion = CheckEveryStepReached(model, t);
   EXPECT_LE(t.max_iterations, 8) << t.BriefReport();
   EXPECT_LE(t.total_passes, 8 * 60) << t.BriefReport();
-  EXPECT_GT(motion[n - 1], motion[0]);      // dies out toward the base
+  EXPECT_GT(motion[n - 1], motion[0]);  // dies out toward the base
   EXPECT_GT(motion[n - 1], motion[n / 2]);
-  std::printf("revolute snake, 16 links: %s, %lld passes; joint motion ee %.3f middle %.3f base %.3f\n",
-              t.BriefReport().c_str(), t.total_passes, motion[n - 1], motion[n / 2], motion[0]);
+  std::printf(
+      "revolute snake, 16 links: %s, %lld passes; joint motion ee %.3f middle %.3f base %.3f\n",
+      t.BriefReport().c_str(), t.total_passes, motion[n - 1], motion[n / 2], motion[0]);
 }
 
 // Tight limits (+-0.25 rad) and targets from angles pushed against them: the active set holds
@@ -378,8 +386,10 @@ TEST(ArmRevolute, ReachesTargetsWithJointsAtTheirLimits) {
   for (const ArmStepReport& step : t.steps) limited += step.limited ? 1 : 0;
   EXPECT_GT(limited, 0);
   EXPECT_GT(motion[n - 1], motion[0]);
-  std::printf("revolute snake at +-0.25 rad limits: %s, %d steps limited; joint motion ee %.3f middle %.3f base %.3f\n",
-              t.BriefReport().c_str(), limited, motion[n - 1], motion[n / 2], motion[0]);
+  std::printf(
+      "revolute snake at +-0.25 rad limits: %s, %d steps limited; joint motion ee %.3f middle %.3f "
+      "base %.3f\n",
+      t.BriefReport().c_str(), limited, motion[n - 1], motion[n / 2], motion[0]);
 }
 
 // Single steps from the initial pose to far targets (100 end effectors of random angles within
@@ -400,7 +410,8 @@ TEST(ArmRevolute, ReachesFarTargetsInOneStep) {
     const ArmStepReport r = ArmStep(model, InitialState(model), target, ArmOptions());
     EXPECT_TRUE(r.reached) << trial << ": " << r.BriefReport();
     EXPECT_TRUE(WithinLimits(model, r.state.angles, 1e-12));
-    EXPECT_LT((ForwardKinematics(model, r.state.angles) - r.state.points).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_LT((ForwardKinematics(model, r.state.angles) - r.state.points).cwiseAbs().maxCoeff(),
+              1e-12);
     max_iterations = std::max(max_iterations, r.iterations);
   }
   std::printf("revolute snake, 100 far targets in one step: max %d iterations\n", max_iterations);
@@ -408,11 +419,13 @@ TEST(ArmRevolute, ReachesFarTargetsInOneStep) {
 
 TEST(ArmRevolute, UnreachableTargetIsReportedWithoutNaN) {
   const ArmModel model = RevoluteSnake(8);
-  const ArmStepReport far = ArmStep(model, InitialState(model), Eigen::Vector3d(20.0, 0.0, 0.0), ArmOptions());
+  const ArmStepReport far =
+      ArmStep(model, InitialState(model), Eigen::Vector3d(20.0, 0.0, 0.0), ArmOptions());
   EXPECT_FALSE(far.reached);
   EXPECT_TRUE(far.state.points.allFinite());
   // Behind the base, beyond what +-0.6 rad joints can fold to.
-  const ArmStepReport back = ArmStep(model, InitialState(model), Eigen::Vector3d(-1.0, 0.0, 0.0), ArmOptions());
+  const ArmStepReport back =
+      ArmStep(model, InitialState(model), Eigen::Vector3d(-1.0, 0.0, 0.0), ArmOptions());
   EXPECT_FALSE(back.reached);
   EXPECT_TRUE(back.state.points.allFinite());
   EXPECT_TRUE(WithinLimits(model, back.state.angles, 1e-12));

@@ -85,7 +85,8 @@ TEST(BandedLuTest, SolvesAsLapackAndDenseLuDo) {
       const Eigen::VectorXd eigen = dense.partialPivLu().solve(rhs);
       EXPECT_LE((x - reference).norm(), 1e-13 * (1.0 + reference.norm()))
           << "size " << size << " band " << b;
-      EXPECT_LE((x - eigen).norm(), 1e-9 * (1.0 + eigen.norm())) << "size " << size << " band " << b;
+      EXPECT_LE((x - eigen).norm(), 1e-9 * (1.0 + eigen.norm()))
+          << "size " << size << " band " << b;
       EXPECT_LE((a.Multiply(x) - rhs).norm(), 1e-12 * (1.0 + rhs.norm()));
       EXPECT_LE((dense * x - rhs).norm(), 1e-12 * (1.0 + rhs.norm()));
     }
@@ -110,7 +111,8 @@ TEST(BandedLuTest, LdltNegativePivotsCountNegativeEigenvalues) {
     BandMatrix a(size, b);
     Eigen::MatrixXd dense;
     RandomBanded(size, b, true, &rng, &a, &dense);
-    const Eigen::VectorXd eigenvalues = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(dense).eigenvalues();
+    const Eigen::VectorXd eigenvalues =
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(dense).eigenvalues();
     BandedLdlt ldlt(a);
     if (!ldlt.Factorize(a, 1e-12)) continue;  // a tiny pivot: undecided, allowed
     const int negative = ldlt.negative();

@@ -1,17 +1,17 @@
 // Tests of the generated initial curves: every link has exactly the requested chord length, the
 // points lie on the intended shape, and bad parameters are refused with the field named.
 #include "flexkin/curves.h"
-#include "test_util.h"
 
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
 #include <cmath>
 #include <string>
 #include <tuple>
 
-#include <gtest/gtest.h>
-#include <Eigen/Geometry>
-
 #include "flexkin/chain.h"
 #include "flexkin/error.h"
+#include "test_util.h"
 
 namespace flexkin {
 namespace {

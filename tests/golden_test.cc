@@ -20,7 +20,6 @@
 // which is to be run only when a result is meant to change, and the change explained in the
 // commit that updates the files.
 #include <gtest/gtest.h>
-
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -31,11 +30,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "test_util.h"
 
@@ -49,8 +47,8 @@ const std::string kCli = FLEXKIN_CLI;
 const fs::path kSource = FLEXKIN_SOURCE_DIR;
 
 // Keys whose values are wall-clock times: they differ from run to run and are not compared.
-const std::set<std::string> kTimingKeys = {"seconds", "solve_seconds", "wall_seconds",
-                                           "microseconds", "time_us", "timing"};
+const std::set<std::string> kTimingKeys = {"seconds",      "solve_seconds", "wall_seconds",
+                                           "microseconds", "time_us",       "timing"};
 
 bool Updating() {
   const char* update = std::getenv("FLEXKIN_GOLDEN_UPDATE");
@@ -209,18 +207,18 @@ bool HasAvx2Fma() {
 // returns its result without the timings.
 json RunExample(const std::string& name, bool scalar) {
   const bool robot = IsRobot(name);
-  const fs::path dir = fs::temp_directory_path() /
-                       ("flexkin_golden_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("flexkin_golden_" + name + "_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const fs::path out = dir / "result.json";
   // The engine is chosen once per process from the environment (src/sequential/propagate.cc).
-  const std::string cli = std::string(scalar ? "FLEXKIN_SIMD=scalar " : "env -u FLEXKIN_SIMD ") +
-                          "'" + kCli + "'";
+  const std::string cli =
+      std::string(scalar ? "FLEXKIN_SIMD=scalar " : "env -u FLEXKIN_SIMD ") + "'" + kCli + "'";
   const std::string args = std::string(robot ? "robot '" : "run '") +
                            (kSource / "examples" / (name + ".json")).string() + "' -o '" +
                            out.string() + "' --quiet";
-  const std::string command = "cd '" + dir.string() + "' && " + cli + " " + args +
-                              " > stdout.txt 2> stderr.txt";
+  const std::string command =
+      "cd '" + dir.string() + "' && " + cli + " " + args + " > stdout.txt 2> stderr.txt";
   const int status = std::system(command.c_str());
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128;
   const std::string err = test_util::ReadFile((dir / "stderr.txt").string());
@@ -260,7 +258,8 @@ TEST_P(GoldenTest, ScalarEngineGivesThePinnedResultBitForBit) {
   for (const std::string& d : diffs) all += "\n  " + d;
   EXPECT_TRUE(diffs.empty()) << name << " (sampled values, bit for bit):" << all;
   EXPECT_EQ(hash, golden["fnv1a64"].get<std::string>())
-      << name << ": the result differs from the pinned one" << (diffs.empty() ? " outside the sample" : "");
+      << name << ": the result differs from the pinned one"
+      << (diffs.empty() ? " outside the sample" : "");
 }
 
 TEST_P(GoldenTest, SimdEnginesAgreeWithTheScalarEngineTo1e14) {

@@ -2,15 +2,15 @@
 // path has no step longer than max_step, visits every vertex exactly, and takes the fewest steps
 // that allow that.
 #include "flexkin/leader.h"
-#include "test_util.h"
+
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 #include <string>
 
-#include <gtest/gtest.h>
-
 #include "flexkin/error.h"
+#include "test_util.h"
 
 namespace flexkin {
 namespace {

@@ -2,7 +2,6 @@
 // against an independent ODE solution (Boost.Odeint), its fast form against its reference form,
 // edge cases and invariants; the follow-the-leader step's invariants; input checking.
 #include "flexkin/link_step.h"
-#include "test_util.h"
 
 #include <gtest/gtest.h>
 
@@ -16,8 +15,9 @@
 #include <type_traits>
 
 #include "flexkin/error.h"
-#include "sequential/link_rules.h"
 #include "reference_ode.h"
+#include "sequential/link_rules.h"
+#include "test_util.h"
 
 namespace flexkin {
 namespace {

@@ -103,7 +103,8 @@ Points SolveAndCheck(const ObjectiveWeights& w, const Eigen::VectorXd& lengths,
     for (int trial = 0; trial < 60; ++trial) {
       Points y = x;
       for (int j = 1; j <= n; ++j) {
-        for (Eigen::Index k = 0; k < x.cols(); ++k) y(j, k) += scale * lengths.minCoeff() * normal(*rng);
+        for (Eigen::Index k = 0; k < x.cols(); ++k)
+          y(j, k) += scale * lengths.minCoeff() * normal(*rng);
       }
       if (!Project(lengths, &y)) continue;
       worst_gain = std::fmax(worst_gain, best - Metric(w, lengths, old_points, y));
@@ -123,8 +124,8 @@ TEST(OverallL2Test, GradientAndHessianMatchFiniteDifferencesAwayFromTheKink) {
     for (Eigen::Index j = 0; j < x.rows(); ++j) {
       for (int k = 0; k < dim; ++k) x(j, k) += 0.1 * uniform(rng);
     }
-    for (const ObjectiveWeights& w : {L2Weights(1, 0, 0, 0), L2Weights(0, 1, 0, 0),
-                                      L2Weights(0.5, 2, 1, 0.3)}) {
+    for (const ObjectiveWeights& w :
+         {L2Weights(1, 0, 0, 0), L2Weights(0, 1, 0, 0), L2Weights(0.5, 2, 1, 0.3)}) {
       Eigen::VectorXd g;
       Eigen::MatrixXd h;
       const double f = OverallObjective(w, lengths, old_points, x, &g, &h);
@@ -245,14 +246,15 @@ TEST(OverallL2Test, StillPointsHoldThePullOfTheirFrictionAndNoMore) {
     bool point2_still;
   };
   std::mt19937 rng(8);
-  for (const Case c : {Case{1, 35.0, false}, Case{1, 55.0, true}, Case{3, 14.0, false},
-                       Case{3, 23.0, true}}) {
+  for (const Case c :
+       {Case{1, 35.0, false}, Case{1, 55.0, true}, Case{3, 14.0, false}, Case{3, 23.0, true}}) {
     const double phi = c.phi_degrees * M_PI / 180.0;
     const int n = 1 + c.tail_links;
     Points p(n + 1, 2);
     p.row(0) << 0.0, 0.0;
     p.row(1) << 1.0, 0.0;
-    for (int i = 2; i <= n; ++i) p.row(i) = p.row(i - 1) + Eigen::RowVector2d(std::cos(phi), std::sin(phi));
+    for (int i = 2; i <= n; ++i)
+      p.row(i) = p.row(i - 1) + Eigen::RowVector2d(std::cos(phi), std::sin(phi));
     const Eigen::VectorXd lengths = LengthsOf(p);
     const Eigen::Vector2d head(-1e-3, 0.0);
     OverallReport report;
@@ -295,8 +297,8 @@ TEST(OverallL2Test, RejectsTheCombinationWithTheJointAngleTerm) {
   ExpectInputError([&] { OverallStep(Eigen::Vector2d(1.1, 0.1), options, &x); },
                    "weights.joint_angle", "cannot be combined with the L2 metric");
   options.weights = L2Weights(-1, 0, 0, 0);
-  ExpectInputError([&] { OverallStep(Eigen::Vector2d(1.1, 0.1), options, &x); },
-                   "weights.l2", "must be a finite number >= 0");
+  ExpectInputError([&] { OverallStep(Eigen::Vector2d(1.1, 0.1), options, &x); }, "weights.l2",
+                   "must be a finite number >= 0");
 }
 
 }  // namespace

@@ -3,7 +3,6 @@
 // dying out, alignment with a long pull) and convergence of the multi-step methods to the
 // continuous motion computed by an independent ODE solver (reference_ode.h).
 #include "flexkin/propagate.h"
-#include "test_util.h"
 
 #include <gtest/gtest.h>
 
@@ -21,14 +20,15 @@
 #include "flexkin/link_step.h"
 #include "reference_ode.h"
 #include "scenes/scenes.h"
+#include "test_util.h"
 
 namespace flexkin {
 namespace {
 
-using test_util::Str;
-using test_util::ExpectInputError;
 using scenes::CurvedChain;
 using scenes::CurvedPoints;
+using test_util::ExpectInputError;
+using test_util::Str;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 

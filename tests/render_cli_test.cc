@@ -15,10 +15,10 @@ namespace flexkin {
 namespace {
 
 using render_test::Exists;
+using render_test::WriteFile;
 using test_util::CliResult;
 using test_util::ReadFile;
 using test_util::RunCli;
-using render_test::WriteFile;
 
 const std::string kCli = FLEXKIN_CLI;
 

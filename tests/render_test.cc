@@ -361,7 +361,8 @@ TEST(PlotTest, LengthErrorHasOneMarkerPerFrameOnALogScale) {
 }
 
 TEST(PlotTest, NamesRoundTrip) {
-  for (const auto& [kind, name, summary] : Vocabulary<PlotKind>::kEntries) EXPECT_EQ(ParsePlotKind(PlotKindName(kind)), kind);
+  for (const auto& [kind, name, summary] : Vocabulary<PlotKind>::kEntries)
+    EXPECT_EQ(ParsePlotKind(PlotKindName(kind)), kind);
   test_util::ExpectInputError([] { ParsePlotKind("speed", "--plot"); }, "--plot", "path_length");
 }
 

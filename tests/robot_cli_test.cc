@@ -31,7 +31,9 @@ class RobotCliTest : public testing::Test {
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
   std::string Path(const std::string& name) const { return dir_ + "/" + name; }
-  void Write(const std::string& name, const std::string& text) const { std::ofstream(Path(name)) << text; }
+  void Write(const std::string& name, const std::string& text) const {
+    std::ofstream(Path(name)) << text;
+  }
 
   // Runs `flexkin robot ARGS`; returns the exit code, stderr in *err.
   int Robot(const std::string& args, std::string* err = nullptr) const {
@@ -48,7 +50,8 @@ class RobotCliTest : public testing::Test {
 // the limits (0.25 rad), which the path saturates. Every step is reached, most of them through
 // the joint-space step (measured: 81 of 120); the bends stay within the cone.
 TEST_F(RobotCliTest, SaturatedLimitsExampleReachesEveryTarget) {
-  const std::string scenario = std::string(FLEXKIN_SOURCE_DIR) + "/examples/robot_spatial_limits.json";
+  const std::string scenario =
+      std::string(FLEXKIN_SOURCE_DIR) + "/examples/robot_spatial_limits.json";
   ASSERT_EQ(Robot("'" + scenario + "' -o " + Path("t.json")), 0);
   const json t = json::parse(ReadFile(Path("t.json")));
   ASSERT_EQ(t["steps"].size(), 120u);
@@ -66,7 +69,8 @@ TEST_F(RobotCliTest, SaturatedLimitsExampleReachesEveryTarget) {
 }
 
 TEST_F(RobotCliTest, ExampleScenarioGivesATrajectoryAndAJointCsv) {
-  const std::string scenario = std::string(FLEXKIN_SOURCE_DIR) + "/examples/robot_planar_8link.json";
+  const std::string scenario =
+      std::string(FLEXKIN_SOURCE_DIR) + "/examples/robot_planar_8link.json";
   ASSERT_EQ(Robot("'" + scenario + "' -o " + Path("t.json") + " --csv " + Path("j.csv")), 0);
   const json t = json::parse(ReadFile(Path("t.json")));
   EXPECT_EQ(t["format"], "flexkin-robot-trajectory");
@@ -149,13 +153,17 @@ TEST_F(RobotCliTest, BadScenariosNameTheFieldAndWriteNothing) {
   for (const auto& [text, expected] : cases) {
     Write("bad.json", text);
     std::string err;
-    EXPECT_EQ(Robot(Path("bad.json") + " -o " + Path("t.json") + " --csv " + Path("j.csv"), &err), 1) << text;
+    EXPECT_EQ(Robot(Path("bad.json") + " -o " + Path("t.json") + " --csv " + Path("j.csv"), &err),
+              1)
+        << text;
     EXPECT_NE(err.find(expected), std::string::npos) << err;
     EXPECT_FALSE(std::filesystem::exists(Path("t.json")));
     EXPECT_FALSE(std::filesystem::exists(Path("j.csv")));
   }
   // A missing output directory is found before anything is written.
-  Write("ok.json", R"({"arm": {"links": 2, "link_length": 1}, "path": {"type": "line", "to": [1, 1], "steps": 2}})");
+  Write(
+      "ok.json",
+      R"({"arm": {"links": 2, "link_length": 1}, "path": {"type": "line", "to": [1, 1], "steps": 2}})");
   EXPECT_EQ(Robot(Path("ok.json") + " -o " + Path("t.json") + " --csv " + Path("no/j.csv")), 4);
   EXPECT_FALSE(std::filesystem::exists(Path("t.json")));
 }
@@ -166,7 +174,9 @@ namespace {
 
 // A scenario that points at a URDF next to it (a relative path): a 3-link planar arm.
 TEST_F(RobotCliTest, ScenarioWithAUrdfArm) {
-  Write("arm.urdf", R"(<robot name="three"><link name="b"/><link name="l1"/><link name="l2"/><link name="l3"/><link name="t"/>
+  Write(
+      "arm.urdf",
+      R"(<robot name="three"><link name="b"/><link name="l1"/><link name="l2"/><link name="l3"/><link name="t"/>
     <joint name="j0" type="continuous"><parent link="b"/><child link="l1"/><axis xyz="0 0 1"/></joint>
     <joint name="j1" type="continuous"><parent link="l1"/><child link="l2"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/></joint>
     <joint name="j2" type="continuous"><parent link="l2"/><child link="l3"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/></joint>
@@ -183,7 +193,9 @@ TEST_F(RobotCliTest, ScenarioWithAUrdfArm) {
   EXPECT_NEAR(ee[1].get<double>(), 1.0, 1e-9);
   // A missing tip link and a missing file: named, nothing written.
   std::filesystem::remove(Path("t.json"));
-  Write("bad.json", R"({"urdf": "arm.urdf", "tip_link": "hand", "path": {"type": "points", "points": [[2, 1]]}})");
+  Write(
+      "bad.json",
+      R"({"urdf": "arm.urdf", "tip_link": "hand", "path": {"type": "points", "points": [[2, 1]]}})");
   std::string err;
   EXPECT_EQ(Robot(Path("bad.json") + " -o " + Path("t.json"), &err), 1);
   EXPECT_NE(err.find("/tip_link"), std::string::npos) << err;

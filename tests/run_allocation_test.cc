@@ -37,9 +37,8 @@ class CountingSink : public FrameSink {
 // (1, 1) / sqrt 2, with `substeps` sub-steps each, recording only the first and last frames.
 long AllocationsOfRun(Method method, int steps, int substeps) {
   const Chain chain = scenes::PaperParabola();
-  const Points targets = scenes::StraightPull(chain.points.row(0).transpose(),
-                                              Eigen::Vector2d(1.0, 1.0).normalized(), 0.05 * steps,
-                                              steps);
+  const Points targets = scenes::StraightPull(
+      chain.points.row(0).transpose(), Eigen::Vector2d(1.0, 1.0).normalized(), 0.05 * steps, steps);
   RunOptions options;
   options.method = method;
   options.substeps = substeps;

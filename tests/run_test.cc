@@ -2,7 +2,6 @@
 // independent computation from the frames, and the accuracy control against the continuous
 // motion computed by an independent ODE solver (reference_ode.h).
 #include "flexkin/run.h"
-#include "test_util.h"
 
 #include <gtest/gtest.h>
 
@@ -19,13 +18,14 @@
 #include "flexkin/propagate.h"
 #include "reference_ode.h"
 #include "scenes/scenes.h"
+#include "test_util.h"
 
 namespace flexkin {
 namespace {
 
 using scenes::CurvedChain;
-using test_util::Str;
 using test_util::ExpectInputError;
+using test_util::Str;
 
 // `count` leader targets along a smooth curve starting at the chain's leading end, about
 // `step` apart.

@@ -3,16 +3,16 @@
 // document gives an InputError whose field is the JSON pointer of the problem.
 #include "flexkin/scenario.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <string>
 #include <system_error>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include "flexkin/error.h"
 #include "flexkin/run.h"

@@ -4,10 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <string>
-
-#include <Eigen/Geometry>
 
 #include "flexkin/error.h"
 
@@ -20,7 +19,8 @@ constexpr double kPi = 3.14159265358979323846;
 ArmModel Snake(int links) {
   ArmModel m = StraightArm(3, links, 0.1);
   m.joint_axes.resize(links, 3);
-  for (int j = 0; j < links; ++j) m.joint_axes.row(j) = j % 2 == 0 ? Eigen::RowVector3d::UnitY() : Eigen::RowVector3d::UnitZ();
+  for (int j = 0; j < links; ++j)
+    m.joint_axes.row(j) = j % 2 == 0 ? Eigen::RowVector3d::UnitY() : Eigen::RowVector3d::UnitZ();
   m.joint_min = Eigen::VectorXd::Constant(links, -1.0);
   m.joint_max = Eigen::VectorXd::Constant(links, 1.0);
   m.initial.azimuth.resize(0);  // revolute joints have none
@@ -134,23 +134,33 @@ std::string Replace(std::string s, const std::string& from, const std::string& t
 
 TEST(Urdf, BadUrdfsNameTheElement) {
   const std::string good = kPlanarUrdf;
-  EXPECT_NE(InputErrorOf(Replace(good, "\"continuous\">", "\"prismatic\"><limit lower=\"0\" upper=\"1\" effort=\"1\" velocity=\"1\"/>")).find("joint \"wrist\""), std::string::npos);
+  EXPECT_NE(
+      InputErrorOf(
+          Replace(good, "\"continuous\">",
+                  "\"prismatic\"><limit lower=\"0\" upper=\"1\" effort=\"1\" velocity=\"1\"/>"))
+          .find("joint \"wrist\""),
+      std::string::npos);
   EXPECT_NE(InputErrorOf(Replace(good, "<origin xyz=\"0.2 0 0\"/>", "<origin xyz=\"0 0 0\"/>"))
-                .find("zero-length"), std::string::npos);
-  EXPECT_NE(InputErrorOf(good, {"", "elbowx"}).find("\"elbowx\" is not in the URDF"), std::string::npos);
+                .find("zero-length"),
+            std::string::npos);
+  EXPECT_NE(InputErrorOf(good, {"", "elbowx"}).find("\"elbowx\" is not in the URDF"),
+            std::string::npos);
   EXPECT_NE(InputErrorOf(good, {"nowhere", ""}).find("base_link"), std::string::npos);
   EXPECT_NE(InputErrorOf(good, {"hand", "upper"}).find("tip_link"), std::string::npos);
-  EXPECT_NE(InputErrorOf("<robot name=\"x\"><link name=\"a\"></robot>").find("not a valid URDF"), std::string::npos);
+  EXPECT_NE(InputErrorOf("<robot name=\"x\"><link name=\"a\"></robot>").find("not a valid URDF"),
+            std::string::npos);
   EXPECT_NE(InputErrorOf("not xml at all").find("urdf"), std::string::npos);
   // A branch: a second child under "fore".
   const std::string branch = Replace(good, "</robot>",
-      "<link name=\"thumb\"/><joint name=\"t\" type=\"fixed\"><parent link=\"fore\"/><child link=\"thumb\"/>"
-      "<origin xyz=\"0 0.1 0\"/></joint></robot>");
+                                     "<link name=\"thumb\"/><joint name=\"t\" "
+                                     "type=\"fixed\"><parent link=\"fore\"/><child link=\"thumb\"/>"
+                                     "<origin xyz=\"0 0.1 0\"/></joint></robot>");
   EXPECT_NE(InputErrorOf(branch).find("link \"fore\""), std::string::npos);
   EXPECT_NO_THROW(ArmFromUrdf(branch, {"", "tool"}));
   // A twist joint: the axis along the link it turns.
   EXPECT_NE(InputErrorOf(Replace(good, "<origin xyz=\"0.2 0 0\"/><axis xyz=\"0 0 1\"/>",
-                                 "<origin xyz=\"0.2 0 0\"/><axis xyz=\"1 0 0\"/>")).find("joint \"wrist\""),
+                                 "<origin xyz=\"0.2 0 0\"/><axis xyz=\"1 0 0\"/>"))
+                .find("joint \"wrist\""),
             std::string::npos);
   EXPECT_THROW(ArmFromUrdfFile("/nonexistent/arm.urdf"), std::system_error);
   // Spherical arms have no URDF form.

@@ -4,7 +4,6 @@
 // 2D run and the two large runs it must play smoothly: 20 links in 3D over 2650 steps and 80
 // links in 2D over 250 steps.
 #include "viewer/viewer.h"
-#include "test_util.h"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -15,16 +14,16 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
-
-#include <nlohmann/json.hpp>
 
 #include "flexkin/chain.h"
 #include "flexkin/error.h"
 #include "flexkin/result_io.h"
 #include "flexkin/run.h"
 #include "scenes/scenes.h"
+#include "test_util.h"
 
 namespace flexkin {
 namespace {
@@ -121,7 +120,8 @@ TEST_F(ViewerTest, PageIsSelfContainedAndCarriesTheResult) {
   ASSERT_EQ(data["frame_length_error"].size(), r.frames.size());
   for (size_t f = 0; f < r.frames.size(); ++f) {
     EXPECT_EQ(data["steps"][f], r.frames[f].step);
-    EXPECT_LE(data["frame_length_error"][f].get<double>(), r.metrics.max_relative_length_error * 1.01);
+    EXPECT_LE(data["frame_length_error"][f].get<double>(),
+              r.metrics.max_relative_length_error * 1.01);
     for (int i = 0; i < 13 * 2; ++i) {
       const double want = r.frames[f].points.data()[i];
       EXPECT_NEAR(data["positions"][f * 26 + i].get<double>(), want, 1e-8 * (1 + std::abs(want)));
@@ -164,8 +164,7 @@ TEST_F(ViewerTest, BadResultIsRefusedAndExistingFileLeftUntouched) {
     ResultFile file = good;
     change(file);
     ExpectInputError([&] { WriteViewerHtml(file, ViewerOptions(), Path("new.html")); }, field);
-    ExpectInputError([&] { WriteViewerHtml(file, ViewerOptions(), Path("existing.html")); },
-                     field);
+    ExpectInputError([&] { WriteViewerHtml(file, ViewerOptions(), Path("existing.html")); }, field);
     EXPECT_FALSE(fs::exists(Path("new.html"))) << field;
     EXPECT_EQ(ReadFile(Path("existing.html")), "the old page") << field;
   };
@@ -198,8 +197,8 @@ TEST_F(ViewerTest, PlaysScrubsAndMovesInHeadlessChromium) {
   // What the browser check needs; all of it is installed by scripts/install-deps.sh.
   const std::string source = FLEXKIN_SOURCE_DIR;
   const std::string tools = source + "/tools/node";
-  const std::string chromium = std::getenv("FLEXKIN_CHROMIUM") ? std::getenv("FLEXKIN_CHROMIUM")
-                                                                : "/usr/bin/chromium";
+  const std::string chromium =
+      std::getenv("FLEXKIN_CHROMIUM") ? std::getenv("FLEXKIN_CHROMIUM") : "/usr/bin/chromium";
   std::string ignored;
   ASSERT_EQ(RunCommand("node --version", &ignored), 0)
       << "node is missing: run scripts/install-deps.sh";
@@ -224,14 +223,14 @@ TEST_F(ViewerTest, PlaysScrubsAndMovesInHeadlessChromium) {
   std::string output;
   const int status =
       RunCommand("node '" + source + "/tests/viewer/browser_check.mjs' '" + tools + "' '" + dir_ +
-                     "' '" + Path("small_2d.html") + "' '" + Path("spatial_20x2650.html") +
-                     "' '" + Path("planar_80x250.html") + "'",
+                     "' '" + Path("small_2d.html") + "' '" + Path("spatial_20x2650.html") + "' '" +
+                     Path("planar_80x250.html") + "'",
                  &output);
   std::printf("%s", output.c_str());
   EXPECT_EQ(status, 0) << output;
   EXPECT_NE(output.find("all viewer checks passed"), std::string::npos);
-  for (const char* shot : {"small_2d-playing.png", "spatial_20x2650-trails.png",
-                           "planar_80x250-dragged.png"}) {
+  for (const char* shot :
+       {"small_2d-playing.png", "spatial_20x2650-trails.png", "planar_80x250-dragged.png"}) {
     EXPECT_TRUE(fs::exists(Path(shot))) << shot;
   }
 }

@@ -3,15 +3,13 @@
 // the output of `flexkin vocabulary` (printed from the tables), the schemas' enums and objective
 // keys are the tables' names, and the command line's help lists every method and format.
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "flexkin/arm.h"
 #include "flexkin/overall.h"
@@ -59,9 +57,12 @@ TEST_F(VocabularyDocsTest, DocsVocabularyPageIsTheLibrarysTables) {
   const test_util::CliResult r = test_util::RunCli(kCli, dir_.string(), "vocabulary");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // Every name of every table is in the output.
-  for (const std::string& name : NamesOf<Method>()) EXPECT_NE(r.out.find("`" + name + "`"), std::string::npos) << name;
-  for (const std::string& name : NamesOf<ObjectiveTerm>()) EXPECT_NE(r.out.find("`" + name + "`"), std::string::npos) << name;
-  for (const std::string& name : NamesOf<OutputFormat>()) EXPECT_NE(r.out.find("`" + name + "`"), std::string::npos) << name;
+  for (const std::string& name : NamesOf<Method>())
+    EXPECT_NE(r.out.find("`" + name + "`"), std::string::npos) << name;
+  for (const std::string& name : NamesOf<ObjectiveTerm>())
+    EXPECT_NE(r.out.find("`" + name + "`"), std::string::npos) << name;
+  for (const std::string& name : NamesOf<OutputFormat>())
+    EXPECT_NE(r.out.find("`" + name + "`"), std::string::npos) << name;
   EXPECT_EQ(r.out, test_util::ReadFile((kSource / "docs" / "vocabulary.md").string()))
       << "docs/vocabulary.md is not the output of `flexkin vocabulary`; regenerate it with "
          "build/apps/flexkin vocabulary > docs/vocabulary.md";
@@ -79,9 +80,9 @@ TEST(VocabularySchemaTest, SchemasNameWhatTheLibraryNames) {
   EXPECT_EQ(Sorted(Keys(result["properties"]["overall"]["properties"]["objective"]["properties"])),
             Sorted(NamesOf<ObjectiveTerm>()));
   const json robot = Schema("robot.schema.json");
-  EXPECT_EQ(robot["properties"]["solver"]["properties"]["method"]["enum"]
-                .get<std::vector<std::string>>(),
-            NamesOf<FixedBaseMethod>());
+  EXPECT_EQ(
+      robot["properties"]["solver"]["properties"]["method"]["enum"].get<std::vector<std::string>>(),
+      NamesOf<FixedBaseMethod>());
 }
 
 TEST_F(VocabularyDocsTest, CommandLineHelpListsEveryMethodAndFormat) {
@@ -89,7 +90,8 @@ TEST_F(VocabularyDocsTest, CommandLineHelpListsEveryMethodAndFormat) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   for (const auto& entry : Vocabulary<Method>::kEntries) {
     EXPECT_NE(run.out.find(std::string(entry.name) + ": " + entry.summary), std::string::npos)
-        << entry.name << " is missing from `flexkin run --help`:\n" << run.out;
+        << entry.name << " is missing from `flexkin run --help`:\n"
+        << run.out;
   }
   const test_util::CliResult render = test_util::RunCli(kCli, dir_.string(), "render --help");
   ASSERT_EQ(render.exit_code, 0) << render.err;

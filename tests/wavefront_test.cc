@@ -81,10 +81,9 @@ TEST(WavefrontTest, EveryEngineMatchesTheOnePassLoop) {
                                        stepper.inv_lengths.data(), links, scalar.data());
                 engine.fn(method, dim, heads.data(), sweeps, stepper.lengths.data(),
                           stepper.inv_lengths.data(), links, simd.data());
-                const std::string what = std::string(engine.name) + " " + MethodName(method) +
-                                         " " + std::to_string(dim) + "D, " +
-                                         std::to_string(links) + " links, " +
-                                         std::to_string(sweeps) + " sweeps of " +
+                const std::string what = std::string(engine.name) + " " + MethodName(method) + " " +
+                                         std::to_string(dim) + "D, " + std::to_string(links) +
+                                         " links, " + std::to_string(sweeps) + " sweeps of " +
                                          std::to_string(step);
                 ASSERT_TRUE(simd.allFinite()) << what;
                 const double scale = scalar.cwiseAbs().maxCoeff() + 1.0;
@@ -126,8 +125,8 @@ TEST(WavefrontTest, StillHeadLeavesTheChainExactlyInPlace) {
     EXPECT_EQ(scalar, chain.points);
     for (const internal::WavefrontEngine& engine : internal::AvailableWavefronts()) {
       Points simd = chain.points;
-      engine.fn(method, 3, heads.data(), 32, stepper.lengths.data(), stepper.inv_lengths.data(),
-                40, simd.data());
+      engine.fn(method, 3, heads.data(), 32, stepper.lengths.data(), stepper.inv_lengths.data(), 40,
+                simd.data());
       EXPECT_EQ(simd, chain.points) << engine.name;
     }
   }

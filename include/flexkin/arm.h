@@ -8,12 +8,11 @@
 // base direction of the model. (Internally the sweep runs on flexkin's chain order, point 0 = the
 // leading end = the end effector.)
 
+#include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <Eigen/Core>
-#include <optional>
 
 #include "flexkin/chain.h"
 #include "flexkin/error.h"
@@ -58,10 +57,10 @@ struct Vocabulary<ArmJoint> {
 };
 
 struct ArmModel {
-  int dim = 2;                                // 2 (revolute) or 3 (spherical, or revolute with axes)
-  Eigen::VectorXd link_lengths;               // n >= 1 positive lengths, base link first
-  Eigen::VectorXd base;                       // dim; where the base is bolted
-  Eigen::VectorXd base_direction;             // dim, non-zero; the direction of "link 0"
+  int dim = 2;                     // 2 (revolute) or 3 (spherical, or revolute with axes)
+  Eigen::VectorXd link_lengths;    // n >= 1 positive lengths, base link first
+  Eigen::VectorXd base;            // dim; where the base is bolted
+  Eigen::VectorXd base_direction;  // dim, non-zero; the direction of "link 0"
   // Revolute limits (rad, planar or with joint_axes): joint j stays in [joint_min[j],
   // joint_max[j]], with -pi <= min <= max <= pi. Empty: no limits.
   Eigen::VectorXd joint_min, joint_max;
@@ -75,7 +74,7 @@ struct ArmModel {
   // With joint_axes: n by 3, row k the unit direction of link k+1 in its own frame (its world
   // direction when all angles are 0). Empty: every link along base_direction.
   Eigen::MatrixXd link_directions;
-  JointAngles initial;                        // the joint angles at the start; within the limits
+  JointAngles initial;  // the joint angles at the start; within the limits
 
   bool has_axes() const { return joint_axes.size() > 0; }
   ArmJoint joint() const {
@@ -191,12 +190,12 @@ struct ArmState {
 ArmState InitialState(const ArmModel& model);
 
 struct ArmStepReport {
-  ArmState state;          // after the step; the base exactly at model.base, limits held
-  double ee_error = 0.0;   // |end effector - target| after the step (length unit)
-  double base_error = 0.0; // the solver's last base residual before the base was re-anchored
-  int iterations = 0;      // solver iterations (Newton steps or fixed-point sweeps)
-  int sweeps = 0;          // sweeps from the end effector, all included
-  int passes = 0;          // passes over the links (cost ~ passes * n): sweeps done together count once
+  ArmState state;           // after the step; the base exactly at model.base, limits held
+  double ee_error = 0.0;    // |end effector - target| after the step (length unit)
+  double base_error = 0.0;  // the solver's last base residual before the base was re-anchored
+  int iterations = 0;       // solver iterations (Newton steps or fixed-point sweeps)
+  int sweeps = 0;           // sweeps from the end effector, all included
+  int passes = 0;  // passes over the links (cost ~ passes * n): sweeps done together count once
   bool converged = false;  // the base residual reached the tolerance
   bool reached = false;    // converged and ee_error within the tolerance: the target was reached
   bool stretched = false;  // out of reach: the arm was stretched straight toward the target
@@ -209,7 +208,7 @@ struct ArmStepReport {
   // many legs of at most half a mean link, the base held after each (docs/robots.md); 0: one
   // sweep. iterations, sweeps and passes count all of them.
   int legs = 0;
-  int restarts = 0;        // joint-space solves after the first (ArmOptions::restarts)
+  int restarts = 0;  // joint-space solves after the first (ArmOptions::restarts)
   std::string BriefReport() const;
 };
 
@@ -224,11 +223,11 @@ ArmStepReport ArmStep(const ArmModel& model, const ArmState& state,
 struct ArmTrajectory {
   std::vector<ArmStepReport> steps;  // one per path point
   double max_ee_error = 0.0, max_base_error = 0.0;
-  int unreached = 0;                 // steps with reached = false
+  int unreached = 0;  // steps with reached = false
   int max_iterations = 0;
   long long total_sweeps = 0;
-  long long total_passes = 0;        // passes over the links (see ArmStepReport::passes)
-  double seconds = 0.0;              // wall time of TrackPath
+  long long total_passes = 0;  // passes over the links (see ArmStepReport::passes)
+  double seconds = 0.0;        // wall time of TrackPath
   std::string BriefReport() const;
 };
 

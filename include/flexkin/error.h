@@ -17,8 +17,7 @@ namespace flexkin {
 
 struct Problem {
   Problem() = default;
-  Problem(std::string field, std::string message, std::string value = "",
-          std::string expected = "")
+  Problem(std::string field, std::string message, std::string value = "", std::string expected = "")
       : field(std::move(field)),
         message(std::move(message)),
         value(std::move(value)),

@@ -7,16 +7,16 @@
 //   flexkin::Chain chain = flexkin::MakeEqualLinkChain(flexkin::MakeParabola({}), 0.25);
 //   flexkin::RunResult result = flexkin::Run(chain, leader_steps, flexkin::RunOptions{});
 
-#include "flexkin/arm.h"           // fixed-base arms: models, forward kinematics, TrackPath
-#include "flexkin/chain.h"         // Chain, Points, MakeChain
-#include "flexkin/curves.h"        // generated initial curves: line, parabola, arc, helix
-#include "flexkin/error.h"         // Problem, Problems, InputError
-#include "flexkin/leader.h"        // leader paths: pulls, resampling
-#include "flexkin/link_step.h"     // the single link step: tractrix, follow-the-leader
-#include "flexkin/overall.h"       // the whole-curve (overall) step and its metric
-#include "flexkin/propagate.h"     // methods, sequential propagation (MoveLeader)
-#include "flexkin/result_io.h"     // result files and frame CSV
+#include "flexkin/arm.h"             // fixed-base arms: models, forward kinematics, TrackPath
+#include "flexkin/chain.h"           // Chain, Points, MakeChain
+#include "flexkin/curves.h"          // generated initial curves: line, parabola, arc, helix
+#include "flexkin/error.h"           // Problem, Problems, InputError
+#include "flexkin/leader.h"          // leader paths: pulls, resampling
+#include "flexkin/link_step.h"       // the single link step: tractrix, follow-the-leader
+#include "flexkin/overall.h"         // the whole-curve (overall) step and its metric
+#include "flexkin/propagate.h"       // methods, sequential propagation (MoveLeader)
+#include "flexkin/result_io.h"       // result files and frame CSV
 #include "flexkin/robot_scenario.h"  // robot scenario files and trajectories
-#include "flexkin/run.h"           // Run: a chain through a list of targets, with metrics
-#include "flexkin/scenario.h"      // scenario files
-#include "flexkin/vocabulary.h"    // the names of every enumerated choice
+#include "flexkin/run.h"             // Run: a chain through a list of targets, with metrics
+#include "flexkin/scenario.h"        // scenario files
+#include "flexkin/vocabulary.h"      // the names of every enumerated choice

@@ -23,10 +23,10 @@ Eigen::Vector3d TractrixStep(const Eigen::Vector3d& head_old, const Eigen::Vecto
 // on the old tail the link keeps its old direction (tail - head_old). `head_old` is otherwise
 // unused; it is taken so that both rules share one signature.
 Eigen::Vector2d FollowTheLeaderStep(const Eigen::Vector2d& head_old,
-                                    const Eigen::Vector2d& head_new,
-                                    const Eigen::Vector2d& tail, double length);
+                                    const Eigen::Vector2d& head_new, const Eigen::Vector2d& tail,
+                                    double length);
 Eigen::Vector3d FollowTheLeaderStep(const Eigen::Vector3d& head_old,
-                                    const Eigen::Vector3d& head_new,
-                                    const Eigen::Vector3d& tail, double length);
+                                    const Eigen::Vector3d& head_new, const Eigen::Vector3d& tail,
+                                    double length);
 
 }  // namespace flexkin

@@ -1,9 +1,8 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 #include <string_view>
-
-#include <Eigen/Core>
 
 #include "flexkin/chain.h"
 #include "flexkin/vocabulary.h"
@@ -12,7 +11,7 @@ namespace flexkin {
 
 // How each link's trailing end follows its leading end.
 enum class Method {
-  kTractrix,         // "tractrix": closed-form tractrix step, velocity along the link (paper Sec. 2-3)
+  kTractrix,  // "tractrix": closed-form tractrix step, velocity along the link (paper Sec. 2-3)
   kFollowTheLeader,  // "ftl": nearest point on the sphere around the new leading end (FABRIK, hair)
   // "min_rotation": sequential minimum body rotation (Sec. 4.1): each link translates, so the
   // whole chain does.

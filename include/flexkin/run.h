@@ -99,7 +99,7 @@ struct RunResult {
   std::vector<Frame> frames;
   Metrics metrics;
   AccuracyReport accuracy;
-  OverallRunReport overall;    // method "overall" only
+  OverallRunReport overall;  // method "overall" only
   ObjectiveWeights weights;  // the overall method's metric (method "overall" only)
   double seconds = 0.0;      // wall time of the computation
 

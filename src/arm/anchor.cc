@@ -5,7 +5,6 @@
 
 #include <cmath>
 #include <cstdint>
-
 #include <xsimd/xsimd.hpp>
 
 namespace flexkin::internal {
@@ -50,14 +49,25 @@ void SinCos(const B& x, B* s, B* c) {
   const B r2 = r * r;
   // sin r = r (1 - r^2/3! + ... + r^16/17!), cos r = 1 - r^2/2! + ... - r^18/18!: Horner in r^2,
   // the coefficients from the highest power down.
-  constexpr double kSin[9] = {1.0 / 355687428096000.0, -1.0 / 1307674368000.0, 1.0 / 6227020800.0,
-                              -1.0 / 39916800.0,       1.0 / 362880.0,         -1.0 / 5040.0,
-                              1.0 / 120.0,             -1.0 / 6.0,             1.0};
-  constexpr double kCos[10] = {-1.0 / 6402373705728000.0, 1.0 / 20922789888000.0,
-                               -1.0 / 87178291200.0,      1.0 / 479001600.0,
-                               -1.0 / 3628800.0,          1.0 / 40320.0,
-                               -1.0 / 720.0,              1.0 / 24.0,
-                               -0.5,                      1.0};
+  constexpr double kSin[9] = {1.0 / 355687428096000.0,
+                              -1.0 / 1307674368000.0,
+                              1.0 / 6227020800.0,
+                              -1.0 / 39916800.0,
+                              1.0 / 362880.0,
+                              -1.0 / 5040.0,
+                              1.0 / 120.0,
+                              -1.0 / 6.0,
+                              1.0};
+  constexpr double kCos[10] = {-1.0 / 6402373705728000.0,
+                               1.0 / 20922789888000.0,
+                               -1.0 / 87178291200.0,
+                               1.0 / 479001600.0,
+                               -1.0 / 3628800.0,
+                               1.0 / 40320.0,
+                               -1.0 / 720.0,
+                               1.0 / 24.0,
+                               -0.5,
+                               1.0};
   B ps(kSin[0]);
   for (int i = 1; i < 9; ++i) ps = xsimd::fma(ps, r2, B(kSin[i]));
   B pc(kCos[0]);
@@ -80,7 +90,8 @@ void Atan2Avx2(const double* y, const double* x, int count, double* out) {
   for (; i + kWidth <= count; i += kWidth) {
     xsimd::atan2(B::load_unaligned(y + i), B::load_unaligned(x + i)).store_unaligned(out + i);
   }
-  if (i < count) StoreTail(xsimd::atan2(LoadTail(y, i, count, 0.0), LoadTail(x, i, count, 1.0)), i, count, out);
+  if (i < count)
+    StoreTail(xsimd::atan2(LoadTail(y, i, count, 0.0), LoadTail(x, i, count, 1.0)), i, count, out);
 }
 
 void SinCosAvx2(const double* a, int count, double* s, double* c) {

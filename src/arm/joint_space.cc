@@ -48,8 +48,15 @@ Vec3 SolveNormal(Mat3 a, const Vec3& rhs, double damping) {
 class RevoluteArm {
  public:
   RevoluteArm(const ArmModel& model, const Eigen::VectorXd& start, const Eigen::VectorXd& winv)
-      : model_(model), n_(model.num_links()), limits_(model.joint_min.size() == n_), winv_(winv),
-        q_(n_), dq_(n_), trial_(n_), jac_(3, n_), held_(n_) {
+      : model_(model),
+        n_(model.num_links()),
+        limits_(model.joint_min.size() == n_),
+        winv_(winv),
+        q_(n_),
+        dq_(n_),
+        trial_(n_),
+        jac_(3, n_),
+        held_(n_) {
     for (int k = 0; k < n_; ++k) q_[k] = std::clamp(start[k], lo(k), hi(k));
     points_ = RevoluteForward(model_, q_, &axes_);
   }
@@ -148,13 +155,21 @@ Vec3 RotationVector(const Vec3& from, const Vec3& to) {
 class SphericalArm {
  public:
   SphericalArm(const ArmModel& model, const Points& start, const Eigen::VectorXd& winv)
-      : model_(model), n_(model.num_links()), limits_(model.max_bend.size() == n_), winv_(winv),
-        dirs_(n_ + 1), trial_dirs_(n_ + 1), omega_(n_), lever_(n_), held_(n_) {
+      : model_(model),
+        n_(model.num_links()),
+        limits_(model.max_bend.size() == n_),
+        winv_(winv),
+        dirs_(n_ + 1),
+        trial_dirs_(n_ + 1),
+        omega_(n_),
+        lever_(n_),
+        held_(n_) {
     dirs_[0] = model.base_direction.head<3>().normalized();
     trial_dirs_[0] = dirs_[0];
     for (int k = 1; k <= n_; ++k) {
       dirs_[k] = (start.row(k) - start.row(k - 1)).transpose().normalized();
-      if (limits_) ClampDirection(3, dirs_[k - 1].data(), 0.0, model.max_bend[k - 1], dirs_[k].data());
+      if (limits_)
+        ClampDirection(3, dirs_[k - 1].data(), 0.0, model.max_bend[k - 1], dirs_[k].data());
     }
     points_.resize(n_ + 1, 3);
     points_.row(0) = model.base.transpose();
@@ -167,7 +182,8 @@ class SphericalArm {
   const Points& points() const { return points_; }
   bool limited() const {
     for (int j = 0; j < n_ && limits_; ++j) {
-      if (std::acos(std::clamp(dirs_[j].dot(dirs_[j + 1]), -1.0, 1.0)) >= model_.max_bend[j] - 1e-12) {
+      if (std::acos(std::clamp(dirs_[j].dot(dirs_[j + 1]), -1.0, 1.0)) >=
+          model_.max_bend[j] - 1e-12) {
         return true;
       }
     }
@@ -226,7 +242,8 @@ class SphericalArm {
       }
       turn = (turn * step).normalized();
       trial_dirs_[j + 1] = (turn * dirs_[j + 1]).normalized();
-      trial_points_.row(j + 1) = trial_points_.row(j) + model_.link_lengths[j] * trial_dirs_[j + 1].transpose();
+      trial_points_.row(j + 1) =
+          trial_points_.row(j) + model_.link_lengths[j] * trial_dirs_[j + 1].transpose();
     }
     return trial_points_.row(n_).transpose();
   }
@@ -339,8 +356,9 @@ Eigen::VectorXd InverseJointWeights(const ArmModel& model) {
 namespace {
 
 // One solve from `previous` with the weights `winv`.
-JointSpaceSolve Attempt(const ArmModel& model, const ArmState& previous, const Eigen::VectorXd& target,
-                        double tol, int max_iterations, const Eigen::VectorXd& winv) {
+JointSpaceSolve Attempt(const ArmModel& model, const ArmState& previous,
+                        const Eigen::VectorXd& target, double tol, int max_iterations,
+                        const Eigen::VectorXd& winv) {
   const double scale = model.link_lengths.mean();
   if (model.has_axes()) {
     RevoluteArm arm(model, previous.angles.angle, winv);
@@ -386,7 +404,8 @@ JointSpaceSolve SolveJointSpace(const ArmModel& model, const ArmState& previous,
   // so with the half or whole range.
   const int n = model.num_links();
   const bool spherical = model.joint() == ArmJoint::kSpherical;
-  const JointAngles from = model.has_axes() ? previous.angles : AnglesUnchecked(model, previous.points);
+  const JointAngles from =
+      model.has_axes() ? previous.angles : AnglesUnchecked(model, previous.points);
   std::mt19937 rng(20261122);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   for (int k = 0; k < restarts && !best.converged; ++k) {

@@ -31,12 +31,12 @@ struct JointSpaceSolve {
 };
 
 // From the arm at `previous` (its angles for revolute joints about axes, otherwise its points;
-// with the model's lengths and within its limits) to the end effector at `target`: every Gauss-Newton step is the smallest in
-// (dq)' W (dq) that cancels the miss to first order; a backtracking line search on the miss, with
-// Levenberg-Marquardt damping where full steps fail; far targets through intermediate goals half
-// a link apart. Each iteration is O(n). Never leaves the limits; where the target cannot be
-// reached from here it ends at the nearest configuration found (no descent left, or
-// max_iterations). The joints:
+// with the model's lengths and within its limits) to the end effector at `target`: every
+// Gauss-Newton step is the smallest in (dq)' W (dq) that cancels the miss to first order; a
+// backtracking line search on the miss, with Levenberg-Marquardt damping where full steps fail; far
+// targets through intermediate goals half a link apart. Each iteration is O(n). Never leaves the
+// limits; where the target cannot be reached from here it ends at the nearest configuration found
+// (no descent left, or max_iterations). The joints:
 //   revolute about given axes (model.has_axes()): dq the joint angles; a joint the step would
 //     carry past a limit is moved onto it and held, and the rest re-solved (the active set);
 //   planar: the same with every axis z;

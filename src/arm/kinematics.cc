@@ -1,16 +1,15 @@
 // Joint angles <-> link points of a fixed-base arm (include/flexkin/arm.h), the model's checks
 // and the joint-limit projections the solver uses.
+#include <Eigen/Geometry>
 #include <cmath>
 #include <optional>
 #include <string>
 
-#include <Eigen/Geometry>
-
+#include "arm/anchor.h"
 #include "arm/internal.h"
 #include "arm/revolute.h"
 #include "flexkin/arm.h"
 #include "flexkin/error.h"
-#include "arm/anchor.h"
 
 namespace flexkin {
 namespace {
@@ -24,12 +23,14 @@ double Wrap(double x) {
   return r <= -kPi ? r + 2.0 * kPi : r;
 }
 
-std::string Indexed(const char* field, int i) { return std::string(field) + "[" + std::to_string(i) + "]"; }
+std::string Indexed(const char* field, int i) {
+  return std::string(field) + "[" + std::to_string(i) + "]";
+}
 
 std::optional<Problem> CheckVector(const Eigen::VectorXd& v, const char* field, int size) {
   if (v.size() != size) {
-    return Problem(field, "has " + std::to_string(v.size()) + " values; expected " +
-                              std::to_string(size));
+    return Problem(field,
+                   "has " + std::to_string(v.size()) + " values; expected " + std::to_string(size));
   }
   for (int i = 0; i < v.size(); ++i) {
     if (!std::isfinite(v[i])) {

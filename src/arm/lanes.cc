@@ -9,8 +9,6 @@
 // Jacobian) share one register, so they cost about one sweep.
 #include "arm/lanes.h"
 
-#include "chain/substep.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -19,6 +17,7 @@
 #include <vector>
 #include <xsimd/xsimd.hpp>
 
+#include "chain/substep.h"
 #include "sequential/link_rules.h"
 
 namespace flexkin::internal {
@@ -131,9 +130,9 @@ void SweepOne(const double* target, int substeps, const double* lengths, const d
 
 // Up to kWidth translations, one per lane; lanes past `lanes` repeat lane 0.
 template <int Dim>
-void SweepLanes(int lanes, const double* start, const double* u, const double* target,
-                int substeps, const double* lengths, const double* inv_lengths, int n,
-                double* points0, double* bases) {
+void SweepLanes(int lanes, const double* start, const double* u, const double* target, int substeps,
+                const double* lengths, const double* inv_lengths, int n, double* points0,
+                double* bases) {
   using Rule = TractrixRule<Dim, EstrinExp>;
   B shift[Dim];
   for (int k = 0; k < Dim; ++k) {

@@ -13,7 +13,9 @@
 namespace flexkin::arm_internal {
 namespace {
 
-std::string Row(const char* field, int i) { return std::string(field) + "[" + std::to_string(i) + "]"; }
+std::string Row(const char* field, int i) {
+  return std::string(field) + "[" + std::to_string(i) + "]";
+}
 
 std::optional<Problem> CheckUnitRows(const Eigen::MatrixXd& m, const char* field, int n) {
   if (m.rows() != n || m.cols() != 3) {
@@ -59,14 +61,14 @@ Eigen::Vector3d RestDirection(const ArmModel& model, int k) {
   return model.base_direction.head<3>().normalized();
 }
 
-double AngleAbout(const Eigen::Vector3d& axis, const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+double AngleAbout(const Eigen::Vector3d& axis, const Eigen::Vector3d& from,
+                  const Eigen::Vector3d& to) {
   const Eigen::Vector3d f = from - axis.dot(from) * axis, t = to - axis.dot(to) * axis;
   if (!(f.squaredNorm() > 0.0) || !(t.squaredNorm() > 0.0)) return 0.0;
   return std::atan2(axis.dot(f.cross(t)), f.dot(t));
 }
 
-Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle,
-                       Eigen::MatrixXd* axes) {
+Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle, Eigen::MatrixXd* axes) {
   const int n = model.num_links();
   Points points(n + 1, 3);
   points.row(0) = model.base.transpose();
@@ -77,7 +79,8 @@ Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle,
     // A rotation about a leaves a fixed: the world axis is the frame above's image of it.
     if (axes != nullptr) axes->row(j) = (frame * a).transpose();
     frame = (frame * Eigen::Quaterniond(Eigen::AngleAxisd(angle[j], a))).normalized();
-    points.row(j + 1) = points.row(j) + model.link_lengths[j] * (frame * RestDirection(model, j)).transpose();
+    points.row(j + 1) =
+        points.row(j) + model.link_lengths[j] * (frame * RestDirection(model, j)).transpose();
   }
   return points;
 }
@@ -105,7 +108,8 @@ RevoluteSweeper::RevoluteSweeper(const ArmModel& model, const ArmState& start,
   // The frames of the start, accumulated from the base as forward kinematics does.
   Eigen::Quaterniond frame = Eigen::Quaterniond::Identity();
   for (int j = 0; j < n_; ++j) {
-    frame = (frame * Eigen::Quaterniond(Eigen::AngleAxisd(start.angles.angle[j], axes_[j]))).normalized();
+    frame = (frame * Eigen::Quaterniond(Eigen::AngleAxisd(start.angles.angle[j], axes_[j])))
+                .normalized();
     start_frames_.push_back(frame);
   }
   angle_.resize(n_);
@@ -134,7 +138,8 @@ SmallVec RevoluteSweeper::Evaluate(const SmallVec& u) {
       if (j == n_) {
         // The end-effector link: the smallest rotation from its old direction to the new one.
         const Eigen::Vector3d e_old = frames_[j - 1] * rest_[j - 1];
-        frames_[j - 1] = (Eigen::Quaterniond::FromTwoVectors(e_old, e) * frames_[j - 1]).normalized();
+        frames_[j - 1] =
+            (Eigen::Quaterniond::FromTwoVectors(e_old, e) * frames_[j - 1]).normalized();
       } else {
         // Joint j turns link j into link j+1 (frame j): link j's direction lies on the cone
         // frames_[j] * Rot(axis_j, -q) * rest_[j-1].
@@ -145,7 +150,8 @@ SmallVec RevoluteSweeper::Evaluate(const SmallVec& u) {
           q = c;
         }
         angle_[j] = q;
-        frames_[j - 1] = (frames_[j] * Eigen::Quaterniond(Eigen::AngleAxisd(-q, axes_[j]))).normalized();
+        frames_[j - 1] =
+            (frames_[j] * Eigen::Quaterniond(Eigen::AngleAxisd(-q, axes_[j]))).normalized();
         const Eigen::Vector3d on_cone = frames_[j - 1] * rest_[j - 1];
         for (int k = 0; k < 3; ++k) tail[k] = p(j, k) - length * on_cone[k];
       }

@@ -4,10 +4,9 @@
 // Spatial arms with revolute joints about given axes (ArmModel::joint_axes, docs/robots.md):
 // kinematics and the sweep that keeps every link on the circle of directions its joint allows.
 
-#include <vector>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <vector>
 
 #include "arm/internal.h"
 #include "flexkin/arm.h"
@@ -24,7 +23,8 @@ Eigen::Vector3d RestDirection(const ArmModel& model, int k);
 // The angle (rad, (-pi, pi]) of the rotation about unit `axis` that takes `from` nearest to
 // `to` (both in the same frame): the signed angle between their components across the axis;
 // 0 where either lies along the axis.
-double AngleAbout(const Eigen::Vector3d& axis, const Eigen::Vector3d& from, const Eigen::Vector3d& to);
+double AngleAbout(const Eigen::Vector3d& axis, const Eigen::Vector3d& from,
+                  const Eigen::Vector3d& to);
 
 // Forward kinematics at `angle` (n): the n+1 points, base first.
 // With `axes`, also each joint's axis in the world (n by 3), as the position Jacobian needs.
@@ -35,13 +35,13 @@ Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle,
 Eigen::VectorXd RevoluteInverse(const ArmModel& model, const Points& points);
 
 // The sweep of one step for these arms, now only for the fixed-point baseline (method
-// "fixed_point"): method "newton" solves in joint space (src/arm/joint_space.h). Each link's frame is carried from the end effector
-// down: the end-effector link turns by the smallest rotation that the tractrix step gives it;
-// every other link's direction, proposed by the tractrix step, is put on the cone of directions
-// that its joint with the link above allows (rotation about that joint's axis, angle within its
-// limits). The joint angles so found are rebuilt into points from the fixed base, and F(u) is
-// the rebuilt end effector minus the target: the same root-finding problem in dim = 3
-// unknowns as the base residual of the other arms (F ~ -(base residual) where frames agree).
+// "fixed_point"): method "newton" solves in joint space (src/arm/joint_space.h). Each link's frame
+// is carried from the end effector down: the end-effector link turns by the smallest rotation that
+// the tractrix step gives it; every other link's direction, proposed by the tractrix step, is put
+// on the cone of directions that its joint with the link above allows (rotation about that joint's
+// axis, angle within its limits). The joint angles so found are rebuilt into points from the fixed
+// base, and F(u) is the rebuilt end effector minus the target: the same root-finding problem in dim
+// = 3 unknowns as the base residual of the other arms (F ~ -(base residual) where frames agree).
 class RevoluteSweeper {
  public:
   RevoluteSweeper(const ArmModel& model, const ArmState& start, const Eigen::VectorXd& target,

@@ -266,13 +266,14 @@ SolveResult SolveFixedPoint(Sweeper* sweeper, const Points& start, const ArmOpti
 
 // The fixed-point baseline for revolute joints about axes: u <- u + F(u), F being the rebuilt
 // end effector's miss, which is about minus the base residual of the other arms.
-SolveResult SolveFixedPointRevolute(arm_internal::RevoluteSweeper* sweeper, const ArmOptions& options,
-                                    double tol) {
+SolveResult SolveFixedPointRevolute(arm_internal::RevoluteSweeper* sweeper,
+                                    const ArmOptions& options, double tol) {
   SolveResult result;
   Vec u = Vec::Zero(3);
   Vec f = sweeper->Evaluate(u);
   result.iterations = 1;
-  while (f.allFinite() && f.norm() > tol && result.iterations < options.max_fixed_point_iterations) {
+  while (f.allFinite() && f.norm() > tol &&
+         result.iterations < options.max_fixed_point_iterations) {
     u += f;
     f = sweeper->Evaluate(u);
     ++result.iterations;
@@ -326,10 +327,9 @@ Problems ArmOptions::Validate() const {
                           {"substeps", substeps, 1}};
   for (const auto& [name, value, least] : counts) {
     if (value < least) {
-      problems.emplace_back(name,
-                            "value " + std::to_string(value) + " is not >= " +
-                                std::to_string(least),
-                            std::to_string(value), ">= " + std::to_string(least));
+      problems.emplace_back(
+          name, "value " + std::to_string(value) + " is not >= " + std::to_string(least),
+          std::to_string(value), ">= " + std::to_string(least));
     }
   }
   if (!(edge_margin >= 0.0 && edge_margin < 0.5)) {
@@ -375,11 +375,12 @@ ArmStepReport Report(const ArmModel& model, const Eigen::VectorXd& target, doubl
 // miss, sweeps 0.
 ArmStepReport JointSpaceStep(const ArmModel& model, const ArmState& state,
                              const Eigen::VectorXd& target, double tol, const ArmOptions& options) {
-  const arm_internal::JointSpaceSolve solved =
-      arm_internal::SolveJointSpace(model, state, target, tol, options.max_iterations, options.restarts);
+  const arm_internal::JointSpaceSolve solved = arm_internal::SolveJointSpace(
+      model, state, target, tol, options.max_iterations, options.restarts);
   ArmStepReport report = Report(
       model, target, tol,
-      SolveResult{solved.points, solved.residual, solved.iterations, solved.converged, solved.limited, {}},
+      SolveResult{
+          solved.points, solved.residual, solved.iterations, solved.converged, solved.limited, {}},
       0, solved.passes);
   report.joint_space = true;
   report.restarts = solved.restarts;
@@ -421,7 +422,8 @@ ArmStepReport LegsStep(const ArmModel& model, const ArmState& state, const Eigen
   ArmState leg_state = state;
   leg_state.memory = ArmSolverMemory();  // the memory is of a step of another length
   for (int leg = 1; leg <= legs; ++leg) {
-    const Eigen::VectorXd goal = leg == legs ? target : Eigen::VectorXd(from + (target - from) * (double(leg) / legs));
+    const Eigen::VectorXd goal =
+        leg == legs ? target : Eigen::VectorXd(from + (target - from) * (double(leg) / legs));
     report = SweepStep(model, leg_state, goal, tol, options);
     AddCost(report, &cost);
     if (!report.reached) break;
@@ -446,7 +448,8 @@ ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
     const Vec dir = to_target.normalized();
     stretched.points.row(0) = model.base.transpose();
     for (int j = 0; j < n; ++j) {
-      stretched.points.row(j + 1) = stretched.points.row(j) + model.link_lengths[j] * dir.transpose();
+      stretched.points.row(j + 1) =
+          stretched.points.row(j) + model.link_lengths[j] * dir.transpose();
     }
     stretched.converged = true;
     ArmStepReport report = Report(model, target, tol, stretched, 0, 0);
@@ -457,14 +460,16 @@ ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
   if (model.has_axes()) {
     if (state.angles.angle.size() != n || !state.angles.angle.allFinite()) {
       throw InputError("state.angles", "has " + std::to_string(state.angles.angle.size()) +
-                                           " finite values or fewer; expected " + std::to_string(n));
+                                           " finite values or fewer; expected " +
+                                           std::to_string(n));
     }
     // Method newton: the weighted minimum-norm joint motion from the last angles
     // (src/arm/joint_space.cc says why not the sweep).
     if (newton) return JointSpaceStep(model, state, target, tol, options);
     arm_internal::RevoluteSweeper sweeper(model, state, target, options.substeps);
     const SolveResult solved = SolveFixedPointRevolute(&sweeper, options, tol);
-    return Report(model, target, tol, solved, sweeper.sweeps(), sweeper.sweeps());  // 1 sweep a pass
+    return Report(model, target, tol, solved, sweeper.sweeps(),
+                  sweeper.sweeps());  // 1 sweep a pass
   }
   // A far move (more than one leg, below) gets fewer Newton iterations in one sweep: where
   // Newton converges it does in a few (at most 10 measured on single jumps across the
@@ -494,7 +499,8 @@ ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
 }  // namespace
 
 ArmStepReport ArmStep(const ArmModel& model, const ArmState& state,
-                      const Eigen::Ref<const Eigen::VectorXd>& target_in, const ArmOptions& options) {
+                      const Eigen::Ref<const Eigen::VectorXd>& target_in,
+                      const ArmOptions& options) {
   arm_internal::CheckModel(model);
   CheckOptions(options);
   const Eigen::VectorXd target = target_in;
@@ -516,8 +522,8 @@ ArmTrajectory TrackPath(const ArmModel& model, const Points& path, const ArmOpti
   arm_internal::CheckModel(model);
   if (path.rows() < 1 || path.cols() != model.dim) {
     throw InputError("path", "shape " + std::to_string(path.rows()) + " by " +
-                                 std::to_string(path.cols()) + " is not valid; expected m >= 1 by " +
-                                 std::to_string(model.dim));
+                                 std::to_string(path.cols()) +
+                                 " is not valid; expected m >= 1 by " + std::to_string(model.dim));
   }
   const auto begin = std::chrono::steady_clock::now();
   ArmTrajectory trajectory;

@@ -5,10 +5,10 @@
 #include <string>
 
 #include "arm/internal.h"
+#include "arm/lanes.h"
 #include "chain/simd.h"
 #include "chain/substep.h"
 #include "sequential/link_rules.h"
-#include "arm/lanes.h"
 
 namespace flexkin::arm_internal {
 
@@ -23,8 +23,13 @@ bool HasAvx2Fma() {
 
 Sweeper::Sweeper(const ArmModel& model, const Points& start, const Eigen::VectorXd& target,
                  int substeps)
-    : model_(model), start_(start), target_(target), substeps_(substeps),
-      n_(model.num_links()), dim_(model.dim), has_limits_(model.has_limits()) {
+    : model_(model),
+      start_(start),
+      target_(target),
+      substeps_(substeps),
+      n_(model.num_links()),
+      dim_(model.dim),
+      has_limits_(model.has_limits()) {
   base_direction_ = model.base_direction.normalized();
   inv_lengths_.resize(n_);
   for (int j = 0; j < n_; ++j) inv_lengths_[j] = 1.0 / model.link_lengths[j];
@@ -88,7 +93,8 @@ void Sweeper::Jacobian(const SmallVec& u, const SmallVec& f, double h, SmallMat*
   bool limited[kMaxLanes];
   RunLanes(dim_, lanes, limited);
   for (int c = 0; c < dim_; ++c) {
-    for (int k = 0; k < dim_; ++k) (*jac)(k, c) = ((lanes_[c + 1](0, k) - model_.base[k]) - f[k]) / h;
+    for (int k = 0; k < dim_; ++k)
+      (*jac)(k, c) = ((lanes_[c + 1](0, k) - model_.base[k]) - f[k]) / h;
   }
 }
 
@@ -128,7 +134,8 @@ SmallVec Sweeper::EvaluateWithJacobian(const SmallVec& u, double h, SmallMat* ja
   limited_ = limited[0];
   const SmallVec f = lanes_[0].row(0).transpose() - model_.base;
   for (int c = 0; c < dim_; ++c) {
-    for (int k = 0; k < dim_; ++k) (*jac)(k, c) = ((lanes_[c + 1](0, k) - model_.base[k]) - f[k]) / h;
+    for (int k = 0; k < dim_; ++k)
+      (*jac)(k, c) = ((lanes_[c + 1](0, k) - model_.base[k]) - f[k]) / h;
   }
   return f;
 }
@@ -144,17 +151,33 @@ void Sweeper::RunLanes(int lanes, double* const* points, bool* limited) {
   ++passes_;
   if (dim_ == 2) {
     switch (lanes) {
-      case 1: Run<2, 1>(points, limited); break;
-      case 2: Run<2, 2>(points, limited); break;
-      case 3: Run<2, 3>(points, limited); break;
-      default: Run<2, 4>(points, limited); break;
+      case 1:
+        Run<2, 1>(points, limited);
+        break;
+      case 2:
+        Run<2, 2>(points, limited);
+        break;
+      case 3:
+        Run<2, 3>(points, limited);
+        break;
+      default:
+        Run<2, 4>(points, limited);
+        break;
     }
   } else {
     switch (lanes) {
-      case 1: Run<3, 1>(points, limited); break;
-      case 2: Run<3, 2>(points, limited); break;
-      case 3: Run<3, 3>(points, limited); break;
-      default: Run<3, 4>(points, limited); break;
+      case 1:
+        Run<3, 1>(points, limited);
+        break;
+      case 2:
+        Run<3, 2>(points, limited);
+        break;
+      case 3:
+        Run<3, 3>(points, limited);
+        break;
+      default:
+        Run<3, 4>(points, limited);
+        break;
     }
   }
 }
@@ -183,7 +206,8 @@ void Sweeper::Run(double* const* lanes, bool* limited_out) {
         double* tail = lanes[l] + (j - 1) * Dim;
         double tail_old[Dim];
         for (int k = 0; k < Dim; ++k) tail_old[k] = tail[k];
-        internal::TractrixStep<Dim>(head_old[l], tail + Dim, tail, lengths[j - 1], inv_lengths[j - 1]);
+        internal::TractrixStep<Dim>(head_old[l], tail + Dim, tail, lengths[j - 1],
+                                    inv_lengths[j - 1]);
         if (has_limits_) limited[l] |= Limit(lanes[l], j);
         for (int k = 0; k < Dim; ++k) head_old[l][k] = tail_old[k];
       }

@@ -10,10 +10,9 @@
 // a sqrt, an exp and a division in a row), so independent lanes interleaved in the same loop cost
 // little more than one: a finite-difference Jacobian's dim sweeps run in about the time of one.
 
+#include <Eigen/Core>
 #include <array>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "arm/internal.h"
 #include "flexkin/arm.h"
@@ -71,7 +70,7 @@ class Sweeper {
   const Eigen::VectorXd target_;
   const int substeps_, n_, dim_;
   const bool has_limits_;
-  bool fast_ = false;  // no limits and the CPU has AVX2 + FMA: src/arm/lanes.h
+  bool fast_ = false;                // no limits and the CPU has AVX2 + FMA: src/arm/lanes.h
   double fast_bases_[kMaxLanes][3];  // the lanes' F after FastLanes
   Eigen::VectorXd base_direction_;
   std::vector<double> inv_lengths_;

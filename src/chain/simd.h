@@ -1,8 +1,8 @@
 #pragma once
 // The instruction sets the engines may use, decided once per process: what the CPU has, capped by
-// FLEXKIN_SIMD=scalar|avx2|avx512 in the environment (unset: avx512) (to compare the engines, or to test each one
-// on one machine). The sequential sweeps (src/sequential) and the arms' lanes (src/arm) both ask
-// here, so one variable switches every engine.
+// FLEXKIN_SIMD=scalar|avx2|avx512 in the environment (unset: avx512) (to compare the engines, or to
+// test each one on one machine). The sequential sweeps (src/sequential) and the arms' lanes
+// (src/arm) both ask here, so one variable switches every engine.
 
 namespace flexkin::internal {
 

@@ -4,8 +4,8 @@
 #include <vector>
 
 #include "flexkin/chain.h"
-#include "flexkin/vocabulary.h"
 #include "flexkin/result_io.h"
+#include "flexkin/vocabulary.h"
 
 namespace flexkin {
 
@@ -46,8 +46,7 @@ struct Vocabulary<GltfUpAxis> {
 };
 inline const char* GltfUpAxisName(GltfUpAxis axis) { return NameOf(axis); }
 // Throws InputError naming `field` and listing the names.
-inline GltfUpAxis ParseGltfUpAxis(const std::string& name,
-                                  const std::string& field = "up_axis") {
+inline GltfUpAxis ParseGltfUpAxis(const std::string& name, const std::string& field = "up_axis") {
   return ParseName<GltfUpAxis>(name, field);
 }
 

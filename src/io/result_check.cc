@@ -41,10 +41,10 @@ std::optional<Problem> FirstProblem(const RunResult& r, int dim) {
     const std::string field = Index("frames", static_cast<Eigen::Index>(f));
     const Points& p = frame.points;
     if (p.rows() != n + 1 || p.cols() != dim) {
-      return Problem(field + ".points",
-                     "is " + std::to_string(p.rows()) + " by " + std::to_string(p.cols()) +
-                         "; expected " + std::to_string(n + 1) + " by " + std::to_string(dim) +
-                         " (one row per point, n+1 for n links)");
+      return Problem(field + ".points", "is " + std::to_string(p.rows()) + " by " +
+                                            std::to_string(p.cols()) + "; expected " +
+                                            std::to_string(n + 1) + " by " + std::to_string(dim) +
+                                            " (one row per point, n+1 for n links)");
     }
     for (Eigen::Index i = 0; i <= n; ++i) {
       if (auto problem = NonFinite(p.row(i).transpose(), Index(field + ".points", i))) {

@@ -14,7 +14,6 @@ namespace {
 
 using json = nlohmann::json;
 
-
 std::string Show(const json& v) {
   std::string text = v.dump(-1, ' ', false, json::error_handler_t::replace);
   return text.size() > 60 ? text.substr(0, 56) + " ..." : text;

@@ -62,7 +62,8 @@ class ChunkWriter {
   void Flush() {
     out_.write(text_.data(), static_cast<std::streamsize>(text_.size()));
     text_.clear();
-    if (!out_) throw std::system_error(EIO, std::generic_category(), "cannot write to the output stream");
+    if (!out_)
+      throw std::system_error(EIO, std::generic_category(), "cannot write to the output stream");
   }
 
  private:

@@ -99,9 +99,7 @@ class BandMatrix {
  private:
   friend class BandedLu;
   friend class BandedLdlt;
-  size_t Index(int i, int j) const {
-    return static_cast<size_t>(j) * ldab_ + (offset_ + i - j);
-  }
+  size_t Index(int i, int j) const { return static_cast<size_t>(j) * ldab_ + (offset_ + i - j); }
 
   int size_ = 0, band_ = 0, ldab_ = 1, offset_ = 0;
   bool lower_ = false;
@@ -158,7 +156,8 @@ class BandedLu {
       if (column[jp] == 0.0 || !std::isfinite(column[jp])) return false;
       ju = std::max(ju, std::min(j + ku + jp, n - 1));
       if (jp != 0) {
-        for (int c = j; c <= ju; ++c) std::swap(lu_.ab_[lu_.Index(j, c)], lu_.ab_[lu_.Index(j + jp, c)]);
+        for (int c = j; c <= ju; ++c)
+          std::swap(lu_.ab_[lu_.Index(j, c)], lu_.ab_[lu_.Index(j + jp, c)]);
       }
       const double inverse = 1.0 / column[0];
       for (int r = 1; r <= km; ++r) column[r] *= inverse;
@@ -172,7 +171,6 @@ class BandedLu {
     factorized_ = true;
     return true;
   }
-
 
  public:
   // Solves A x = rhs with the last factorization.

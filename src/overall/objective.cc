@@ -181,10 +181,10 @@ Problems ObjectiveWeights::Validate() const {
   for (const auto& entry : Vocabulary<ObjectiveTerm>::kEntries) {
     const double value = (*this)[entry.value];
     if (!(value >= 0.0) || !std::isfinite(value)) {
-      problems.emplace_back(entry.name,
-                            FormatNumber(value) +
-                                " is not valid; each weight must be a finite number >= 0",
-                            FormatNumber(value), "a finite number >= 0");
+      problems.emplace_back(
+          entry.name,
+          FormatNumber(value) + " is not valid; each weight must be a finite number >= 0",
+          FormatNumber(value), "a finite number >= 0");
     }
     total += value;
   }
@@ -202,8 +202,8 @@ Problems ObjectiveWeights::Validate() const {
     for (const std::string& name : NamesOf<ObjectiveTerm>()) {
       names += (names.empty() ? "" : ", ") + name;
     }
-    problems.emplace_back("", "all weights are 0; give at least one term (" + names +
-                                  ") a positive weight");
+    problems.emplace_back(
+        "", "all weights are 0; give at least one term (" + names + ") a positive weight");
   }
   return problems;
 }

@@ -8,8 +8,8 @@
 #include <cstdlib>
 #include <vector>
 
-#include "overall/banded_lu.h"
 #include "flexkin/overall.h"
+#include "overall/banded_lu.h"
 
 namespace flexkin::internal {
 
@@ -28,7 +28,7 @@ struct Sink {
   double* form = nullptr;
   const double* form_vector = nullptr;
   Triplets* hessian = nullptr;
-  std::vector<int> offset;              // offset[j] for j = 0..n; -1: point j is fixed
+  std::vector<int> offset;  // offset[j] for j = 0..n; -1: point j is fixed
   // With `band`: if set, Identity() terms are summed here by point instead, s I at (j, j) into
   // identity_diagonal[j] and at (j, j - 1) into identity_below[j] (its mirror (j - 1, j) is not
   // summed again), and the caller writes them into the band in one pass. (Such terms, of the

@@ -50,10 +50,11 @@ void CheckSize(int width, int height, Problems* problems) {
 // 0 (automatic) or an integer from 64 to 8192.
 void CheckAutoHeight(int height, Problems* problems) {
   if (height != 0 && (height < kMinSize || height > kMaxSize)) {
-    problems->emplace_back("height",
-                           FormatNumber(height) +
-                               " is not valid; expected 0 (automatic) or an integer from 64 to 8192",
-                           FormatNumber(height), "0 (automatic) or an integer from 64 to 8192");
+    problems->emplace_back(
+        "height",
+        FormatNumber(height) +
+            " is not valid; expected 0 (automatic) or an integer from 64 to 8192",
+        FormatNumber(height), "0 (automatic) or an integer from 64 to 8192");
   }
 }
 
@@ -67,10 +68,9 @@ void CheckEveryK(int every_k, Problems* problems) {
 
 void CheckAzimuth(double azimuth, Problems* problems) {
   if (!std::isfinite(azimuth)) {
-    problems->emplace_back("azimuth",
-                           FormatNumber(azimuth) +
-                               " is not valid; expected a finite number of degrees",
-                           FormatNumber(azimuth), "a finite number of degrees");
+    problems->emplace_back(
+        "azimuth", FormatNumber(azimuth) + " is not valid; expected a finite number of degrees",
+        FormatNumber(azimuth), "a finite number of degrees");
   }
 }
 }  // namespace

@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "render/render.h"
 #include "render/axes.h"
 #include "render/legend.h"
+#include "render/render.h"
 #include "render/scene.h"
 
 namespace flexkin::render {

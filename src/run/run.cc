@@ -7,8 +7,8 @@
 #include <optional>
 #include <sstream>
 
-#include "flexkin/error.h"
 #include "chain/substep.h"
+#include "flexkin/error.h"
 #include "overall/step.h"
 
 namespace flexkin {
@@ -210,8 +210,8 @@ class MetricsAccumulator {
     m_->l2_weighted_per_step[s] = moved_.dot(weights_);
     for (Eigen::Index i = 1; i <= lengths_.size(); ++i) {
       const double length = (points.row(i) - points.row(i - 1)).norm();
-      m_->max_relative_length_error = std::fmax(m_->max_relative_length_error,
-                                                std::fabs(length - lengths_[i - 1]) / lengths_[i - 1]);
+      m_->max_relative_length_error = std::fmax(
+          m_->max_relative_length_error, std::fabs(length - lengths_[i - 1]) / lengths_[i - 1]);
     }
   }
   void Finish() {

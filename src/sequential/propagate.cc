@@ -184,8 +184,8 @@ void MoveLeader(const Stepper& stepper, const Eigen::Ref<const Eigen::VectorXd>&
   const int lanes = internal::WavefrontLanes();
   const bool wavefront = lanes > 1 && substeps >= 2 * lanes && n >= 8;
   (wavefront ? internal::SweepsWavefront : internal::SweepsScalar)(
-      stepper.method, dim, heads, substeps, stepper.lengths.data(),
-      stepper.inv_lengths.data(), n, points->data());
+      stepper.method, dim, heads, substeps, stepper.lengths.data(), stepper.inv_lengths.data(), n,
+      points->data());
 }
 
 void MoveLeader(Method method, const Eigen::Ref<const Eigen::VectorXd>& target, int substeps,

@@ -9,9 +9,9 @@
 #include <vector>
 #include <xsimd/xsimd.hpp>
 
+#include "flexkin/propagate.h"
 #include "sequential/link_rules.h"
 #include "sequential/sweep.h"
-#include "flexkin/propagate.h"
 
 namespace flexkin::internal {
 namespace {

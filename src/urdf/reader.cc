@@ -23,21 +23,24 @@ std::string Quote(const std::string& s) { return "\"" + s + "\""; }
 Eigen::Isometry3d Transform(const urdf::Pose& pose) {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   t.translate(Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z));
-  t.rotate(Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z).normalized());
+  t.rotate(Eigen::Quaterniond(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z)
+               .normalized());
   return t;
 }
 
 // The joints from `base` down to `tip`, parent first.
-std::vector<urdf::JointConstSharedPtr> ChainJoints(const urdf::ModelInterface& robot, const urdf::LinkConstSharedPtr& base,
-                                             urdf::LinkConstSharedPtr tip) {
+std::vector<urdf::JointConstSharedPtr> ChainJoints(const urdf::ModelInterface& robot,
+                                                   const urdf::LinkConstSharedPtr& base,
+                                                   urdf::LinkConstSharedPtr tip) {
   std::vector<urdf::JointConstSharedPtr> joints;
   if (!tip) {
     tip = base;
     while (!tip->child_links.empty()) {
       if (tip->child_links.size() > 1) {
-        throw InputError("link " + Quote(tip->name),
-                         "has " + std::to_string(tip->child_links.size()) +
-                             " child links: the URDF branches; name the end effector's link (tip_link)");
+        throw InputError(
+            "link " + Quote(tip->name),
+            "has " + std::to_string(tip->child_links.size()) +
+                " child links: the URDF branches; name the end effector's link (tip_link)");
       }
       tip = tip->child_links[0];
     }
@@ -45,7 +48,8 @@ std::vector<urdf::JointConstSharedPtr> ChainJoints(const urdf::ModelInterface& r
   for (urdf::LinkConstSharedPtr link = tip; link != base; link = link->getParent()) {
     if (!link->parent_joint || !link->getParent()) {
       throw InputError("tip_link", "link " + Quote(tip->name) + " is not below base link " +
-                                       Quote(base->name) + "; expected a link of the chain under it");
+                                       Quote(base->name) +
+                                       "; expected a link of the chain under it");
     }
     joints.insert(joints.begin(), link->parent_joint);
   }
@@ -56,20 +60,26 @@ std::vector<urdf::JointConstSharedPtr> ChainJoints(const urdf::ModelInterface& r
 }  // namespace
 
 ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
-  console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);  // errors are ours to report
+  console_bridge::setLogLevel(
+      console_bridge::CONSOLE_BRIDGE_LOG_NONE);  // errors are ours to report
   const urdf::ModelInterfaceSharedPtr robot = urdf::parseURDF(text);
   if (!robot || !robot->getRoot()) {
-    throw InputError("urdf", "is not a valid URDF document (urdfdom could not parse it: check the XML, "
-                             "that every joint names existing parent and child links and that "
-                             "revolute joints have <limit>)");
+    throw InputError("urdf",
+                     "is not a valid URDF document (urdfdom could not parse it: check the XML, "
+                     "that every joint names existing parent and child links and that "
+                     "revolute joints have <limit>)");
   }
   auto find = [&](const std::string& name, const char* field) {
     const urdf::LinkConstSharedPtr link = robot->getLink(name);
-    if (!link) throw InputError(field, "link " + Quote(name) + " is not in the URDF; expected one of its links");
+    if (!link)
+      throw InputError(field,
+                       "link " + Quote(name) + " is not in the URDF; expected one of its links");
     return link;
   };
-  const urdf::LinkConstSharedPtr base = chain.base_link.empty() ? robot->getRoot() : find(chain.base_link, "base_link");
-  const urdf::LinkConstSharedPtr tip = chain.tip_link.empty() ? nullptr : find(chain.tip_link, "tip_link");
+  const urdf::LinkConstSharedPtr base =
+      chain.base_link.empty() ? robot->getRoot() : find(chain.base_link, "base_link");
+  const urdf::LinkConstSharedPtr tip =
+      chain.tip_link.empty() ? nullptr : find(chain.tip_link, "tip_link");
   // The base link's pose in the world, joints above it at 0.
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   for (urdf::LinkConstSharedPtr link = base; link->parent_joint; link = link->getParent()) {
@@ -85,11 +95,13 @@ ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
     pose = pose * Transform(joint->parent_to_joint_origin_transform);
     if (joint->type == urdf::Joint::FIXED) continue;
     if (joint->type != urdf::Joint::REVOLUTE && joint->type != urdf::Joint::CONTINUOUS) {
-      throw InputError(field, "has a type other than revolute, continuous or fixed (prismatic, floating "
-                              "or planar); flexkin arms have revolute joints only");
+      throw InputError(field,
+                       "has a type other than revolute, continuous or fixed (prismatic, floating "
+                       "or planar); flexkin arms have revolute joints only");
     }
     const Eigen::Vector3d axis(joint->axis.x, joint->axis.y, joint->axis.z);
-    if (!(axis.norm() > 0.0) || !axis.allFinite()) throw InputError(field, "axis is zero; expected a direction");
+    if (!(axis.norm() > 0.0) || !axis.allFinite())
+      throw InputError(field, "axis is zero; expected a direction");
     origins.push_back(pose.translation());
     axes.push_back((pose.linear() * axis).normalized());
     names.push_back(joint->name);
@@ -97,18 +109,21 @@ ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
     if (joint->type == urdf::Joint::REVOLUTE && joint->limits) {
       if (!(joint->limits->lower <= joint->limits->upper)) {
         throw InputError(field, "limit lower " + FormatNumber(joint->limits->lower) + " > upper " +
-                                    FormatNumber(joint->limits->upper) + "; expected lower <= upper");
+                                    FormatNumber(joint->limits->upper) +
+                                    "; expected lower <= upper");
       }
       lo = std::max(-kPi, joint->limits->lower);
       hi = std::min(kPi, joint->limits->upper);
-      if (!(lo <= hi)) throw InputError(field, "limits lie outside [-pi, pi] rad; expected an overlap with it");
+      if (!(lo <= hi))
+        throw InputError(field, "limits lie outside [-pi, pi] rad; expected an overlap with it");
       any_limits = true;
     }
     lower.push_back(lo);
     upper.push_back(hi);
   }
   const int n = static_cast<int>(origins.size());
-  if (n == 0) throw InputError("urdf", "the chain from the base link to the tip link has no revolute joint");
+  if (n == 0)
+    throw InputError("urdf", "the chain from the base link to the tip link has no revolute joint");
   origins.push_back(pose.translation());  // the tip
   ArmModel model;
   model.dim = 3;
@@ -127,8 +142,9 @@ ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
     model.link_directions.row(k) = v.normalized().transpose();
     model.joint_axes.row(k) = axes[k].transpose();
     if (axes[k].cross(v.normalized()).norm() < 1e-6) {
-      throw InputError("joint " + Quote(names[k]), "axis lies along the link it turns (a pure twist); "
-                                                   "flexkin arms need axes across their links");
+      throw InputError("joint " + Quote(names[k]),
+                       "axis lies along the link it turns (a pure twist); "
+                       "flexkin arms need axes across their links");
     }
   }
   model.base_direction = model.link_directions.row(0).transpose();
@@ -136,7 +152,8 @@ ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
   if (any_limits) {
     model.joint_min = Eigen::Map<Eigen::VectorXd>(lower.data(), n);
     model.joint_max = Eigen::Map<Eigen::VectorXd>(upper.data(), n);
-    for (int j = 0; j < n; ++j) model.initial.angle[j] = arm_internal::ClampCircular(0.0, lower[j], upper[j]);
+    for (int j = 0; j < n; ++j)
+      model.initial.angle[j] = arm_internal::ClampCircular(0.0, lower[j], upper[j]);
   }
   // A planar arm: every axis +z, every link along one direction of the z = 0 plane.
   bool planar = std::abs(model.base[2]) == 0.0;

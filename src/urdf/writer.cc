@@ -26,11 +26,16 @@ std::string Number(double x) {
 std::string XmlEscape(const std::string& s) {
   std::string out;
   for (char c : s) {
-    if (c == '&') out += "&amp;";
-    else if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '"') out += "&quot;";
-    else out += c;
+    if (c == '&')
+      out += "&amp;";
+    else if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '"')
+      out += "&quot;";
+    else
+      out += c;
   }
   return out;
 }
@@ -42,8 +47,9 @@ std::string UrdfFromArm(const ArmModel& model, const std::string& robot_name) {
   AppendNested("model", model.Validate(), &problems);
   ThrowIfAny(problems);
   if (model.joint() == ArmJoint::kSpherical) {
-    throw InputError("model.joint_axes", "is empty: spherical joints have no URDF form; expected revolute joints "
-                                         "(a planar arm, or joint_axes)");
+    throw InputError("model.joint_axes",
+                     "is empty: spherical joints have no URDF form; expected revolute joints "
+                     "(a planar arm, or joint_axes)");
   }
   const int n = model.num_links();
   const bool planar = model.dim == 2;
@@ -65,21 +71,24 @@ std::string UrdfFromArm(const ArmModel& model, const std::string& robot_name) {
   out << "  <link name=\"tip_link\"/>\n";
   for (int j = 0; j < n; ++j) {
     const bool limited = model.joint_min.size() > 0;
-    const Eigen::Vector3d origin = j == 0 ? base : Eigen::Vector3d(model.link_lengths[j - 1] * direction(j - 1));
-    out << "  <joint name=\"joint_" << j << "\" type=\"" << (limited ? "revolute" : "continuous") << "\">\n"
+    const Eigen::Vector3d origin =
+        j == 0 ? base : Eigen::Vector3d(model.link_lengths[j - 1] * direction(j - 1));
+    out << "  <joint name=\"joint_" << j << "\" type=\"" << (limited ? "revolute" : "continuous")
+        << "\">\n"
         << "    <parent link=\"" << (j == 0 ? "base_link" : "link_" + std::to_string(j)) << "\"/>\n"
         << "    <child link=\"link_" << j + 1 << "\"/>\n"
         << "    <origin xyz=\"" << Triple(origin) << "\" rpy=\"0 0 0\"/>\n"
         << "    <axis xyz=\"" << Triple(axis(j)) << "\"/>\n";
     if (limited) {
-      out << "    <limit lower=\"" << Number(model.joint_min[j]) << "\" upper=\"" << Number(model.joint_max[j])
-          << "\" effort=\"0\" velocity=\"0\"/>\n";
+      out << "    <limit lower=\"" << Number(model.joint_min[j]) << "\" upper=\""
+          << Number(model.joint_max[j]) << "\" effort=\"0\" velocity=\"0\"/>\n";
     }
     out << "  </joint>\n";
   }
   out << "  <joint name=\"tip_joint\" type=\"fixed\">\n    <parent link=\"link_" << n << "\"/>\n"
       << "    <child link=\"tip_link\"/>\n"
-      << "    <origin xyz=\"" << Triple(model.link_lengths[n - 1] * direction(n - 1)) << "\" rpy=\"0 0 0\"/>\n"
+      << "    <origin xyz=\"" << Triple(model.link_lengths[n - 1] * direction(n - 1))
+      << "\" rpy=\"0 0 0\"/>\n"
       << "  </joint>\n</robot>\n";
   return out.str();
 }

@@ -56,8 +56,7 @@ Problems ViewerOptions::Validate() const {
   }
   if (!(elevation >= -90.0 && elevation <= 90.0)) {
     problems.emplace_back("elevation",
-                          FormatNumber(elevation) +
-                              " is not valid; must be in [-90, 90] (degrees)",
+                          FormatNumber(elevation) + " is not valid; must be in [-90, 90] (degrees)",
                           FormatNumber(elevation), "in [-90, 90]");
   }
   if (digits < 6 || digits > 17) {
@@ -86,11 +85,13 @@ void WriteViewerHtml(const ResultFile& result, const ViewerOptions& options,
     // viewer.html links the style sheet and script by name, so that it can be opened during
     // development next to them; here they are put inline.
     std::string_view rest = html;
-    rest = WriteReplacing(out, rest, "<link rel=\"stylesheet\" href=\"viewer.css\">",
-                          [&] { out << "<style>\n" << css << "</style>"; });
+    rest = WriteReplacing(out, rest, "<link rel=\"stylesheet\" href=\"viewer.css\">", [&] {
+      out << "<style>\n" << css << "</style>";
+    });
     rest = WriteReplacing(out, rest, "FLEXKIN_DATA", [&] { out << data; });
-    rest = WriteReplacing(out, rest, "<script src=\"viewer.js\"></script>",
-                          [&] { out << "<script>\n" << js << "</script>"; });
+    rest = WriteReplacing(out, rest, "<script src=\"viewer.js\"></script>", [&] {
+      out << "<script>\n" << js << "</script>";
+    });
     out << rest;
   });
 }

@@ -89,9 +89,9 @@ std::string ViewerDataJson(const ResultFile& file, const ViewerOptions& options)
   out.reserve(num_frames * r.frames[0].points.size() * (options.digits + 8) + 4096);
 
   AppendKey("title", &out);
-  AppendString(!options.title.empty()           ? options.title
-               : !file.scenario_name.empty()    ? file.scenario_name
-                                                : std::string("flexkin result"),
+  AppendString(!options.title.empty()        ? options.title
+               : !file.scenario_name.empty() ? file.scenario_name
+                                             : std::string("flexkin result"),
                &out);
   AppendKey("scenario", &out);
   AppendString(file.scenario_name, &out);
