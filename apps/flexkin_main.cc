@@ -28,6 +28,7 @@
 #include "flexkin/result_io.h"
 #include "flexkin/run.h"
 #include "flexkin/scenario.h"
+#include "output_check.h"
 #include "render_command.h"
 #include "robot_command.h"
 #include "vocabulary_command.h"
@@ -67,19 +68,6 @@ struct RunArgs {
   CLI::Option *substeps_opt = nullptr, *record_every_opt = nullptr, *max_substeps_opt = nullptr,
               *tolerance_opt = nullptr, *method_opt = nullptr;
 };
-
-// Fails early, before a possibly long run, if an output's directory does not exist.
-void CheckOutputDirectory(const std::string& path) {
-  const size_t slash = path.rfind('/');
-  const std::string dir = slash == std::string::npos ? "." : path.substr(0, slash + 1);
-  struct stat st;
-  if (::stat(dir.c_str(), &st) != 0) {
-    throw std::system_error(errno, std::generic_category(), "cannot write '" + path + "'");
-  }
-  if (!S_ISDIR(st.st_mode)) {
-    throw std::system_error(ENOTDIR, std::generic_category(), "cannot write '" + path + "'");
-  }
-}
 
 // Progress on stderr, rewritten in place; only used when stderr is a terminal.
 void ShowProgress(int64_t done, int64_t total) {
@@ -135,8 +123,8 @@ int RunCommand(const RunArgs& args) {
     return kExitInvalidInput;
   }
   ApplyOverrides(args, &scenario.options);
-  CheckOutputDirectory(args.output);
-  if (!args.csv.empty()) CheckOutputDirectory(args.csv);
+  flexkin::cli::CheckOutputDirectory(args.output);
+  if (!args.csv.empty()) flexkin::cli::CheckOutputDirectory(args.csv);
   if (!args.quiet && ::isatty(STDERR_FILENO)) scenario.options.progress = ShowProgress;
 
   const flexkin::RunResult result =

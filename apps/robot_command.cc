@@ -11,19 +11,19 @@
 #include "flexkin/error.h"
 #include "flexkin/robot_scenario.h"
 #include "flexkin/urdf.h"
+#include "flexkin/vocabulary.h"
+#include "output_check.h"
 
 namespace flexkin::cli {
 namespace {
 
-// Fails before the run if an output's directory does not exist, so that no output is written
-// when another cannot be.
-void CheckDirectory(const std::string& path) {
-  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
-  std::error_code ec;
-  if (!std::filesystem::is_directory(dir.empty() ? "." : dir, ec)) {
-    throw std::system_error(std::make_error_code(std::errc::no_such_file_or_directory),
-                            "cannot write '" + path + "'");
+// The --method help, from the library's vocabulary.
+std::string MethodHelp() {
+  std::string help = "How the base is brought back:";
+  for (const auto& entry : Vocabulary<FixedBaseMethod>::kEntries) {
+    help += std::string("\n  ") + entry.name + ": " + entry.summary;
   }
+  return help;
 }
 
 }  // namespace
@@ -35,7 +35,7 @@ RobotCommand::RobotCommand(CLI::App* app, const std::string& footer) {
       ->required();
   command_->add_option("-o,--output", output_, "Trajectory file to write (JSON)")->required();
   command_->add_option("--csv", csv_, "Also write the joint trajectories as CSV");
-  command_->add_option("--method", method_, "newton (default) or fixed_point (the baseline)");
+  command_->add_option("--method", method_, MethodHelp());
   command_->add_flag("-q,--quiet", quiet_, "Print no report");
   command_->footer(footer);
 }
@@ -50,8 +50,8 @@ int RobotCommand::Run() const {
     throw InputError(p);
   }
   if (!method_.empty()) s.options.method = ParseFixedBaseMethod(method_, "--method");
-  CheckDirectory(output_);
-  if (!csv_.empty()) CheckDirectory(csv_);
+  CheckOutputDirectory(output_);
+  if (!csv_.empty()) CheckOutputDirectory(csv_);
   const ArmTrajectory t = TrackPath(s.model, s.path, s.options);
   WriteRobotTrajectoryJson(s, t, output_);
   if (!csv_.empty()) WriteRobotJointsCsv(s, t, csv_);
