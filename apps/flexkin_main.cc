@@ -1,8 +1,8 @@
 // The flexkin command line: runs and checks scenario files.
 //
-//   flexkin run SCENARIO.json -o RESULT.json [--csv FRAMES.csv] [--method METHOD]
+//   flexkin run SCENARIO.json -o RESULT.json|RESULT.npz [--csv FRAMES.csv] [--method METHOD]
 //       [--substeps N] [--tolerance T] [--max-substeps N] [--record-every N]
-//       [--report brief|full] [--quiet]
+//       [--max-output-size SIZE] [--report brief|full] [--quiet]
 //   flexkin validate SCENARIO.json
 //   flexkin render RESULT.json ...   (render_command.h)
 //   flexkin robot SCENARIO.json ...  (robot_command.h)
@@ -15,13 +15,17 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <memory>
 #include <new>
 #include <string>
 #include <system_error>
+#include <utility>
+#include <vector>
 
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
@@ -29,6 +33,7 @@
 #include "flexkin/run.h"
 #include "flexkin/scenario.h"
 #include "output_check.h"
+#include "output_limit.h"
 #include "render_command.h"
 #include "robot_command.h"
 #include "vocabulary_command.h"
@@ -60,7 +65,7 @@ constexpr const char* kExitCodesHelp =
 void PrintError(const std::string& message) { std::cerr << "flexkin: error: " << message << "\n"; }
 
 struct RunArgs {
-  std::string scenario, output, csv, method, report = "brief";
+  std::string scenario, output, csv, method, report = "brief", max_output_size;
   int substeps = 0, record_every = 0, max_substeps = 0;
   double tolerance = 0.0;
   bool quiet = false;
@@ -114,6 +119,78 @@ std::string MethodHelp() {
   return help;
 }
 
+// Hands every frame to each of the sinks (the result file and the CSV file).
+class FanOutSink : public flexkin::FrameSink {
+ public:
+  explicit FanOutSink(std::vector<flexkin::FrameSink*> sinks) : sinks_(std::move(sinks)) {}
+  void Add(int64_t step, const flexkin::Points& points,
+           const Eigen::VectorXd& link_angles) override {
+    for (flexkin::FrameSink* sink : sinks_) sink->Add(step, points, link_angles);
+  }
+
+ private:
+  std::vector<flexkin::FrameSink*> sinks_;
+};
+
+// The smallest record_every (above the scenario's) whose output fits in `limit`; 0 if none does.
+int64_t RecordEveryThatFits(const flexkin::Scenario& s, flexkin::ResultFileFormat format, bool csv,
+                            uint64_t limit) {
+  const int64_t steps = s.leader_steps.rows();
+  auto fits = [&](int64_t every) {
+    flexkin::RunOptions options = s.options;
+    options.record_every = static_cast<int>(every);
+    const flexkin::ResultSizeEstimate e =
+        flexkin::EstimateResultSize(s.chain.num_links(), s.chain.dim(), steps, options);
+    return e.bytes(format) <= limit && (!csv || e.csv_bytes <= limit);
+  };
+  int64_t lo = s.options.record_every + 1, hi = std::max<int64_t>(steps, lo);
+  if (hi > (int64_t{1} << 30)) hi = int64_t{1} << 30;  // record_every is an int
+  if (!fits(hi)) return 0;
+  while (lo < hi) {
+    const int64_t mid = lo + (hi - lo) / 2;
+    if (fits(mid)) {
+      hi = mid;
+    } else {
+      lo = mid + 1;
+    }
+  }
+  return lo;
+}
+
+// Refuses, before the run, outputs whose estimated size is over --max-output-size.
+void CheckOutputSize(const RunArgs& args, const flexkin::Scenario& s,
+                     flexkin::ResultFileFormat format) {
+  const uint64_t limit = args.max_output_size.empty()
+                             ? flexkin::cli::kDefaultMaxOutputSize
+                             : flexkin::cli::ParseByteSize(args.max_output_size);
+  if (limit == 0) return;
+  const flexkin::ResultSizeEstimate e = flexkin::EstimateResultSize(
+      s.chain.num_links(), s.chain.dim(), s.leader_steps.rows(), s.options);
+  const bool csv = !args.csv.empty();
+  const bool result_over = e.bytes(format) > limit;
+  if (!result_over && !(csv && e.csv_bytes > limit)) return;
+  using flexkin::cli::FormatBytes;
+  const uint64_t bytes = result_over ? e.bytes(format) : e.csv_bytes;
+  std::string message = (result_over ? "the result " + args.output : "the frames CSV " + args.csv) +
+                        " would be about " + FormatBytes(bytes) + " (" + std::to_string(e.frames) +
+                        " frames of " + std::to_string(s.chain.num_links() + 1) + " points, " +
+                        std::to_string(s.leader_steps.rows()) + " leader steps, recording every " +
+                        std::to_string(s.options.record_every) + "), over the limit of " +
+                        FormatBytes(limit) + ". Record fewer frames";
+  if (const int64_t every = RecordEveryThatFits(s, format, csv, limit); every > 0) {
+    message += " with --record-every " + std::to_string(every) +
+               " (or \"record\": {\"every\": " + std::to_string(every) + "} in the scenario)";
+  } else {
+    message += " (even recording only the first and last frames would not fit)";
+  }
+  if (result_over && format == flexkin::ResultFileFormat::kJson) {
+    message += ", write the binary format (-o with .npz: about " + FormatBytes(e.npz_bytes) + ")";
+  }
+  message += ", or raise the limit with --max-output-size " + flexkin::cli::SizeOptionFor(bytes) +
+             " (0 = no limit)";
+  throw flexkin::InputError(flexkin::Problem(flexkin::cli::kMaxOutputSizeOption, message));
+}
+
 int RunCommand(const RunArgs& args) {
   flexkin::Scenario scenario;
   try {
@@ -122,15 +199,29 @@ int RunCommand(const RunArgs& args) {
     PrintError(args.scenario + ": " + e.what());
     return kExitInvalidInput;
   }
+  const flexkin::ResultFileFormat format = flexkin::ResultFileFormatOfPath(args.output, "-o");
   ApplyOverrides(args, &scenario.options);
+  CheckOutputSize(args, scenario, format);
   flexkin::cli::CheckOutputDirectory(args.output);
   if (!args.csv.empty()) flexkin::cli::CheckOutputDirectory(args.csv);
   if (!args.quiet && ::isatty(STDERR_FILENO)) scenario.options.progress = ShowProgress;
 
+  // The frames stream to the files as the run records them; the files are renamed into place
+  // only after the run, and removed if it fails.
+  flexkin::ResultFileWriter writer(
+      args.output, format,
+      flexkin::MakeResultHeader(scenario.chain, scenario.options, scenario.name));
+  std::vector<flexkin::FrameSink*> sinks = {&writer};
+  std::unique_ptr<flexkin::FramesCsvWriter> csv;
+  if (!args.csv.empty()) {
+    csv = std::make_unique<flexkin::FramesCsvWriter>(args.csv, scenario.chain.dim());
+    sinks.push_back(csv.get());
+  }
+  FanOutSink sink(sinks);
   const flexkin::RunResult result =
-      flexkin::Run(scenario.chain, scenario.leader_steps, scenario.options);
-  flexkin::WriteResultJson(result, args.output, scenario.name);
-  if (!args.csv.empty()) flexkin::WriteFramesCsv(result, args.csv);
+      flexkin::Run(scenario.chain, scenario.leader_steps, scenario.options, &sink);
+  writer.Commit(result);
+  if (csv) csv->Commit();
 
   if (!args.quiet) {
     std::cout << (args.report == "full" ? result.FullReport() : result.BriefReport() + "\n");
@@ -165,7 +256,18 @@ int ValidateCommand(const std::string& path) {
     }
     return kExitInvalidInput;
   }
-  std::cout << "ok: " << flexkin::ScenarioSummary(flexkin::LoadScenarioFile(path)) << "\n";
+  const flexkin::Scenario scenario = flexkin::LoadScenarioFile(path);
+  std::cout << "ok: " << flexkin::ScenarioSummary(scenario) << "\n";
+  const flexkin::ResultSizeEstimate e =
+      flexkin::EstimateResultSize(scenario.chain.num_links(), scenario.chain.dim(),
+                                  scenario.leader_steps.rows(), scenario.options);
+  using flexkin::cli::FormatBytes;
+  std::cout << "output: " << e.frames << " frames (recording every "
+            << scenario.options.record_every << " of " << scenario.leader_steps.rows()
+            << " leader steps); result about " << FormatBytes(e.json_bytes) << " as .json, "
+            << FormatBytes(e.npz_bytes) << " as .npz; --csv about " << FormatBytes(e.csv_bytes)
+            << "; keeping every frame in memory (Run without a sink) about "
+            << FormatBytes(e.recorder_bytes) << "\n";
   return kExitOk;
 }
 
@@ -182,7 +284,9 @@ int Main(int argc, char** argv) {
   CLI::App* run = app.add_subcommand("run", "Run a scenario file and write the result.");
   run->add_option("scenario", args.scenario, "Scenario file (JSON, docs/scenario-format.md)")
       ->required();
-  run->add_option("-o,--output", args.output, "Result file to write (JSON)")->required();
+  run->add_option("-o,--output", args.output,
+                  "Result file to write: .json (JSON) or .npz (NumPy archive), by its extension")
+      ->required();
   run->add_option("--csv", args.csv, "Also write the recorded frames as CSV");
   args.method_opt = run->add_option("--method", args.method, MethodHelp());
   args.substeps_opt =
@@ -194,6 +298,7 @@ int Main(int argc, char** argv) {
                                           "Upper bound of the automatic sub-steps");
   args.record_every_opt = run->add_option("--record-every", args.record_every,
                                           "Record every N-th leader step (and the last)");
+  flexkin::cli::AddMaxOutputSizeOption(run, &args.max_output_size);
   run->add_option("--report", args.report, "Report printed after the run")
       ->check(CLI::IsMember({"brief", "full"}));
   run->add_flag("-q,--quiet", args.quiet, "Print no report and no progress");

@@ -134,8 +134,12 @@ void CheckOptions(const Problems& problems) {
 // OUTDIR/<stem>: <stem> is the result file's name without ".json".
 std::string OutputBase(const std::string& result, const std::string& output_dir) {
   std::string stem = std::filesystem::path(result).filename().string();
-  if (stem.size() > 5 && stem.compare(stem.size() - 5, 5, ".json") == 0)
-    stem.resize(stem.size() - 5);
+  for (const std::string extension : {".json", ".npz"}) {
+    if (stem.size() > extension.size() &&
+        stem.compare(stem.size() - extension.size(), extension.size(), extension) == 0) {
+      stem.resize(stem.size() - extension.size());
+    }
+  }
   std::string dir = output_dir;
   if (dir.empty()) {
     dir = std::filesystem::path(result).parent_path().string();
@@ -148,7 +152,7 @@ std::string OutputBase(const std::string& result, const std::string& output_dir)
 
 RenderCommand::RenderCommand(CLI::App* app, const std::string& footer) {
   command_ = app->add_subcommand("render", "Draw a result file: figures, plots, animations.");
-  command_->add_option("result", args_.result, "Result file (JSON, docs/result-format.md)")
+  command_->add_option("result", args_.result, "Result file (.json or .npz, docs/result-format.md)")
       ->required();
   command_->add_option("-o,--output-dir", args_.output_dir,
                        "Directory for the outputs, created if missing (default: the result's)");
@@ -195,7 +199,7 @@ int RenderCommand::Run() const {
 
   ResultFile file;
   try {
-    file = ReadResultJson(args_.result);
+    file = ReadResultFile(args_.result);  // JSON or .npz, by content
   } catch (const InputError& e) {
     throw InputError(args_.result + (e.field().empty() ? "" : ": " + e.field()),
                      std::string(e.what()).substr(e.field().empty() ? 0 : e.field().size() + 2));

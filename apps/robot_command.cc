@@ -13,6 +13,7 @@
 #include "flexkin/urdf.h"
 #include "flexkin/vocabulary.h"
 #include "output_check.h"
+#include "output_limit.h"
 
 namespace flexkin::cli {
 namespace {
@@ -26,6 +27,27 @@ std::string MethodHelp() {
   return help;
 }
 
+// The estimated sizes of the trajectory JSON and the joint CSV: about 24 bytes per number (as
+// result files, docs/result-format.md) for the initial state and one step per target: joint
+// angles (and azimuths of spherical joints), joint quaternions in 3D, the points, the target, and
+// about 300 bytes of keys and per-step reports.
+struct RobotOutputEstimate {
+  uint64_t json_bytes = 0, csv_bytes = 0;
+};
+
+RobotOutputEstimate EstimateRobotOutput(const RobotScenario& s) {
+  const double n = s.model.num_links(), dim = s.model.dim;
+  const double steps = static_cast<double>(s.path.rows()) + 1;  // and the initial state
+  const bool spherical = s.model.joint() == ArmJoint::kSpherical;
+  const double angles = n * (spherical ? 2 : 1);
+  const double numbers = angles + (dim == 3 ? 4 * n : 0) + (n + 1) * dim + dim;
+  auto bytes = [](double x) { return x < 1.8e19 ? static_cast<uint64_t>(x) : ~uint64_t{0}; };
+  RobotOutputEstimate e;
+  e.json_bytes = bytes(1024 + steps * (300 + numbers * 24 + (n + 1) * 3));
+  e.csv_bytes = bytes(64 + angles * 12 + steps * (8 + angles * 24));
+  return e;
+}
+
 }  // namespace
 
 RobotCommand::RobotCommand(CLI::App* app, const std::string& footer) {
@@ -36,6 +58,7 @@ RobotCommand::RobotCommand(CLI::App* app, const std::string& footer) {
   command_->add_option("-o,--output", output_, "Trajectory file to write (JSON)")->required();
   command_->add_option("--csv", csv_, "Also write the joint trajectories as CSV");
   command_->add_option("--method", method_, MethodHelp());
+  AddMaxOutputSizeOption(command_, &max_output_size_);
   command_->add_flag("-q,--quiet", quiet_, "Print no report");
   command_->footer(footer);
 }
@@ -50,6 +73,20 @@ int RobotCommand::Run() const {
     throw InputError(p);
   }
   if (!method_.empty()) s.options.method = ParseFixedBaseMethod(method_, "--method");
+  const uint64_t limit =
+      max_output_size_.empty() ? kDefaultMaxOutputSize : ParseByteSize(max_output_size_);
+  const RobotOutputEstimate estimate = EstimateRobotOutput(s);
+  const bool json_over = estimate.json_bytes > limit;
+  if (limit > 0 && (json_over || (!csv_.empty() && estimate.csv_bytes > limit))) {
+    const uint64_t bytes = json_over ? estimate.json_bytes : estimate.csv_bytes;
+    throw InputError(Problem(
+        kMaxOutputSizeOption,
+        (json_over ? "the trajectory " + output_ : "the joint CSV " + csv_) + " would be about " +
+            FormatBytes(bytes) + " (" + std::to_string(s.path.rows()) + " targets, " +
+            std::to_string(s.model.num_links()) + " joints), over the limit of " +
+            FormatBytes(limit) + ". Follow a path with fewer targets, or raise the limit with " +
+            "--max-output-size " + SizeOptionFor(bytes) + " (0 = no limit)"));
+  }
   CheckOutputDirectory(output_);
   if (!csv_.empty()) CheckOutputDirectory(csv_);
   const ArmTrajectory t = TrackPath(s.model, s.path, s.options);

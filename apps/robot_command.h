@@ -1,8 +1,8 @@
 #pragma once
-// `flexkin robot SCENARIO.json -o TRAJECTORY.json [--csv JOINTS.csv]`: joint trajectories of a
-// fixed-base hyper-redundant arm whose end effector follows a path (docs/robot-format.md,
-// docs/robots.md). The scenario reader and the trajectory writers are the library's
-// (flexkin/robot_scenario.h); this is the command line around them. Kept apart from
+// `flexkin robot SCENARIO.json -o TRAJECTORY.json [--csv JOINTS.csv] [--max-output-size SIZE]`:
+// joint trajectories of a fixed-base hyper-redundant arm whose end effector follows a path
+// (docs/robot-format.md, docs/robots.md). The scenario reader and the trajectory writers are the
+// library's (flexkin/robot_scenario.h); this is the command line around them. Kept apart from
 // flexkin_main.cc, which only registers it.
 
 #include <CLI/CLI.hpp>
@@ -22,7 +22,7 @@ class RobotCommand {
 
  private:
   CLI::App* command_ = nullptr;
-  std::string scenario_, output_, csv_, method_;
+  std::string scenario_, output_, csv_, method_, max_output_size_;
   bool quiet_ = false;
 };
 

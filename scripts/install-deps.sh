@@ -10,6 +10,8 @@ packages+=(libtinygltf-dev)  # glTF export (src/gltf)
 packages+=(liborocos-kdl-dev)  # the pseudo-inverse peer of the arm comparison (testing/kdl_peer.h)
 packages+=(chromium)         # the viewer's browser test (headless)
 packages+=(liburdfdom-dev)   # URDF arms (src/urdf)
+packages+=(zlib1g-dev)       # CRC-32 of the .npz result files (src/io/npz.cc)
+packages+=(python3-numpy)    # the tests read .npz results with numpy.load (tests/result_npz_test)
 # Node.js runs the glTF validator and the browser test. Debian's nodejs and npm only if there is
 # no node or npm on the PATH: one from another source (e.g. NodeSource) is used as it is.
 if ! command -v node >/dev/null || ! command -v npm >/dev/null; then packages+=(nodejs npm); fi

@@ -9,10 +9,12 @@
 #include <cerrno>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <ostream>
 #include <streambuf>
 #include <string>
 #include <system_error>
+#include <vector>
 
 #include "flexkin/error.h"
 
@@ -28,6 +30,8 @@ class FdStreamBuf : public std::streambuf {
  public:
   explicit FdStreamBuf(int fd) : fd_(fd) { setp(buffer_, buffer_ + sizeof buffer_); }
   int error() const { return error_; }
+  // Bytes handed to the buffer so far, written or not.
+  uint64_t position() const { return drained_ + static_cast<uint64_t>(pptr() - pbase()); }
 
  protected:
   int_type overflow(int_type c) override {
@@ -53,6 +57,7 @@ class FdStreamBuf : public std::streambuf {
       }
       p += n;
       left -= static_cast<size_t>(n);
+      drained_ += static_cast<uint64_t>(n);
     }
     setp(buffer_, buffer_ + sizeof buffer_);
     return 0;
@@ -60,6 +65,7 @@ class FdStreamBuf : public std::streambuf {
 
   int fd_;
   int error_ = 0;
+  uint64_t drained_ = 0;
   char buffer_[1 << 16];
 };
 
@@ -100,49 +106,150 @@ std::string ReadTextFile(const std::string& path) {
   return text;
 }
 
-void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
-  if (path.empty()) throw InputError("path", "is empty; expected a file name");
-  const size_t slash = path.rfind('/');
-  const std::string dir = slash == std::string::npos ? "" : path.substr(0, slash + 1);
-  const std::string base = slash == std::string::npos ? path : path.substr(slash + 1);
-  const std::string what = "cannot write '" + path + "'";
-  struct stat existing;
-  mode_t mode = 0666 & ~CurrentUmask();
-  if (base.empty() || (::stat(path.c_str(), &existing) == 0 && S_ISDIR(existing.st_mode))) {
-    throw SystemError(EISDIR, what);
-  }
-  if (::stat(path.c_str(), &existing) == 0) mode = existing.st_mode & 07777;
-
+struct AtomicFile::State {
+  std::string path, dir, what;
+  mode_t mode = 0;
   TempFile temp;
-  temp.name = dir + "." + base + ".tmp-XXXXXX";
-  temp.fd = ::mkstemp(temp.name.data());
-  if (temp.fd < 0) {
-    temp.committed = true;  // nothing to remove
-    throw SystemError(errno, what + " (creating a temporary file in its directory failed)");
+  std::unique_ptr<FdStreamBuf> buffer;
+  std::unique_ptr<std::ostream> out;
+};
+
+AtomicFile::AtomicFile(const std::string& path) : state_(std::make_unique<State>()) {
+  if (path.empty()) throw InputError("path", "is empty; expected a file name");
+  State& s = *state_;
+  const size_t slash = path.rfind('/');
+  s.path = path;
+  s.dir = slash == std::string::npos ? "" : path.substr(0, slash + 1);
+  const std::string base = slash == std::string::npos ? path : path.substr(slash + 1);
+  s.what = "cannot write '" + path + "'";
+  struct stat existing;
+  s.mode = 0666 & ~CurrentUmask();
+  if (base.empty() || (::stat(path.c_str(), &existing) == 0 && S_ISDIR(existing.st_mode))) {
+    throw SystemError(EISDIR, s.what);
   }
-  {
-    FdStreamBuf buffer(temp.fd);
-    std::ostream out(&buffer);
-    try {
-      write(out);
-      out.flush();
-    } catch (...) {
-      // A failed write(2) is the cause, whatever the writer made of it: report its errno.
-      if (buffer.error() != 0) throw SystemError(buffer.error(), what);
-      throw;
+  if (::stat(path.c_str(), &existing) == 0) s.mode = existing.st_mode & 07777;
+  s.temp.name = s.dir + "." + base + ".tmp-XXXXXX";
+  s.temp.fd = ::mkstemp(s.temp.name.data());
+  if (s.temp.fd < 0) {
+    s.temp.committed = true;  // nothing to remove
+    throw SystemError(errno, s.what + " (creating a temporary file in its directory failed)");
+  }
+  s.buffer = std::make_unique<FdStreamBuf>(s.temp.fd);
+  s.out = std::make_unique<std::ostream>(s.buffer.get());
+}
+
+AtomicFile::~AtomicFile() = default;
+
+const std::string& AtomicFile::path() const { return state_->path; }
+const std::string& AtomicFile::directory() const { return state_->dir; }
+std::ostream& AtomicFile::stream() { return *state_->out; }
+uint64_t AtomicFile::position() const { return state_->buffer->position(); }
+
+std::system_error AtomicFile::Error(int fallback) const {
+  const int err = state_->buffer->error();
+  return SystemError(err != 0 ? err : fallback, state_->what);
+}
+
+void AtomicFile::Check() const {
+  if (!*state_->out || state_->buffer->error() != 0) throw Error();
+}
+
+void AtomicFile::WriteAt(uint64_t offset, const void* data, size_t size) {
+  State& s = *state_;
+  s.out->flush();
+  Check();
+  const char* p = static_cast<const char*>(data);
+  while (size > 0) {
+    const ssize_t n = ::pwrite(s.temp.fd, p, size, static_cast<off_t>(offset));
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw SystemError(errno, s.what);
     }
-    if (!out || buffer.error() != 0) throw SystemError(buffer.error(), what);
+    p += n;
+    offset += static_cast<uint64_t>(n);
+    size -= static_cast<size_t>(n);
   }
-  if (::fchmod(temp.fd, mode) != 0) throw SystemError(errno, what);
+}
+
+void AtomicFile::Commit() {
+  State& s = *state_;
+  s.out->flush();
+  Check();
+  if (::fchmod(s.temp.fd, s.mode) != 0) throw SystemError(errno, s.what);
   // Data on disk before the rename, so a crash leaves the old file or the whole new one.
-  if (::fsync(temp.fd) != 0 && errno != EINVAL && errno != EROFS) {
-    throw SystemError(errno, what);
+  if (::fsync(s.temp.fd) != 0 && errno != EINVAL && errno != EROFS) {
+    throw SystemError(errno, s.what);
   }
-  const int fd = temp.fd;
-  temp.fd = -1;
-  if (::close(fd) != 0) throw SystemError(errno, what);
-  if (std::rename(temp.name.c_str(), path.c_str()) != 0) throw SystemError(errno, what);
-  temp.committed = true;
+  const int fd = s.temp.fd;
+  s.temp.fd = -1;
+  if (::close(fd) != 0) throw SystemError(errno, s.what);
+  if (std::rename(s.temp.name.c_str(), s.path.c_str()) != 0) throw SystemError(errno, s.what);
+  s.temp.committed = true;
+}
+
+void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  AtomicFile file(path);
+  try {
+    write(file.stream());
+    file.stream().flush();
+  } catch (...) {
+    // A failed write(2) is the cause, whatever the writer made of it: report its errno.
+    file.Check();
+    throw;
+  }
+  file.Commit();
+}
+
+ScratchFile::ScratchFile(const std::string& directory, const std::string& what) : what_(what) {
+  std::string name = directory + ".flexkin-scratch-XXXXXX";
+  fd_ = ::mkstemp(name.data());
+  if (fd_ < 0)
+    throw SystemError(errno, what_ + " (creating a scratch file in its directory failed)");
+  ::unlink(name.c_str());
+  buffer_.reserve(1 << 16);
+}
+
+ScratchFile::~ScratchFile() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void ScratchFile::Drain() {
+  const char* p = buffer_.data();
+  size_t left = buffer_.size();
+  while (left > 0) {
+    const ssize_t n = ::write(fd_, p, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw SystemError(errno, what_);
+    }
+    p += n;
+    left -= static_cast<size_t>(n);
+  }
+  buffer_.clear();
+}
+
+void ScratchFile::Write(const void* data, size_t size) {
+  if (buffer_.size() + size > (1u << 16)) Drain();
+  if (size >= (1u << 16)) {
+    buffer_.assign(static_cast<const char*>(data), size);
+    Drain();
+  } else {
+    buffer_.append(static_cast<const char*>(data), size);
+  }
+  size_ += size;
+}
+
+void ScratchFile::CopyTo(const std::function<void(const char* data, size_t size)>& write) {
+  Drain();
+  std::vector<char> chunk(1 << 20);
+  uint64_t offset = 0;
+  while (offset < size_) {
+    const ssize_t n = ::pread(fd_, chunk.data(), chunk.size(), static_cast<off_t>(offset));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) throw SystemError(n < 0 ? errno : EIO, what_ + " (reading the scratch file back)");
+    write(chunk.data(), static_cast<size_t>(n));
+    offset += static_cast<uint64_t>(n);
+  }
 }
 
 }  // namespace flexkin

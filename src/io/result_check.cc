@@ -1,4 +1,6 @@
 // The one check of a result: what every reader and writer of results relies on (result_io.h).
+#include "io/result_check.h"
+
 #include <cmath>
 #include <optional>
 #include <string>
@@ -23,47 +25,52 @@ std::optional<Problem> NonFinite(const Eigen::Ref<const Eigen::VectorXd>& v,
   return std::nullopt;
 }
 
-std::optional<Problem> FirstProblem(const RunResult& r, int dim) {
+}  // namespace
+
+std::optional<Problem> ResultHeaderProblem(const Eigen::VectorXd& lengths, int dim) {
   if (dim != 2 && dim != 3) return Problem::Invalid("dim", std::to_string(dim), "2 or 3");
-  const Eigen::Index n = r.lengths.size();
+  const Eigen::Index n = lengths.size();
   if (n < 1) return Problem("link_lengths", "the result has no links; expected at least one");
   for (Eigen::Index i = 0; i < n; ++i) {
-    if (!(r.lengths[i] > 0.0) || !std::isfinite(r.lengths[i])) {
-      return Problem::Invalid(Index("link_lengths", i), FormatNumber(r.lengths[i]),
+    if (!(lengths[i] > 0.0) || !std::isfinite(lengths[i])) {
+      return Problem::Invalid(Index("link_lengths", i), FormatNumber(lengths[i]),
                               "a positive finite number");
     }
   }
-  if (r.frames.empty()) {
-    return Problem("frames", "the result has no frames; expected at least the initial frame");
+  return std::nullopt;
+}
+
+std::optional<Problem> ResultFrameProblem(size_t f, int64_t step, const Points& p,
+                                          const Eigen::VectorXd& link_angles, int64_t previous_step,
+                                          Eigen::Index n, int dim) {
+  const std::string field = Index("frames", static_cast<Eigen::Index>(f));
+  if (p.rows() != n + 1 || p.cols() != dim) {
+    return Problem(field + ".points", "is " + std::to_string(p.rows()) + " by " +
+                                          std::to_string(p.cols()) + "; expected " +
+                                          std::to_string(n + 1) + " by " + std::to_string(dim) +
+                                          " (one row per point, n+1 for n links)");
   }
-  for (size_t f = 0; f < r.frames.size(); ++f) {
-    const Frame& frame = r.frames[f];
-    const std::string field = Index("frames", static_cast<Eigen::Index>(f));
-    const Points& p = frame.points;
-    if (p.rows() != n + 1 || p.cols() != dim) {
-      return Problem(field + ".points", "is " + std::to_string(p.rows()) + " by " +
-                                            std::to_string(p.cols()) + "; expected " +
-                                            std::to_string(n + 1) + " by " + std::to_string(dim) +
-                                            " (one row per point, n+1 for n links)");
-    }
-    for (Eigen::Index i = 0; i <= n; ++i) {
-      if (auto problem = NonFinite(p.row(i).transpose(), Index(field + ".points", i))) {
-        return problem;
-      }
-    }
-    if (frame.link_angles.size() != 0 && frame.link_angles.size() != n) {
-      return Problem(field + ".link_angles", "has " + std::to_string(frame.link_angles.size()) +
-                                                 " values; expected one per link (" +
-                                                 std::to_string(n) + ") or none");
-    }
-    if (auto problem = NonFinite(frame.link_angles, field + ".link_angles")) return problem;
-    if (frame.step < 0 || (f > 0 && frame.step <= r.frames[f - 1].step)) {
-      return Problem(field + ".step",
-                     std::to_string(frame.step) +
-                         " is not valid; steps must be >= 0 and increase from frame to frame",
-                     std::to_string(frame.step), ">= 0 and above the previous frame's");
+  for (Eigen::Index i = 0; i <= n; ++i) {
+    if (auto problem = NonFinite(p.row(i).transpose(), Index(field + ".points", i))) {
+      return problem;
     }
   }
+  if (link_angles.size() != 0 && link_angles.size() != n) {
+    return Problem(field + ".link_angles", "has " + std::to_string(link_angles.size()) +
+                                               " values; expected one per link (" +
+                                               std::to_string(n) + ") or none");
+  }
+  if (auto problem = NonFinite(link_angles, field + ".link_angles")) return problem;
+  if (step < 0 || step <= previous_step) {
+    return Problem(
+        field + ".step",
+        std::to_string(step) + " is not valid; steps must be >= 0 and increase from frame to frame",
+        std::to_string(step), ">= 0 and above the previous frame's");
+  }
+  return std::nullopt;
+}
+
+std::optional<Problem> ResultSummaryProblem(const RunResult& r) {
   const Metrics& m = r.metrics;
   const std::pair<const char*, const Eigen::VectorXd*> vectors[] = {
       {"metrics.l2_per_step", &m.l2_per_step},
@@ -85,6 +92,24 @@ std::optional<Problem> FirstProblem(const RunResult& r, int dim) {
     if (!std::isfinite(x)) return Problem::Invalid(name, FormatNumber(x), "a finite number");
   }
   return std::nullopt;
+}
+
+namespace {
+
+std::optional<Problem> FirstProblem(const RunResult& r, int dim) {
+  if (auto problem = ResultHeaderProblem(r.lengths, dim)) return problem;
+  if (r.frames.empty()) {
+    return Problem("frames", "the result has no frames; expected at least the initial frame");
+  }
+  for (size_t f = 0; f < r.frames.size(); ++f) {
+    const Frame& frame = r.frames[f];
+    if (auto problem =
+            ResultFrameProblem(f, frame.step, frame.points, frame.link_angles,
+                               f > 0 ? r.frames[f - 1].step : -1, r.lengths.size(), dim)) {
+      return problem;
+    }
+  }
+  return ResultSummaryProblem(r);
 }
 
 }  // namespace

@@ -1,3 +1,5 @@
+#include <cstdio>
+#include <cstring>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
@@ -71,8 +73,8 @@ Points ReadPoints(const json& v, const std::string& ptr, Eigen::Index rows, int 
 
 }  // namespace
 
-ResultFile ResultFromJson(const json& j) {
-  ResultFile file;
+void ReadResultSummary(const json& j, const ResultArrays* arrays, ResultFile* out) {
+  ResultFile& file = *out;
   RunResult& r = file.result;
   const json& format = Member(j, "", "format");
   if (format != kResultFormat) {
@@ -95,7 +97,8 @@ ResultFile ResultFromJson(const json& j) {
   file.dim = static_cast<int>(ReadInteger(Member(j, "", "dim"), "/dim", 2));
   if (file.dim > 3)
     throw InputError("/dim", "value " + std::to_string(file.dim) + " is not 2 or 3");
-  r.lengths = ReadVector(Member(j, "", "link_lengths"), "/link_lengths", -1);
+  r.lengths =
+      arrays ? arrays->lengths : ReadVector(Member(j, "", "link_lengths"), "/link_lengths", -1);
   const Eigen::Index n = r.lengths.size();
   r.num_steps = ReadInteger(Member(j, "", "num_steps"), "/num_steps", 0);
 
@@ -143,13 +146,26 @@ ResultFile ResultFromJson(const json& j) {
       ReadNumber(Member(metrics, "/metrics", "l2_weighted_total"), "/metrics/l2_weighted_total");
   m.max_relative_length_error = ReadNumber(Member(metrics, "/metrics", "max_relative_length_error"),
                                            "/metrics/max_relative_length_error");
-  m.path_length =
-      ReadVector(Member(metrics, "/metrics", "path_length"), "/metrics/path_length", n + 1);
-  m.l2_per_step =
-      ReadVector(Member(metrics, "/metrics", "l2_per_step"), "/metrics/l2_per_step", r.num_steps);
-  m.l2_weighted_per_step = ReadVector(Member(metrics, "/metrics", "l2_weighted_per_step"),
-                                      "/metrics/l2_weighted_per_step", r.num_steps);
+  if (arrays != nullptr) {
+    m.path_length = arrays->path_length;
+    m.l2_per_step = arrays->l2_per_step;
+    m.l2_weighted_per_step = arrays->l2_weighted_per_step;
+  } else {
+    m.path_length =
+        ReadVector(Member(metrics, "/metrics", "path_length"), "/metrics/path_length", n + 1);
+    m.l2_per_step =
+        ReadVector(Member(metrics, "/metrics", "l2_per_step"), "/metrics/l2_per_step", r.num_steps);
+    m.l2_weighted_per_step = ReadVector(Member(metrics, "/metrics", "l2_weighted_per_step"),
+                                        "/metrics/l2_weighted_per_step", r.num_steps);
+  }
   if (const auto it = j.find("seconds"); it != j.end()) r.seconds = ReadNumber(*it, "/seconds");
+}
+
+ResultFile ResultFromJson(const json& j) {
+  ResultFile file;
+  RunResult& r = file.result;
+  ReadResultSummary(j, nullptr, &file);
+  const Eigen::Index n = r.lengths.size();
 
   const json& frames = Member(j, "", "frames");
   if (!frames.is_array() || frames.empty()) {
@@ -175,6 +191,16 @@ ResultFile ResultFromJson(const json& j) {
 }
 
 ResultFile ReadResultJson(const std::string& path) { return ResultFromJson(ReadJsonFile(path)); }
+
+ResultFile ReadResultFile(const std::string& path) {
+  char magic[4] = {0, 0, 0, 0};
+  if (std::FILE* file = std::fopen(path.c_str(), "rb")) {
+    const size_t n = std::fread(magic, 1, sizeof magic, file);
+    std::fclose(file);
+    if (n == sizeof magic && std::memcmp(magic, "PK\x03\x04", 4) == 0) return ReadNpzResult(path);
+  }
+  return ReadResultJson(path);  // reports a file that cannot be read
+}
 
 ResultFile ResultFromText(const std::string& json_text) {
   return ResultFromJson(ParseJsonText(json_text));

@@ -1,0 +1,116 @@
+#pragma once
+// NumPy .npz archives, written and read without NumPy (docs/result-format.md, "npz"): a ZIP archive
+// (stored, uncompressed members; ZIP64 records throughout, so that members and archives over
+// 4 GiB work) of .npy arrays (format 1.0: a dict header with descr, fortran_order and shape,
+// padded so that the data starts 64-byte aligned in the member). Private to the library and its
+// tests.
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "io/atomic_file.h"
+
+namespace flexkin {
+
+// The .npy header of an array of `descr` ("<f8", "<i8") in C order with `shape`, padded with
+// spaces to `length` bytes (0: the smallest multiple of 64 that holds it).
+std::string NpyHeader(const std::string& descr, const std::vector<uint64_t>& shape,
+                      size_t length = 0);
+
+// Writes the members of a ZIP archive one after another into `file`: each member's data streams
+// through Write, its CRC-32 computed on the way; its local header's sizes and CRC are patched when
+// it ends. A member may start with a provisional prefix (an .npy header whose shape is not known
+// yet) that EndMember replaces by one of the same length.
+class ZipWriter {
+ public:
+  explicit ZipWriter(AtomicFile* file) : file_(file) {}
+  void BeginMember(const std::string& name, const std::string& prefix = "");
+  void Write(const void* data, size_t size);
+  // Ends the member; `final_prefix` replaces the prefix given to BeginMember (same length; ""
+  // keeps it).
+  void EndMember(const std::string& final_prefix = "");
+  // A whole member at once.
+  void AddMember(const std::string& name, const std::string& data);
+  // The central directory and the end records. The archive is complete after this.
+  void Finish();
+  // Bytes of the current member written so far, prefix included.
+  uint64_t member_size() const { return size_; }
+
+ private:
+  struct Entry {
+    std::string name;
+    uint64_t offset = 0, size = 0;
+    uint32_t crc = 0;
+  };
+  AtomicFile* file_;
+  std::vector<Entry> entries_;
+  bool open_ = false;
+  std::string prefix_;
+  uint64_t offset_ = 0, size_ = 0;
+  unsigned long body_crc_ = 0;
+};
+
+// A ZIP archive read member by member (stored members only). Every structure is checked against
+// the file's size before it is used: a malformed archive throws InputError naming the structure
+// ("zip: end of central directory") or the member ("frames.npy"), never reads out of bounds.
+class ZipReader {
+ public:
+  // Throws std::system_error if the file cannot be read, InputError if it is not a valid archive.
+  explicit ZipReader(const std::string& path);
+  ~ZipReader();
+  ZipReader(const ZipReader&) = delete;
+  ZipReader& operator=(const ZipReader&) = delete;
+
+  bool Has(const std::string& name) const { return members_.count(name) > 0; }
+
+  // Reads a member sequentially: Read fills exactly `size` bytes (InputError if the member ends
+  // first); Finish checks that the member was read whole and that its CRC-32 matches.
+  class Member {
+   public:
+    Member(const ZipReader* zip, const std::string& name);
+    uint64_t size() const { return size_; }
+    uint64_t left() const { return size_ - consumed_; }
+    void Read(void* out, size_t size);
+    void Finish();
+
+   private:
+    const ZipReader* zip_;
+    std::string name_;
+    uint64_t start_ = 0, size_ = 0, loaded_ = 0, consumed_ = 0;
+    uint32_t expected_crc_ = 0;
+    unsigned long crc_ = 0;
+    std::vector<char> buffer_;
+    size_t buffer_pos_ = 0;
+  };
+
+  // A whole member, at most `max_size` bytes.
+  std::string ReadWhole(const std::string& name, uint64_t max_size);
+
+ private:
+  struct Entry {
+    uint64_t local_offset = 0, size = 0;
+    uint32_t crc = 0;
+  };
+  void ReadAt(uint64_t offset, void* out, size_t size, const std::string& what) const;
+  int fd_ = -1;
+  std::string path_;
+  uint64_t file_size_ = 0, members_end_ = 0;  // members lie in [0, members_end_)
+  std::map<std::string, Entry> members_;
+};
+
+// An .npy member's header, read and checked: descr, fortran_order False, shape.
+struct NpyArray {
+  std::string descr;
+  std::vector<uint64_t> shape;
+  uint64_t count = 0;  // product of shape
+};
+// Reads the header of the .npy member being read by `member` (left at the first data byte) and
+// checks that the member holds exactly count * 8 data bytes after it and that descr is `descr`.
+// InputError named `name`.
+NpyArray ReadNpyHeader(ZipReader::Member* member, const std::string& name,
+                       const std::string& descr);
+
+}  // namespace flexkin

@@ -1,0 +1,456 @@
+// Tests of the streaming result writers and the .npz result format: the npz reads back bit for
+// bit (and numpy.load reads it as the JSON of the same run says), the streamed JSON parses to
+// WriteResultJson's document, a failed or abandoned write leaves nothing behind and an existing
+// file untouched, a corrupted npz is an InputError (never a crash), and the size estimate is
+// within a factor of the files written.
+#include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "flexkin/chain.h"
+#include "flexkin/error.h"
+#include "flexkin/result_io.h"
+#include "flexkin/run.h"
+#include "flexkin/scenario.h"
+#include "test_util.h"
+
+namespace flexkin {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using test_util::ReadFile;
+
+class TempDir {
+ public:
+  // In memory where there is a tmpfs (the corruption test writes thousands of small files).
+  explicit TempDir(bool memory = false) {
+    const fs::path base = memory && fs::is_directory("/dev/shm") && ::access("/dev/shm", W_OK) == 0
+                              ? fs::path("/dev/shm")
+                              : fs::temp_directory_path();
+    std::string name = (base / "flexkin_npz_XXXXXX").string();
+    path_ = ::mkdtemp(name.data());
+  }
+  ~TempDir() { fs::remove_all(path_); }
+  std::string operator/(const std::string& name) const { return path_ + "/" + name; }
+  const std::string& path() const { return path_; }
+  std::vector<std::string> Files() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(path_)) names.push_back(e.path().filename());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+
+ private:
+  std::string path_;
+};
+
+void WriteText(const std::string& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+void ExpectSameBits(const Eigen::Ref<const Eigen::VectorXd>& a,
+                    const Eigen::Ref<const Eigen::VectorXd>& b, const std::string& what) {
+  ASSERT_EQ(a.size(), b.size()) << what;
+  for (Eigen::Index i = 0; i < a.size(); ++i) {
+    ASSERT_TRUE(SameBits(a[i], b[i])) << what << "[" << i << "]: " << a[i] << " vs " << b[i];
+  }
+}
+
+void ExpectSameFrames(const RunResult& a, const RunResult& b) {
+  ASSERT_EQ(a.frames.size(), b.frames.size());
+  for (size_t f = 0; f < a.frames.size(); ++f) {
+    EXPECT_EQ(a.frames[f].step, b.frames[f].step);
+    const Points &p = a.frames[f].points, &q = b.frames[f].points;
+    ASSERT_EQ(p.rows(), q.rows());
+    ASSERT_EQ(p.cols(), q.cols());
+    ExpectSameBits(Eigen::Map<const Eigen::VectorXd>(p.data(), p.size()),
+                   Eigen::Map<const Eigen::VectorXd>(q.data(), q.size()),
+                   "frame " + std::to_string(f));
+    ExpectSameBits(a.frames[f].link_angles, b.frames[f].link_angles, "angles");
+  }
+}
+
+void ExpectSameResult(const ResultFile& back, const RunResult& r, int dim,
+                      const std::string& name) {
+  EXPECT_EQ(back.dim, dim);
+  EXPECT_EQ(back.scenario_name, name);
+  EXPECT_EQ(back.result.method, r.method);
+  EXPECT_EQ(back.result.num_steps, r.num_steps);
+  ExpectSameBits(back.result.lengths, r.lengths, "lengths");
+  ExpectSameFrames(back.result, r);
+  const Metrics &m = back.result.metrics, &n = r.metrics;
+  ExpectSameBits(m.l2_per_step, n.l2_per_step, "l2_per_step");
+  ExpectSameBits(m.l2_weighted_per_step, n.l2_weighted_per_step, "l2_weighted_per_step");
+  ExpectSameBits(m.path_length, n.path_length, "path_length");
+  EXPECT_TRUE(SameBits(m.l2_total, n.l2_total));
+  EXPECT_TRUE(SameBits(m.l2_weighted_total, n.l2_weighted_total));
+  EXPECT_TRUE(SameBits(m.max_relative_length_error, n.max_relative_length_error));
+  EXPECT_TRUE(SameBits(back.result.accuracy.estimated_error, r.accuracy.estimated_error));
+  EXPECT_TRUE(SameBits(back.result.accuracy.tolerance, r.accuracy.tolerance));
+  EXPECT_EQ(back.result.accuracy.enabled, r.accuracy.enabled);
+  EXPECT_EQ(back.result.accuracy.substeps, r.accuracy.substeps);
+  EXPECT_EQ(back.result.accuracy.max_substeps, r.accuracy.max_substeps);
+  EXPECT_EQ(back.result.accuracy.met, r.accuracy.met);
+  EXPECT_EQ(back.result.overall.solves, r.overall.solves);
+  EXPECT_EQ(back.result.overall.iterations, r.overall.iterations);
+  EXPECT_TRUE(SameBits(back.result.overall.optimality, r.overall.optimality));
+  for (const auto& [term, term_name, summary] : Vocabulary<ObjectiveTerm>::kEntries) {
+    EXPECT_TRUE(SameBits(back.result.weights[term], r.weights[term])) << term_name;
+  }
+  EXPECT_TRUE(SameBits(back.result.seconds, r.seconds));
+}
+
+Scenario Example(const std::string& name) {
+  return LoadScenarioFile(std::string(FLEXKIN_SOURCE_DIR) + "/examples/" + name);
+}
+
+// A run whose numbers are awkward: random finite bit patterns, negative zero, subnormals.
+RunResult AwkwardResult(int dim, uint64_t seed) {
+  const Chain chain = MakeChain(Points::Random(6, dim));
+  RunOptions options;
+  options.tolerance = 1e-3;
+  RunResult r = flexkin::Run(chain, Points::Random(4, dim), options);
+  std::mt19937_64 rng(seed);
+  const double specials[] = {-0.0, 5e-324, std::numeric_limits<double>::max(), -1e300};
+  size_t next = 0;
+  auto awkward = [&](double* x) {
+    if (next < std::size(specials)) {
+      *x = specials[next++];
+      return;
+    }
+    do {
+      const uint64_t bits = rng();
+      std::memcpy(x, &bits, sizeof *x);
+    } while (!std::isfinite(*x));
+  };
+  for (Frame& f : r.frames) {
+    for (Eigen::Index i = 0; i < f.points.size(); ++i) awkward(f.points.data() + i);
+    for (Eigen::Index i = 0; i < f.link_angles.size(); ++i) awkward(f.link_angles.data() + i);
+  }
+  for (Eigen::Index i = 0; i < r.metrics.path_length.size(); ++i) {
+    awkward(r.metrics.path_length.data() + i);
+  }
+  awkward(&r.metrics.l2_total);
+  awkward(&r.accuracy.estimated_error);
+  return r;
+}
+
+TEST(ResultNpzTest, RoundTripIsBitExact) {
+  TempDir dir;
+  for (int dim : {2, 3}) {
+    const RunResult r = AwkwardResult(dim, 11 + dim);
+    WriteResultFile(r, dir / "r.npz", ResultFileFormat::kNpz, "awkward \"name\"");
+    ExpectSameResult(ReadResultFile(dir / "r.npz"), r, dim, "awkward \"name\"");
+  }
+  // The overall method (its report and weights) and frames without link angles.
+  const Scenario s = Example("fig06_parabola_overall_multi_step.json");
+  RunResult r = flexkin::Run(s.chain, s.leader_steps, s.options);
+  ASSERT_EQ(r.method, Method::kOverall);
+  WriteResultFile(r, dir / "overall.npz", ResultFileFormat::kNpz, s.name);
+  ExpectSameResult(ReadResultFile(dir / "overall.npz"), r, 2, s.name);
+  for (Frame& f : r.frames) f.link_angles.resize(0);
+  WriteResultFile(r, dir / "no_angles.npz", ResultFileFormat::kNpz);
+  ExpectSameResult(ReadResultFile(dir / "no_angles.npz"), r, 2, "");
+  // ReadResultFile reads JSON too, as ReadResultJson does.
+  WriteResultJson(r, dir / "no_angles.json");
+  ExpectSameResult(ReadResultFile(dir / "no_angles.json"), r, 2, "");
+}
+
+// Streams a plain run's frames and result through a ResultFileWriter.
+void Stream(const RunResult& r, const std::string& path, ResultFileFormat format,
+            const std::string& name) {
+  ResultHeader header;
+  header.method = r.method;
+  header.dim = static_cast<int>(r.frames[0].points.cols());
+  header.lengths = r.lengths;
+  header.scenario_name = name;
+  ResultFileWriter writer(path, format, header);
+  for (const Frame& f : r.frames) writer.Add(f.step, f.points, f.link_angles);
+  EXPECT_EQ(writer.frames(), static_cast<int64_t>(r.frames.size()));
+  writer.Commit(r);
+}
+
+TEST(ResultStreamTest, StreamedJsonParsesAsWriteResultJson) {
+  TempDir dir;
+  for (const char* name : {"fig06_parabola_multi_step.json",
+                           "fig06_parabola_overall_multi_step.json", "fig12_spatial_curve.json"}) {
+    const Scenario s = Example(name);
+    const RunResult r = flexkin::Run(s.chain, s.leader_steps, s.options);
+    std::ostringstream whole;
+    WriteResultJson(r, whole, s.name);
+    Stream(r, dir / "streamed.json", ResultFileFormat::kJson, s.name);
+    EXPECT_EQ(json::parse(ReadFile(dir / "streamed.json")), json::parse(whole.str())) << name;
+    // Through Run's sink, as the command line does: the same but for the timing.
+    {
+      ResultFileWriter writer(dir / "run.json", ResultFileFormat::kJson,
+                              MakeResultHeader(s.chain, s.options, s.name));
+      const RunResult streamed = flexkin::Run(s.chain, s.leader_steps, s.options, &writer);
+      EXPECT_TRUE(streamed.frames.empty());
+      writer.Commit(streamed);
+    }
+    json a = json::parse(ReadFile(dir / "run.json")), b = json::parse(whole.str());
+    a.erase("seconds");
+    b.erase("seconds");
+    EXPECT_EQ(a, b) << name;
+    // And the npz of the same run reads back as the JSON does.
+    Stream(r, dir / "streamed.npz", ResultFileFormat::kNpz, s.name);
+    ExpectSameResult(ReadResultFile(dir / "streamed.npz"), r, s.chain.dim(), s.name);
+  }
+  EXPECT_EQ(dir.Files(), (std::vector<std::string>{"run.json", "streamed.json", "streamed.npz"}));
+}
+
+TEST(ResultStreamTest, CsvWriterWritesWhatWriteFramesCsvWrites) {
+  TempDir dir;
+  const Scenario s = Example("fig12_spatial_curve.json");
+  const RunResult r = flexkin::Run(s.chain, s.leader_steps, s.options);
+  FramesCsvWriter csv(dir / "run.csv", 3);
+  const RunResult streamed = flexkin::Run(s.chain, s.leader_steps, s.options, &csv);
+  csv.Commit();
+  WriteFramesCsv(r, dir / "whole.csv");
+  EXPECT_EQ(ReadFile(dir / "run.csv"), ReadFile(dir / "whole.csv"));
+}
+
+TEST(ResultStreamTest, NonFiniteFrameStopsTheRunAndWritesNothing) {
+  TempDir dir;
+  for (ResultFileFormat format : {ResultFileFormat::kJson, ResultFileFormat::kNpz}) {
+    const std::string path = dir / (std::string("r.") + ResultFileFormatName(format));
+    WriteText(path, "old");
+    const Scenario s = Example("fig06_parabola_multi_step.json");
+    const RunResult r = flexkin::Run(s.chain, s.leader_steps, s.options);
+    ResultHeader header = MakeResultHeader(s.chain, s.options);
+    test_util::ExpectInputError(
+        [&] {
+          ResultFileWriter writer(path, format, header);
+          writer.Add(0, r.frames[0].points, r.frames[0].link_angles);
+          Points bad = r.frames[1].points;
+          bad(2, 1) = std::numeric_limits<double>::quiet_NaN();
+          writer.Add(1, bad, r.frames[1].link_angles);
+        },
+        "frames[1].points[2][1]", "nothing was written");
+    // A run that throws (here: a sink after the writer that fails at frame 3) leaves nothing.
+    struct Failing : FrameSink {
+      ResultFileWriter* writer;
+      void Add(int64_t step, const Points& p, const Eigen::VectorXd& a) override {
+        writer->Add(step, p, a);
+        if (step == 3) throw std::runtime_error("stop");
+      }
+    };
+    {
+      ResultFileWriter writer(path, format, header);
+      Failing sink;
+      sink.writer = &writer;
+      EXPECT_THROW(flexkin::Run(s.chain, s.leader_steps, s.options, &sink), std::runtime_error);
+    }
+    // Commit of a result that does not match the header.
+    {
+      ResultFileWriter writer(path, format, header);
+      writer.Add(0, r.frames[0].points, r.frames[0].link_angles);
+      RunResult other = r;
+      other.method = Method::kFollowTheLeader;
+      test_util::ExpectInputError([&] { writer.Commit(other); }, "method", "nothing was written");
+    }
+    EXPECT_EQ(ReadFile(path), "old");
+    EXPECT_EQ(dir.Files().size(), format == ResultFileFormat::kJson ? 1u : 2u);
+  }
+}
+
+// A write that fails half way (the file size limit, in a child process) leaves the old file
+// byte-identical and no temporary file, for both formats and for small and large results.
+TEST(ResultStreamTest, FailedWriteKeepsTheOldFile) {
+  TempDir dir;
+  const Scenario big = Example("fig10_planar_curve.json");
+  const RunResult results[] = {AwkwardResult(3, 5),
+                               flexkin::Run(big.chain, big.leader_steps, big.options)};
+  for (ResultFileFormat format : {ResultFileFormat::kJson, ResultFileFormat::kNpz}) {
+    for (const RunResult& r : results) {
+      const std::string path = dir / "result";
+      WriteText(path, "old");
+      const pid_t child = ::fork();
+      ASSERT_GE(child, 0);
+      if (child == 0) {
+        std::signal(SIGXFSZ, SIG_IGN);
+        rlimit small;
+        ::getrlimit(RLIMIT_FSIZE, &small);
+        small.rlim_cur = 1024;
+        ::setrlimit(RLIMIT_FSIZE, &small);
+        try {
+          WriteResultFile(r, path, format);
+        } catch (const std::system_error& e) {
+          std::_Exit(e.code() == std::errc::file_too_large ? 0 : 2);
+        } catch (...) {
+          std::_Exit(3);
+        }
+        std::_Exit(1);
+      }
+      int status = 0;
+      ASSERT_EQ(::waitpid(child, &status, 0), child);
+      ASSERT_TRUE(WIFEXITED(status));
+      EXPECT_EQ(WEXITSTATUS(status), 0) << ResultFileFormatName(format);
+      EXPECT_EQ(ReadFile(path), "old");
+      EXPECT_EQ(dir.Files(), std::vector<std::string>{"result"});
+    }
+  }
+}
+
+// Cut at every offset, and every byte flipped: InputError or, where the flipped byte is one that
+// readers ignore (a date, a version), the same frames; never a crash or another exception.
+TEST(ResultNpzTest, CorruptedFilesAreInputErrors) {
+  TempDir dir(true);
+  const Scenario s = Example("fig06_parabola_multi_step.json");
+  RunResult r = flexkin::Run(s.chain, s.leader_steps, s.options);
+  r.frames.resize(3);
+  WriteResultFile(r, dir / "good.npz", ResultFileFormat::kNpz, s.name);
+  const std::string good = ReadFile(dir / "good.npz");
+  const std::string path = dir / "bad.npz";
+  int errors = 0, successes = 0;
+  auto check = [&](const std::string& bytes, const std::string& what) {
+    WriteText(path, bytes);
+    try {
+      const ResultFile back = ReadResultFile(path);
+      ++successes;
+      RunResult expected;
+      expected.frames = r.frames;
+      if (!back.result.frames.empty() && back.result.frames[0].link_angles.size() == 0) {
+        for (Frame& f : expected.frames) f.link_angles.resize(0);  // its member's name was hit
+      }
+      ExpectSameFrames(back.result, expected);
+    } catch (const InputError& e) {
+      ++errors;
+      EXPECT_FALSE(std::string(e.what()).empty()) << what;
+    }
+  };
+  for (size_t cut = 0; cut < good.size(); ++cut) check(good.substr(0, cut), "cut");
+  EXPECT_EQ(successes, 0) << "a truncated file was read";
+  for (size_t i = 0; i < good.size(); ++i) {
+    std::string bytes = good;
+    bytes[i] = static_cast<char>(bytes[i] ^ 0x5a);
+    check(bytes, "byte " + std::to_string(i));
+  }
+  EXPECT_GT(errors, static_cast<int>(good.size() * 18 / 10)) << successes << " flips were read";
+  // Hand-made corruptions: a shape far too large, a member compressed, a huge directory.
+  auto replace = [&](const std::string& from, const std::string& to) {
+    std::string bytes = good;
+    const size_t at = bytes.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    bytes.replace(at, from.size(), to);
+    return bytes;
+  };
+  test_util::ExpectInputError(
+      [&] {  // the same length: the provisional header's spaces make room
+        WriteText(path,
+                  replace("'shape': (3, 21, 2), }          ", "'shape': (9999999999999, 21, 2)}"));
+        ReadResultFile(path);
+      },
+      "frames.npy");
+  test_util::ExpectInputError(
+      [&] {
+        WriteText(path, replace("'descr': '<f8', 'fortran_order': False, 'shape': (3, 21",
+                                "'descr': '<f4', 'fortran_order': False, 'shape': (3, 21"));
+        ReadResultFile(path);
+      },
+      "frames.npy");
+}
+
+TEST(ResultNpzTest, NumpyReadsWhatTheJsonOfTheSameRunSays) {
+  if (std::system("/usr/bin/python3 -c 'import numpy' > /dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "/usr/bin/python3 has no numpy (Debian package python3-numpy, installed by "
+                    "scripts/install-deps.sh)";
+  }
+  TempDir dir;
+  for (const char* name : {"fig06_parabola_overall_multi_step.json", "fig12_spatial_curve.json"}) {
+    const Scenario s = Example(name);
+    const RunResult r = flexkin::Run(s.chain, s.leader_steps, s.options);
+    WriteResultFile(r, dir / "r.npz", ResultFileFormat::kNpz, s.name);
+    WriteResultFile(r, dir / "r.json", ResultFileFormat::kJson, s.name);
+    const std::string script = dir / "check.py";
+    WriteText(script, R"(
+import json, sys
+import numpy as np
+r = np.load(sys.argv[1])
+j = json.load(open(sys.argv[2]))
+s = json.loads(r["result.json"])
+frames = np.array([f["points"] for f in j["frames"]], dtype=np.float64)
+assert r["frames"].dtype == np.float64 and r["frames"].shape == frames.shape, r["frames"].shape
+assert (r["frames"] == frames).all()
+assert r["steps"].dtype == np.int64 and list(r["steps"]) == [f["step"] for f in j["frames"]]
+assert (r["link_angles"] == np.array([f["link_angles"] for f in j["frames"]])).all()
+assert list(r["link_lengths"]) == j["link_lengths"]
+for key in ("l2_per_step", "l2_weighted_per_step", "path_length"):
+    assert list(r[key]) == j["metrics"][key], key
+    del j["metrics"][key]
+del j["frames"], j["link_lengths"]
+assert s.pop("num_frames") == len(frames) and s.pop("link_angles") is True
+assert s == j, (s, j)
+print("ok", r["frames"].shape)
+)");
+    const std::string command = "/usr/bin/python3 '" + script + "' '" + (dir / "r.npz") + "' '" +
+                                (dir / "r.json") + "' > '" + (dir / "out.txt") + "' 2>&1";
+    EXPECT_EQ(std::system(command.c_str()), 0) << name << ": " << ReadFile(dir / "out.txt");
+  }
+}
+
+TEST(ResultEstimateTest, FramesExactAndBytesWithinAFactorOfTheFiles) {
+  TempDir dir;
+  struct Case {
+    const char* name;
+    int record_every;
+  };
+  for (const Case& c :
+       {Case{"fig06_parabola_multi_step.json", 1}, Case{"fig10_planar_curve.json", 1},
+        Case{"fig10_planar_curve.json", 7}, Case{"fig12_spatial_curve.json", 50},
+        Case{"fig06_parabola_overall_multi_step.json", 2}}) {
+    Scenario s = Example(c.name);
+    s.options.record_every = c.record_every;
+    const RunResult r = flexkin::Run(s.chain, s.leader_steps, s.options);
+    const ResultSizeEstimate e =
+        EstimateResultSize(s.chain.num_links(), s.chain.dim(), s.leader_steps.rows(), s.options);
+    EXPECT_EQ(e.frames, static_cast<int64_t>(r.frames.size())) << c.name;
+    EXPECT_EQ(CountRecordedFrames(s.leader_steps.rows(), c.record_every), e.frames);
+    for (ResultFileFormat format : {ResultFileFormat::kJson, ResultFileFormat::kNpz}) {
+      const std::string path = dir / (std::string("r.") + ResultFileFormatName(format));
+      WriteResultFile(r, path, format, s.name);
+      const double actual = static_cast<double>(fs::file_size(path));
+      const double estimate = static_cast<double>(e.bytes(format));
+      EXPECT_EQ(EstimateResultBytes(s.chain.num_links(), s.chain.dim(), s.leader_steps.rows(),
+                                    s.options, format),
+                e.bytes(format));
+      EXPECT_LT(estimate, 1.5 * actual) << c.name << " " << ResultFileFormatName(format);
+      EXPECT_GT(estimate, actual / 1.5) << c.name << " " << ResultFileFormatName(format);
+    }
+    WriteFramesCsv(r, dir / "r.csv");
+    const double csv = static_cast<double>(fs::file_size(dir / "r.csv"));
+    EXPECT_LT(e.csv_bytes, 1.5 * csv) << c.name;
+    EXPECT_GT(e.csv_bytes, csv / 1.5) << c.name;
+  }
+  EXPECT_EQ(CountRecordedFrames(0, 1), 1);
+  EXPECT_EQ(CountRecordedFrames(10, 3), 5);  // 0, 3, 6, 9, 10
+  EXPECT_EQ(CountRecordedFrames(9, 3), 4);   // 0, 3, 6, 9
+}
+
+TEST(ResultFormatTest, FormatFromTheExtension) {
+  EXPECT_EQ(ResultFileFormatOfPath("a/b.json"), ResultFileFormat::kJson);
+  EXPECT_EQ(ResultFileFormatOfPath("B.NPZ"), ResultFileFormat::kNpz);
+  test_util::ExpectInputError([] { ResultFileFormatOfPath("r.csv", "-o"); }, "-o", ".npz");
+  test_util::ExpectInputError([] { ResultFileFormatOfPath("dir.json/r", "-o"); }, "-o",
+                              "no extension");
+}
+
+}  // namespace
+}  // namespace flexkin
