@@ -9,7 +9,9 @@
 // sample of the result (arrays longer than 48 elements thinned to every k-th element and the
 // last), which locates a difference when the hash differs. With the SIMD engines the machine has
 // (FLEXKIN_SIMD unset), every number must be within 1e-14 of the scalar run's (relative to its
-// magnitude, absolute below 1), and every integer, flag and string the same. The fixed-base arms'
+// magnitude, absolute below 1), and every integer, flag and string the same; the frames' points
+// to 1e-14 of the frame's magnitude, their link angles and the per-step L2 sums within the bounds
+// that gives them (CompareFrames). The fixed-base arms'
 // SIMD path (src/arm/lanes.cc, AVX2 and FMA) solves each step to the solver's tolerance by another
 // sequence of iterates, so its result is not the scalar one to 1e-14 (joint angles differ by up to
 // 1e-11, iteration counts by one): for robot scenarios that path is pinned by a hash of its own,
@@ -262,6 +264,86 @@ TEST_P(GoldenTest, ScalarEngineGivesThePinnedResultBitForBit) {
       << (diffs.empty() ? " outside the sample" : "");
 }
 
+// The frames: every coordinate of a frame is computed with the others, so its rounding is that of
+// the frame's magnitude X (its largest coordinate, at least 1), not its own: a coordinate near 0
+// in a chain far from the origin differs by ulps of X. Points are checked to 1e-14 X. Link angles
+// are computed from the points: a difference of d in a point turns its link by up to d / L, so
+// they are checked to 2e-14 X / L (both ends of the link may move). Both are then removed so that
+// Compare sees the rest (metrics, reports) with its own tolerance.
+void CompareFrames(json* simd, json* scalar, std::vector<std::string>* diffs, double* worst) {
+  if (!scalar->contains("frames") || !simd->contains("frames")) return;
+  const json& lengths = (*scalar)["link_lengths"];
+  json& a_frames = (*simd)["frames"];
+  json& g_frames = (*scalar)["frames"];
+  if (a_frames.size() != g_frames.size()) return;  // Compare reports it
+  auto check = [&](double a, double g, double bound, const std::string& where) {
+    const double err = std::abs(a - g);
+    *worst = std::max(*worst, err / bound * 1e-14);
+    if (!(err <= bound) && diffs->size() < 10) {
+      diffs->push_back(where + ": " + json(a).dump() + " differs from " + json(g).dump() + " by " +
+                       test_util::Str(err) + " > " + test_util::Str(bound));
+    }
+  };
+  double run_magnitude = 1.0;
+  for (const json& frame : g_frames) {
+    for (const json& point : frame["points"]) {
+      for (const json& x : point)
+        run_magnitude = std::max(run_magnitude, std::abs(x.get<double>()));
+    }
+  }
+  for (size_t f = 0; f < g_frames.size(); ++f) {
+    json& a = a_frames[f];
+    json& g = g_frames[f];
+    const std::string where = "/frames/" + std::to_string(f);
+    double magnitude = 1.0;
+    for (const json& point : g["points"]) {
+      for (const json& x : point) magnitude = std::max(magnitude, std::abs(x.get<double>()));
+    }
+    if (a["points"].size() != g["points"].size()) continue;
+    for (size_t i = 0; i < g["points"].size(); ++i) {
+      if (a["points"][i].size() != g["points"][i].size()) continue;
+      for (size_t k = 0; k < g["points"][i].size(); ++k) {
+        check(a["points"][i][k].get<double>(), g["points"][i][k].get<double>(), 1e-14 * magnitude,
+              where + "/points/" + std::to_string(i) + "/" + std::to_string(k));
+      }
+    }
+    a.erase("points");
+    g.erase("points");
+    if (!a.contains("link_angles") || !g.contains("link_angles")) continue;
+    const json& a_angles = a["link_angles"];
+    const json& g_angles = g["link_angles"];
+    if (a_angles.size() != g_angles.size()) continue;
+    for (size_t i = 0; i < g_angles.size(); ++i) {
+      check(a_angles[i].get<double>(), g_angles[i].get<double>(),
+            2e-14 * magnitude / lengths[i].get<double>(),
+            where + "/link_angles/" + std::to_string(i));
+    }
+    a.erase("link_angles");
+    g.erase("link_angles");
+  }
+  // The distances of a leader step are differences of points known to 1e-14 X (X the largest
+  // magnitude of any frame): each of the n+1 distances to 2e-14 X, so each step's L2 sum to
+  // 2 (n+1) 1e-14 X, and its weighted sum (weights summing to the chain's length) to twice the
+  // chain's length times 1e-14 X.
+  double total_length = 0.0;
+  for (const json& length : lengths) total_length += length.get<double>();
+  const std::pair<const char*, double> per_step[] = {
+      {"l2_per_step", 2e-14 * static_cast<double>(lengths.size() + 1) * run_magnitude},
+      {"l2_weighted_per_step", 2e-14 * total_length * run_magnitude}};
+  for (const auto& [key, bound] : per_step) {
+    json& a = (*simd)["metrics"][key];
+    json& g = (*scalar)["metrics"][key];
+    if (!a.is_array() || !g.is_array() || a.size() != g.size()) continue;
+    for (size_t s = 0; s < g.size(); ++s) {
+      check(a[s].get<double>(), g[s].get<double>(),
+            std::max(bound, 1e-14 * std::abs(g[s].get<double>())),
+            "/metrics/" + std::string(key) + "/" + std::to_string(s));
+    }
+    (*simd)["metrics"].erase(key);
+    (*scalar)["metrics"].erase(key);
+  }
+}
+
 TEST_P(GoldenTest, SimdEnginesAgreeWithTheScalarEngineTo1e14) {
   ASSERT_FALSE(kCli.empty()) << "the flexkin command line was not built";
   const std::string name = GetParam();
@@ -280,11 +362,12 @@ TEST_P(GoldenTest, SimdEnginesAgreeWithTheScalarEngineTo1e14) {
         << name << ": the AVX2 arm path's result differs from the pinned one";
     return;
   }
-  const json scalar = RunExample(name, true);
-  const json simd = RunExample(name, false);
+  json scalar = RunExample(name, true);
+  json simd = RunExample(name, false);
   ASSERT_FALSE(scalar.is_null() || simd.is_null()) << name << ": no result";
   std::vector<std::string> diffs;
   double worst = 0.0;
+  CompareFrames(&simd, &scalar, &diffs, &worst);
   Compare(simd, scalar, "", false, &diffs, &worst);
   std::string all;
   for (const std::string& d : diffs) all += "\n  " + d;

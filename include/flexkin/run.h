@@ -33,6 +33,9 @@ struct RunOptions {
   double tolerance = 0.0;
   // Upper bound for the automatic choice of `substeps`; >= 2 when `tolerance` > 0. Typical: 65536.
   int max_substeps = 1 << 16;
+  // Compute Frame::link_angles for each recorded frame (an atan2 per link per frame). false leaves
+  // them empty: a recorded frame then costs a copy of its points and nothing more.
+  bool link_angles = true;
   // Called with (leader steps done, total) about every 0.1 s of work; may be empty.
   std::function<void(int64_t done, int64_t total)> progress;
 

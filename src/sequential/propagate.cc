@@ -35,27 +35,111 @@ void Sweeps(const double* heads, int64_t num_sweeps, const double* lengths,
   }
 }
 
+// The one-pass loop, observed (SweepTrace). The distance a point moves and a link's length are
+// computed as (d0 d0 + d1 d1) + d2 d2, the order Eigen's norm() uses for these rows, so that the
+// exact accounting gives the metrics of the sub-step by sub-step run bit for bit.
+template <int Dim>
+inline double Distance(const double* a, const double* b) {
+  double q = 0.0;
+  for (int k = 0; k < Dim; ++k) q += (a[k] - b[k]) * (a[k] - b[k]);
+  return std::sqrt(q);
+}
+
+template <class Rule, int Dim>
+void TracedSweeps(const double* heads, int64_t first, int64_t num_sweeps, const double* lengths,
+                  const double* inv_lengths, int n, double* pts, internal::SweepTrace* trace) {
+  const bool exact = trace->moved != nullptr;
+  for (int64_t s = first; s < num_sweeps; ++s) {
+    const uint8_t flag = trace->flags[s];
+    const bool check_lengths = !exact && (flag & internal::SweepTrace::kStepEnd);
+    double lead_old[Dim], lead_new[Dim];
+    for (int k = 0; k < Dim; ++k) {
+      lead_old[k] = pts[k];
+      pts[k] = lead_new[k] = heads[s * Dim + k];
+    }
+    double l2 = 0.0, l2w = 0.0, worst = trace->max_length_error;
+    auto account = [&](int j, const double* before, const double* after) {
+      const double moved = Distance<Dim>(after, before);
+      if (exact) {
+        trace->moved[j] += moved;
+      } else {
+        l2 += moved;
+        l2w += moved * trace->weights[j];
+        trace->path_length[j] += moved;
+      }
+    };
+    account(0, lead_old, lead_new);
+    for (int i = 1; i <= n; ++i) {
+      double* tail = pts + i * Dim;
+      double tail_old[Dim];
+      for (int k = 0; k < Dim; ++k) tail_old[k] = tail[k];
+      internal::ApplyScalar<Rule, Dim>(lead_old, lead_new, tail, lengths[i - 1],
+                                       inv_lengths[i - 1]);
+      account(i, tail_old, tail);
+      if (check_lengths) {
+        const double error = std::fabs(Distance<Dim>(tail, lead_new) - lengths[i - 1]);
+        worst = std::fmax(worst, error * inv_lengths[i - 1]);
+      }
+      for (int k = 0; k < Dim; ++k) lead_old[k] = tail_old[k], lead_new[k] = tail[k];
+    }
+    if (!exact) {
+      trace->sweep_l2[s] = l2;
+      trace->sweep_l2w[s] = l2w;
+      trace->max_length_error = worst;
+    }
+    if (flag & internal::SweepTrace::kCapture) trace->capture(trace->context, s, -1);
+  }
+}
+
 }  // namespace
 
 namespace internal {
+
+void TracedSweepsScalarFrom(Method method, int dim, const double* heads, int64_t first,
+                            int64_t num_sweeps, const double* lengths, const double* inv_lengths,
+                            int n, double* pts, SweepTrace* trace) {
+  const bool tractrix = method == Method::kTractrix;
+  if (dim == 2) {
+    tractrix ? TracedSweeps<TractrixRule<2>, 2>(heads, first, num_sweeps, lengths, inv_lengths, n,
+                                                pts, trace)
+             : TracedSweeps<FollowTheLeaderRule<2>, 2>(heads, first, num_sweeps, lengths,
+                                                       inv_lengths, n, pts, trace);
+  } else {
+    tractrix ? TracedSweeps<TractrixRule<3>, 3>(heads, first, num_sweeps, lengths, inv_lengths, n,
+                                                pts, trace)
+             : TracedSweeps<FollowTheLeaderRule<3>, 3>(heads, first, num_sweeps, lengths,
+                                                       inv_lengths, n, pts, trace);
+  }
+}
+
+void TracedSweepsScalar(Method method, int dim, const double* heads, int64_t num_sweeps,
+                        const double* lengths, const double* inv_lengths, int n, double* pts,
+                        SweepTrace* trace) {
+  TracedSweepsScalarFrom(method, dim, heads, 0, num_sweeps, lengths, inv_lengths, n, pts, trace);
+}
 
 #if FLEXKIN_HAVE_WAVEFRONT
 void SweepsWavefrontAvx2(Method, int, const double*, int64_t, const double*, const double*, int,
                          double*);
 void SweepsWavefrontAvx512(Method, int, const double*, int64_t, const double*, const double*, int,
                            double*);
+void TracedSweepsWavefrontAvx2(Method, int, const double*, int64_t, const double*, const double*,
+                               int, double*, SweepTrace*);
+void TracedSweepsWavefrontAvx512(Method, int, const double*, int64_t, const double*, const double*,
+                                 int, double*, SweepTrace*);
 
 namespace {
 struct WavefrontChoice {
   SweepsFn fn;
+  TracedSweepsFn traced;
   int lanes;
 };
 // The widest engine AllowedSimd() permits (src/chain/simd.h). Without AVX2 and FMA there is no
 // wavefront (lanes = 1) and every move takes the one-pass loop.
 WavefrontChoice ChooseWavefront() {
-  if (AllowedSimd().avx512) return {SweepsWavefrontAvx512, 8};
-  if (AllowedSimd().avx2_fma) return {SweepsWavefrontAvx2, 4};
-  return {nullptr, 1};
+  if (AllowedSimd().avx512) return {SweepsWavefrontAvx512, TracedSweepsWavefrontAvx512, 8};
+  if (AllowedSimd().avx2_fma) return {SweepsWavefrontAvx2, TracedSweepsWavefrontAvx2, 4};
+  return {nullptr, nullptr, 1};
 }
 const WavefrontChoice& Wavefront() {
   static const WavefrontChoice choice = ChooseWavefront();
@@ -87,11 +171,25 @@ void SweepsWavefront(Method method, int dim, const double* heads, int64_t num_sw
   SweepsScalar(method, dim, heads, num_sweeps, lengths, inv_lengths, n, pts);
 }
 
+void TracedSweepsWavefront(Method method, int dim, const double* heads, int64_t num_sweeps,
+                           const double* lengths, const double* inv_lengths, int n, double* pts,
+                           SweepTrace* trace) {
+#if FLEXKIN_HAVE_WAVEFRONT
+  if (Wavefront().traced != nullptr && trace->moved == nullptr) {
+    Wavefront().traced(method, dim, heads, num_sweeps, lengths, inv_lengths, n, pts, trace);
+    return;
+  }
+#endif
+  TracedSweepsScalar(method, dim, heads, num_sweeps, lengths, inv_lengths, n, pts, trace);
+}
+
 std::vector<WavefrontEngine> AvailableWavefronts() {
   std::vector<WavefrontEngine> engines;
 #if FLEXKIN_HAVE_WAVEFRONT
-  if (CpuSimd().avx2_fma) engines.push_back({"avx2", SweepsWavefrontAvx2, 4});
-  if (CpuSimd().avx512) engines.push_back({"avx512", SweepsWavefrontAvx512, 8});
+  if (CpuSimd().avx2_fma)
+    engines.push_back({"avx2", SweepsWavefrontAvx2, TracedSweepsWavefrontAvx2, 4});
+  if (CpuSimd().avx512)
+    engines.push_back({"avx512", SweepsWavefrontAvx512, TracedSweepsWavefrontAvx512, 8});
 #endif
   return engines;
 }

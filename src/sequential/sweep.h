@@ -21,6 +21,67 @@ void SweepsWavefront(Method method, int dim, const double* heads, int64_t num_sw
                      const double* lengths, const double* inv_lengths, int num_links,
                      double* points);
 
+// What a run observes of its sweeps (src/run/run.cc), filled in by the traced engines below in
+// the same pass that moves the chain.
+struct SweepTrace {
+  static constexpr uint8_t kStepEnd = 1;  // the last sub-step of a leader step: lengths checked
+  static constexpr uint8_t kCapture = 2;  // the configuration after it is handed to `capture`
+  static constexpr int kMaxSlots = 16;    // the most captures one call keeps at once
+  static constexpr int kPad = 15;         // padding of the arrays below: the most lanes - 1
+  // The link lengths of point i (from point i-1), their negated inverses, and the arc-length
+  // weights of point i, at index kPad + i, padded with kPad entries either side (lengths 1,
+  // weights 0) as the wavefront's lanes read them. Prepare fills them once per chain.
+  std::vector<double> padded_lengths, padded_neg_inv_lengths, padded_weights;
+  void Prepare(const double* lengths, const double* inv_lengths, const double* point_weights,
+               int num_links) {
+    const size_t size = static_cast<size_t>(num_links) + 1 + 2 * kPad;
+    padded_lengths.assign(size, 1.0);
+    padded_neg_inv_lengths.assign(size, -1.0);
+    padded_weights.assign(size, 0.0);
+    for (int i = 0; i < num_links; ++i) {
+      padded_lengths[kPad + 1 + i] = lengths[i];
+      padded_neg_inv_lengths[kPad + 1 + i] = -inv_lengths[i];
+    }
+    for (int i = 0; i <= num_links; ++i) padded_weights[kPad + i] = point_weights[i];
+    weights = point_weights;
+  }
+  // In: per sweep of the call, kStepEnd | kCapture.
+  const uint8_t* flags = nullptr;
+  // In: the n+1 arc-length weights of the weighted L2 metric (set by Prepare).
+  const double* weights = nullptr;
+  // Exact accounting (the scalar engine): if not null, moved[j] += the distance point j moves in
+  // each sweep, and the caller does the rest at the end of each leader step; sweep_l2, sweep_l2w,
+  // path_length and max_length_error are then left alone.
+  double* moved = nullptr;
+  // Out, per sweep of the call: the sum over the points of the distance each moves, and that sum
+  // weighted by `weights`.
+  double* sweep_l2 = nullptr;
+  double* sweep_l2w = nullptr;
+  // Accumulated: the distance each of the n+1 points has moved.
+  double* path_length = nullptr;
+  // Accumulated: the largest |(|x_i - x_{i-1}| - L_i)| / L_i after a kStepEnd sweep.
+  double max_length_error = 0.0;
+  // Capture slots, kMaxSlots arrays of (n+1) * dim doubles the wavefront copies configurations
+  // into; `capture(context, sweep, slot)` is called for every kCapture sweep, in sweep order, with
+  // the slot holding it, or slot -1 when the chain itself (`points`) holds it.
+  double* const* slots = nullptr;
+  void (*capture)(void* context, int64_t sweep, int slot) = nullptr;
+  void* context = nullptr;
+};
+
+// SweepsScalar and SweepsWavefront, observed: the same motion, bit for bit, plus `trace`.
+void TracedSweepsScalar(Method method, int dim, const double* heads, int64_t num_sweeps,
+                        const double* lengths, const double* inv_lengths, int num_links,
+                        double* points, SweepTrace* trace);
+// TracedSweepsScalar from sweep `first` on (heads, flags and per-sweep outputs indexed from the
+// call's start): the wavefront finishes its last few sweeps with it.
+void TracedSweepsScalarFrom(Method method, int dim, const double* heads, int64_t first,
+                            int64_t num_sweeps, const double* lengths, const double* inv_lengths,
+                            int num_links, double* points, SweepTrace* trace);
+void TracedSweepsWavefront(Method method, int dim, const double* heads, int64_t num_sweeps,
+                           const double* lengths, const double* inv_lengths, int num_links,
+                           double* points, SweepTrace* trace);
+
 // The sequential rules of the rotation and joint-angle metrics (metric_rules.cc).
 void SweepsMinRotation(int dim, const double* heads, int64_t num_sweeps, int num_links,
                        double* points);
@@ -34,9 +95,12 @@ int WavefrontLanes();
 // against SweepsScalar whatever FLEXKIN_SIMD says.
 using SweepsFn = void (*)(Method, int, const double*, int64_t, const double*, const double*, int,
                           double*);
+using TracedSweepsFn = void (*)(Method, int, const double*, int64_t, const double*, const double*,
+                                int, double*, SweepTrace*);
 struct WavefrontEngine {
   const char* name;
   SweepsFn fn;
+  TracedSweepsFn traced;
   int lanes;
 };
 std::vector<WavefrontEngine> AvailableWavefronts();

@@ -5,6 +5,7 @@
 #include <immintrin.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 #include <xsimd/xsimd.hpp>
@@ -86,26 +87,62 @@ inline double First(__m512d v) { return _mm_cvtsd_f64(_mm512_castpd512_pd128(v))
 // lane 0, the group's last sweep). Nothing goes through memory between lanes (no store-to-load
 // forwarding stalls), and the U registers' rule evaluations are independent, so their latencies
 // overlap. Returns the number of sweeps done (a multiple of G).
-template <class Arch, class Rule, int Dim, int U>
-int64_t WavefrontGroups(const double* heads, int64_t num_sweeps, const double* lengths,
-                        const double* inv_lengths, int n, double* points) {
+//
+// Traced (SweepTrace, for runs): each lane also measures the distance its point moves (summed per
+// sweep, plain and weighted, and per point in a window of path lengths that slides down the chain
+// with the points), the length of its link after a sweep that ends a leader step, and copies its
+// point into a capture slot when its sweep is to be captured.
+// Starts at sweep `g` and returns the sweep it stopped at (g plus a multiple of G).
+template <class Arch, class Rule, int Dim, int U, bool Traced>
+int64_t WavefrontGroups(const double* heads, int64_t g, int64_t num_sweeps, const double* lengths,
+                        const double* inv_lengths, int n, double* points, SweepTrace* trace) {
   using B = xsimd::batch<double, Arch>;
   constexpr int W = B::size;
   constexpr int G = U * W;
-  if (num_sweeps < G) return 0;
+  static_assert(G - 1 <= SweepTrace::kPad && G <= SweepTrace::kMaxSlots);
+  if (num_sweeps - g < G) return g;
   // Link lengths of point i at len[pad + i]; the padding lanes compute garbage never stored.
-  const int pad = G - 1;
-  std::vector<double> len(n + 1 + 2 * pad, 1.0), neg_inv_len(n + 1 + 2 * pad, -1.0);
-  std::copy(lengths, lengths + n, len.begin() + pad + 1);
-  for (int i = 0; i < n; ++i) neg_inv_len[pad + 1 + i] = -inv_lengths[i];
+  // Traced: the trace's arrays, prepared once per chain, and the arc-length weights likewise.
+  const int pad = Traced ? SweepTrace::kPad : G - 1;
+  std::vector<double> own_len, own_neg_inv_len;
+  if constexpr (!Traced) {
+    own_len.assign(n + 1 + 2 * pad, 1.0);
+    own_neg_inv_len.assign(n + 1 + 2 * pad, -1.0);
+    for (int i = 0; i < n; ++i) {
+      own_len[pad + 1 + i] = lengths[i];
+      own_neg_inv_len[pad + 1 + i] = -inv_lengths[i];
+    }
+  }
+  const double* len = Traced ? trace->padded_lengths.data() : own_len.data();
+  const double* neg_inv_len =
+      Traced ? trace->padded_neg_inv_lengths.data() : own_neg_inv_len.data();
+  [[maybe_unused]] const double* weight = Traced ? trace->padded_weights.data() : nullptr;
   alignas(64) double lane_index[W];
   for (int j = 0; j < W; ++j) lane_index[j] = j;
   const B lane = B::load_aligned(lane_index);
   const B last = B(static_cast<double>(n));
 
-  int64_t g = 0;
   for (; g + G <= num_sweeps; g += G) {
     B head[U][Dim], lead_old[U][Dim], lead_new[U][Dim], window[U][Dim];
+    // Traced: per register, the lanes whose sweep ends a leader step, the running sums of the
+    // sweeps' distances, the path-length window and the largest length error; the capture slot
+    // of each lane (-1: not captured), given in sweep order.
+    [[maybe_unused]] xsimd::batch_bool<double, Arch> step_end[U];
+    [[maybe_unused]] B l2[U], l2w[U], path[U], worst[U];
+    [[maybe_unused]] int slot_of_lane[G];
+    [[maybe_unused]] int num_slots = 0;
+    if constexpr (Traced) {
+      alignas(64) double end_flag[G];
+      for (int j = G - 1; j >= 0; --j) {  // lane G-1 has the group's first sweep
+        const uint8_t flag = trace->flags[g + G - 1 - j];
+        end_flag[j] = (flag & SweepTrace::kStepEnd) ? 1.0 : 0.0;
+        slot_of_lane[j] = (flag & SweepTrace::kCapture) ? num_slots++ : -1;
+      }
+      for (int u = 0; u < U; ++u) {
+        step_end[u] = B::load_aligned(end_flag + u * W) != B(0.0);
+        l2[u] = l2w[u] = path[u] = worst[u] = B(0.0);
+      }
+    }
     for (int u = 0; u < U; ++u) {
       for (int k = 0; k < Dim; ++k) {
         alignas(64) double h[W];
@@ -120,6 +157,11 @@ int64_t WavefrontGroups(const double* heads, int64_t num_sweeps, const double* l
         for (int u = 0; u + 1 < U; ++u) window[u][k] = B(SlideIn(window[u][k], window[u + 1][k]));
         window[U - 1][k] = B(SlideIn(window[U - 1][k], B(t <= n ? points[t * Dim + k] : 0.0)));
       }
+      if constexpr (Traced) {
+        for (int u = 0; u + 1 < U; ++u) path[u] = B(SlideIn(path[u], path[u + 1]));
+        path[U - 1] = B(SlideIn(path[U - 1], B(t <= n ? trace->path_length[t] : 0.0)));
+      }
+      [[maybe_unused]] alignas(64) double captured[Traced ? Dim : 1][Traced ? G : 1];
       B tail[U][Dim];
       for (int u = 0; u < U; ++u) {
         const int first = base + u * W;  // point of this register's lane 0
@@ -158,8 +200,36 @@ int64_t WavefrontGroups(const double* heads, int64_t num_sweeps, const double* l
           }
         }
         const auto is_head = index == B(0.0);
+        for (int k = 0; k < Dim; ++k) tail[u][k] = xsimd::select(is_head, head[u][k], tail[u][k]);
+        if constexpr (Traced) {
+          // The distance the point moved (window: before the sweep, tail: after) and the length
+          // of its link (lead_new: the point before it, after the sweep).
+          B moved2 = B(0.0), link2 = B(0.0);
+          for (int k = 0; k < Dim; ++k) {
+            const B d = tail[u][k] - window[u][k], e = tail[u][k] - lead_new[u][k];
+            moved2 = xsimd::fma(d, d, moved2);
+            link2 = xsimd::fma(e, e, link2);
+          }
+          const auto on_chain = (index >= B(0.0)) & (index <= last);
+          const B moved = xsimd::select(on_chain, xsimd::sqrt(moved2), B(0.0));
+          l2[u] += moved;
+          l2w[u] = xsimd::fma(moved, B::load_unaligned(&weight[pad + first]), l2w[u]);
+          path[u] += moved;
+          // |sqrt(r) - 1| = |r - 1| / (1 + sqrt(r)) with r = q / L^2: |r - 1| / 2 where r is
+          // within 1e-9 of 1 (always, unless something is wrong: the difference is then below
+          // 1e-18), else the exact form with its square root.
+          const B excess = xsimd::abs(xsimd::fms(link2, neg_inv_length * neg_inv_length, B(1.0)));
+          B error = excess * B(0.5);
+          if (xsimd::any(excess > B(1e-9))) {
+            error = excess / (B(1.0) + xsimd::sqrt(link2 * (neg_inv_length * neg_inv_length)));
+          }
+          worst[u] = xsimd::select(step_end[u] & (index >= B(1.0)) & (index <= last),
+                                   xsimd::max(worst[u], error), worst[u]);
+          if (num_slots > 0) {
+            for (int k = 0; k < Dim; ++k) tail[u][k].store_aligned(&captured[k][u * W]);
+          }
+        }
         for (int k = 0; k < Dim; ++k) {
-          tail[u][k] = xsimd::select(is_head, head[u][k], tail[u][k]);
           lead_old[u][k] = window[u][k];
           lead_new[u][k] = window[u][k] = tail[u][k];
         }
@@ -173,6 +243,31 @@ int64_t WavefrontGroups(const double* heads, int64_t num_sweeps, const double* l
       }
       if (base >= 0) {
         for (int k = 0; k < Dim; ++k) points[base * Dim + k] = First(tail[0][k]);
+        if constexpr (Traced) trace->path_length[base] = First(path[0]);
+      }
+      if constexpr (Traced) {
+        for (int j = 0; j < G && num_slots > 0; ++j) {
+          const int point = base + j;
+          if (slot_of_lane[j] < 0 || point < 0 || point > n) continue;
+          double* slot = trace->slots[slot_of_lane[j]] + point * Dim;
+          for (int k = 0; k < Dim; ++k) slot[k] = captured[k][j];
+        }
+      }
+    }
+    if constexpr (Traced) {
+      alignas(64) double sums[2][G], errors[G];
+      for (int u = 0; u < U; ++u) {
+        l2[u].store_aligned(&sums[0][u * W]);
+        l2w[u].store_aligned(&sums[1][u * W]);
+        worst[u].store_aligned(&errors[u * W]);
+      }
+      for (int j = 0; j < G; ++j) {
+        trace->sweep_l2[g + G - 1 - j] = sums[0][j];
+        trace->sweep_l2w[g + G - 1 - j] = sums[1][j];
+        trace->max_length_error = std::fmax(trace->max_length_error, errors[j]);
+      }
+      for (int j = G - 1; j >= 0; --j) {
+        if (slot_of_lane[j] >= 0) trace->capture(trace->context, g + G - 1 - j, slot_of_lane[j]);
       }
     }
   }
@@ -181,33 +276,41 @@ int64_t WavefrontGroups(const double* heads, int64_t num_sweeps, const double* l
 
 // Sweeps done by the engine (two registers per coordinate while at least 2 W sweeps are left,
 // then one); the caller finishes the fewer than W left with the one-pass loop.
-template <class Arch, class Rule, int Dim>
+template <class Arch, class Rule, int Dim, bool Traced>
 int64_t WavefrontSweeps(const double* heads, int64_t num_sweeps, const double* lengths,
-                        const double* inv_lengths, int n, double* points) {
-  const int64_t done =
-      WavefrontGroups<Arch, Rule, Dim, 2>(heads, num_sweeps, lengths, inv_lengths, n, points);
-  return done + WavefrontGroups<Arch, Rule, Dim, 1>(heads + done * Dim, num_sweeps - done, lengths,
-                                                    inv_lengths, n, points);
+                        const double* inv_lengths, int n, double* points, SweepTrace* trace) {
+  const int64_t done = WavefrontGroups<Arch, Rule, Dim, 2, Traced>(heads, 0, num_sweeps, lengths,
+                                                                   inv_lengths, n, points, trace);
+  return WavefrontGroups<Arch, Rule, Dim, 1, Traced>(heads, done, num_sweeps, lengths, inv_lengths,
+                                                     n, points, trace);
 }
 
 // Entry point of one instruction set: picks the rule and the dimension; the sweeps left over
 // (fewer than the lanes) go through the one-pass loop.
-template <class Arch>
+// Traced: `trace` observes every sweep, the engine's and the one-pass loop's.
+template <class Arch, bool Traced>
 void WavefrontDispatch(Method method, int dim, const double* heads, int64_t num_sweeps,
-                       const double* lengths, const double* inv_lengths, int n, double* points) {
+                       const double* lengths, const double* inv_lengths, int n, double* points,
+                       SweepTrace* trace) {
   const bool tractrix = method == Method::kTractrix;
   auto run = [&](auto sweeps) {
-    return sweeps(heads, num_sweeps, lengths, inv_lengths, n, points);
+    return sweeps(heads, num_sweeps, lengths, inv_lengths, n, points, trace);
   };
   int64_t done;
   if (dim == 2) {
-    done = tractrix ? run(WavefrontSweeps<Arch, TractrixRule<2, BatchExp>, 2>)
-                    : run(WavefrontSweeps<Arch, FollowTheLeaderRule<2>, 2>);
+    done = tractrix ? run(WavefrontSweeps<Arch, TractrixRule<2, BatchExp>, 2, Traced>)
+                    : run(WavefrontSweeps<Arch, FollowTheLeaderRule<2>, 2, Traced>);
   } else {
-    done = tractrix ? run(WavefrontSweeps<Arch, TractrixRule<3, BatchExp>, 3>)
-                    : run(WavefrontSweeps<Arch, FollowTheLeaderRule<3>, 3>);
+    done = tractrix ? run(WavefrontSweeps<Arch, TractrixRule<3, BatchExp>, 3, Traced>)
+                    : run(WavefrontSweeps<Arch, FollowTheLeaderRule<3>, 3, Traced>);
   }
-  SweepsScalar(method, dim, heads + done * dim, num_sweeps - done, lengths, inv_lengths, n, points);
+  if constexpr (Traced) {
+    TracedSweepsScalarFrom(method, dim, heads, done, num_sweeps, lengths, inv_lengths, n, points,
+                           trace);
+  } else {
+    SweepsScalar(method, dim, heads + done * dim, num_sweeps - done, lengths, inv_lengths, n,
+                 points);
+  }
 }
 
 }  // namespace
