@@ -68,7 +68,7 @@ struct RunArgs {
   std::string scenario, output, csv, method, report = "brief", max_output_size;
   int substeps = 0, record_every = 0, max_substeps = 0;
   double tolerance = 0.0;
-  bool quiet = false;
+  bool quiet = false, no_link_angles = false;
   // Which overrides were given.
   CLI::Option *substeps_opt = nullptr, *record_every_opt = nullptr, *max_substeps_opt = nullptr,
               *tolerance_opt = nullptr, *method_opt = nullptr;
@@ -88,6 +88,7 @@ void ApplyOverrides(const RunArgs& args, flexkin::RunOptions* options) {
   if (*args.method_opt) options->method = flexkin::ParseMethod(args.method, "--method");
   if (*args.substeps_opt) options->substeps = args.substeps;
   if (*args.record_every_opt) options->record_every = args.record_every;
+  if (args.no_link_angles) options->link_angles = false;
   if (*args.tolerance_opt) options->tolerance = args.tolerance;
   if (*args.max_substeps_opt) {
     options->max_substeps = args.max_substeps;
@@ -298,6 +299,8 @@ int Main(int argc, char** argv) {
                                           "Upper bound of the automatic sub-steps");
   args.record_every_opt = run->add_option("--record-every", args.record_every,
                                           "Record every N-th leader step (and the last)");
+  run->add_flag("--no-link-angles", args.no_link_angles,
+                "Record frames without their link angles (an atan2 per link per frame saved)");
   flexkin::cli::AddMaxOutputSizeOption(run, &args.max_output_size);
   run->add_option("--report", args.report, "Report printed after the run")
       ->check(CLI::IsMember({"brief", "full"}));

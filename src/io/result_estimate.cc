@@ -5,7 +5,6 @@
 #include <cstdint>
 #include <limits>
 #include <string>
-#include <type_traits>
 #include <utility>
 
 #include "flexkin/result_io.h"
@@ -17,22 +16,6 @@ namespace {
 // separator; typical numbers take 19 to 23 bytes, so the estimate errs on the large side.
 constexpr double kTextBytesPerNumber = 24.0;
 constexpr double kBinaryBytesPerNumber = 8.0;
-
-// RunOptions::link_angles (bool), where the library has it: frames without link angles then.
-template <typename T, typename = void>
-struct HasLinkAnglesOption : std::false_type {};
-template <typename T>
-struct HasLinkAnglesOption<T, std::void_t<decltype(std::declval<const T&>().link_angles)>>
-    : std::true_type {};
-template <typename T>
-bool RecordsLinkAngles(const T& options) {
-  if constexpr (HasLinkAnglesOption<T>::value) {
-    return static_cast<bool>(options.link_angles);
-  } else {
-    (void)options;
-    return true;
-  }
-}
 
 uint64_t Bytes(double x) {
   if (!(x < 1.8e19)) return std::numeric_limits<uint64_t>::max();
@@ -57,7 +40,7 @@ ResultSizeEstimate EstimateResultSize(int num_links, int dim, int64_t num_steps,
                                       const RunOptions& options) {
   ResultSizeEstimate e;
   e.frames = CountRecordedFrames(num_steps, options.record_every);
-  e.link_angles = RecordsLinkAngles(options);
+  e.link_angles = options.link_angles;
   const double n = std::max(num_links, 0), d = dim, f = static_cast<double>(e.frames);
   const double steps = static_cast<double>(std::max<int64_t>(num_steps, 0));
   const double angles = e.link_angles ? n : 0.0;

@@ -62,6 +62,7 @@ const std::vector<OptionLocation>& RunOptionLocations() {
       {"method", "/method", "--method"},
       {"substeps", "/leader/substeps", "--substeps"},
       {"record_every", "/record/every", "--record-every"},
+      {"link_angles", "/record/link_angles", "--no-link-angles"},
       {"tolerance", "/accuracy/tolerance", "--tolerance"},
       {"max_substeps", "/accuracy/max_substeps", "--max-substeps"},
       {"overall.weights.", "/objective", ""},

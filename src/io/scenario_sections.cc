@@ -247,11 +247,18 @@ void Parser::ParseOptions(const json& root, RunOptions* options) {
     }
   }
   if (const json* r = Find(root, "record")) {
-    if (ExpectObject(*r, "/record", "an object {\"every\": n}")) {
-      CheckKeys(*r, "/record", {"every"});
+    if (ExpectObject(*r, "/record", "an object {\"every\": n, \"link_angles\": true|false}")) {
+      CheckKeys(*r, "/record", {"every", "link_angles"});
       if (const json* e = Find(*r, "every")) {
         if (const auto n = Integer(*e, "/record/every", 1, kMaxCount)) {
           options->record_every = static_cast<int>(*n);
+        }
+      }
+      if (const json* a = Find(*r, "link_angles")) {
+        if (a->is_boolean()) {
+          options->link_angles = a->get<bool>();
+        } else {
+          TypeProblem(*a, "/record/link_angles", "true or false");
         }
       }
     }
