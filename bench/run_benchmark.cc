@@ -7,7 +7,8 @@
 //   one_pass      the one-pass loop (SweepsScalar) over the same sweeps
 //   single_calls  one MoveLeader call per leader step (the loop a user would write by hand)
 //   run_*         Run with the frames copied into one buffer by the sink: recording every step
-//                 (with and without link angles), every 100th step, and first and last
+//                 (with and without link angles), every 100th step, and first and last (also
+//                 with a progress callback, whose hidden cost is the difference)
 //   cli_json, cli_npz  `flexkin run -q` end to end (reading the scenario, the run, the file
 //                 written), one sub-process per iteration
 // Run: build/bench/run_benchmark --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
@@ -96,7 +97,7 @@ class CopySink : public FrameSink {
   int64_t frames = 0;
 };
 
-void BM_Run(benchmark::State& state, int record_every, bool link_angles) {
+void BM_Run(benchmark::State& state, int record_every, bool link_angles, bool progress = false) {
   const int n = static_cast<int>(state.range(0));
   const Chain chain = StraightLine(n);
   const int64_t steps = StepsFor(n);
@@ -104,6 +105,8 @@ void BM_Run(benchmark::State& state, int record_every, bool link_angles) {
   RunOptions options;
   options.record_every = record_every;
   options.link_angles = link_angles;
+  int64_t reports = 0;
+  if (progress) options.progress = [&reports](int64_t, int64_t) { ++reports; };
   CopySink sink;
   double length_error = 0.0;
   for (auto _ : state) {
@@ -166,6 +169,7 @@ BENCHMARK_CAPTURE(BM_Run, every_step, 1, true)->Apply(Sizes);
 BENCHMARK_CAPTURE(BM_Run, every_step_no_angles, 1, false)->Apply(Sizes);
 BENCHMARK_CAPTURE(BM_Run, every_100, 100, true)->Apply(Sizes);
 BENCHMARK_CAPTURE(BM_Run, first_last, 1 << 30, true)->Apply(Sizes);
+BENCHMARK_CAPTURE(BM_Run, first_last_with_progress, 1 << 30, true, true)->Apply(Sizes);
 BENCHMARK_CAPTURE(BM_Cli, json, "json")->Apply(CliSizes);
 BENCHMARK_CAPTURE(BM_Cli, npz, "npz")->Apply(CliSizes);
 
