@@ -35,19 +35,21 @@ class CountingSink : public FrameSink {
 
 // Allocations of one run of the paper's parabola pulled `steps` leader steps of 0.05 along
 // (1, 1) / sqrt 2, with `substeps` sub-steps each, recording only the first and last frames.
-long AllocationsOfRun(Method method, int steps, int substeps) {
+long AllocationsOfRun(Method method, int steps, int substeps, int record_every = 1 << 20,
+                      bool link_angles = true) {
   const Chain chain = scenes::PaperParabola();
   const Points targets = scenes::StraightPull(
       chain.points.row(0).transpose(), Eigen::Vector2d(1.0, 1.0).normalized(), 0.05 * steps, steps);
   RunOptions options;
   options.method = method;
   options.substeps = substeps;
-  options.record_every = 1 << 20;
+  options.record_every = record_every;
+  options.link_angles = link_angles;
   CountingSink sink;
   const long before = allocations.load();
   const RunResult result = Run(chain, targets, options, &sink);
   const long count = allocations.load() - before;
-  EXPECT_EQ(sink.frames, 2);
+  EXPECT_EQ(sink.frames, record_every == 1 ? steps + 1 : 2);
   EXPECT_LE(result.metrics.max_relative_length_error, 1e-12);
   return count;
 }
@@ -67,6 +69,20 @@ TEST(RunAllocation, NothingPerUnrecordedLeaderStep) {
     const long more = AllocationsOfRun(method, 200, 4);
     EXPECT_EQ(more, few) << MethodName(method) << ": " << few << " allocations for 10 leader "
                          << "steps, " << more << " for 200";
+  }
+}
+
+// A recorded frame costs a copy into a buffer the run keeps (and its link angles, computed into
+// a vector sized once): recording 200 frames allocates no more than recording 40.
+TEST(RunAllocation, NothingPerRecordedFrame) {
+  for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {
+    for (const bool link_angles : {true, false}) {
+      const long few = AllocationsOfRun(method, 40, 1, 1, link_angles);
+      const long more = AllocationsOfRun(method, 200, 1, 1, link_angles);
+      EXPECT_EQ(more, few) << MethodName(method) << (link_angles ? " with" : " without")
+                           << " link angles: " << few << " allocations for 40 recorded frames, "
+                           << more << " for 200";
+    }
   }
 }
 

@@ -108,6 +108,167 @@ TEST(WavefrontTest, EveryEngineMatchesTheOnePassLoop) {
             << worst << "\n";
 }
 
+// What the traced engines record of a call: the trace's outputs and every captured
+// configuration, in the order captured.
+struct Traced {
+  Points points;
+  std::vector<double> sweep_l2, sweep_l2w;
+  Eigen::VectorXd path_length;
+  double max_length_error = 0.0;
+  std::vector<int64_t> captured_sweeps;
+  std::vector<Points> captured;
+};
+
+Traced RunTraced(internal::TracedSweepsFn fn, Method method, const Chain& chain,
+                 const std::vector<double>& heads, const std::vector<uint8_t>& flags) {
+  const int n = chain.num_links(), dim = chain.dim();
+  const int64_t sweeps = static_cast<int64_t>(flags.size());
+  const Stepper stepper = MakeStepper(method, chain);
+  Traced out;
+  out.points = chain.points;
+  out.sweep_l2.assign(sweeps, -1.0);
+  out.sweep_l2w.assign(sweeps, -1.0);
+  out.path_length = Eigen::VectorXd::Zero(n + 1);
+  Eigen::VectorXd weights = Eigen::VectorXd::LinSpaced(n + 1, 1.0, 2.0);
+  std::vector<Points> slots(internal::SweepTrace::kMaxSlots, Points(n + 1, dim));
+  std::vector<double*> slot_ptrs;
+  for (Points& slot : slots) slot_ptrs.push_back(slot.data());
+  internal::SweepTrace trace;
+  trace.Prepare(stepper.lengths.data(), stepper.inv_lengths.data(), weights.data(), n);
+  trace.flags = flags.data();
+  trace.sweep_l2 = out.sweep_l2.data();
+  trace.sweep_l2w = out.sweep_l2w.data();
+  trace.path_length = out.path_length.data();
+  trace.slots = slot_ptrs.data();
+  struct Context {
+    Traced* out;
+    std::vector<Points>* slots;
+  } context{&out, &slots};
+  trace.context = &context;
+  trace.capture = [](void* c, int64_t sweep, int slot) {
+    auto* ctx = static_cast<Context*>(c);
+    ctx->out->captured_sweeps.push_back(sweep);
+    ctx->out->captured.push_back(slot < 0 ? ctx->out->points : (*ctx->slots)[slot]);
+  };
+  fn(method, dim, heads.data(), sweeps, stepper.lengths.data(), stepper.inv_lengths.data(), n,
+     out.points.data(), &trace);
+  out.max_length_error = trace.max_length_error;
+  return out;
+}
+
+// The traced engines (what Run uses) move the chain exactly as the plain ones, and what they
+// measure in the lanes (per-sweep L2 sums, path lengths, link lengths at step ends) and capture
+// (the configuration after chosen sweeps, slot by slot) is what the one-pass loop measures and
+// sees, to rounding.
+TEST(WavefrontTest, TracedEnginesMoveAsThePlainOnesAndMeasureAsTheOnePassLoop) {
+  const std::vector<internal::WavefrontEngine> engines = internal::AvailableWavefronts();
+  if (engines.empty()) GTEST_SKIP() << "this CPU has no AVX2+FMA: no wavefront engine";
+  std::mt19937 rng(19);
+  std::bernoulli_distribution coin(0.3);
+  int64_t captures = 0;
+  for (const internal::WavefrontEngine& engine : engines) {
+    for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {
+      for (const int dim : {2, 3}) {
+        for (const int links : {1, 8, 9, 17, 100}) {
+          for (const int sweeps : {1, 9, 16, 33, 50}) {
+            for (const double step : {1e-3, 0.7}) {
+              const Chain chain = RandomChain(dim, links, rng);
+              const std::vector<double> heads = Heads(chain, sweeps, step, false, rng);
+              std::vector<uint8_t> flags(sweeps);
+              int captured = 0;
+              for (uint8_t& flag : flags) {
+                flag = coin(rng) ? internal::SweepTrace::kStepEnd : 0;
+                // No call captures more than the slots hold (the run cuts its chunks so).
+                if (coin(rng) && captured < internal::SweepTrace::kMaxSlots) {
+                  flag |= internal::SweepTrace::kCapture;
+                  ++captured;
+                }
+              }
+              const std::string what = std::string(engine.name) + " " + MethodName(method) + " " +
+                                       std::to_string(dim) + "D, " + std::to_string(links) +
+                                       " links, " + std::to_string(sweeps) + " sweeps of " +
+                                       std::to_string(step);
+              Points plain = chain.points;
+              const Stepper stepper = MakeStepper(method, chain);
+              engine.fn(method, dim, heads.data(), sweeps, stepper.lengths.data(),
+                        stepper.inv_lengths.data(), links, plain.data());
+              const Traced simd = RunTraced(engine.traced, method, chain, heads, flags);
+              const Traced scalar =
+                  RunTraced(internal::TracedSweepsScalar, method, chain, heads, flags);
+              EXPECT_EQ(simd.points, plain) << what;
+              const double scale = scalar.points.cwiseAbs().maxCoeff() + 1.0;
+              EXPECT_LE(MaxDifference(simd.points, scalar.points) / scale, 1e-12) << what;
+              for (int s = 0; s < sweeps; ++s) {
+                EXPECT_NEAR(simd.sweep_l2[s], scalar.sweep_l2[s], 1e-12 * scale * (links + 1))
+                    << what << ", sweep " << s;
+                EXPECT_NEAR(simd.sweep_l2w[s], scalar.sweep_l2w[s], 2e-12 * scale * (links + 1))
+                    << what << ", sweep " << s;
+              }
+              for (int j = 0; j <= links; ++j) {
+                EXPECT_NEAR(simd.path_length[j], scalar.path_length[j], 1e-12 * scale * sweeps)
+                    << what << ", point " << j;
+              }
+              EXPECT_NEAR(simd.max_length_error, scalar.max_length_error, 1e-13 * scale) << what;
+              ASSERT_EQ(simd.captured_sweeps, scalar.captured_sweeps) << what;
+              for (size_t c = 0; c < simd.captured.size(); ++c) {
+                EXPECT_LE(MaxDifference(simd.captured[c], scalar.captured[c]) / scale, 1e-12)
+                    << what << ", capture " << c;
+              }
+              // The last sweep's capture is the chain the call leaves, bit for bit.
+              if (!simd.captured.empty() && simd.captured_sweeps.back() == sweeps - 1) {
+                EXPECT_EQ(simd.captured.back(), simd.points) << what;
+              }
+              captures += static_cast<int64_t>(simd.captured.size());
+            }
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(captures, 1000);  // the captures were exercised
+}
+
+// Run's pipeline against the plain definition: each leader step a MoveLeader call with the
+// sub-steps, the frames the configurations after the recorded steps. Sub-step counts that do not
+// divide the lanes, recording that does not divide the steps, and a chain long enough (200,000
+// links) that a call holds fewer than 16 captured configurations.
+TEST(WavefrontTest, RunFramesAreTheConfigurationsOfSuccessiveMoves) {
+  std::mt19937 rng(23);
+  struct Case {
+    int links, steps, substeps, record_every;
+  };
+  for (const Case c :
+       {Case{9, 37, 3, 2}, Case{40, 25, 5, 1}, Case{100, 20, 1, 3}, Case{200000, 20, 1, 1}}) {
+    for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {
+      const Chain chain = RandomChain(3, c.links, rng);
+      const std::vector<double> heads = Heads(chain, c.steps, 0.3, false, rng);
+      const Points targets = Eigen::Map<const Points>(heads.data(), c.steps, 3);
+      RunOptions options;
+      options.method = method;
+      options.substeps = c.substeps;
+      options.record_every = c.record_every;
+      const RunResult result = flexkin::Run(chain, targets, options);
+      const Stepper stepper = MakeStepper(method, chain);
+      Points points = chain.points;
+      size_t frame = 1;
+      ASSERT_EQ(result.frames[0].points, chain.points);
+      for (int s = 0; s < c.steps; ++s) {
+        MoveLeader(stepper, targets.row(s).transpose(), c.substeps, &points);
+        if ((s + 1) % c.record_every != 0 && s + 1 != c.steps) continue;
+        ASSERT_LT(frame, result.frames.size());
+        EXPECT_EQ(result.frames[frame].step, s + 1);
+        const double scale = points.cwiseAbs().maxCoeff() + 1.0;
+        EXPECT_LE(MaxDifference(result.frames[frame].points, points) / scale, 1e-12)
+            << MethodName(method) << ", " << c.links << " links, frame " << frame;
+        ++frame;
+      }
+      EXPECT_EQ(frame, result.frames.size());
+      EXPECT_LT(result.metrics.max_relative_length_error, 1e-12);
+      EXPECT_TRUE(result.metrics.l2_per_step.allFinite());
+    }
+  }
+}
+
 // Where the motion has died out completely (the head of a link did not move) both paths leave
 // the rest of the chain exactly where it was.
 TEST(WavefrontTest, StillHeadLeavesTheChainExactlyInPlace) {
