@@ -12,6 +12,7 @@ packages+=(chromium)         # the viewer's browser test (headless)
 packages+=(liburdfdom-dev)   # URDF arms (src/urdf)
 packages+=(zlib1g-dev)       # CRC-32 of the .npz result files (src/io/npz.cc)
 packages+=(python3-numpy)    # the tests read .npz results with numpy.load (tests/result_npz_test)
+packages+=(python3-dev pybind11-dev python3-pytest)  # the Python module (python/, docs/python.md)
 # Node.js runs the glTF validator and the browser test. Debian's nodejs and npm only if there is
 # no node or npm on the PATH: one from another source (e.g. NodeSource) is used as it is.
 if ! command -v node >/dev/null || ! command -v npm >/dev/null; then packages+=(nodejs npm); fi

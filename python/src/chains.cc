@@ -1,0 +1,285 @@
+// Chains, generated curves, leader paths, the single link step and multi-step propagation:
+// flexkin.Chain, line, parabola, arc, helix, split_pull, resample_path, tractrix_step,
+// follow_the_leader_step, move_leader, overall_step.
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include <string>
+
+#include "convert.h"
+#include "flexkin/curves.h"
+#include "flexkin/leader.h"
+#include "flexkin/link_step.h"
+#include "flexkin/overall.h"
+#include "flexkin/propagate.h"
+
+namespace flexkin::python {
+namespace {
+
+// The single link step, 2D or 3D by the size of the points.
+template <typename Step2, typename Step3>
+py::array_t<double> LinkStep(py::handle head_old, py::handle head_new, py::handle tail,
+                             double length, Step2 step2, Step3 step3) {
+  const Eigen::VectorXd a = ReadVector(head_old, "head_old");
+  const Eigen::VectorXd b = ReadVector(head_new, "head_new", static_cast<int>(a.size()));
+  const Eigen::VectorXd t = ReadVector(tail, "tail", static_cast<int>(a.size()));
+  CheckPositive(length, "length");
+  if (a.size() == 2) {
+    return ToArray(
+        Eigen::VectorXd(step2(Eigen::Vector2d(a), Eigen::Vector2d(b), Eigen::Vector2d(t), length)));
+  }
+  return ToArray(
+      Eigen::VectorXd(step3(Eigen::Vector3d(a), Eigen::Vector3d(b), Eigen::Vector3d(t), length)));
+}
+
+std::string ChainRepr(const Chain& c) {
+  return "Chain(" + std::to_string(c.dim()) + "D, " + std::to_string(c.num_links()) +
+         " links, total length " + Num(c.lengths.sum()) + ", leading end " +
+         VectorText(c.points.row(0).transpose()) + ")";
+}
+
+void MoveChain(Chain* chain, py::handle target, const std::string& method, int substeps) {
+  const Method m = MethodArg(method);
+  const Eigen::VectorXd head = ReadVector(target, "target", chain->dim());
+  if (m == Method::kOverall) {
+    ThrowInput("method",
+               "\"overall\" is not a link rule; use overall_step (or run with method "
+               "\"overall\")",
+               "\"overall\"", "\"tractrix\", \"ftl\", \"min_rotation\" or \"min_joint_angle\"");
+  }
+  const Stepper stepper = MakeStepper(m, *chain);
+  py::gil_scoped_release release;
+  MoveLeader(stepper, head, substeps, &chain->points);
+}
+
+OverallReport StepChainOverall(Chain* chain, py::handle head, py::handle options) {
+  const Eigen::VectorXd h = ReadVector(head, "head", chain->dim());
+  const OverallOptions o = OverallArg(options);
+  py::gil_scoped_release release;
+  return OverallStep(h, o, chain);
+}
+
+}  // namespace
+
+Chain ChainArg(py::handle object, const std::string& name) {
+  if (py::isinstance<Chain>(object)) return py::cast<Chain>(object);
+  return MakeChain(ReadPoints(object, name, 2));
+}
+
+void BindChains(py::module_& m) {
+  py::class_<Chain>(m, "Chain", R"doc(
+A chain of rigid links: points (n+1, dim) float64, row 0 the leading end; link i joins points
+i-1 and i and keeps its length lengths[i-1], fixed when the chain is made.
+
+Chain(points, *, link_length=None, lengths=None)
+  points: (n+1, 2) or (n+1, 3) array-like, n >= 1.
+  link_length: every link exactly this long (points from the curve generators, whose chords
+               equal it to rounding); else
+  lengths: the n link lengths; else the distances between consecutive points.
+)doc")
+      .def(py::init([](py::handle points, py::object link_length, py::object lengths) {
+             Points p = ReadPoints(points, "points", 2);
+             if (!link_length.is_none() && !lengths.is_none()) {
+               ThrowInput("lengths", "given with link_length; give one of them");
+             }
+             if (!link_length.is_none()) {
+               return MakeEqualLinkChain(
+                   p, CheckPositive(py::cast<double>(link_length), "link_length"));
+             }
+             if (!lengths.is_none()) {
+               Chain c;
+               c.lengths = ReadArray(lengths, "lengths", 1, 1, 0, static_cast<int>(p.rows() - 1))
+                               .cast<Eigen::VectorXd>();
+               c.points = std::move(p);
+               ValidateChain(c, "lengths");
+               return c;
+             }
+             return MakeChain(p);
+           }),
+           py::arg("points"), py::kw_only(), py::arg("link_length") = py::none(),
+           py::arg("lengths") = py::none())
+      .def_property_readonly(
+          "points", [](const Chain& c) { return ToArray(Points(c.points)); },
+          "(n+1, dim) float64, a copy; row 0 the leading end")
+      .def_property_readonly(
+          "lengths", [](const Chain& c) { return ToArray(c.lengths); }, "(n,) link lengths, a copy")
+      .def_property_readonly("dim", &Chain::dim)
+      .def_property_readonly("num_links", &Chain::num_links)
+      .def("max_relative_length_error", &MaxRelativeLengthError,
+           "Largest |(|p_i - p_{i-1}| - L_i)| / L_i over the links.")
+      .def(
+          "move_leader",
+          [](Chain& c, py::handle target, const std::string& method, int substeps) {
+            MoveChain(&c, target, method, substeps);
+          },
+          py::arg("target"), py::kw_only(), py::arg("method") = "tractrix", py::arg("substeps") = 1,
+          "Moves the leading end in a straight line to target (dim values) in `substeps` equal "
+          "sub-steps, every link following by `method`; in place.")
+      .def(
+          "overall_step",
+          [](Chain& c, py::handle head, py::handle options) {
+            return StepChainOverall(&c, head, options);
+          },
+          py::arg("head"), py::kw_only(), py::arg("options") = py::none(),
+          "One overall step in place: the leading end to head, the other points to the "
+          "minimizer of the objective under the length constraints. options: OverallOptions, "
+          "ObjectiveWeights or a dict of term weights. Returns an OverallReport.")
+      .def("__repr__", &ChainRepr)
+      .def(py::pickle(
+          [](const Chain& c) {
+            return py::make_tuple(ToArray(Points(c.points)), ToArray(c.lengths));
+          },
+          [](const py::tuple& state) {
+            StateTuple(state, 2, "Chain");
+            Chain c;
+            c.points = ReadPoints(state[0], "points", 2);
+            c.lengths =
+                ReadArray(state[1], "lengths", 1, 1, 0, static_cast<int>(c.points.rows() - 1))
+                    .cast<Eigen::VectorXd>();
+            ValidateChain(c, "lengths");
+            return c;
+          }));
+
+  m.def(
+      "line",
+      [](py::handle start, py::handle direction, int links, double link_length) {
+        LineDef d;
+        d.start = ReadVector(start, "start");
+        d.direction = ReadVector(direction, "direction", static_cast<int>(d.start.size()));
+        d.links = links;
+        d.link_length = link_length;
+        return ToArray(MakeLine(d));
+      },
+      py::kw_only(), py::arg("start") = std::vector<double>{0.0, 0.0},
+      py::arg("direction") = std::vector<double>{1.0, 0.0}, py::arg("links") = 10,
+      py::arg("link_length") = 0.1,
+      "A straight line of `links` links of `link_length` from start (the leading end) along "
+      "direction: (links+1, dim) float64.");
+  m.def(
+      "parabola",
+      [](double a, int links, double link_length, int side) {
+        ParabolaDef d;
+        d.a = a;
+        d.links = links;
+        d.link_length = link_length;
+        d.side = side;
+        return ToArray(MakeParabola(d));
+      },
+      py::kw_only(), py::arg("a") = 1.0, py::arg("links") = 20, py::arg("link_length") = 0.25,
+      py::arg("side") = 1,
+      "The parabola y = a x^2 from the vertex (the leading end) toward +x (side=1) or -x "
+      "(side=-1), every chord link_length: (links+1, 2) float64 (paper Sec. 5.1: a=1, 20 links "
+      "of 0.25).");
+  m.def(
+      "arc",
+      [](double radius, py::handle center, double start_angle, bool clockwise, int links,
+         double link_length) {
+        ArcDef d;
+        d.radius = radius;
+        d.center = ReadVector(center, "center", 2);
+        d.start_angle = start_angle;
+        d.clockwise = clockwise;
+        d.links = links;
+        d.link_length = link_length;
+        return ToArray(MakeArc(d));
+      },
+      py::kw_only(), py::arg("radius") = 1.0, py::arg("center") = std::vector<double>{0.0, 0.0},
+      py::arg("start_angle") = 0.0, py::arg("clockwise") = false, py::arg("links") = 10,
+      py::arg("link_length") = 0.1,
+      "A circular arc about center, point 0 at start_angle (radians), every chord link_length: "
+      "(links+1, 2) float64.");
+  m.def(
+      "helix",
+      [](double radius, double pitch, py::handle center, double start_angle, bool clockwise,
+         int links, double link_length) {
+        HelixDef d;
+        d.radius = radius;
+        d.pitch = pitch;
+        d.center = ReadVector(center, "center", 3);
+        d.start_angle = start_angle;
+        d.clockwise = clockwise;
+        d.links = links;
+        d.link_length = link_length;
+        return ToArray(MakeHelix(d));
+      },
+      py::kw_only(), py::arg("radius") = 1.0, py::arg("pitch") = 1.0,
+      py::arg("center") = std::vector<double>{0.0, 0.0, 0.0}, py::arg("start_angle") = 0.0,
+      py::arg("clockwise") = false, py::arg("links") = 20, py::arg("link_length") = 1.5,
+      "A circular helix about an axis parallel to z (rise `pitch` per turn), every chord "
+      "link_length: (links+1, 3) float64.");
+
+  m.def(
+      "split_pull",
+      [](py::handle start, py::handle pull, int64_t steps) {
+        const Eigen::VectorXd s = ReadVector(start, "start");
+        return ToArray(SplitPull(s, ReadVector(pull, "pull", static_cast<int>(s.size())), steps));
+      },
+      py::arg("start"), py::arg("pull"), py::arg("steps"),
+      "Leader steps of one straight pull: (steps, dim), row k-1 = start + k/steps pull, the "
+      "last exactly start + pull.");
+  m.def(
+      "resample_path",
+      [](py::handle start, py::handle path, double max_step) {
+        const Eigen::VectorXd s = ReadVector(start, "start");
+        return ToArray(
+            ResamplePath(s, ReadPoints(path, "path", 1, static_cast<int>(s.size())), max_step));
+      },
+      py::arg("start"), py::arg("path"), py::arg("max_step"),
+      "Leader steps along the polyline start -> path[0] -> ..., each segment split into equal "
+      "steps of at most max_step: (total steps, dim).");
+
+  m.def(
+      "tractrix_step",
+      [](py::handle head_old, py::handle head_new, py::handle tail, double length) {
+        return LinkStep(
+            head_old, head_new, tail, length,
+            [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& t,
+               double l) { return TractrixStep(a, b, t, l); },
+            [](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& t,
+               double l) { return TractrixStep(a, b, t, l); });
+      },
+      py::arg("head_old"), py::arg("head_new"), py::arg("tail"), py::arg("length"),
+      "One link's tractrix step: the new trailing end when the leading end moves in a straight "
+      "line from head_old to head_new (2 or 3 values each), the trailing end's velocity along "
+      "the link (closed form). Returns (dim,) float64.");
+  m.def(
+      "follow_the_leader_step",
+      [](py::handle head_old, py::handle head_new, py::handle tail, double length) {
+        return LinkStep(
+            head_old, head_new, tail, length,
+            [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& t,
+               double l) { return FollowTheLeaderStep(a, b, t, l); },
+            [](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& t,
+               double l) { return FollowTheLeaderStep(a, b, t, l); });
+      },
+      py::arg("head_old"), py::arg("head_new"), py::arg("tail"), py::arg("length"),
+      "One link's follow-the-leader step (FABRIK): the point at distance length from head_new "
+      "nearest the old trailing end. Returns (dim,) float64.");
+
+  m.def(
+      "move_leader",
+      [](py::handle points, py::handle target, const std::string& method, int substeps) {
+        Chain chain = ChainArg(points);
+        MoveChain(&chain, target, method, substeps);
+        return ToArray(std::move(chain.points));
+      },
+      py::arg("points"), py::arg("target"), py::kw_only(), py::arg("method") = "tractrix",
+      py::arg("substeps") = 1,
+      "Multi-step propagation: the leading end of points (an (n+1, dim) array-like or a Chain) "
+      "moves in a straight line to target in `substeps` equal sub-steps, each link following by "
+      "`method` (\"tractrix\", \"ftl\", \"min_rotation\", \"min_joint_angle\"). Returns the new "
+      "(n+1, dim) points; the input is not changed (Chain.move_leader moves a chain in place).");
+  m.def(
+      "overall_step",
+      [](py::handle points, py::handle head, py::handle options) {
+        Chain chain = ChainArg(points);
+        OverallReport report = StepChainOverall(&chain, head, options);
+        return py::make_tuple(ToArray(std::move(chain.points)), report);
+      },
+      py::arg("points"), py::arg("head"), py::kw_only(), py::arg("options") = py::none(),
+      "One overall step: the leading end to head, every other point to the minimizer of the "
+      "objective (options: OverallOptions, ObjectiveWeights or a dict of term weights) under "
+      "the length constraints. Returns (new points, OverallReport).");
+}
+
+}  // namespace flexkin::python

@@ -1,0 +1,90 @@
+#pragma once
+// Conversions between Python objects and flexkin's Eigen types, shared by the binding files.
+//
+// Every array argument goes through ReadArray: any array-like that numpy converts to float64
+// (lists, tuples, integer and float arrays of any layout) is accepted; other dtypes (strings,
+// objects, complex, bool), wrong shapes, NaN and inf are refused with flexkin::InputError naming
+// the argument ("points", "leader_steps[3][1]"), which the module raises as flexkin.InputError.
+// A C-contiguous float64 ndarray is read where it lies (no conversion); flexkin's functions take
+// Eigen matrices, so its values are then copied once into the Points the call needs.
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <Eigen/Core>
+#include <string>
+
+#include "flexkin/chain.h"
+#include "flexkin/error.h"
+#include "flexkin/propagate.h"
+#include "flexkin/run.h"
+
+namespace flexkin::python {
+
+namespace py = pybind11;
+
+// The float64, C-contiguous form of `object`, checked: `ndim` dimensions (1 or 2); with ndim 2,
+// at least `min_rows` rows and 2 or 3 columns (`cols` if it is not 0); with ndim 1, `size`
+// values if it is not 0 (2 or 3 if it is 0). Every value finite. Throws InputError naming `name`.
+py::array_t<double, py::array::c_style> ReadArray(py::handle object, const std::string& name,
+                                                  int ndim, int min_rows = 1, int cols = 0,
+                                                  int size = 0);
+
+// Checked (n, dim) points (see ReadArray) copied into flexkin's Points.
+Points ReadPoints(py::handle object, const std::string& name, int min_rows = 1, int cols = 0);
+// A checked vector of `size` values (2 or 3 if size is 0).
+Eigen::VectorXd ReadVector(py::handle object, const std::string& name, int size = 0);
+
+// A numpy array that owns `points` (moved, not copied): (rows, cols) float64.
+py::array_t<double> ToArray(Points&& points);
+// A numpy copy of a vector.
+py::array_t<double> ToArray(const Eigen::VectorXd& vector);
+
+// A finite number, else InputError naming `name`.
+double CheckFinite(double value, const std::string& name);
+// A number > 0 and finite, else InputError naming `name`.
+double CheckPositive(double value, const std::string& name);
+
+// "1.5", "nan": a number as the library writes it in messages and reprs.
+std::string Num(double x);
+// "[1, 2.5]": a short vector for a repr (its size alone when it is long).
+std::string VectorText(const Eigen::VectorXd& v);
+// A Python string's repr ("'tractrix'").
+std::string Quoted(const std::string& text);
+
+// Registers flexkin.InputError (a ValueError with field, message, value, expected) and the
+// translation of std::system_error to OSError (FileNotFoundError, PermissionError, ... by errno).
+void BindErrors(py::module_& m);
+// Throws InputError(Problem(field, message, value, expected)), raised as flexkin.InputError.
+[[noreturn]] void ThrowInput(const std::string& field, const std::string& message,
+                             const std::string& value = "", const std::string& expected = "");
+
+// Option and report classes (options.cc), chains, curves, link steps (chains.cc), runs and
+// scenarios (run.cc), fixed-base arms (robot.cc).
+void BindOptions(py::module_& m);
+void BindChains(py::module_& m);
+void BindRun(py::module_& m);
+void BindRobot(py::module_& m);
+
+}  // namespace flexkin::python
+
+namespace flexkin::python {
+// The checked state tuple of a pickled object: `size` items, else InputError naming `type`.
+py::tuple StateTuple(const py::tuple& state, size_t size, const char* type);
+// Method from its name, as in scenario files ("tractrix", "ftl", ...); InputError naming `field`.
+Method MethodArg(const std::string& name, const std::string& field = "method");
+// The overall options from an `overall` argument: None (the defaults), OverallOptions,
+// ObjectiveWeights or a dict of term weights (only the terms given count).
+OverallOptions OverallArg(py::handle object);
+std::string RunOptionsRepr(const RunOptions& options);
+// A chain from a `Chain` or from points (link lengths the distances between them; MakeChain).
+Chain ChainArg(py::handle object, const std::string& name = "points");
+}  // namespace flexkin::python
+
+namespace flexkin::python {
+// JSON text of a dict (numpy arrays and scalars as lists and numbers) for the scenario readers;
+// InputError naming `name` if it cannot be written.
+std::string JsonOfDict(py::handle dict, const std::string& name);
+// A path (str or os.PathLike) as a string, or "" if `object` is not one.
+std::string PathArg(py::handle object);
+}  // namespace flexkin::python

@@ -1,0 +1,348 @@
+// Runs: flexkin.run (a chain and its leader steps), flexkin.load_scenario and run_scenario (the
+// `flexkin run` of a scenario file or dict), and their Result. The frames stream from the run
+// into preallocated numpy arrays through a FrameSink (flexkin/run.h), with the GIL released;
+// the progress callback takes it back, and Ctrl-C (or an exception in the callback) stops the
+// run.
+#include "flexkin/run.h"
+
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <limits>
+#include <string>
+
+#include "convert.h"
+#include "flexkin/result_io.h"
+#include "flexkin/scenario.h"
+#include "progress.h"
+
+namespace flexkin::python {
+namespace {
+
+// A run's result with its frames as numpy arrays.
+struct Result {
+  RunResult run;               // frames empty: they are in the arrays below
+  py::array_t<double> frames;  // (F, n+1, dim)
+  py::array_t<int64_t> steps;  // (F,)
+  py::object link_angles;      // (F, n) float64, or None
+  std::string scenario;        // the scenario's name, "" if none
+  int dim = 2;
+};
+
+// Copies each recorded frame into the next row of preallocated arrays: no Python object is
+// touched, so it runs with the GIL released.
+class ArraySink : public FrameSink {
+ public:
+  ArraySink(double* frames, int64_t* steps, double* angles, int64_t capacity, int64_t frame_size,
+            int64_t links)
+      : frames_(frames),
+        steps_(steps),
+        angles_(angles),
+        capacity_(capacity),
+        frame_size_(frame_size),
+        links_(links) {}
+  void Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) override {
+    if (count_ >= capacity_ || points.size() != frame_size_) {
+      throw std::logic_error("flexkin: a run recorded more frames than it counted");
+    }
+    std::memcpy(frames_ + count_ * frame_size_, points.data(),
+                sizeof(double) * static_cast<size_t>(frame_size_));
+    steps_[count_] = step;
+    if (angles_ != nullptr) {
+      if (link_angles.size() == links_) {
+        std::memcpy(angles_ + count_ * links_, link_angles.data(),
+                    sizeof(double) * static_cast<size_t>(links_));
+      } else {
+        has_angles_ = false;  // the leader never moves: no angles (as in result files)
+      }
+    }
+    ++count_;
+  }
+  int64_t count() const { return count_; }
+  bool has_angles() const { return angles_ != nullptr && has_angles_; }
+
+ private:
+  double* frames_;
+  int64_t* steps_;
+  double* angles_;
+  int64_t capacity_, frame_size_, links_, count_ = 0;
+  bool has_angles_ = true;
+};
+
+Result RunToArrays(const Chain& chain, const Points& leader_steps, RunOptions options,
+                   py::object progress, std::string scenario) {
+  ThrowIfAny(options.Validate());
+  ValidateChain(chain, "points");
+  if (leader_steps.rows() < 1 || leader_steps.cols() != chain.dim()) {
+    ThrowInput("leader_steps", "has shape (" + std::to_string(leader_steps.rows()) + ", " +
+                                   std::to_string(leader_steps.cols()) + "); expected (m, " +
+                                   std::to_string(chain.dim()) +
+                                   ") with m >= 1, the chain's dimension");
+  }
+  const int64_t n = chain.num_links(), dim = chain.dim();
+  const int64_t count = CountRecordedFrames(leader_steps.rows(), options.record_every);
+  Result result;
+  result.dim = static_cast<int>(dim);
+  result.scenario = std::move(scenario);
+  result.frames = py::array_t<double>({count, n + 1, dim});
+  result.steps = py::array_t<int64_t>(count);
+  py::array_t<double> angles;
+  if (options.link_angles) angles = py::array_t<double>({count, n});
+  ArraySink sink(result.frames.mutable_data(), result.steps.mutable_data(),
+                 options.link_angles ? angles.mutable_data() : nullptr, count, (n + 1) * dim, n);
+  ProgressHook hook(std::move(progress));
+  hook.Install(&options.progress);
+  try {
+    py::gil_scoped_release release;
+    result.run = Run(chain, leader_steps, options, &sink);
+  } catch (const StopRun&) {
+    hook.Rethrow();
+  }
+  if (sink.count() != count) {
+    throw std::logic_error("flexkin: a run recorded " + std::to_string(sink.count()) +
+                           " frames; it counted " + std::to_string(count));
+  }
+  result.link_angles = sink.has_angles() ? py::object(angles) : py::none();
+  return result;
+}
+
+// A scenario file's InputError with the file's path before its JSON pointer, as `flexkin run`
+// prints it; field() stays the pointer.
+Scenario LoadScenarioPath(const std::string& path) {
+  try {
+    return LoadScenarioFile(path);
+  } catch (const InputError& e) {
+    Problem p = e.problem();
+    p.field = p.field.empty() ? path : path + ": " + p.field;
+    throw InputError(p);
+  }
+}
+
+}  // namespace
+
+// JSON text of a dict (numpy arrays and numbers as lists and numbers) for the scenario readers.
+std::string JsonOfDict(py::handle dict, const std::string& name) {
+  py::module_ json = py::module_::import("json");
+  py::object to_list = py::cpp_function([](py::handle o) -> py::object {
+    if (py::hasattr(o, "tolist")) return o.attr("tolist")();
+    throw py::type_error(std::string("an object of type ") +
+                         std::string(py::str(py::type::of(o).attr("__name__"))) +
+                         " cannot be written as JSON");
+  });
+  try {
+    return py::cast<std::string>(json.attr("dumps")(dict, py::arg("default") = to_list));
+  } catch (py::error_already_set& e) {
+    ThrowInput(name, "cannot be written as JSON: " + std::string(e.what()));
+  }
+}
+
+// A path (str or os.PathLike) as a string, or "" if `object` is not one.
+std::string PathArg(py::handle object) {
+  if (py::isinstance<py::str>(object) || py::hasattr(object, "__fspath__")) {
+    return py::cast<std::string>(py::module_::import("os").attr("fsdecode")(object));
+  }
+  return "";
+}
+
+namespace {
+
+Scenario ScenarioArg(py::handle scenario) {
+  if (py::isinstance<Scenario>(scenario)) return py::cast<Scenario>(scenario);
+  if (py::isinstance<py::dict>(scenario))
+    return ParseScenarioText(JsonOfDict(scenario, "scenario"));
+  const std::string path = PathArg(scenario);
+  if (path.empty()) {
+    ThrowInput("scenario",
+               "is a " + std::string(py::str(py::type::of(scenario).attr("__name__"))) +
+                   "; expected a path to a scenario file, a dict of its JSON form or a Scenario");
+  }
+  return LoadScenarioPath(path);
+}
+
+std::string ResultRepr(const Result& r) {
+  return "Result(method=" + Quoted(MethodName(r.run.method)) + ", " + std::to_string(r.dim) +
+         "D, " + std::to_string(r.run.lengths.size()) + " links, " +
+         std::to_string(r.run.num_steps) + " leader steps, " + std::to_string(r.steps.size()) +
+         " frames, substeps=" + std::to_string(r.run.accuracy.substeps) +
+         ", l2_total=" + Num(r.run.metrics.l2_total) +
+         ", max_relative_length_error=" + Num(r.run.metrics.max_relative_length_error) +
+         (r.scenario.empty() ? "" : ", scenario=" + Quoted(r.scenario)) + ")";
+}
+
+// The RunResult with placeholders for its frames, for the C++ full report (which counts them
+// and prints the last frame's link angles).
+std::string FullReport(const Result& r) {
+  RunResult copy = r.run;
+  copy.frames.resize(static_cast<size_t>(r.steps.size()));
+  if (!r.link_angles.is_none() && !copy.frames.empty()) {
+    const auto angles = py::cast<py::array_t<double>>(r.link_angles);
+    const int64_t n = angles.shape(1);
+    copy.frames.back().link_angles =
+        Eigen::Map<const Eigen::VectorXd>(angles.data() + (angles.shape(0) - 1) * n, n);
+  }
+  return copy.FullReport();
+}
+
+const char* kRunDoc = R"doc(
+Runs a chain whose leading end moves in straight lines through leader_steps.
+
+run(points, leader_steps, *, method="tractrix", substeps=1, record_every=1, tolerance=0.0,
+    max_substeps=65536, link_angles=True, overall=None, progress=None) -> Result
+
+  points: (n+1, dim) array-like (row 0 the leading end; link lengths the distances between
+          the points) or a Chain.
+  leader_steps: (m, dim) array-like, m >= 1: the successive targets of the leading end, not
+          including its start (flexkin.split_pull, flexkin.resample_path make them).
+  method: "tractrix", "ftl", "min_rotation", "min_joint_angle" or "overall".
+  substeps: equal sub-steps per leader step (>= 1).
+  record_every: keep frame 0, every record_every-th leader step and the last.
+  tolerance: if > 0, sub-steps are doubled until the estimated largest distance to the
+          continuous motion is at most tolerance (length unit), up to max_substeps.
+  link_angles: compute each frame's link angles to the pull (radians).
+  overall: OverallOptions, ObjectiveWeights or a dict of term weights (method "overall").
+  progress: callable(done, total) called about every 0.1 s with leader steps done.
+
+The GIL is released during the run; Ctrl-C stops it (KeyboardInterrupt). Raises InputError
+for invalid input, naming the argument ("leader_steps[2][0]", "substeps").
+)doc";
+
+}  // namespace
+
+void BindRun(py::module_& m) {
+  py::class_<Result>(m, "Result", R"doc(
+The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
+(docs/result-format.md).
+  frames: (F, n+1, dim) float64, the recorded configurations, row 0 the leading end
+  steps: (F,) int64, leader steps done at each frame (0 the initial configuration)
+  link_angles: (F, n) float64 (radians, each link's angle to the pull) or None
+  metrics: Metrics; accuracy: AccuracyReport; overall: OverallRunReport (method "overall")
+  method, lengths (n,), num_steps, substeps (used), weights, seconds, scenario, dim, num_links
+)doc")
+      .def_readonly("frames", &Result::frames)
+      .def_readonly("steps", &Result::steps)
+      .def_readonly("link_angles", &Result::link_angles)
+      .def_property_readonly("metrics", [](const Result& r) { return r.run.metrics; })
+      .def_property_readonly("accuracy", [](const Result& r) { return r.run.accuracy; })
+      .def_property_readonly("overall", [](const Result& r) { return r.run.overall; })
+      .def_property_readonly("weights", [](const Result& r) { return r.run.weights; })
+      .def_property_readonly("method",
+                             [](const Result& r) { return std::string(MethodName(r.run.method)); })
+      .def_property_readonly("lengths", [](const Result& r) { return ToArray(r.run.lengths); })
+      .def_property_readonly("num_steps", [](const Result& r) { return r.run.num_steps; })
+      .def_property_readonly("substeps", [](const Result& r) { return r.run.accuracy.substeps; })
+      .def_property_readonly("seconds", [](const Result& r) { return r.run.seconds; })
+      .def_readonly("scenario", &Result::scenario)
+      .def_readonly("dim", &Result::dim)
+      .def_property_readonly("num_links",
+                             [](const Result& r) { return static_cast<int>(r.run.lengths.size()); })
+      .def(
+          "brief_report", [](const Result& r) { return r.run.BriefReport(); },
+          "One line: method, steps, length error, L2 total, accuracy, time.")
+      .def("full_report", &FullReport, "Several lines, with the path-length profile.")
+      .def("__repr__", &ResultRepr)
+      .def(py::pickle(
+          [](const Result& r) {
+            return py::make_tuple(std::string(MethodName(r.run.method)), r.run.lengths,
+                                  r.run.num_steps, r.frames, r.steps, r.link_angles, r.run.metrics,
+                                  r.run.accuracy, r.run.overall, r.run.weights, r.run.seconds,
+                                  r.scenario);
+          },
+          [](const py::tuple& state) {
+            StateTuple(state, 12, "Result");
+            Result r;
+            r.run.method = MethodArg(py::cast<std::string>(state[0]));
+            r.run.lengths = py::cast<Eigen::VectorXd>(state[1]);
+            r.run.num_steps = py::cast<int64_t>(state[2]);
+            r.frames = py::cast<py::array_t<double>>(state[3]);
+            r.steps = py::cast<py::array_t<int64_t>>(state[4]);
+            r.link_angles = state[5];
+            r.run.metrics = py::cast<Metrics>(state[6]);
+            r.run.accuracy = py::cast<AccuracyReport>(state[7]);
+            r.run.overall = py::cast<OverallRunReport>(state[8]);
+            r.run.weights = py::cast<ObjectiveWeights>(state[9]);
+            r.run.seconds = py::cast<double>(state[10]);
+            r.scenario = py::cast<std::string>(state[11]);
+            if (r.frames.ndim() != 3 || r.steps.ndim() != 1 ||
+                r.frames.shape(0) != r.steps.shape(0) ||
+                r.frames.shape(1) != r.run.lengths.size() + 1 ||
+                (r.frames.shape(2) != 2 && r.frames.shape(2) != 3)) {
+              ThrowInput("state", "the pickled Result's frames, steps and lengths disagree");
+            }
+            r.dim = static_cast<int>(r.frames.shape(2));
+            return r;
+          }));
+
+  m.def(
+      "run",
+      [](py::handle points, py::handle leader_steps, const std::string& method, int substeps,
+         int record_every, double tolerance, int max_substeps, bool link_angles, py::handle overall,
+         py::object progress) {
+        const Chain chain = ChainArg(points);
+        const Points steps = ReadPoints(leader_steps, "leader_steps", 1, chain.dim());
+        RunOptions options;
+        options.method = MethodArg(method);
+        options.substeps = substeps;
+        options.record_every = record_every;
+        options.tolerance = tolerance;
+        options.max_substeps = max_substeps;
+        options.link_angles = link_angles;
+        options.overall = OverallArg(overall);
+        return RunToArrays(chain, steps, options, std::move(progress), "");
+      },
+      kRunDoc, py::arg("points"), py::arg("leader_steps"), py::kw_only(),
+      py::arg("method") = "tractrix", py::arg("substeps") = 1, py::arg("record_every") = 1,
+      py::arg("tolerance") = 0.0, py::arg("max_substeps") = 1 << 16, py::arg("link_angles") = true,
+      py::arg("overall") = py::none(), py::arg("progress") = py::none());
+
+  py::class_<Scenario>(m, "Scenario", R"doc(
+A scenario (docs/scenario-format.md) read by flexkin.load_scenario: name, description,
+chain (Chain), leader_steps ((m, dim) float64), options (RunOptions).
+)doc")
+      .def_readwrite("name", &Scenario::name)
+      .def_readwrite("description", &Scenario::description)
+      .def_readwrite("chain", &Scenario::chain)
+      .def_property(
+          "leader_steps", [](const Scenario& s) { return ToArray(Points(s.leader_steps)); },
+          [](Scenario& s, py::handle steps) {
+            s.leader_steps = ReadPoints(steps, "leader_steps", 1, s.chain.dim());
+          })
+      .def_readwrite("options", &Scenario::options)
+      .def("summary", &ScenarioSummary)
+      .def("__repr__",
+           [](const Scenario& s) {
+             return "Scenario(" + (s.name.empty() ? "" : Quoted(s.name) + ": ") +
+                    ScenarioSummary(s) + ")";
+           })
+      .def(py::pickle(
+          [](const Scenario& s) {
+            return py::make_tuple(s.name, s.description, s.chain, ToArray(Points(s.leader_steps)),
+                                  s.options);
+          },
+          [](const py::tuple& state) {
+            StateTuple(state, 5, "Scenario");
+            Scenario s;
+            s.name = py::cast<std::string>(state[0]);
+            s.description = py::cast<std::string>(state[1]);
+            s.chain = py::cast<Chain>(state[2]);
+            s.leader_steps = ReadPoints(state[3], "leader_steps", 1, s.chain.dim());
+            s.options = py::cast<RunOptions>(state[4]);
+            return s;
+          }));
+
+  m.def("load_scenario", &ScenarioArg, py::arg("scenario"),
+        "Reads a scenario: a path (str or os.PathLike) to a scenario file, or a dict of its JSON "
+        "form (docs/scenario-format.md). Raises InputError naming the JSON pointer of the first "
+        "problem (field '/leader/steps'), OSError for a file that cannot be read.");
+  m.def(
+      "run_scenario",
+      [](py::handle scenario, py::object progress) {
+        const Scenario s = ScenarioArg(scenario);
+        return RunToArrays(s.chain, s.leader_steps, s.options, std::move(progress), s.name);
+      },
+      py::arg("scenario"), py::kw_only(), py::arg("progress") = py::none(),
+      "Runs a scenario (a path, a dict of the scenario JSON form, or a Scenario) as `flexkin "
+      "run` does, with the same result bit for bit. Returns a Result; progress as in run.");
+}
+
+}  // namespace flexkin::python
