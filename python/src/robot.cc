@@ -1,6 +1,5 @@
 // Fixed-base arms: flexkin.run_robot (the `flexkin robot` of a robot scenario file or dict) and
-// its RobotResult. The steps stream from TrackPath into preallocated numpy arrays through an
-// ArmStepSink (flexkin/arm.h), with the GIL released.
+// its RobotResult: TrackPath with the GIL released, its steps turned into numpy arrays.
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
@@ -13,7 +12,6 @@
 #include "convert.h"
 #include "flexkin/arm.h"
 #include "flexkin/robot_scenario.h"
-#include "progress.h"
 #ifdef FLEXKIN_PYTHON_URDF
 #include "flexkin/urdf.h"
 #endif
@@ -28,74 +26,55 @@ constexpr const char* kBoolSteps[] = {"converged", "reached", "stretched", "limi
                                       "joint_space"};
 
 struct RobotResult {
-  std::string scenario, method, joint;
+  std::string scenario, method, joint, brief;
   int dim = 2;
-  ArmTrajectory summary;                   // steps empty
+  ArmTrajectory summary;  // steps empty: they are in `data`
+  long long num_steps = 0;
   std::map<std::string, py::object> data;  // arrays (and None for absent azimuths)
 };
 
-// Copies each step into the next row of the arrays; checks for Ctrl-C about every 0.1 s.
-class ArraySteps : public ArmStepSink {
- public:
-  ArraySteps(RobotResult* r, int64_t steps, int64_t links, int64_t dim, bool azimuths,
-             ProgressHook* hook)
-      : total_(steps), links_(links), dim_(dim), hook_(hook) {
-    angles_ = py::array_t<double>({steps, links});
-    points_ = py::array_t<double>({steps, links + 1, dim});
-    if (azimuths) azimuths_ = py::array_t<double>({steps, links});
-    for (size_t i = 0; i < std::size(kFloatSteps); ++i) floats_.emplace_back(steps);
-    for (size_t i = 0; i < std::size(kIntSteps); ++i) ints_.emplace_back(steps);
-    for (size_t i = 0; i < std::size(kBoolSteps); ++i) bools_.emplace_back(steps);
-    r->data["angles"] = angles_;
-    r->data["points"] = points_;
-    r->data["azimuths"] = azimuths ? py::object(azimuths_) : py::none();
-    for (size_t i = 0; i < floats_.size(); ++i) r->data[kFloatSteps[i]] = floats_[i];
-    for (size_t i = 0; i < ints_.size(); ++i) r->data[kIntSteps[i]] = ints_[i];
-    for (size_t i = 0; i < bools_.size(); ++i) r->data[kBoolSteps[i]] = bools_[i];
-    angle_data_ = angles_.mutable_data();
-    point_data_ = points_.mutable_data();
-    azimuth_data_ = azimuths ? azimuths_.mutable_data() : nullptr;
-    for (auto& a : floats_) float_data_.push_back(a.mutable_data());
-    for (auto& a : ints_) int_data_.push_back(a.mutable_data());
-    for (auto& a : bools_) bool_data_.push_back(a.mutable_data());
-  }
-
-  void Add(const ArmStepReport& s) override {
-    if (count_ >= total_ || s.state.angles.angle.size() != links_ ||
-        s.state.points.size() != (links_ + 1) * dim_) {
+// The steps of a trajectory as arrays: (T, n) angles and azimuths, (T, n+1, dim) points, and
+// one (T,) array per per-step report member.
+void StepsToArrays(const std::vector<ArmStepReport>& steps, int64_t links, int64_t dim,
+                   bool azimuths, RobotResult* r) {
+  const int64_t count = static_cast<int64_t>(steps.size());
+  py::array_t<double> angles({count, links}), points({count, links + 1, dim});
+  py::array_t<double> azimuth_array;
+  if (azimuths) azimuth_array = py::array_t<double>({count, links});
+  std::vector<py::array_t<double>> floats;  // one array each (not copies of one handle)
+  std::vector<py::array_t<int64_t>> ints;
+  std::vector<py::array_t<bool>> bools;
+  for (size_t k = 0; k < std::size(kFloatSteps); ++k) floats.emplace_back(count);
+  for (size_t k = 0; k < std::size(kIntSteps); ++k) ints.emplace_back(count);
+  for (size_t k = 0; k < std::size(kBoolSteps); ++k) bools.emplace_back(count);
+  for (int64_t t = 0; t < count; ++t) {
+    const ArmStepReport& s = steps[static_cast<size_t>(t)];
+    if (s.state.angles.angle.size() != links || s.state.points.size() != (links + 1) * dim ||
+        (azimuths && s.state.angles.azimuth.size() != links)) {
       throw std::logic_error("flexkin: TrackPath produced a step of another shape");
     }
-    std::memcpy(angle_data_ + count_ * links_, s.state.angles.angle.data(),
-                sizeof(double) * static_cast<size_t>(links_));
-    std::memcpy(point_data_ + count_ * (links_ + 1) * dim_, s.state.points.data(),
-                sizeof(double) * static_cast<size_t>((links_ + 1) * dim_));
-    if (azimuth_data_ != nullptr && s.state.angles.azimuth.size() == links_) {
-      std::memcpy(azimuth_data_ + count_ * links_, s.state.angles.azimuth.data(),
-                  sizeof(double) * static_cast<size_t>(links_));
+    std::memcpy(angles.mutable_data() + t * links, s.state.angles.angle.data(),
+                sizeof(double) * static_cast<size_t>(links));
+    std::memcpy(points.mutable_data() + t * (links + 1) * dim, s.state.points.data(),
+                sizeof(double) * static_cast<size_t>((links + 1) * dim));
+    if (azimuths) {
+      std::memcpy(azimuth_array.mutable_data() + t * links, s.state.angles.azimuth.data(),
+                  sizeof(double) * static_cast<size_t>(links));
     }
-    const double floats[] = {s.ee_error, s.base_error};
-    const int64_t ints[] = {s.iterations, s.sweeps, s.passes, s.legs, s.restarts};
-    const bool bools[] = {s.converged, s.reached, s.stretched, s.limited, s.joint_space};
-    for (size_t i = 0; i < float_data_.size(); ++i) float_data_[i][count_] = floats[i];
-    for (size_t i = 0; i < int_data_.size(); ++i) int_data_[i][count_] = ints[i];
-    for (size_t i = 0; i < bool_data_.size(); ++i) bool_data_[i][count_] = bools[i];
-    ++count_;
-    hook_->Tick(count_, total_);
+    const double f[] = {s.ee_error, s.base_error};
+    const int64_t i[] = {s.iterations, s.sweeps, s.passes, s.legs, s.restarts};
+    const bool b[] = {s.converged, s.reached, s.stretched, s.limited, s.joint_space};
+    for (size_t k = 0; k < floats.size(); ++k) floats[k].mutable_data()[t] = f[k];
+    for (size_t k = 0; k < ints.size(); ++k) ints[k].mutable_data()[t] = i[k];
+    for (size_t k = 0; k < bools.size(); ++k) bools[k].mutable_data()[t] = b[k];
   }
-  int64_t count() const { return count_; }
-
- private:
-  int64_t total_, links_, dim_, count_ = 0;
-  ProgressHook* hook_;
-  py::array_t<double> angles_, points_, azimuths_;
-  std::vector<py::array_t<double>> floats_;
-  std::vector<py::array_t<int64_t>> ints_;
-  std::vector<py::array_t<bool>> bools_;
-  double *angle_data_, *point_data_, *azimuth_data_;
-  std::vector<double*> float_data_;
-  std::vector<int64_t*> int_data_;
-  std::vector<bool*> bool_data_;
-};
+  r->data["angles"] = angles;
+  r->data["points"] = points;
+  r->data["azimuths"] = azimuths ? py::object(azimuth_array) : py::none();
+  for (size_t k = 0; k < floats.size(); ++k) r->data[kFloatSteps[k]] = floats[k];
+  for (size_t k = 0; k < ints.size(); ++k) r->data[kIntSteps[k]] = ints[k];
+  for (size_t k = 0; k < bools.size(); ++k) r->data[kBoolSteps[k]] = bools[k];
+}
 
 RobotScenarioOptions ReaderOptions(const std::string& directory) {
 #ifdef FLEXKIN_PYTHON_URDF
@@ -130,13 +109,12 @@ RobotScenario RobotScenarioArg(py::handle scenario, py::handle directory) {
   }
 }
 
-RobotResult RunRobot(py::handle scenario, py::handle directory, py::object method,
-                     py::object progress) {
+RobotResult RunRobot(py::handle scenario, py::handle directory, py::object method) {
   RobotScenario s = RobotScenarioArg(scenario, directory);
   if (!method.is_none()) s.options.method = ParseFixedBaseMethod(py::cast<std::string>(method));
   ThrowIfAny(s.model.Validate());
   ThrowIfAny(s.options.Validate());
-  const int64_t steps = s.path.rows(), links = s.model.num_links(), dim = s.model.dim;
+  const int64_t links = s.model.num_links(), dim = s.model.dim;
   const bool spherical = s.model.joint() == ArmJoint::kSpherical;
   RobotResult r;
   r.scenario = s.name;
@@ -150,23 +128,21 @@ RobotResult RunRobot(py::handle scenario, py::handle directory, py::object metho
   r.data["initial_angles"] = ToArray(initial.angles.angle);
   r.data["initial_azimuths"] = spherical ? py::object(ToArray(initial.angles.azimuth)) : py::none();
   r.data["initial_points"] = ToArray(Points(initial.points));
-  ProgressHook hook(std::move(progress));
-  ArraySteps sink(&r, steps, links, dim, spherical, &hook);
-  try {
+  {
     py::gil_scoped_release release;
-    r.summary = TrackPath(s.model, s.path, s.options, &sink);
-  } catch (const StopRun&) {
-    hook.Rethrow();
+    r.summary = TrackPath(s.model, s.path, s.options);
   }
-  if (sink.count() != steps) throw std::logic_error("flexkin: TrackPath skipped steps");
+  StepsToArrays(r.summary.steps, links, dim, spherical, &r);
+  r.num_steps = static_cast<long long>(r.summary.steps.size());
+  r.brief = r.summary.BriefReport();
+  r.summary.steps.clear();
   return r;
 }
 
 std::string RobotRepr(const RobotResult& r) {
   return "RobotResult(" + std::to_string(r.dim) + "D " + r.joint + " arm, " +
          std::to_string(py::len(r.data.at("link_lengths"))) + " links, method " + Quoted(r.method) +
-         ", " + std::to_string(r.summary.num_steps) + " steps, " +
-         std::to_string(r.summary.unreached) +
+         ", " + std::to_string(r.num_steps) + " steps, " + std::to_string(r.summary.unreached) +
          " not reached, max_ee_error=" + Num(r.summary.max_ee_error) +
          (r.scenario.empty() ? "" : ", scenario=" + Quoted(r.scenario)) + ")";
 }
@@ -202,7 +178,7 @@ number of path targets; row t is the state after the step to path[t].
       .def_readonly("method", &RobotResult::method)
       .def_readonly("joint", &RobotResult::joint)
       .def_readonly("dim", &RobotResult::dim)
-      .def_property_readonly("num_steps", [](const RobotResult& r) { return r.summary.num_steps; })
+      .def_property_readonly("num_steps", [](const RobotResult& r) { return r.num_steps; })
       .def_property_readonly("unreached", [](const RobotResult& r) { return r.summary.unreached; })
       .def_property_readonly("max_ee_error",
                              [](const RobotResult& r) { return r.summary.max_ee_error; })
@@ -215,7 +191,7 @@ number of path targets; row t is the state after the step to path[t].
       .def_property_readonly("total_passes",
                              [](const RobotResult& r) { return r.summary.total_passes; })
       .def_property_readonly("seconds", [](const RobotResult& r) { return r.summary.seconds; })
-      .def("brief_report", [](const RobotResult& r) { return r.summary.BriefReport(); })
+      .def("brief_report", [](const RobotResult& r) { return r.brief; })
       .def("__repr__", &RobotRepr)
       .def(py::pickle(
           [](const RobotResult& r) {
@@ -224,11 +200,12 @@ number of path targets; row t is the state after the step to path[t].
             const ArmTrajectory& t = r.summary;
             return py::make_tuple(
                 r.scenario, r.method, r.joint, r.dim, arrays,
-                py::make_tuple(t.num_steps, t.max_ee_error, t.max_base_error, t.unreached,
-                               t.max_iterations, t.total_sweeps, t.total_passes, t.seconds));
+                py::make_tuple(r.num_steps, t.max_ee_error, t.max_base_error, t.unreached,
+                               t.max_iterations, t.total_sweeps, t.total_passes, t.seconds),
+                r.brief);
           },
           [](const py::tuple& state) {
-            StateTuple(state, 6, "RobotResult");
+            StateTuple(state, 7, "RobotResult");
             RobotResult r;
             r.scenario = py::cast<std::string>(state[0]);
             r.method = py::cast<std::string>(state[1]);
@@ -240,7 +217,7 @@ number of path targets; row t is the state after the step to path[t].
               r.data[name] = arrays[name];
             }
             const auto t = StateTuple(py::cast<py::tuple>(state[5]), 8, "RobotResult summary");
-            r.summary.num_steps = py::cast<long long>(t[0]);
+            r.num_steps = py::cast<long long>(t[0]);
             r.summary.max_ee_error = py::cast<double>(t[1]);
             r.summary.max_base_error = py::cast<double>(t[2]);
             r.summary.unreached = py::cast<int>(t[3]);
@@ -248,18 +225,18 @@ number of path targets; row t is the state after the step to path[t].
             r.summary.total_sweeps = py::cast<long long>(t[5]);
             r.summary.total_passes = py::cast<long long>(t[6]);
             r.summary.seconds = py::cast<double>(t[7]);
+            r.brief = py::cast<std::string>(state[6]);
             return r;
           }));
 
   m.def("run_robot", &RunRobot, py::arg("scenario"), py::kw_only(),
         py::arg("directory") = py::none(), py::arg("method") = py::none(),
-        py::arg("progress") = py::none(),
         "Tracks a robot scenario's path (a path to a robot scenario file or a dict of its JSON "
         "form, docs/robot-format.md) as `flexkin robot` does, with the same numbers. "
         "directory: where a relative \"urdf\" file is looked up (default: the scenario file's "
         "directory, or the working directory for a dict). method: overrides the solver's "
-        "method (\"newton\", \"fixed_point\"), as --method. progress: callable(done, total). "
-        "The GIL is released; Ctrl-C stops it. Returns a RobotResult.");
+        "method (\"newton\", \"fixed_point\"), as --method. The GIL is released during the "
+        "tracking. Returns a RobotResult.");
 }
 
 }  // namespace flexkin::python

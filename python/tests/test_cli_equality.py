@@ -63,8 +63,10 @@ def test_run_robot_equals_cli(path, cli, tmp_path):
     assert same_bits(traj.points, np.array([s["points"] for s in steps], dtype=float))
     assert same_bits(traj.path, np.array([s["target"] for s in steps], dtype=float))
     assert same_bits(traj.ee_error, np.array([s["ee_error"] for s in steps], dtype=float))
-    assert list(traj.reached) == [s["reached"] for s in steps]
-    assert list(traj.iterations) == [s["iterations"] for s in steps]
+    assert same_bits(traj.base_error, np.array([s["base_error"] for s in steps], dtype=float))
+    for key in ("iterations", "sweeps", "legs", "restarts", "reached", "stretched", "limited",
+                "joint_space"):
+        assert getattr(traj, key).tolist() == [s[key] for s in steps], key
     assert same_bits(traj.initial_angles,
                      np.array(cli_result["initial"]["joint_angles"], dtype=float))
     assert traj.unreached == cli_result["summary"]["unreached"]
