@@ -3,7 +3,7 @@
 //   flexkin run SCENARIO.json -o RESULT.json|RESULT.npz [--csv FRAMES.csv] [--method METHOD]
 //       [--substeps N] [--tolerance T] [--max-substeps N] [--record-every N]
 //       [--max-output-size SIZE] [--report brief|full] [--quiet]
-//   flexkin validate SCENARIO.json
+//   flexkin validate SCENARIO.json   (chain or robot scenario, recognised by its keys)
 //   flexkin render RESULT.json ...   (render_command.h)
 //   flexkin robot SCENARIO.json ...  (robot_command.h)
 //   flexkin vocabulary               (vocabulary_command.h: every enumerated name)
@@ -30,8 +30,10 @@
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
 #include "flexkin/result_io.h"
+#include "flexkin/robot_scenario.h"
 #include "flexkin/run.h"
 #include "flexkin/scenario.h"
+#include "flexkin/urdf.h"
 #include "output_check.h"
 #include "output_limit.h"
 #include "render_command.h"
@@ -248,7 +250,28 @@ int RunCommand(const RunArgs& args) {
   return kExitOk;
 }
 
+// validate for a robot scenario (docs/robot-format.md): the robot reader's problems, or its
+// summary and the estimated sizes of the trajectory JSON and the joint CSV.
+int ValidateRobotCommand(const std::string& path) {
+  const flexkin::RobotScenarioOptions options = flexkin::UrdfRobotScenarioOptions();
+  const flexkin::Problems problems = flexkin::ValidateRobotScenarioFile(path, options);
+  if (!problems.empty()) {
+    for (const auto& p : problems) std::cout << path << ": " << p.Text() << "\n";
+    return kExitInvalidInput;
+  }
+  const flexkin::RobotScenario scenario = flexkin::LoadRobotScenarioFile(path, options);
+  std::cout << "ok: " << flexkin::RobotScenarioSummary(scenario) << "\n";
+  const flexkin::RobotOutputEstimate e = flexkin::EstimateRobotOutput(scenario);
+  using flexkin::cli::FormatBytes;
+  std::cout << "output: " << scenario.path.rows() + 1
+            << " states (the initial one and one per target); trajectory about "
+            << FormatBytes(e.json_bytes) << " as .json; --csv about " << FormatBytes(e.csv_bytes)
+            << "; streamed, memory independent of the targets\n";
+  return kExitOk;
+}
+
 int ValidateCommand(const std::string& path) {
+  if (flexkin::IsRobotScenarioFile(path)) return ValidateRobotCommand(path);
   // Text that is not JSON is one problem, like any other.
   const flexkin::Problems problems = flexkin::ValidateScenarioFile(path);
   if (!problems.empty()) {
@@ -308,7 +331,8 @@ int Main(int argc, char** argv) {
   run->footer(kExitCodesHelp);
 
   std::string validate_path;
-  CLI::App* validate = app.add_subcommand("validate", "Check a scenario file; list every problem.");
+  CLI::App* validate =
+      app.add_subcommand("validate", "Check a scenario file (chain or robot); list every problem.");
   validate->add_option("scenario", validate_path, "Scenario file (JSON)")->required();
   validate->footer(kExitCodesHelp);
 

@@ -1,11 +1,14 @@
 // flexkin robot: a robot scenario in, a trajectory JSON (and a joint CSV) out, each written whole
-// or not at all. The scenario's format is in docs/robot-format.md; reading and writing are the
-// library's (flexkin/robot_scenario.h), URDF arms read by the URDF component (flexkin/urdf.h).
+// or not at all, streamed step by step. The scenario's format is in docs/robot-format.md; reading
+// and writing are the library's (flexkin/robot_scenario.h), URDF arms read by the URDF component
+// (flexkin/urdf.h).
 #include "robot_command.h"
 
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <system_error>
+#include <vector>
 
 #include "flexkin/arm.h"
 #include "flexkin/error.h"
@@ -25,27 +28,6 @@ std::string MethodHelp() {
     help += std::string("\n  ") + entry.name + ": " + entry.summary;
   }
   return help;
-}
-
-// The estimated sizes of the trajectory JSON and the joint CSV: about 24 bytes per number (as
-// result files, docs/result-format.md) for the initial state and one step per target: joint
-// angles (and azimuths of spherical joints), joint quaternions in 3D, the points, the target, and
-// about 300 bytes of keys and per-step reports.
-struct RobotOutputEstimate {
-  uint64_t json_bytes = 0, csv_bytes = 0;
-};
-
-RobotOutputEstimate EstimateRobotOutput(const RobotScenario& s) {
-  const double n = s.model.num_links(), dim = s.model.dim;
-  const double steps = static_cast<double>(s.path.rows()) + 1;  // and the initial state
-  const bool spherical = s.model.joint() == ArmJoint::kSpherical;
-  const double angles = n * (spherical ? 2 : 1);
-  const double numbers = angles + (dim == 3 ? 4 * n : 0) + (n + 1) * dim + dim;
-  auto bytes = [](double x) { return x < 1.8e19 ? static_cast<uint64_t>(x) : ~uint64_t{0}; };
-  RobotOutputEstimate e;
-  e.json_bytes = bytes(1024 + steps * (300 + numbers * 24 + (n + 1) * 3));
-  e.csv_bytes = bytes(64 + angles * 12 + steps * (8 + angles * 24));
-  return e;
 }
 
 }  // namespace
@@ -89,12 +71,19 @@ int RobotCommand::Run() const {
   }
   CheckOutputDirectory(output_);
   if (!csv_.empty()) CheckOutputDirectory(csv_);
-  const ArmTrajectory t = TrackPath(s.model, s.path, s.options);
-  WriteRobotTrajectoryJson(s, t, output_);
-  if (!csv_.empty()) WriteRobotJointsCsv(s, t, csv_);
+  // Streamed: the steps go to the files as they are produced, so memory does not grow with the
+  // targets; each file is renamed into place only when complete.
+  RobotTrajectoryWriter json_writer(s, output_);
+  std::optional<RobotJointsCsvWriter> csv_writer;
+  std::vector<ArmStepSink*> sinks = {&json_writer};
+  if (!csv_.empty()) sinks.push_back(&csv_writer.emplace(s, csv_));
+  ArmStepFanOut sink(sinks);
+  const ArmTrajectory t = TrackPath(s.model, s.path, s.options, &sink);
+  json_writer.Commit(t);
+  if (csv_writer) csv_writer->Commit(t);
   if (!quiet_) std::cout << t.BriefReport() << "\n";
   if (t.unreached > 0) {
-    std::cerr << "flexkin: warning: " << t.unreached << " of " << t.steps.size()
+    std::cerr << "flexkin: warning: " << t.unreached << " of " << t.num_steps
               << " targets were not reached (see \"reached\" in " << output_ << ")\n";
     return 3;
   }

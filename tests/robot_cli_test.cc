@@ -11,6 +11,8 @@
 #include <sstream>
 #include <string>
 
+#include "flexkin/arm.h"
+#include "flexkin/robot_scenario.h"
 #include "test_util.h"
 
 namespace {
@@ -204,6 +206,60 @@ TEST_F(RobotCliTest, ScenarioWithAUrdfArm) {
   EXPECT_EQ(Robot(Path("gone.json") + " -o " + Path("t.json"), &err), 4);
   EXPECT_NE(err.find("nowhere.urdf"), std::string::npos) << err;
   EXPECT_FALSE(std::filesystem::exists(Path("t.json")));
+}
+
+// `flexkin validate` recognises a robot scenario by its keys and checks it with the robot reader:
+// ok with a summary and the estimated sizes of the outputs, or every problem with its JSON
+// pointer and exit 1. Chain scenarios are validated as before.
+TEST_F(RobotCliTest, ValidateRecognisesRobotScenarios) {
+  const std::string examples = std::string(FLEXKIN_SOURCE_DIR) + "/examples/";
+  for (const char* name : {"robot_planar_8link.json", "robot_snake_urdf.json"}) {
+    const flexkin::test_util::CliResult r =
+        flexkin::test_util::RunCli(kCli, dir_, "validate '" + examples + name + "'");
+    EXPECT_EQ(r.exit_code, 0) << name << ": " << r.out << r.err;
+    EXPECT_EQ(r.out.rfind("ok: robot, ", 0), 0u) << r.out;
+    EXPECT_NE(r.out.find("\noutput: "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("trajectory about "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("--csv about "), std::string::npos) << r.out;
+  }
+  const flexkin::test_util::CliResult planar =
+      flexkin::test_util::RunCli(kCli, dir_, "validate '" + examples + "robot_planar_8link.json'");
+  EXPECT_NE(planar.out.find("2D, 8 links, revolute joints"), std::string::npos) << planar.out;
+  EXPECT_NE(planar.out.find("200 targets"), std::string::npos) << planar.out;
+  EXPECT_NE(planar.out.find("201 states"), std::string::npos) << planar.out;
+
+  // Two problems, both listed with their pointers; nothing else is printed.
+  Write("bad.json", R"({"format": "flexkin-robot",
+    "arm": {"dim": 2, "links": 3, "link_length": -1, "base": [0, 0], "base_direction": [1, 0]},
+    "path": {"type": "points", "points": [[1, 0]]}, "solver": {"tolerence": 1e-9}})");
+  const flexkin::test_util::CliResult bad =
+      flexkin::test_util::RunCli(kCli, dir_, "validate bad.json");
+  EXPECT_EQ(bad.exit_code, 1) << bad.out << bad.err;
+  EXPECT_NE(bad.out.find("bad.json: /arm/link_length"), std::string::npos) << bad.out;
+  EXPECT_NE(bad.out.find("/solver/tolerence"), std::string::npos) << bad.out;
+  EXPECT_EQ(bad.out.find("ok:"), std::string::npos) << bad.out;
+
+  const flexkin::test_util::CliResult chain =
+      flexkin::test_util::RunCli(kCli, dir_, "validate '" + examples + "fig12_spatial_curve.json'");
+  EXPECT_EQ(chain.exit_code, 0) << chain.out << chain.err;
+  EXPECT_EQ(chain.out.find("ok: robot"), std::string::npos) << chain.out;
+}
+
+// The streamed command writes the joint CSV of the whole-trajectory writer, with --csv.
+TEST_F(RobotCliTest, StreamedCsvIsTheLibrarysJointCsv) {
+  const std::string scenario =
+      std::string(FLEXKIN_SOURCE_DIR) + "/examples/robot_spatial_limits.json";
+  ASSERT_EQ(Robot("'" + scenario + "' -o " + Path("t.json") + " --csv " + Path("j.csv")), 0);
+  const flexkin::RobotScenario s = flexkin::LoadRobotScenarioFile(scenario);
+  const flexkin::ArmTrajectory t = flexkin::TrackPath(s.model, s.path, s.options);
+  std::ostringstream csv, trajectory;
+  flexkin::WriteRobotJointsCsv(s, t, csv);
+  EXPECT_EQ(ReadFile(Path("j.csv")), csv.str());
+  flexkin::WriteRobotTrajectoryJson(s, t, trajectory);
+  json expected = json::parse(trajectory.str()), actual = json::parse(ReadFile(Path("t.json")));
+  expected["summary"].erase("seconds");
+  actual["summary"].erase("seconds");
+  EXPECT_EQ(actual, expected);
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include <stdexcept>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include "flexkin/arm.h"
@@ -505,6 +506,57 @@ TEST(RobotTrajectoryWriterTest, FilesAreWrittenWholeOrNotAtAll) {
   EXPECT_THROW(WriteRobotTrajectoryJson(s, t, dir / "no/t.json"), std::system_error);
   EXPECT_THROW(WriteRobotJointsCsv(s, t, dir / "no/j.csv"), std::system_error);
   EXPECT_FALSE(std::filesystem::exists(dir / "no"));
+}
+
+// TrackPath with a sink gives the numbers of the plain TrackPath, and the streaming writers
+// (RobotTrajectoryWriter, RobotJointsCsvWriter) write what the whole-trajectory writers write: the
+// same JSON value (same number of lines) and the same CSV text, for every example.
+TEST(RobotTrajectoryStreamTest, StreamedFilesEqualTheWholeTrajectoryWritersForEveryExample) {
+  int examples = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(Example(""))) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("robot_", 0) != 0 || entry.path().extension() != ".json") continue;
+    ++examples;
+    const std::string path = entry.path().string();
+    SCOPED_TRACE(path);
+    const RobotScenario s = LoadRobotScenarioFile(path, UrdfRobotScenarioOptions());
+    TempDir dir;
+    RobotTrajectoryWriter json_writer(s, dir / "t.json");
+    RobotJointsCsvWriter csv_writer(s, dir / "j.csv");
+    ArmStepFanOut both({&json_writer, &csv_writer});
+    const ArmTrajectory streamed = TrackPath(s.model, s.path, s.options, &both);
+    EXPECT_TRUE(streamed.steps.empty());
+    EXPECT_EQ(streamed.num_steps, s.path.rows());
+    EXPECT_FALSE(std::filesystem::exists(dir / "t.json"));  // until Commit
+    json_writer.Commit(streamed);
+    csv_writer.Commit(streamed);
+
+    ArmTrajectory whole = TrackPath(s.model, s.path, s.options);
+    ASSERT_EQ(whole.steps.size(), static_cast<size_t>(s.path.rows()));
+    EXPECT_EQ(whole.num_steps, s.path.rows());
+    // The same numbers with and without a sink; only the wall time differs.
+    EXPECT_EQ(whole.max_ee_error, streamed.max_ee_error);
+    EXPECT_EQ(whole.max_base_error, streamed.max_base_error);
+    EXPECT_EQ(whole.unreached, streamed.unreached);
+    EXPECT_EQ(whole.max_iterations, streamed.max_iterations);
+    EXPECT_EQ(whole.total_sweeps, streamed.total_sweeps);
+    EXPECT_EQ(whole.total_passes, streamed.total_passes);
+    whole.seconds = streamed.seconds;
+    std::ostringstream json_text, csv_text;
+    WriteRobotTrajectoryJson(s, whole, json_text);
+    WriteRobotJointsCsv(s, whole, csv_text);
+    const std::string file = ReadTextFile(dir / "t.json");
+    EXPECT_EQ(json::parse(file), json::parse(json_text.str()));
+    EXPECT_EQ(ReadTextFile(dir / "j.csv"), csv_text.str());
+    // One key per line and one step per line, as the whole-trajectory writer.
+    const std::string text = json_text.str();
+    EXPECT_EQ(std::count(file.begin(), file.end(), '\n'),
+              std::count(text.begin(), text.end(), '\n'));
+    // The path versions of the whole-trajectory writers write the same.
+    WriteRobotTrajectoryJson(s, whole, dir / "w.json");
+    EXPECT_EQ(ReadTextFile(dir / "w.json"), json_text.str());
+  }
+  EXPECT_GE(examples, 5);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "flexkin/chain.h"
@@ -221,7 +222,10 @@ ArmStepReport ArmStep(const ArmModel& model, const ArmState& state,
                       const Eigen::Ref<const Eigen::VectorXd>& target, const ArmOptions& options);
 
 struct ArmTrajectory {
-  std::vector<ArmStepReport> steps;  // one per path point
+  // One per path point from the plain TrackPath; empty from TrackPath with a sink (the steps went
+  // to the sink).
+  std::vector<ArmStepReport> steps;
+  long long num_steps = 0;  // steps tracked (one per path point), with or without a sink
   double max_ee_error = 0.0, max_base_error = 0.0;
   int unreached = 0;  // steps with reached = false
   int max_iterations = 0;
@@ -231,8 +235,44 @@ struct ArmTrajectory {
   std::string BriefReport() const;
 };
 
+// Receives TrackPath's steps as they are produced (path row 0 first), so that a caller can stream
+// them to a file or keep only what it needs: the tracking itself holds one step, not the
+// trajectory.
+class ArmStepSink {
+ public:
+  virtual ~ArmStepSink() = default;
+  // The step that moved the end effector to the next path row; valid only during the call. May
+  // throw: the tracking stops and the exception propagates.
+  virtual void Add(const ArmStepReport& step) = 0;
+};
+
+// The sink of TrackPath's plain form: keeps every step, in `steps`.
+class ArmStepRecorder : public ArmStepSink {
+ public:
+  void Add(const ArmStepReport& step) override { steps.push_back(step); }
+  std::vector<ArmStepReport> steps;
+};
+
+// Hands every step to each of `sinks` in turn (a trajectory file and a joint CSV, say).
+class ArmStepFanOut : public ArmStepSink {
+ public:
+  explicit ArmStepFanOut(std::vector<ArmStepSink*> sinks) : sinks_(std::move(sinks)) {}
+  void Add(const ArmStepReport& step) override {
+    for (ArmStepSink* sink : sinks_) sink->Add(step);
+  }
+
+ private:
+  std::vector<ArmStepSink*> sinks_;
+};
+
 // Tracks `path` (m by dim targets, one per row) from the model's initial state: one ArmStep per
-// row. The first step moves the end effector from its initial position to path row 0.
+// row. The first step moves the end effector from its initial position to path row 0. Each step
+// goes to `sink` (may be null) as it is produced; the trajectory returned has the summary
+// (num_steps, errors, unreached, iterations, sweeps, passes, seconds) and no steps. Throws
+// InputError on an invalid model, options or path before any step is produced.
+ArmTrajectory TrackPath(const ArmModel& model, const Points& path, const ArmOptions& options,
+                        ArmStepSink* sink);
+// The same with every step kept in ArmTrajectory::steps.
 ArmTrajectory TrackPath(const ArmModel& model, const Points& path, const ArmOptions& options);
 
 }  // namespace flexkin

@@ -8,12 +8,19 @@
 //   const ArmTrajectory t = TrackPath(s.model, s.path, s.options);
 //   WriteRobotTrajectoryJson(s, t, "trajectory.json");
 //
+// or, streamed in memory that does not grow with the number of targets:
+//
+//   RobotTrajectoryWriter writer(s, "trajectory.json");
+//   writer.Commit(TrackPath(s.model, s.path, s.options, &writer));
+//
 // Errors as everywhere in flexkin: InputError for content that is not valid (its field the JSON
 // pointer of the value, "/arm/link_lengths/2"), std::system_error for a file that cannot be read
 // or written (the message has the path and the system's reason).
 
+#include <cstdint>
 #include <functional>
 #include <iosfwd>
+#include <memory>
 #include <string>
 
 #include "flexkin/arm.h"
@@ -77,9 +84,30 @@ RobotScenario LoadRobotScenarioFile(const std::string& path,
 Problems ValidateRobotScenarioFile(const std::string& path,
                                    const RobotScenarioOptions& options = {});
 
+// Whether the JSON text is a robot scenario rather than a chain scenario (docs/scenario-format.md):
+// an object whose "format" is "flexkin-robot", or, without "format", one with "arm" or "urdf" and
+// neither "curve" nor "leader". False for text that is not JSON. The file version throws
+// std::system_error if the file cannot be read.
+bool IsRobotScenarioText(const std::string& json_text);
+bool IsRobotScenarioFile(const std::string& path);
+
+// One line about a robot scenario, as `flexkin validate` prints it: "robot, 2D, 8 links, revolute
+// joints (reach 0.56), 120 targets, method newton, tolerance 1e-10" (", joint limits" where it
+// has some, ", 4 sub-steps" where more than one).
+std::string RobotScenarioSummary(const RobotScenario& scenario);
+
 // The identification and version of robot trajectory files.
 inline constexpr const char* kRobotTrajectoryFormat = "flexkin-robot-trajectory";
 inline constexpr int kRobotTrajectoryVersion = 1;
+
+// The estimated sizes of the outputs of `scenario`: the trajectory JSON and the joint CSV, about
+// 24 bytes per number (as result files) for the initial state and one step per target (joint
+// angles, azimuths of spherical joints, joint quaternions in 3D, the points, the target) and
+// about 300 bytes of keys and reports per step. Saturates at the largest uint64_t.
+struct RobotOutputEstimate {
+  uint64_t json_bytes = 0, csv_bytes = 0;
+};
+RobotOutputEstimate EstimateRobotOutput(const RobotScenario& scenario);
 
 // Writes the trajectory of `scenario` (TrackPath of its model, path and options) as a trajectory
 // JSON document (docs/robot-format.md, "Outputs"): the arm, the method, a summary, the initial
@@ -97,5 +125,65 @@ void WriteRobotJointsCsv(const RobotScenario& scenario, const ArmTrajectory& tra
                          std::ostream& out);
 void WriteRobotJointsCsv(const RobotScenario& scenario, const ArmTrajectory& trajectory,
                          const std::string& path);
+
+// An ArmStepSink that writes the trajectory JSON of `scenario` (the document of
+// WriteRobotTrajectoryJson) while TrackPath produces its steps, in bounded memory (one step and
+// a buffer):
+//
+//   RobotTrajectoryWriter writer(scenario, path);
+//   writer.Commit(TrackPath(scenario.model, scenario.path, scenario.options, &writer));
+//
+// All-or-nothing: the file is written to a temporary file in the destination's directory, and
+// only Commit renames it over `path`. A step holding a non-finite number (or of the wrong shape,
+// or beyond the path's targets) is refused by Add with InputError naming it
+// ("steps[3].points[2][1]"), which stops the tracking; destroyed without a successful Commit (an
+// exception, a failed write), the writer removes its temporary file and leaves an existing file
+// at `path` untouched. The JSON written parses to the same value as WriteRobotTrajectoryJson's
+// for the same trajectory ("summary" comes last). `scenario` must outlive the writer. Errors
+// writing throw std::system_error naming the path.
+class RobotTrajectoryWriter : public ArmStepSink {
+ public:
+  // Creates the temporary file and writes the head (the arm, the method, the initial state).
+  RobotTrajectoryWriter(const RobotScenario& scenario, const std::string& path);
+  ~RobotTrajectoryWriter() override;
+  RobotTrajectoryWriter(const RobotTrajectoryWriter&) = delete;
+  RobotTrajectoryWriter& operator=(const RobotTrajectoryWriter&) = delete;
+
+  void Add(const ArmStepReport& step) override;
+  // Writes the summary of `trajectory` (its steps, if any, are ignored: they came through Add),
+  // syncs the file and renames it over the destination. Throws InputError (nothing written) if
+  // fewer steps than targets were added, the trajectory's num_steps differs, or a summary number
+  // is not finite ("summary.max_ee_error"); std::system_error if the file cannot be written.
+  // Once only.
+  void Commit(const ArmTrajectory& trajectory);
+  // Steps added so far.
+  int64_t steps() const { return steps_; }
+
+  class Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;  // null after Commit or a failure
+  int64_t steps_ = 0;
+};
+
+// The same for the joint CSV of WriteRobotJointsCsv: the header and the initial angles at
+// construction, a row per step, renamed into place by Commit.
+class RobotJointsCsvWriter : public ArmStepSink {
+ public:
+  RobotJointsCsvWriter(const RobotScenario& scenario, const std::string& path);
+  ~RobotJointsCsvWriter() override;
+  RobotJointsCsvWriter(const RobotJointsCsvWriter&) = delete;
+  RobotJointsCsvWriter& operator=(const RobotJointsCsvWriter&) = delete;
+
+  void Add(const ArmStepReport& step) override;
+  void Commit(const ArmTrajectory& trajectory);
+  int64_t steps() const { return steps_; }
+
+  class Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+  int64_t steps_ = 0;
+};
 
 }  // namespace flexkin

@@ -518,7 +518,8 @@ std::string ArmStepReport::BriefReport() const {
   return line;
 }
 
-ArmTrajectory TrackPath(const ArmModel& model, const Points& path, const ArmOptions& options) {
+ArmTrajectory TrackPath(const ArmModel& model, const Points& path, const ArmOptions& options,
+                        ArmStepSink* sink) {
   arm_internal::CheckModel(model);
   if (path.rows() < 1 || path.cols() != model.dim) {
     throw InputError("path", "shape " + std::to_string(path.rows()) + " by " +
@@ -527,30 +528,41 @@ ArmTrajectory TrackPath(const ArmModel& model, const Points& path, const ArmOpti
   }
   const auto begin = std::chrono::steady_clock::now();
   ArmTrajectory trajectory;
-  trajectory.steps.reserve(path.rows());
   CheckOptions(options);
-  const ArmState initial = InitialState(model);
-  const ArmState* state = &initial;  // the last step's (steps are reserved: never moved)
-  for (int i = 0; i < path.rows(); ++i) {
-    const Eigen::VectorXd target = path.row(i).transpose();
-    for (int k = 0; k < target.size(); ++k) {
-      if (!std::isfinite(target[k])) {
+  for (int i = 0; i < path.rows(); ++i) {  // every target before the first step
+    for (int k = 0; k < path.cols(); ++k) {
+      if (!std::isfinite(path(i, k))) {
         throw InputError("path[" + std::to_string(i) + "][" + std::to_string(k) + "]",
-                         "value " + FormatNumber(target[k]) + " is not a finite number");
+                         "value " + FormatNumber(path(i, k)) + " is not a finite number");
       }
     }
-    trajectory.steps.push_back(StepChecked(model, *state, target, options));
-    const ArmStepReport& step = trajectory.steps.back();
-    state = &step.state;
+  }
+  // The last step's state is the next step's start: two reports, swapped after each step.
+  ArmStepReport last;
+  last.state = InitialState(model);
+  for (int i = 0; i < path.rows(); ++i) {
+    const Eigen::VectorXd target = path.row(i).transpose();
+    ArmStepReport step = StepChecked(model, last.state, target, options);
     trajectory.max_ee_error = std::max(trajectory.max_ee_error, step.ee_error);
     trajectory.max_base_error = std::max(trajectory.max_base_error, step.base_error);
     trajectory.unreached += step.reached ? 0 : 1;
     trajectory.max_iterations = std::max(trajectory.max_iterations, step.iterations);
     trajectory.total_sweeps += step.sweeps;
     trajectory.total_passes += step.passes;
+    ++trajectory.num_steps;
+    if (sink != nullptr) sink->Add(step);
+    last = std::move(step);
   }
   trajectory.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  return trajectory;
+}
+
+ArmTrajectory TrackPath(const ArmModel& model, const Points& path, const ArmOptions& options) {
+  ArmStepRecorder recorder;
+  recorder.steps.reserve(path.rows() > 0 ? path.rows() : 0);
+  ArmTrajectory trajectory = TrackPath(model, path, options, &recorder);
+  trajectory.steps = std::move(recorder.steps);
   return trajectory;
 }
 
@@ -559,8 +571,8 @@ std::string ArmTrajectory::BriefReport() const {
   std::snprintf(line, sizeof(line),
                 "%zu steps, %d not reached, max end-effector error %.3g, max base residual %.3g, "
                 "max %d iterations, %lld sweeps, %.3g s",
-                steps.size(), unreached, max_ee_error, max_base_error, max_iterations, total_sweeps,
-                seconds);
+                static_cast<size_t>(std::max<long long>(num_steps, steps.size())), unreached,
+                max_ee_error, max_base_error, max_iterations, total_sweeps, seconds);
   return line;
 }
 

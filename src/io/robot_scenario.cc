@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -449,6 +450,41 @@ RobotScenario LoadRobotScenarioFile(const std::string& path, const RobotScenario
 
 Problems ValidateRobotScenarioFile(const std::string& path, const RobotScenarioOptions& options) {
   return ValidateRobotText(ReadTextFile(path), options, DirectoryOf(path, options));
+}
+
+bool IsRobotScenarioText(const std::string& json_text) {
+  json root;
+  try {
+    root = ParseJsonText(json_text);
+  } catch (const InputError&) {
+    return false;
+  }
+  if (!root.is_object()) return false;
+  if (const auto format = root.find("format"); format != root.end()) {
+    return *format == "flexkin-robot";
+  }
+  return (root.contains("arm") || root.contains("urdf")) && !root.contains("curve") &&
+         !root.contains("leader");
+}
+
+bool IsRobotScenarioFile(const std::string& path) {
+  return IsRobotScenarioText(ReadTextFile(path));
+}
+
+std::string RobotScenarioSummary(const RobotScenario& s) {
+  const ArmModel& m = s.model;
+  char reach[40], tolerance[40];
+  std::snprintf(reach, sizeof reach, "%.6g", m.reach());
+  std::snprintf(tolerance, sizeof tolerance, "%.3g", s.options.tolerance);
+  const auto rows = s.path.rows();
+  std::string out = "robot, " + std::to_string(m.dim) + "D, " + std::to_string(m.num_links()) +
+                    (m.num_links() == 1 ? " link, " : " links, ") + NameOf(m.joint()) +
+                    " joints (reach " + reach + ")" + (m.has_limits() ? ", joint limits" : "") +
+                    ", " + std::to_string(rows) + (rows == 1 ? " target" : " targets") +
+                    ", method " + FixedBaseMethodName(s.options.method) + ", tolerance " +
+                    tolerance;
+  if (s.options.substeps > 1) out += ", " + std::to_string(s.options.substeps) + " sub-steps";
+  return out;
 }
 
 }  // namespace flexkin
