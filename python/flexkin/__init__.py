@@ -16,6 +16,9 @@ naming the argument or field; files that cannot be read raise OSError.
 
 from ._flexkin import (
     AccuracyReport,
+    ArmModel,
+    ArmOptions,
+    ArmStepReport,
     Chain,
     InputError,
     Metrics,
@@ -28,8 +31,11 @@ from ._flexkin import (
     RunOptions,
     Scenario,
     arc,
+    arm_step,
     follow_the_leader_step,
+    forward_kinematics,
     helix,
+    joint_angles_from_points,
     line,
     load_scenario,
     move_leader,
@@ -40,20 +46,22 @@ from ._flexkin import (
     run_robot,
     run_scenario,
     split_pull,
+    track_path,
     tractrix_step,
 )
 
 # The C++ classes are defined in flexkin._flexkin; they are documented and pickled as flexkin's.
-for _name in ("AccuracyReport", "Chain", "Metrics", "ObjectiveWeights", "OverallOptions",
+for _name in ("AccuracyReport", "ArmModel", "ArmOptions", "ArmStepReport", "Chain", "Metrics", "ObjectiveWeights", "OverallOptions",
               "OverallReport", "OverallRunReport", "Result", "RobotResult", "RunOptions",
               "Scenario"):
     globals()[_name].__module__ = __name__
 del _name
 
 __all__ = [
-    "AccuracyReport", "Chain", "InputError", "Metrics", "ObjectiveWeights", "OverallOptions",
+    "AccuracyReport", "ArmModel", "ArmOptions", "ArmStepReport", "Chain", "InputError", "Metrics", "ObjectiveWeights", "OverallOptions",
     "OverallReport", "OverallRunReport", "Result", "RobotResult", "RunOptions", "Scenario",
     "arc", "follow_the_leader_step", "helix", "line", "load_scenario", "move_leader",
     "overall_step", "parabola", "resample_path", "run", "run_robot", "run_scenario",
-    "split_pull", "tractrix_step",
+    "split_pull", "tractrix_step", "arm_step", "forward_kinematics", "joint_angles_from_points",
+    "track_path",
 ]

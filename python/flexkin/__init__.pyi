@@ -203,3 +203,63 @@ def run_scenario(scenario: Union[PathLike, Dict[str, Any], Scenario], *,
                  progress: Progress = None) -> Result: ...
 def run_robot(scenario: Union[PathLike, Dict[str, Any]], *, directory: Optional[PathLike] = None,
               method: Optional[str] = None) -> RobotResult: ...
+
+class ArmModel:
+    def __init__(self, link_lengths: ArrayLike, *, dim: int = 2, base: Optional[ArrayLike] = None,
+                 base_direction: Optional[ArrayLike] = None,
+                 joint_min: Optional[ArrayLike] = None, joint_max: Optional[ArrayLike] = None,
+                 max_bend: Optional[ArrayLike] = None, joint_axes: Optional[ArrayLike] = None,
+                 link_directions: Optional[ArrayLike] = None,
+                 initial_angles: Optional[ArrayLike] = None,
+                 initial_azimuths: Optional[ArrayLike] = None) -> None: ...
+    @staticmethod
+    def straight(dim: int, links: int, link_length: float) -> "ArmModel": ...
+    dim: int
+    link_lengths: Float64Array
+    base: Float64Array
+    base_direction: Float64Array
+    initial_angles: Float64Array
+    initial_azimuths: Optional[Float64Array]
+    joint: str
+    num_links: int
+    reach: float
+    has_limits: bool
+
+class ArmOptions:
+    method: str
+    tolerance: float
+    max_iterations: int
+    max_fixed_point_iterations: int
+    restarts: int
+    substeps: int
+    edge_margin: float
+    def __init__(self, *, method: str = "newton", tolerance: float = 1e-10,
+                 max_iterations: int = 100, max_fixed_point_iterations: int = 100000,
+                 restarts: int = 8, substeps: int = 1, edge_margin: float = 1e-9) -> None: ...
+
+class ArmStepReport:
+    points: Float64Array
+    angles: Float64Array
+    azimuths: Optional[Float64Array]
+    ee_error: float
+    base_error: float
+    iterations: int
+    sweeps: int
+    passes: int
+    converged: bool
+    reached: bool
+    stretched: bool
+    limited: bool
+    joint_space: bool
+    legs: int
+    restarts: int
+    def brief_report(self) -> str: ...
+
+def forward_kinematics(model: ArmModel, angles: ArrayLike,
+                       azimuths: Optional[ArrayLike] = None) -> Float64Array: ...
+def joint_angles_from_points(model: ArmModel, points: ArrayLike
+                             ) -> Tuple[Float64Array, Optional[Float64Array]]: ...
+def arm_step(model: ArmModel, target: ArrayLike, *, state: Optional[ArmStepReport] = None,
+             options: Optional[ArmOptions] = None) -> ArmStepReport: ...
+def track_path(model: ArmModel, path: ArrayLike, *,
+               options: Optional[ArmOptions] = None) -> RobotResult: ...

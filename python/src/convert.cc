@@ -29,6 +29,7 @@ std::string ShapeText(const py::array& array) {
 
 std::string ExpectedShape(int ndim, int min_rows, int cols, int size) {
   if (ndim == 1) {
+    if (size < 0) return "a 1-D array of at least one value";
     return size > 0 ? std::to_string(size) + " values" : "2 or 3 values (a 2D or 3D point)";
   }
   const std::string columns = cols > 0 ? std::to_string(cols) : "2 or 3";
@@ -80,7 +81,7 @@ py::array_t<double, py::array::c_style> ReadArray(py::handle object, const std::
     }
   } else {
     const py::ssize_t n = array.shape(0);
-    const bool size_ok = size > 0 ? n == size : (n == 2 || n == 3);
+    const bool size_ok = size > 0 ? n == size : size < 0 ? n >= 1 : (n == 2 || n == 3);
     if (!size_ok) {
       ThrowInput(name, "has shape " + ShapeText(array) + "; expected " + expected, ShapeText(array),
                  expected);

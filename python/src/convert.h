@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <string>
 
+#include "flexkin/arm.h"
 #include "flexkin/chain.h"
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
@@ -25,7 +26,8 @@ namespace py = pybind11;
 
 // The float64, C-contiguous form of `object`, checked: `ndim` dimensions (1 or 2); with ndim 2,
 // at least `min_rows` rows and 2 or 3 columns (`cols` if it is not 0); with ndim 1, `size`
-// values if it is not 0 (2 or 3 if it is 0). Every value finite. Throws InputError naming `name`.
+// values if it is > 0 (2 or 3 if it is 0, any number >= 1 if it is < 0). Every value finite. Throws
+// InputError naming `name`.
 py::array_t<double, py::array::c_style> ReadArray(py::handle object, const std::string& name,
                                                   int ndim, int min_rows = 1, int cols = 0,
                                                   int size = 0);
@@ -65,6 +67,10 @@ void BindOptions(py::module_& m);
 void BindChains(py::module_& m);
 void BindRun(py::module_& m);
 void BindRobot(py::module_& m);
+void BindArms(py::module_& m);
+// TrackPath of `model` along `path` with the GIL released, as a flexkin.RobotResult (robot.cc).
+py::object TrackToResult(const ArmModel& model, const Points& path, const ArmOptions& options,
+                         const std::string& scenario);
 
 }  // namespace flexkin::python
 

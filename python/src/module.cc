@@ -11,4 +11,5 @@ PYBIND11_MODULE(_flexkin, m) {
   flexkin::python::BindChains(m);
   flexkin::python::BindRun(m);
   flexkin::python::BindRobot(m);
+  flexkin::python::BindArms(m);
 }

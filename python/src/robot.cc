@@ -109,34 +109,39 @@ RobotScenario RobotScenarioArg(py::handle scenario, py::handle directory) {
   }
 }
 
-RobotResult RunRobot(py::handle scenario, py::handle directory, py::object method) {
-  RobotScenario s = RobotScenarioArg(scenario, directory);
-  if (!method.is_none()) s.options.method = ParseFixedBaseMethod(py::cast<std::string>(method));
-  ThrowIfAny(s.model.Validate());
-  ThrowIfAny(s.options.Validate());
-  const int64_t links = s.model.num_links(), dim = s.model.dim;
-  const bool spherical = s.model.joint() == ArmJoint::kSpherical;
+RobotResult Track(const ArmModel& model, const Points& path, const ArmOptions& options,
+                  const std::string& scenario) {
+  ThrowIfAny(model.Validate());
+  ThrowIfAny(options.Validate());
+  const int64_t links = model.num_links(), dim = model.dim;
+  const bool spherical = model.joint() == ArmJoint::kSpherical;
   RobotResult r;
-  r.scenario = s.name;
-  r.method = FixedBaseMethodName(s.options.method);
-  r.joint = NameOf(s.model.joint());
+  r.scenario = scenario;
+  r.method = FixedBaseMethodName(options.method);
+  r.joint = NameOf(model.joint());
   r.dim = static_cast<int>(dim);
-  r.data["link_lengths"] = ToArray(s.model.link_lengths);
-  r.data["base"] = ToArray(s.model.base);
-  r.data["path"] = ToArray(Points(s.path));
-  const ArmState initial = InitialState(s.model);
+  r.data["link_lengths"] = ToArray(model.link_lengths);
+  r.data["base"] = ToArray(model.base);
+  r.data["path"] = ToArray(Points(path));
+  const ArmState initial = InitialState(model);
   r.data["initial_angles"] = ToArray(initial.angles.angle);
   r.data["initial_azimuths"] = spherical ? py::object(ToArray(initial.angles.azimuth)) : py::none();
   r.data["initial_points"] = ToArray(Points(initial.points));
   {
     py::gil_scoped_release release;
-    r.summary = TrackPath(s.model, s.path, s.options);
+    r.summary = TrackPath(model, path, options);
   }
   StepsToArrays(r.summary.steps, links, dim, spherical, &r);
   r.num_steps = static_cast<long long>(r.summary.steps.size());
   r.brief = r.summary.BriefReport();
   r.summary.steps.clear();
   return r;
+}
+
+RobotResult RunRobot(py::handle scenario, py::handle directory, py::object method) {
+  RobotScenario s = RobotScenarioArg(scenario, directory);
+  if (!method.is_none()) s.options.method = ParseFixedBaseMethod(py::cast<std::string>(method));
+  return Track(s.model, s.path, s.options, s.name);
 }
 
 std::string RobotRepr(const RobotResult& r) {
@@ -155,6 +160,11 @@ constexpr const char* kArrayNames[] = {
     "joint_space"};
 
 }  // namespace
+
+py::object TrackToResult(const ArmModel& model, const Points& path, const ArmOptions& options,
+                         const std::string& scenario) {
+  return py::cast(Track(model, path, options, scenario));
+}
 
 void BindRobot(py::module_& m) {
   py::class_<RobotResult> c(m, "RobotResult", R"doc(
