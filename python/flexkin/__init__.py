@@ -42,9 +42,7 @@ from ._flexkin import (
     overall_step,
     parabola,
     resample_path,
-    run,
     run_robot,
-    run_scenario,
     split_pull,
     track_path,
     tractrix_step,
@@ -56,6 +54,52 @@ for _name in ("AccuracyReport", "ArmModel", "ArmOptions", "ArmStepReport", "Chai
               "Scenario"):
     globals()[_name].__module__ = __name__
 del _name
+
+from . import _flexkin
+
+
+class _ProgressBar:
+    """progress=True: a tqdm bar where tqdm is installed, else a line on stderr rewritten."""
+
+    def __init__(self):
+        self._bar = None
+        self._done = 0
+
+    def __call__(self, done, total):
+        if self._bar is None:
+            try:
+                from tqdm import tqdm
+                self._bar = tqdm(total=total, unit="step")
+            except ImportError:
+                self._bar = False
+        if self._bar:
+            self._bar.update(done - self._done)
+            if done >= total:
+                self._bar.close()
+        else:
+            import sys
+            end = "\n" if done >= total else ""
+            print(f"\rflexkin: leader step {done} of {total}", end=end, file=sys.stderr,
+                  flush=True)
+        self._done = done
+
+
+def _progress(progress):
+    return _ProgressBar() if progress is True else (None if progress is False else progress)
+
+
+def run(points, leader_steps, *, progress=None, **options):
+    return _flexkin.run(points, leader_steps, progress=_progress(progress), **options)
+
+
+def run_scenario(scenario, *, progress=None):
+    return _flexkin.run_scenario(scenario, progress=_progress(progress))
+
+
+run.__doc__ = _flexkin.run.__doc__ + """
+progress=True shows a tqdm progress bar (a line on stderr where tqdm is not installed)."""
+run_scenario.__doc__ = _flexkin.run_scenario.__doc__ + """
+progress=True shows a tqdm progress bar (a line on stderr where tqdm is not installed)."""
 
 __all__ = [
     "AccuracyReport", "ArmModel", "ArmOptions", "ArmStepReport", "Chain", "InputError", "Metrics", "ObjectiveWeights", "OverallOptions",

@@ -8,7 +8,7 @@ import numpy.typing as npt
 ArrayLike = npt.ArrayLike
 Float64Array = npt.NDArray[np.float64]
 PathLike = Union[str, "os.PathLike[str]"]
-Progress = Optional[Callable[[int, int], Any]]
+Progress = Union[None, bool, Callable[[int, int], Any]]
 OverallArg = Union[None, "OverallOptions", "ObjectiveWeights", Dict[str, float]]
 
 class InputError(ValueError):

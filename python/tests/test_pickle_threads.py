@@ -91,3 +91,25 @@ def test_ctrl_c_stops_a_run():
             long_run()
     finally:
         timer.cancel()
+
+
+def test_progress_true_uses_tqdm_when_installed(monkeypatch):
+    import sys
+    import types
+    updates = []
+
+    class FakeBar:
+        def __init__(self, total, unit):
+            updates.append(("total", total))
+
+        def update(self, n):
+            updates.append(("update", n))
+
+        def close(self):
+            updates.append(("close",))
+
+    monkeypatch.setitem(sys.modules, "tqdm", types.SimpleNamespace(tqdm=FakeBar))
+    res = flexkin.run(flexkin.parabola(links=5), [[0.1, 0.1], [0.2, 0.2]], progress=True)
+    assert res.frames.shape == (3, 6, 2)
+    assert updates[0] == ("total", 2) and updates[-1] == ("close",)
+    assert sum(n for kind, *n in updates if kind == "update" for n in n) == 2
