@@ -113,3 +113,37 @@ def test_progress_true_uses_tqdm_when_installed(monkeypatch):
     assert res.frames.shape == (3, 6, 2)
     assert updates[0] == ("total", 2) and updates[-1] == ("close",)
     assert sum(n for kind, *n in updates if kind == "update" for n in n) == 2
+
+
+def test_the_gil_is_released_during_a_run():
+    stop = threading.Event()
+    outcome = []
+
+    def progress(done, total):
+        if stop.is_set():
+            raise RuntimeError("stopped")
+
+    def work():
+        try:
+            long_run(progress=progress)
+        except RuntimeError as e:
+            outcome.append(str(e))
+
+    thread = threading.Thread(target=work)
+    thread.start()
+    count = 0
+    import time
+    end = time.monotonic() + 0.3
+    while time.monotonic() < end:       # Python keeps running beside the run
+        count += 1
+    stop.set()
+    thread.join()
+    assert outcome == ["stopped"] and count > 10000
+
+
+def test_scenario_options_changed_before_running():
+    scenario = flexkin.load_scenario(EXAMPLES / "fig06_parabola_multi_step.json")
+    scenario.options.substeps = 8
+    scenario.options.record_every = 5
+    res = flexkin.run_scenario(scenario)
+    assert res.substeps == 8 and res.steps.tolist() == [0, 5]
