@@ -44,27 +44,33 @@ Eigen::VectorXd ArcLengthWeights(const Eigen::VectorXd& lengths) {
 }
 
 // Angle in [0, pi] between each link (trailing -> leading end) and the unit vector `direction`,
-// into `angles` (sized n once; nothing allocated per frame).
-void LinkAngles(const Points& points, const Eigen::VectorXd& direction, Eigen::VectorXd* angles) {
+// into `angles`, as atan2(|across|, along) (accurate near 0 and pi, unlike acos), the atan2s a
+// batch at a time (internal::Atan2OfSqrt). `across2` is scratch; both are sized n once: nothing
+// is allocated per frame.
+void LinkAngles(const Points& points, const Eigen::VectorXd& direction, Eigen::VectorXd* angles,
+                Eigen::VectorXd* across2) {
   const Eigen::Index n = points.rows() - 1, dim = points.cols();
   if (direction.size() == 0) {
     angles->resize(0);
     return;
   }
   angles->resize(n);
+  across2->resize(n);
   for (Eigen::Index i = 1; i <= n; ++i) {
     double link[3], along = 0.0;
     for (Eigen::Index k = 0; k < dim; ++k) {
       link[k] = points(i - 1, k) - points(i, k);
       along += link[k] * direction[k];
     }
-    double across2 = 0.0;
+    double sum = 0.0;
     for (Eigen::Index k = 0; k < dim; ++k) {
       const double c = link[k] - along * direction[k];
-      across2 += c * c;
+      sum += c * c;
     }
-    (*angles)[i - 1] = std::atan2(std::sqrt(across2), along);  // accurate near 0 and pi
+    (*angles)[i - 1] = along;
+    (*across2)[i - 1] = sum;
   }
+  internal::Atan2OfSqrt(across2->data(), angles->data(), n, angles->data());
 }
 
 double MaxPointDistance(const Points& a, const Points& b) {
@@ -491,9 +497,9 @@ RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& 
   const int64_t num_steps = result.num_steps;
 
   const Eigen::VectorXd first_direction = FirstDirection(chain.points, leader_steps);
-  Eigen::VectorXd angles;  // reused by every frame
+  Eigen::VectorXd angles, across2;  // reused by every frame
   const auto add_frame = [&](int64_t step, const Points& points, const Eigen::VectorXd& direction) {
-    if (options.link_angles) LinkAngles(points, direction, &angles);
+    if (options.link_angles) LinkAngles(points, direction, &angles, &across2);
     sink->Add(step, points, angles);
   };
   add_frame(0, chain.points, first_direction);

@@ -123,6 +123,8 @@ void SweepsWavefrontAvx2(Method, int, const double*, int64_t, const double*, con
                          double*);
 void SweepsWavefrontAvx512(Method, int, const double*, int64_t, const double*, const double*, int,
                            double*);
+void Atan2OfSqrtAvx2(const double*, const double*, int64_t, double*);
+void Atan2OfSqrtAvx512(const double*, const double*, int64_t, double*);
 void TracedSweepsWavefrontAvx2(Method, int, const double*, int64_t, const double*, const double*,
                                int, double*, SweepTrace*);
 void TracedSweepsWavefrontAvx512(Method, int, const double*, int64_t, const double*, const double*,
@@ -132,14 +134,19 @@ namespace {
 struct WavefrontChoice {
   SweepsFn fn;
   TracedSweepsFn traced;
+  void (*atan2_of_sqrt)(const double*, const double*, int64_t, double*);
   int lanes;
 };
 // The widest engine AllowedSimd() permits (src/chain/simd.h). Without AVX2 and FMA there is no
 // wavefront (lanes = 1) and every move takes the one-pass loop.
 WavefrontChoice ChooseWavefront() {
-  if (AllowedSimd().avx512) return {SweepsWavefrontAvx512, TracedSweepsWavefrontAvx512, 8};
-  if (AllowedSimd().avx2_fma) return {SweepsWavefrontAvx2, TracedSweepsWavefrontAvx2, 4};
-  return {nullptr, nullptr, 1};
+  if (AllowedSimd().avx512) {
+    return {SweepsWavefrontAvx512, TracedSweepsWavefrontAvx512, Atan2OfSqrtAvx512, 8};
+  }
+  if (AllowedSimd().avx2_fma) {
+    return {SweepsWavefrontAvx2, TracedSweepsWavefrontAvx2, Atan2OfSqrtAvx2, 4};
+  }
+  return {nullptr, nullptr, nullptr, 1};
 }
 const WavefrontChoice& Wavefront() {
   static const WavefrontChoice choice = ChooseWavefront();
@@ -181,6 +188,16 @@ void TracedSweepsWavefront(Method method, int dim, const double* heads, int64_t 
   }
 #endif
   TracedSweepsScalar(method, dim, heads, num_sweeps, lengths, inv_lengths, n, pts, trace);
+}
+
+void Atan2OfSqrt(const double* across2, const double* along, int64_t count, double* out) {
+#if FLEXKIN_HAVE_WAVEFRONT
+  if (Wavefront().atan2_of_sqrt != nullptr) {
+    Wavefront().atan2_of_sqrt(across2, along, count, out);
+    return;
+  }
+#endif
+  for (int64_t i = 0; i < count; ++i) out[i] = std::atan2(std::sqrt(across2[i]), along[i]);
 }
 
 std::vector<WavefrontEngine> AvailableWavefronts() {

@@ -88,6 +88,11 @@ void SweepsMinRotation(int dim, const double* heads, int64_t num_sweeps, int num
 void SweepsMinJointAngle(int dim, const double* heads, int64_t num_sweeps, const double* lengths,
                          const double* inv_lengths, int num_links, double* points);
 
+// out[i] = atan2(sqrt(across2[i]), along[i]) for i < count, with the widest instruction set the
+// engines may use (the one-pass loop's std::atan2 without one; a vector atan2 within a few ulps of
+// it with one). `out` may be `along`.
+void Atan2OfSqrt(const double* across2, const double* along, int64_t count, double* out);
+
 // Number of sweeps in flight in SweepsWavefront on this CPU (the SIMD width in doubles).
 int WavefrontLanes();
 

@@ -1,6 +1,8 @@
 // The wavefront engine compiled for one instruction set. CMakeLists.txt builds this file once per
 // instruction set with its flags and FLEXKIN_ISA set to 2 (AVX2+FMA) or 3 (AVX-512);
 // propagate.cc calls the entry point only after checking at run time that the CPU has it.
+#include <cmath>
+
 #include "sequential/wavefront.h"
 
 namespace flexkin::internal {
@@ -8,10 +10,12 @@ namespace flexkin::internal {
 #if FLEXKIN_ISA == 2
 #define FLEXKIN_ENTRY SweepsWavefrontAvx2
 #define FLEXKIN_TRACED_ENTRY TracedSweepsWavefrontAvx2
+#define FLEXKIN_ATAN2_ENTRY Atan2OfSqrtAvx2
 using Arch = xsimd::fma3<xsimd::avx2>;
 #elif FLEXKIN_ISA == 3
 #define FLEXKIN_ENTRY SweepsWavefrontAvx512
 #define FLEXKIN_TRACED_ENTRY TracedSweepsWavefrontAvx512
+#define FLEXKIN_ATAN2_ENTRY Atan2OfSqrtAvx512
 using Arch = xsimd::avx512f;
 #else
 #error "FLEXKIN_ISA must be 2 or 3"
@@ -28,6 +32,16 @@ void FLEXKIN_TRACED_ENTRY(Method method, int dim, const double* heads, int64_t n
                           SweepTrace* trace) {
   WavefrontDispatch<Arch, true>(method, dim, heads, num_sweeps, lengths, inv_lengths, n, points,
                                 trace);
+}
+
+void FLEXKIN_ATAN2_ENTRY(const double* across2, const double* along, int64_t count, double* out) {
+  using B = xsimd::batch<double, Arch>;
+  int64_t i = 0;
+  for (; i + static_cast<int64_t>(B::size) <= count; i += B::size) {
+    const B y = xsimd::sqrt(B::load_unaligned(across2 + i));
+    xsimd::atan2(y, B::load_unaligned(along + i)).store_unaligned(out + i);
+  }
+  for (; i < count; ++i) out[i] = std::atan2(std::sqrt(across2[i]), along[i]);
 }
 
 }  // namespace flexkin::internal
