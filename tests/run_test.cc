@@ -370,5 +370,28 @@ TEST(RunTest, ReportsAndProgress) {
   EXPECT_GE(result.seconds, 0.0);
 }
 
+// A progress callback that throws stops the run: the exception comes out of Run, during the
+// accuracy control and during the run itself.
+TEST(RunTest, ProgressThatThrowsStopsTheRun) {
+  const Chain chain = CurvedChain(3, 400, 0.2, 0.3);
+  const Points targets = CurvedLeaderPath(chain, 2000, 0.05);
+  for (const bool accuracy : {true, false}) {
+    RunOptions options;
+    // Work of seconds either way, stopped at the first report (about 0.1 s in).
+    options.tolerance = accuracy ? 1e-12 : 0.0;
+    options.substeps = accuracy ? 1 : 4096;
+    int64_t calls = 0, first_done = -1;
+    options.progress = [&](int64_t done, int64_t) {
+      if (calls++ == 0) first_done = done;
+      throw std::runtime_error("stop");
+    };
+    EXPECT_THROW(flexkin::Run(chain, targets, options), std::runtime_error);
+    EXPECT_EQ(calls, 1);
+    // Stopped at its first report: while the sub-steps were chosen (0 done), or part way.
+    if (accuracy) EXPECT_EQ(first_done, 0);
+    if (!accuracy) EXPECT_LT(first_done, 2000);
+  }
+}
+
 }  // namespace
 }  // namespace flexkin

@@ -36,7 +36,9 @@ struct RunOptions {
   // Compute Frame::link_angles for each recorded frame (an atan2 per link per frame). false leaves
   // them empty: a recorded frame then costs a copy of its points and nothing more.
   bool link_angles = true;
-  // Called with (leader steps done, total) about every 0.1 s of work; may be empty.
+  // Called with (leader steps done, total) about every 0.1 s of work (with 0 done while accuracy
+  // control chooses the sub-steps); may be empty. It may throw to stop the run: the exception
+  // propagates out of Run.
   std::function<void(int64_t done, int64_t total)> progress;
 
   // Every problem with the options (empty if valid), each naming its member ("substeps",
