@@ -12,6 +12,7 @@
 #include "convert.h"
 #include "flexkin/arm.h"
 #include "flexkin/robot_scenario.h"
+#include "progress.h"
 #ifdef FLEXKIN_PYTHON_URDF
 #include "flexkin/urdf.h"
 #endif
@@ -33,48 +34,77 @@ struct RobotResult {
   std::map<std::string, py::object> data;  // arrays (and None for absent azimuths)
 };
 
-// The steps of a trajectory as arrays: (T, n) angles and azimuths, (T, n+1, dim) points, and
-// one (T,) array per per-step report member.
-void StepsToArrays(const std::vector<ArmStepReport>& steps, int64_t links, int64_t dim,
-                   bool azimuths, RobotResult* r) {
-  const int64_t count = static_cast<int64_t>(steps.size());
-  py::array_t<double> angles({count, links}), points({count, links + 1, dim});
-  py::array_t<double> azimuth_array;
-  if (azimuths) azimuth_array = py::array_t<double>({count, links});
-  std::vector<py::array_t<double>> floats;  // one array each (not copies of one handle)
-  std::vector<py::array_t<int64_t>> ints;
-  std::vector<py::array_t<bool>> bools;
-  for (size_t k = 0; k < std::size(kFloatSteps); ++k) floats.emplace_back(count);
-  for (size_t k = 0; k < std::size(kIntSteps); ++k) ints.emplace_back(count);
-  for (size_t k = 0; k < std::size(kBoolSteps); ++k) bools.emplace_back(count);
-  for (int64_t t = 0; t < count; ++t) {
-    const ArmStepReport& s = steps[static_cast<size_t>(t)];
-    if (s.state.angles.angle.size() != links || s.state.points.size() != (links + 1) * dim ||
-        (azimuths && s.state.angles.azimuth.size() != links)) {
+// The steps of a trajectory streamed into preallocated arrays: (T, n) angles and azimuths,
+// (T, n+1, dim) points, and one (T,) array per per-step report member. The arrays are made and
+// their pointers taken with the GIL held; Add runs with it released (TrackPath's thread) and
+// ticks the progress hook, which checks for Ctrl-C about every 0.1 s and throws StopRun.
+class StepArrays : public ArmStepSink {
+ public:
+  StepArrays(int64_t count, int64_t links, int64_t dim, bool azimuths, ProgressHook* hook)
+      : count_(count), links_(links), dim_(dim), hook_(hook) {
+    angles_ = py::array_t<double>({count, links});
+    points_ = py::array_t<double>({count, links + 1, dim});
+    if (azimuths) azimuths_ = py::array_t<double>({count, links});
+    for (size_t k = 0; k < std::size(kFloatSteps); ++k) floats_.emplace_back(count);
+    for (size_t k = 0; k < std::size(kIntSteps); ++k) ints_.emplace_back(count);
+    for (size_t k = 0; k < std::size(kBoolSteps); ++k) bools_.emplace_back(count);
+    angle_data_ = angles_.mutable_data();
+    point_data_ = points_.mutable_data();
+    azimuth_data_ = azimuths ? azimuths_.mutable_data() : nullptr;
+    for (auto& a : floats_) float_data_.push_back(a.mutable_data());
+    for (auto& a : ints_) int_data_.push_back(a.mutable_data());
+    for (auto& a : bools_) bool_data_.push_back(a.mutable_data());
+  }
+
+  void Add(const ArmStepReport& s) override {
+    if (done_ >= count_) throw std::logic_error("flexkin: TrackPath produced more steps than rows");
+    if (s.state.angles.angle.size() != links_ || s.state.points.size() != (links_ + 1) * dim_ ||
+        (azimuth_data_ != nullptr && s.state.angles.azimuth.size() != links_)) {
       throw std::logic_error("flexkin: TrackPath produced a step of another shape");
     }
-    std::memcpy(angles.mutable_data() + t * links, s.state.angles.angle.data(),
-                sizeof(double) * static_cast<size_t>(links));
-    std::memcpy(points.mutable_data() + t * (links + 1) * dim, s.state.points.data(),
-                sizeof(double) * static_cast<size_t>((links + 1) * dim));
-    if (azimuths) {
-      std::memcpy(azimuth_array.mutable_data() + t * links, s.state.angles.azimuth.data(),
-                  sizeof(double) * static_cast<size_t>(links));
+    const int64_t t = done_;
+    std::memcpy(angle_data_ + t * links_, s.state.angles.angle.data(),
+                sizeof(double) * static_cast<size_t>(links_));
+    std::memcpy(point_data_ + t * (links_ + 1) * dim_, s.state.points.data(),
+                sizeof(double) * static_cast<size_t>((links_ + 1) * dim_));
+    if (azimuth_data_ != nullptr) {
+      std::memcpy(azimuth_data_ + t * links_, s.state.angles.azimuth.data(),
+                  sizeof(double) * static_cast<size_t>(links_));
     }
     const double f[] = {s.ee_error, s.base_error};
     const int64_t i[] = {s.iterations, s.sweeps, s.passes, s.legs, s.restarts};
     const bool b[] = {s.converged, s.reached, s.stretched, s.limited, s.joint_space};
-    for (size_t k = 0; k < floats.size(); ++k) floats[k].mutable_data()[t] = f[k];
-    for (size_t k = 0; k < ints.size(); ++k) ints[k].mutable_data()[t] = i[k];
-    for (size_t k = 0; k < bools.size(); ++k) bools[k].mutable_data()[t] = b[k];
+    for (size_t k = 0; k < float_data_.size(); ++k) float_data_[k][t] = f[k];
+    for (size_t k = 0; k < int_data_.size(); ++k) int_data_[k][t] = i[k];
+    for (size_t k = 0; k < bool_data_.size(); ++k) bool_data_[k][t] = b[k];
+    ++done_;
+    if (hook_ != nullptr) hook_->Tick(done_, count_);
   }
-  r->data["angles"] = angles;
-  r->data["points"] = points;
-  r->data["azimuths"] = azimuths ? py::object(azimuth_array) : py::none();
-  for (size_t k = 0; k < floats.size(); ++k) r->data[kFloatSteps[k]] = floats[k];
-  for (size_t k = 0; k < ints.size(); ++k) r->data[kIntSteps[k]] = ints[k];
-  for (size_t k = 0; k < bools.size(); ++k) r->data[kBoolSteps[k]] = bools[k];
-}
+
+  int64_t done() const { return done_; }
+
+  // Needs the GIL.
+  void MoveTo(RobotResult* r) {
+    r->data["angles"] = angles_;
+    r->data["points"] = points_;
+    r->data["azimuths"] = azimuth_data_ != nullptr ? py::object(azimuths_) : py::none();
+    for (size_t k = 0; k < floats_.size(); ++k) r->data[kFloatSteps[k]] = floats_[k];
+    for (size_t k = 0; k < ints_.size(); ++k) r->data[kIntSteps[k]] = ints_[k];
+    for (size_t k = 0; k < bools_.size(); ++k) r->data[kBoolSteps[k]] = bools_[k];
+  }
+
+ private:
+  int64_t count_, links_, dim_, done_ = 0;
+  ProgressHook* hook_;
+  py::array_t<double> angles_, points_, azimuths_;
+  std::vector<py::array_t<double>> floats_;  // one array each (not copies of one handle)
+  std::vector<py::array_t<int64_t>> ints_;
+  std::vector<py::array_t<bool>> bools_;
+  double *angle_data_, *point_data_, *azimuth_data_;
+  std::vector<double*> float_data_;
+  std::vector<int64_t*> int_data_;
+  std::vector<bool*> bool_data_;
+};
 
 RobotScenarioOptions ReaderOptions(const std::string& directory) {
 #ifdef FLEXKIN_PYTHON_URDF
@@ -127,14 +157,22 @@ RobotResult Track(const ArmModel& model, const Points& path, const ArmOptions& o
   r.data["initial_angles"] = ToArray(initial.angles.angle);
   r.data["initial_azimuths"] = spherical ? py::object(ToArray(initial.angles.azimuth)) : py::none();
   r.data["initial_points"] = ToArray(Points(initial.points));
-  {
+  const int64_t count = static_cast<int64_t>(path.rows());
+  ProgressHook hook{py::none()};  // Ctrl-C only
+  StepArrays sink(count, links, dim, spherical, &hook);
+  try {
     py::gil_scoped_release release;
-    r.summary = TrackPath(model, path, options);
+    r.summary = TrackPath(model, path, options, &sink);
+  } catch (const StopRun&) {
+    hook.Rethrow();
   }
-  StepsToArrays(r.summary.steps, links, dim, spherical, &r);
-  r.num_steps = static_cast<long long>(r.summary.steps.size());
+  if (sink.done() != count) {
+    throw std::logic_error("flexkin: TrackPath produced " + std::to_string(sink.done()) +
+                           " steps for " + std::to_string(count) + " path rows");
+  }
+  sink.MoveTo(&r);
+  r.num_steps = count;
   r.brief = r.summary.BriefReport();
-  r.summary.steps.clear();
   return r;
 }
 

@@ -58,3 +58,30 @@ def test_arm_arguments_checked():
         flexkin.track_path(model, np.zeros((0, 2)))
     with pytest.raises(flexkin.InputError):
         flexkin.ArmOptions(method="newtn")
+
+
+def test_ctrl_c_stops_a_tracked_path():
+    import _thread
+    import threading
+    import time
+    model = flexkin.ArmModel.straight(2, 200, 1.0)
+    t = np.linspace(0, 2 * np.pi, 200000)
+    path = np.column_stack([150 + 20 * np.cos(t), 20 * np.sin(t)])
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    timer.start()
+    start = time.monotonic()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            flexkin.track_path(model, path)
+    finally:
+        timer.cancel()
+    assert time.monotonic() - start < 5.0
+
+
+def test_streamed_steps_are_their_own_arrays():
+    traj = flexkin.track_path(flexkin.ArmModel.straight(2, 4, 1.0), [[3.0, 0.5], [3.0, 1.0]])
+    arrays = [traj.ee_error, traj.base_error, traj.iterations, traj.sweeps, traj.passes,
+              traj.converged, traj.reached, traj.joint_space]
+    assert len({id(a) for a in arrays}) == len(arrays)
+    assert all(a.shape == (2,) for a in arrays) and traj.num_steps == 2
+    assert traj.angles.shape == (2, 4) and traj.points.shape == (2, 5, 2)
