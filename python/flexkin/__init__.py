@@ -28,6 +28,10 @@ from ._flexkin import (
     OverallRunReport,
     Result,
     RobotResult,
+    estimate_output,
+    read_result,
+    validate_scenario,
+    write_result,
     RunOptions,
     Scenario,
     arc,
@@ -107,5 +111,5 @@ __all__ = [
     "arc", "follow_the_leader_step", "helix", "line", "load_scenario", "move_leader",
     "overall_step", "parabola", "resample_path", "run", "run_robot", "run_scenario",
     "split_pull", "tractrix_step", "arm_step", "forward_kinematics", "joint_angles_from_points",
-    "track_path",
+    "track_path", "read_result", "write_result", "validate_scenario", "estimate_output",
 ]

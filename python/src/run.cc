@@ -11,6 +11,8 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <system_error>
+#include <vector>
 
 #include "convert.h"
 #include "flexkin/result_io.h"
@@ -209,6 +211,147 @@ for invalid input, naming the argument ("leader_steps[2][0]", "substeps").
 
 }  // namespace
 
+// A result file read back, as the Result of a run.
+Result ResultOfFile(ResultFile&& file) {
+  Result r;
+  r.dim = file.dim;
+  r.scenario = std::move(file.scenario_name);
+  std::vector<Frame> frames = std::move(file.result.frames);
+  r.run = std::move(file.result);
+  r.run.frames.clear();
+  const int64_t count = static_cast<int64_t>(frames.size()), n = r.run.lengths.size();
+  const int64_t size = (n + 1) * r.dim;
+  r.frames = py::array_t<double>({count, n + 1, static_cast<int64_t>(r.dim)});
+  r.steps = py::array_t<int64_t>(count);
+  bool angles = count > 0;
+  for (const Frame& f : frames) angles = angles && f.link_angles.size() == n;
+  py::array_t<double> angle_array;
+  if (angles) angle_array = py::array_t<double>({count, n});
+  for (int64_t k = 0; k < count; ++k) {
+    const Frame& f = frames[static_cast<size_t>(k)];
+    if (f.points.size() != size) ThrowInput("frames", "a frame of another shape");
+    std::memcpy(r.frames.mutable_data() + k * size, f.points.data(),
+                sizeof(double) * static_cast<size_t>(size));
+    r.steps.mutable_data()[k] = f.step;
+    if (angles) {
+      std::memcpy(angle_array.mutable_data() + k * n, f.link_angles.data(),
+                  sizeof(double) * static_cast<size_t>(n));
+    }
+  }
+  r.link_angles = angles ? py::object(angle_array) : py::none();
+  return r;
+}
+
+// The RunResult of a Result, its frames copied back from the arrays.
+RunResult RunResultOf(const Result& r) {
+  RunResult run = r.run;
+  const int64_t count = r.frames.shape(0), n = run.lengths.size(), dim = r.dim;
+  const bool angles = !r.link_angles.is_none();
+  py::array_t<double, py::array::c_style | py::array::forcecast> angle_array;
+  if (angles) angle_array = py::cast<py::array_t<double, py::array::c_style>>(r.link_angles);
+  const auto frames = py::array_t<double, py::array::c_style | py::array::forcecast>(r.frames);
+  const auto steps = py::array_t<int64_t, py::array::c_style | py::array::forcecast>(r.steps);
+  run.frames.resize(static_cast<size_t>(count));
+  for (int64_t k = 0; k < count; ++k) {
+    Frame& f = run.frames[static_cast<size_t>(k)];
+    f.step = steps.data()[k];
+    f.points = Points(n + 1, dim);
+    std::memcpy(f.points.data(), frames.data() + k * (n + 1) * dim,
+                sizeof(double) * static_cast<size_t>((n + 1) * dim));
+    if (angles) {
+      f.link_angles.resize(n);
+      std::memcpy(f.link_angles.data(), angle_array.data() + k * n,
+                  sizeof(double) * static_cast<size_t>(n));
+    }
+  }
+  return run;
+}
+
+// A std::system_error with the path in its message (raised as OSError).
+[[noreturn]] void RethrowWithPath(const std::system_error& e, const std::string& path) {
+  const std::string what = e.what();
+  if (what.find(path) != std::string::npos) throw;
+  throw std::system_error(e.code(), path + ": " + what);
+}
+
+Result ReadResult(py::handle path_arg) {
+  const std::string path = PathArg(path_arg);
+  if (path.empty()) ThrowInput("path", "is not a path; expected a str or os.PathLike");
+  ResultFile file;
+  try {
+    py::gil_scoped_release release;
+    file = ReadResultFile(path);
+  } catch (const std::system_error& e) {
+    RethrowWithPath(e, path);
+  } catch (const InputError& e) {
+    Problem p = e.problem();
+    p.field = p.field.empty() ? path : path + ": " + p.field;
+    throw InputError(p);
+  }
+  return ResultOfFile(std::move(file));
+}
+
+void WriteResult(const Result& r, py::handle path_arg) {
+  const std::string path = PathArg(path_arg);
+  if (path.empty()) ThrowInput("path", "is not a path; expected a str or os.PathLike");
+  const ResultFileFormat format = ResultFileFormatOfPath(path);
+  const RunResult run = RunResultOf(r);
+  try {
+    py::gil_scoped_release release;
+    WriteResultFile(run, path, format, r.scenario);
+  } catch (const std::system_error& e) {
+    RethrowWithPath(e, path);
+  }
+}
+
+py::list ProblemList(const Problems& problems) {
+  py::list out;
+  for (const Problem& p : problems) {
+    py::dict d;
+    d["field"] = p.field;
+    d["message"] = p.message;
+    d["value"] = p.value;
+    d["expected"] = p.expected;
+    out.append(d);
+  }
+  return out;
+}
+
+py::list ValidateScenario(py::handle scenario) {
+  if (py::isinstance<py::dict>(scenario)) {
+    return ProblemList(ValidateScenarioText(JsonOfDict(scenario, "scenario")));
+  }
+  const std::string path = PathArg(scenario);
+  if (path.empty()) {
+    ThrowInput("scenario", "is not a path or a dict; expected a path to a scenario file or a dict");
+  }
+  try {
+    return ProblemList(ValidateScenarioFile(path));
+  } catch (const std::system_error& e) {
+    RethrowWithPath(e, path);
+  }
+}
+
+py::dict EstimateOutput(int num_links, int dim, int64_t num_steps, int record_every,
+                        bool link_angles) {
+  RunOptions options;
+  options.record_every = record_every;
+  options.link_angles = link_angles;
+  ThrowIfAny(options.Validate());
+  if (num_links < 1) ThrowInput("num_links", "must be at least 1", std::to_string(num_links));
+  if (dim != 2 && dim != 3) ThrowInput("dim", "must be 2 or 3", std::to_string(dim));
+  if (num_steps < 0) ThrowInput("num_steps", "must not be negative", std::to_string(num_steps));
+  const ResultSizeEstimate e = EstimateResultSize(num_links, dim, num_steps, options);
+  py::dict d;
+  d["frames"] = e.frames;
+  d["link_angles"] = e.link_angles;
+  d["json_bytes"] = e.json_bytes;
+  d["npz_bytes"] = e.npz_bytes;
+  d["csv_bytes"] = e.csv_bytes;
+  d["recorder_bytes"] = e.recorder_bytes;
+  return d;
+}
+
 void BindRun(py::module_& m) {
   py::class_<Result>(m, "Result", R"doc(
 The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
@@ -241,6 +384,9 @@ The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
           "One line: method, steps, length error, L2 total, accuracy, time.")
       .def("full_report", &FullReport, "Several lines, with the path-length profile.")
       .def("__repr__", &ResultRepr)
+      .def("write", &WriteResult, py::arg("path"),
+           "Writes the result file `path`: JSON (.json) or NumPy .npz (.npz) by its extension, "
+           "as `flexkin run -o`; all-or-nothing (an existing file is left untouched on error).")
       .def(py::pickle(
           [](const Result& r) {
             return py::make_tuple(std::string(MethodName(r.run.method)), r.run.lengths,
@@ -273,6 +419,21 @@ The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
             return r;
           }));
 
+  m.def("read_result", &ReadResult, py::arg("path"),
+        "Reads a result file (JSON or .npz, recognised by its content) as a Result. Raises "
+        "OSError if it cannot be read, InputError (field: the path, then the member) if it is "
+        "not a valid result file.");
+  m.def("write_result", &WriteResult, py::arg("result"), py::arg("path"),
+        "Writes `result` to `path` (.json or .npz by the extension), as Result.write.");
+  m.def("validate_scenario", &ValidateScenario, py::arg("scenario"),
+        "The problems of a scenario (a path to a scenario file or a dict of its JSON form) as "
+        "`flexkin validate` finds them: a list of dicts (field, message, value, expected), "
+        "empty if the scenario is valid. Raises OSError for a file that cannot be read.");
+  m.def("estimate_output", &EstimateOutput, py::arg("num_links"), py::arg("dim"),
+        py::arg("num_steps"), py::kw_only(), py::arg("record_every") = 1,
+        py::arg("link_angles") = true,
+        "The size of a run's output before the run: a dict of frames (exact), link_angles, "
+        "json_bytes, npz_bytes, csv_bytes and recorder_bytes (estimates).");
   m.def(
       "run",
       [](py::handle points, py::handle leader_steps, const std::string& method, int substeps,

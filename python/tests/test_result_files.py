@@ -1,0 +1,121 @@
+"""Result files from Python: read_result, Result.write / write_result, validate_scenario,
+estimate_output."""
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+import flexkin
+from conftest import EXAMPLES
+
+
+def same_bits(a, b):
+    a, b = np.asarray(a), np.asarray(b)
+    return a.shape == b.shape and a.dtype == b.dtype and a.tobytes() == b.tobytes()
+
+
+def assert_same_result(a, b):
+    for key in ("frames", "steps", "lengths"):
+        assert same_bits(getattr(a, key), getattr(b, key)), key
+    if a.link_angles is None:
+        assert b.link_angles is None
+    else:
+        assert same_bits(a.link_angles, b.link_angles)
+    for key in ("l2_per_step", "l2_weighted_per_step", "path_length"):
+        assert same_bits(getattr(a.metrics, key), getattr(b.metrics, key)), key
+    for key in ("l2_total", "l2_weighted_total", "max_relative_length_error"):
+        assert getattr(a.metrics, key) == getattr(b.metrics, key), key
+    assert (a.method, a.num_steps, a.substeps, a.dim, a.scenario) == (
+        b.method, b.num_steps, b.substeps, b.dim, b.scenario)
+
+
+@pytest.mark.parametrize("ext", ["json", "npz", "NPZ"])
+def test_round_trip_bit_for_bit(tmp_path, ext):
+    res = flexkin.run_scenario(EXAMPLES / "fig12_spatial_curve.json")
+    path = tmp_path / ("result." + ext)
+    res.write(path)
+    assert_same_result(flexkin.read_result(path), res)
+    other = tmp_path / ("again." + ext)
+    flexkin.write_result(res, str(other))
+    assert_same_result(flexkin.read_result(str(other)), res)
+    if ext == "json":
+        assert json.loads(path.read_text())["format"] == "flexkin-result"
+    else:
+        assert path.read_bytes()[:4] == b"PK\x03\x04"
+
+
+def test_round_trip_without_link_angles(tmp_path):
+    res = flexkin.run(flexkin.parabola(links=6), [[0.1, 0.0], [0.1, 0.1]], link_angles=False)
+    res.write(tmp_path / "r.npz")
+    back = flexkin.read_result(tmp_path / "r.npz")
+    assert back.link_angles is None and same_bits(back.frames, res.frames)
+
+
+def test_cli_npz_read_equals_run_scenario(cli, tmp_path):
+    path = EXAMPLES / "fig10_planar_curve.json"
+    out = tmp_path / "cli.npz"
+    subprocess.run([cli, "run", str(path), "-o", str(out), "-q"], check=True)
+    assert_same_result(flexkin.read_result(out), flexkin.run_scenario(path))
+
+
+def test_read_errors(tmp_path):
+    missing = tmp_path / "missing.npz"
+    with pytest.raises(OSError, match="missing.npz"):
+        flexkin.read_result(missing)
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"format": "flexkin-result", "version": 1, "dim": 7}')
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.read_result(bad)
+    assert "bad.json" in info.value.field
+    res = flexkin.run(flexkin.parabola(links=4), [[0.1, 0.0]])
+    good = tmp_path / "good.npz"
+    res.write(good)
+    data = good.read_bytes()
+    corrupt = tmp_path / "corrupt.npz"
+    corrupt.write_bytes(data[:len(data) // 2])  # truncated
+    with pytest.raises(flexkin.InputError, match="corrupt.npz"):
+        flexkin.read_result(corrupt)
+    text = tmp_path / "text.json"
+    text.write_text("not json")
+    with pytest.raises(flexkin.InputError, match="text.json"):
+        flexkin.read_result(text)
+
+
+def test_write_is_all_or_nothing(tmp_path):
+    res = flexkin.run(flexkin.parabola(links=4), [[0.1, 0.0]])
+    target = tmp_path / "keep.json"
+    target.write_text("old")
+    res.frames.setflags(write=True)
+    frames = res.frames
+    frames[0, 0, 0] = np.nan
+    with pytest.raises(flexkin.InputError, match="frames"):
+        res.write(target)
+    assert target.read_text() == "old"
+    with pytest.raises(flexkin.InputError) as info:
+        res.write(tmp_path / "result.txt")
+    assert ".npz" in str(info.value)
+
+
+def test_validate_scenario():
+    path = EXAMPLES / "fig10_planar_curve.json"
+    assert flexkin.validate_scenario(path) == []
+    with open(path) as f:
+        scenario = json.load(f)
+    assert flexkin.validate_scenario(scenario) == []
+    scenario["options"] = {}
+    scenario["method"] = "no_such_method"
+    problems = flexkin.validate_scenario(scenario)
+    assert problems and all(set(p) == {"field", "message", "value", "expected"} for p in problems)
+    assert {p["field"] for p in problems} >= {"/options", "/method"}
+    with pytest.raises(OSError):
+        flexkin.validate_scenario(EXAMPLES / "no_such_scenario.json")
+
+
+def test_estimate_output():
+    e = flexkin.estimate_output(10, 2, 100, record_every=10)
+    assert e["frames"] == 11 and e["link_angles"] is True
+    assert e["npz_bytes"] < e["json_bytes"]
+    assert flexkin.estimate_output(10, 2, 100, link_angles=False)["frames"] == 101
+    with pytest.raises(flexkin.InputError):
+        flexkin.estimate_output(10, 4, 100)
