@@ -105,6 +105,15 @@ progress=True shows a tqdm progress bar (a line on stderr where tqdm is not inst
 run_scenario.__doc__ = _flexkin.run_scenario.__doc__ + """
 progress=True shows a tqdm progress bar (a line on stderr where tqdm is not installed)."""
 
+if hasattr(_flexkin, "render"):
+    render = _flexkin.render
+else:
+    def render(result, out_dir, formats=("svg", "png", "plots"), **options):
+        """flexkin.render: not built (the render, viewer and glTF components are built with
+        the apps or the tests: FLEXKIN_BUILD_APPS or FLEXKIN_BUILD_TESTS)."""
+        raise RuntimeError("flexkin.render is not built in this module: configure with "
+                           "FLEXKIN_BUILD_APPS=ON (the render, viewer and glTF components)")
+
 __all__ = [
     "AccuracyReport", "ArmModel", "ArmOptions", "ArmStepReport", "Chain", "InputError", "Metrics", "ObjectiveWeights", "OverallOptions",
     "OverallReport", "OverallRunReport", "Result", "RobotResult", "RunOptions", "Scenario",
@@ -112,4 +121,5 @@ __all__ = [
     "overall_step", "parabola", "resample_path", "run", "run_robot", "run_scenario",
     "split_pull", "tractrix_step", "arm_step", "forward_kinematics", "joint_angles_from_points",
     "track_path", "read_result", "write_result", "validate_scenario", "estimate_output",
+    "render",
 ]

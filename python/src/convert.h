@@ -18,6 +18,7 @@
 #include "flexkin/chain.h"
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
+#include "flexkin/result_io.h"
 #include "flexkin/run.h"
 
 namespace flexkin::python {
@@ -71,6 +72,11 @@ void BindArms(py::module_& m);
 // TrackPath of `model` along `path` with the GIL released, as a flexkin.RobotResult (robot.cc).
 py::object TrackToResult(const ArmModel& model, const Points& path, const ArmOptions& options,
                          const std::string& scenario);
+// A flexkin.Result as the ResultFile the render, viewer and glTF writers take (run.cc); InputError
+// for another object.
+ResultFile ResultFileOfObject(py::handle object);
+// flexkin.render (render.cc; built where the render, viewer and glTF components are).
+void BindRender(py::module_& m);
 
 }  // namespace flexkin::python
 

@@ -12,4 +12,7 @@ PYBIND11_MODULE(_flexkin, m) {
   flexkin::python::BindRun(m);
   flexkin::python::BindRobot(m);
   flexkin::python::BindArms(m);
+#ifdef FLEXKIN_PYTHON_RENDER
+  flexkin::python::BindRender(m);
+#endif
 }

@@ -352,6 +352,20 @@ py::dict EstimateOutput(int num_links, int dim, int64_t num_steps, int record_ev
   return d;
 }
 
+ResultFile ResultFileOfObject(py::handle object) {
+  if (!py::isinstance<Result>(object)) {
+    ThrowInput("result",
+               "is a " + std::string(py::str(py::type::of(object).attr("__name__"))) +
+                   "; expected a flexkin.Result (flexkin.run, run_scenario, read_result)");
+  }
+  const Result& r = py::cast<const Result&>(object);
+  ResultFile file;
+  file.result = RunResultOf(r);
+  file.dim = r.dim;
+  file.scenario_name = r.scenario;
+  return file;
+}
+
 void BindRun(py::module_& m) {
   py::class_<Result>(m, "Result", R"doc(
 The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
