@@ -1,6 +1,6 @@
 # Type stubs of the flexkin module (docs/python.md). Arrays are numpy float64 unless noted.
 import os
-from typing import Any, Callable, Dict, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -130,6 +130,7 @@ class Result:
     num_links: int
     def brief_report(self) -> str: ...
     def full_report(self) -> str: ...
+    def write(self, path: PathLike) -> None: ...
 
 class Scenario:
     name: str
@@ -203,6 +204,18 @@ def run_scenario(scenario: Union[PathLike, Dict[str, Any], Scenario], *,
                  progress: Progress = None) -> Result: ...
 def run_robot(scenario: Union[PathLike, Dict[str, Any]], *, directory: Optional[PathLike] = None,
               method: Optional[str] = None) -> RobotResult: ...
+def read_result(path: PathLike) -> Result: ...
+def write_result(result: Result, path: PathLike) -> None: ...
+def validate_scenario(scenario: Union[PathLike, Dict[str, Any]]) -> List[Dict[str, str]]: ...
+def estimate_output(num_links: int, dim: int, num_steps: int, *, record_every: int = 1,
+                    link_angles: bool = True) -> Dict[str, Union[int, bool]]: ...
+def render(result: Result, out_dir: PathLike,
+           formats: Union[str, Sequence[str]] = ("svg", "png", "plots"), *,
+           stem: str = "result", every: int = 0, width: Optional[int] = None,
+           height: Optional[int] = None, azimuth: Optional[float] = None,
+           elevation: Optional[float] = None, fps: Optional[int] = None,
+           max_frames: Optional[int] = None, title: str = "",
+           ffmpeg: str = "ffmpeg") -> List[str]: ...
 
 class ArmModel:
     def __init__(self, link_lengths: ArrayLike, *, dim: int = 2, base: Optional[ArrayLike] = None,
