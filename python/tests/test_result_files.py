@@ -76,6 +76,14 @@ def test_read_errors(tmp_path):
     corrupt.write_bytes(data[:len(data) // 2])  # truncated
     with pytest.raises(flexkin.InputError, match="corrupt.npz"):
         flexkin.read_result(corrupt)
+    import zipfile
+    with zipfile.ZipFile(good) as z:
+        member = z.getinfo("frames.npy")
+    flipped = bytearray(data)
+    flipped[member.header_offset + 100] ^= 0xFF  # inside frames.npy's data: its CRC-32 fails
+    corrupt.write_bytes(bytes(flipped))
+    with pytest.raises(flexkin.InputError, match="frames.npy"):
+        flexkin.read_result(corrupt)
     text = tmp_path / "text.json"
     text.write_text("not json")
     with pytest.raises(flexkin.InputError, match="text.json"):
