@@ -438,10 +438,10 @@ AccuracyReport ChooseSubsteps(const Chain& chain, const Points& leader_steps,
     const int coarse = std::max(1, fine / 2);
     SweepPipeline coarse_run(stepper, chain.points, leader_steps, coarse, nullptr);
     SweepPipeline fine_run(stepper, chain.points, leader_steps, fine, nullptr);
+    // While the sub-steps are chosen no leader step of the run is done: progress (0, total),
+    // about every 0.1 s, so that a caller can still show life or stop the run (by throwing).
+    auto last = Clock::now();  // lives as long as the pipelines that report through it
     if (options.progress) {
-      // While the sub-steps are chosen no leader step of the run is done: progress (0, total),
-      // about every 0.1 s, so that a caller can still show life or stop the run (by throwing).
-      auto last = Clock::now();
       const auto report = [&options, &last, num_steps](int64_t) {
         if (Clock::now() - last > std::chrono::milliseconds(100)) {
           options.progress(0, num_steps);
