@@ -13,6 +13,8 @@ packages+=(liburdfdom-dev)   # URDF arms (src/urdf)
 packages+=(zlib1g-dev)       # CRC-32 of the .npz result files (src/io/npz.cc)
 packages+=(python3-numpy)    # the tests read .npz results with numpy.load (tests/result_npz_test)
 packages+=(python3-dev pybind11-dev python3-pytest)  # the Python module (python/, docs/python.md)
+packages+=(python3-venv python3-pip python3-setuptools)  # its pip install, tested (python/tests/test_pip.py)
+packages+=(python3-matplotlib python3-distributed python3-tqdm)  # its examples (examples/python)
 # Node.js runs the glTF validator and the browser test. Debian's nodejs and npm only if there is
 # no node or npm on the PATH: one from another source (e.g. NodeSource) is used as it is.
 if ! command -v node >/dev/null || ! command -v npm >/dev/null; then packages+=(nodejs npm); fi
