@@ -2,7 +2,8 @@
 # make demo: runs the paper's scenarios (examples/*.json) with the flexkin command line, writes
 # the results to out/, and prints for each the link-length error, the L2 metric and the
 # path-length profile; then the closed-form check of Fig. 7 and the Fig. 6 comparison; then
-# renders every result into out/ (figures, plots, MP4 and GIF animations).
+# renders every result into out/ (figures, plots, MP4 and GIF animations); then the Python
+# examples (docs/python-examples.md) into out/python/.
 set -euo pipefail
 build=${1:-build}
 cd "$(dirname "$0")/.."
@@ -37,6 +38,21 @@ echo "== figures, plots, animations, viewers and glTF (docs/rendering.md)"
 for result in out/fig*.json; do
   "$flexkin" render "$result" -o out --formats svg,png,pdf,plots,mp4,gif,html,glb --quiet
 done
+echo "== Python examples (docs/python-examples.md)"
+# The same figures' numbers and the robot arm through the Python module, drawn with matplotlib,
+# and a sweep of 1,000 variations on dask.distributed checked against the serial results.
+python=$(sed -n 's/^Python3_EXECUTABLE:[A-Z]*=//p' "$build/CMakeCache.txt" 2>/dev/null || true)
+python=${python:-/usr/bin/python3}
+if [ -d "$build/python/flexkin" ] && ls "$build"/python/flexkin/_flexkin*.so >/dev/null 2>&1; then
+  mkdir -p out/python
+  for example in fig06_compare fig07_closed_form arm_circle; do
+    PYTHONPATH="$build/python" "$python" "examples/python/$example.py" --out out/python
+  done
+  PYTHONPATH="$build/python" "$python" examples/python/dask_sweep.py
+else
+  echo "skipped: the Python module is not built ($build/python/flexkin; docs/python.md)"
+fi
 echo "results: out/*.json (format: docs/result-format.md)"
 echo "pictures: out/*.{svg,png,pdf}, out/*_{path_length,link_angles,length_error}.{svg,png},"
 echo "  out/*.{mp4,gif}, out/*.html (open in a browser), out/*.glb (docs/rendering.md)"
+echo "Python examples' figures: out/python/*.png (docs/python-examples.md)"
