@@ -7,6 +7,7 @@ BUILD      ?= build
 BUILD_SAN  ?= build-sanitize
 JOBS       ?= $(shell nproc)
 PREFIX     ?= /usr/local
+PYTHON     ?= /usr/bin/python3
 
 # The C++ sources that clang-format keeps in the style of .clang-format (make format applies it).
 FORMAT_FILES = $(shell git ls-files '*.cc' '*.h' 2>/dev/null)
@@ -41,6 +42,7 @@ bench: build
 	@for b in propagation_benchmark overall_benchmark arm_benchmark arm_kdl_benchmark arm_limits_benchmark; do \
 	  $(BUILD)/bench/$$b --benchmark_repetitions=5 --benchmark_report_aggregates_only=true || exit 1; \
 	done
+	@$(PYTHON) bench/python_benchmark.py --build $(BUILD)
 
 format: deps
 	@clang-format -i $(FORMAT_FILES)

@@ -3,7 +3,7 @@
 # packages of tools/node that the tests use (npm ci, exact versions from its package-lock.json).
 # Safe to run repeatedly.
 set -euo pipefail
-packages=(cmake make g++ pkg-config clang-format git libeigen3-dev nlohmann-json3-dev libcli11-dev libgtest-dev
+packages=(cmake make g++ ccache pkg-config clang-format git libeigen3-dev nlohmann-json3-dev libcli11-dev libgtest-dev
           libgmock-dev libbenchmark-dev libboost-dev libxsimd-dev liblapack-dev libnlopt-dev coinor-libipopt-dev)
 packages+=(libcairo2-dev fonts-dejavu-core ffmpeg)  # flexkin render (src/render)
 packages+=(libtinygltf-dev)  # glTF export (src/gltf)

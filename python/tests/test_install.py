@@ -23,3 +23,15 @@ def test_installed_module_imports_and_runs(tmp_path):
     out = subprocess.run([sys.executable, "-c", code], env=env, cwd=tmp_path, check=True,
                          capture_output=True, text=True).stdout
     assert pathlib.Path(out.split()[0]).is_relative_to(site) and "(2, 5, 2)" in out
+
+
+def test_the_default_install_dir_is_where_debians_python_looks():
+    """make install (prefix /usr/local) puts the package in a folder on the interpreter's own
+    sys.path, with no PYTHONPATH: Debian's python3 reads /usr/local/lib/python3.X/dist-packages."""
+    install_dir = os.environ.get("FLEXKIN_PYTHON_INSTALL_DIR")
+    if not install_dir:
+        pytest.skip("run by ctest (FLEXKIN_PYTHON_INSTALL_DIR)")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
+    path = subprocess.run([sys.executable, "-c", "import sys; print('\\n'.join(sys.path))"],
+                          env=env, check=True, capture_output=True, text=True).stdout.split()
+    assert str(pathlib.Path("/usr/local") / install_dir) in path, path

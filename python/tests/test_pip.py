@@ -1,5 +1,6 @@
 """pip install --no-build-isolation . into a venv made with --system-site-packages (Debian's
-numpy), offline. It builds the module from scratch (minutes): run with FLEXKIN_TEST_PIP=1."""
+numpy), offline. It builds the module again (minutes, less where ccache has the objects of the
+tree's build): ctest python_install sets FLEXKIN_TEST_PIP=1; by hand, set it too."""
 import os
 import subprocess
 import sys
@@ -10,7 +11,7 @@ from conftest import SOURCE_DIR
 
 
 @pytest.mark.skipif(os.environ.get("FLEXKIN_TEST_PIP") != "1",
-                    reason="builds the module from scratch; set FLEXKIN_TEST_PIP=1")
+                    reason="builds the module again (minutes); ctest python_install sets FLEXKIN_TEST_PIP=1")
 def test_pip_install_into_a_venv(tmp_path):
     venv = tmp_path / "venv"
     subprocess.run([sys.executable, "-m", "venv", "--system-site-packages", str(venv)],
