@@ -14,6 +14,7 @@ naming the argument or field; files that cannot be read raise OSError.
     traj = flexkin.run_robot("examples/robot_planar_8link.json")      # as `flexkin robot`
 """
 
+from . import _flexkin
 from ._flexkin import (
     AccuracyReport,
     ArmModel,
@@ -28,44 +29,71 @@ from ._flexkin import (
     OverallRunReport,
     Result,
     RobotResult,
-    estimate_output,
-    read_result,
-    validate_scenario,
-    write_result,
+    RobotScenario,
     RunOptions,
     Scenario,
     arc,
     arm_step,
+    estimate_output,
     follow_the_leader_step,
     forward_kinematics,
     helix,
     joint_angles_from_points,
+    joint_quaternions,
     line,
+    load_robot_scenario,
     load_scenario,
     move_leader,
+    overall_objective,
     overall_step,
     parabola,
+    read_result,
     resample_path,
-    run_robot,
     split_pull,
-    track_path,
     tractrix_step,
+    validate_scenario,
+    within_limits,
+    write_result,
 )
 
-# The C++ classes are defined in flexkin._flexkin; they are documented and pickled as flexkin's.
-for _name in ("AccuracyReport", "ArmModel", "ArmOptions", "ArmStepReport", "Chain", "Metrics", "ObjectiveWeights", "OverallOptions",
-              "OverallReport", "OverallRunReport", "Result", "RobotResult", "RunOptions",
-              "Scenario"):
-    globals()[_name].__module__ = __name__
-del _name
+# The render options and the URDF functions exist where their components are built (the
+# default CMake build); elsewhere their names raise RuntimeError saying so.
+_RENDER_CLASSES = ("AnimationOptions", "FigureOptions", "GltfOptions", "PlotOptions",
+                   "ViewerOptions")
 
-from . import _flexkin
+
+def _not_built(name, what, option):
+    def missing(*args, **kwargs):
+        raise RuntimeError(f"flexkin.{name} is not built in this module: {what} ({option})")
+    missing.__name__ = name
+    missing.__doc__ = f"flexkin.{name}: not built: {what} ({option})."
+    return missing
+
+
+_RENDER_WHAT = ("the render, viewer and glTF components are built with the apps or the tests",
+                "configure with FLEXKIN_BUILD_APPS=ON")
+_URDF_WHAT = ("the URDF component needs Debian's liburdfdom-dev",
+              "install it and configure again")
+for _name in _RENDER_CLASSES + ("render",):
+    globals()[_name] = getattr(_flexkin, _name, None) or _not_built(_name, *_RENDER_WHAT)
+for _name in ("arm_from_urdf", "urdf_from_arm"):
+    globals()[_name] = getattr(_flexkin, _name, None) or _not_built(_name, *_URDF_WHAT)
+
+# The C++ classes are defined in flexkin._flexkin; they are documented and pickled as flexkin's.
+_CLASSES = ("AccuracyReport", "ArmModel", "ArmOptions", "ArmStepReport", "Chain", "Metrics",
+            "ObjectiveWeights", "OverallOptions", "OverallReport", "OverallRunReport", "Result",
+            "RobotResult", "RobotScenario", "RunOptions", "Scenario") + _RENDER_CLASSES
+for _name in _CLASSES:
+    if isinstance(globals()[_name], type):
+        globals()[_name].__module__ = __name__
+del _name
 
 
 class _ProgressBar:
     """progress=True: a tqdm bar where tqdm is installed, else a line on stderr rewritten."""
 
-    def __init__(self):
+    def __init__(self, what):
+        self._what = what
         self._bar = None
         self._done = 0
 
@@ -83,43 +111,51 @@ class _ProgressBar:
         else:
             import sys
             end = "\n" if done >= total else ""
-            print(f"\rflexkin: leader step {done} of {total}", end=end, file=sys.stderr,
+            print(f"\rflexkin: {self._what} {done} of {total}", end=end, file=sys.stderr,
                   flush=True)
         self._done = done
 
 
-def _progress(progress):
-    return _ProgressBar() if progress is True else (None if progress is False else progress)
+def _progress(progress, what):
+    if progress is True:
+        return _ProgressBar(what)
+    return None if progress is False else progress
+
+
+_PROGRESS_DOC = """
+progress=True shows a tqdm progress bar (a line on stderr where tqdm is not installed)."""
 
 
 def run(points, leader_steps, *, progress=None, **options):
-    return _flexkin.run(points, leader_steps, progress=_progress(progress), **options)
+    return _flexkin.run(points, leader_steps, progress=_progress(progress, "leader step"),
+                        **options)
 
 
 def run_scenario(scenario, *, progress=None):
-    return _flexkin.run_scenario(scenario, progress=_progress(progress))
+    return _flexkin.run_scenario(scenario, progress=_progress(progress, "leader step"))
 
 
-run.__doc__ = _flexkin.run.__doc__ + """
-progress=True shows a tqdm progress bar (a line on stderr where tqdm is not installed)."""
-run_scenario.__doc__ = _flexkin.run_scenario.__doc__ + """
-progress=True shows a tqdm progress bar (a line on stderr where tqdm is not installed)."""
+def run_robot(scenario, *, progress=None, **options):
+    return _flexkin.run_robot(scenario, progress=_progress(progress, "target"), **options)
 
-if hasattr(_flexkin, "render"):
-    render = _flexkin.render
-else:
-    def render(result, out_dir, formats=("svg", "png", "plots"), **options):
-        """flexkin.render: not built (the render, viewer and glTF components are built with
-        the apps or the tests: FLEXKIN_BUILD_APPS or FLEXKIN_BUILD_TESTS)."""
-        raise RuntimeError("flexkin.render is not built in this module: configure with "
-                           "FLEXKIN_BUILD_APPS=ON (the render, viewer and glTF components)")
+
+def track_path(model, path, *, progress=None, **options):
+    return _flexkin.track_path(model, path, progress=_progress(progress, "target"), **options)
+
+
+for _function in (run, run_scenario, run_robot, track_path):
+    _function.__doc__ = getattr(_flexkin, _function.__name__).__doc__ + _PROGRESS_DOC
+del _function
 
 __all__ = [
-    "AccuracyReport", "ArmModel", "ArmOptions", "ArmStepReport", "Chain", "InputError", "Metrics", "ObjectiveWeights", "OverallOptions",
-    "OverallReport", "OverallRunReport", "Result", "RobotResult", "RunOptions", "Scenario",
-    "arc", "follow_the_leader_step", "helix", "line", "load_scenario", "move_leader",
-    "overall_step", "parabola", "resample_path", "run", "run_robot", "run_scenario",
-    "split_pull", "tractrix_step", "arm_step", "forward_kinematics", "joint_angles_from_points",
-    "track_path", "read_result", "write_result", "validate_scenario", "estimate_output",
-    "render",
+    "AccuracyReport", "AnimationOptions", "ArmModel", "ArmOptions", "ArmStepReport", "Chain",
+    "FigureOptions", "GltfOptions", "InputError", "Metrics", "ObjectiveWeights",
+    "OverallOptions", "OverallReport", "OverallRunReport", "PlotOptions", "Result",
+    "RobotResult", "RobotScenario", "RunOptions", "Scenario", "ViewerOptions",
+    "arc", "arm_from_urdf", "arm_step", "estimate_output", "follow_the_leader_step",
+    "forward_kinematics", "helix", "joint_angles_from_points", "joint_quaternions", "line",
+    "load_robot_scenario", "load_scenario", "move_leader", "overall_objective", "overall_step",
+    "parabola", "read_result", "render", "resample_path", "run", "run_robot", "run_scenario",
+    "split_pull", "track_path", "tractrix_step", "urdf_from_arm", "validate_scenario",
+    "within_limits", "write_result",
 ]

@@ -10,6 +10,10 @@ Float64Array = npt.NDArray[np.float64]
 PathLike = Union[str, "os.PathLike[str]"]
 Progress = Union[None, bool, Callable[[int, int], Any]]
 OverallArg = Union[None, "OverallOptions", "ObjectiveWeights", Dict[str, float]]
+ArmOptionsArg = Union[None, "ArmOptions", Dict[str, Any]]
+
+# Every class below also compares field by field (==), pickles, copies and prints as
+# Name(field=value, ...) or a one-line summary.
 
 class InputError(ValueError):
     field: str
@@ -131,6 +135,7 @@ class Result:
     def brief_report(self) -> str: ...
     def full_report(self) -> str: ...
     def write(self, path: PathLike) -> None: ...
+    def write_csv(self, path: PathLike) -> None: ...
 
 class Scenario:
     name: str
@@ -202,20 +207,104 @@ def run(points: PointsArg, leader_steps: ArrayLike, *, method: str = "tractrix",
 def load_scenario(scenario: Union[PathLike, Dict[str, Any]]) -> Scenario: ...
 def run_scenario(scenario: Union[PathLike, Dict[str, Any], Scenario], *,
                  progress: Progress = None) -> Result: ...
-def run_robot(scenario: Union[PathLike, Dict[str, Any]], *, directory: Optional[PathLike] = None,
-              method: Optional[str] = None) -> RobotResult: ...
+def run_robot(scenario: Union[PathLike, Dict[str, Any], "RobotScenario"], *,
+              directory: Optional[PathLike] = None, method: Optional[str] = None,
+              progress: Progress = None, output: Optional[PathLike] = None,
+              csv: Optional[PathLike] = None) -> RobotResult: ...
+def load_robot_scenario(scenario: Union[PathLike, Dict[str, Any]], *,
+                        directory: Optional[PathLike] = None) -> "RobotScenario": ...
 def read_result(path: PathLike) -> Result: ...
 def write_result(result: Result, path: PathLike) -> None: ...
-def validate_scenario(scenario: Union[PathLike, Dict[str, Any]]) -> List[Dict[str, str]]: ...
+def validate_scenario(scenario: Union[PathLike, Dict[str, Any]], *,
+                      directory: Optional[PathLike] = None) -> List[Dict[str, str]]: ...
+def overall_objective(weights: Union["ObjectiveWeights", Dict[str, float]], lengths: ArrayLike,
+                      old_points: ArrayLike, new_points: ArrayLike, *, gradient: bool = False,
+                      hessian: bool = False
+                      ) -> Union[float, Tuple[float, Float64Array],
+                                 Tuple[float, Float64Array, Float64Array]]: ...
 def estimate_output(num_links: int, dim: int, num_steps: int, *, record_every: int = 1,
                     link_angles: bool = True) -> Dict[str, Union[int, bool]]: ...
+class FigureOptions:
+    every_k: int
+    width: int
+    height: int
+    azimuth: float
+    elevation: float
+    title: str
+    show_leader_path: bool
+    show_legend: bool
+    def __init__(self, *, every_k: int = 0, width: int = 960, height: int = 0,
+                 azimuth: float = -60.0, elevation: float = 30.0, title: str = "",
+                 show_leader_path: bool = True, show_legend: bool = True) -> None: ...
+    def validate(self) -> None: ...
+
+class PlotOptions:
+    width: int
+    height: int
+    title: str
+    def __init__(self, *, width: int = 800, height: int = 500, title: str = "") -> None: ...
+    def validate(self) -> None: ...
+
+class AnimationOptions:
+    width: int
+    height: int
+    fps: int
+    every_k: int
+    max_frames: int
+    min_seconds: float
+    end_pause: float
+    azimuth: float
+    elevation: float
+    title: str
+    ffmpeg: str
+    crf: int
+    def __init__(self, *, width: int = 640, height: int = 0, fps: int = 30, every_k: int = 0,
+                 max_frames: int = 300, min_seconds: float = 3.0, end_pause: float = 1.0,
+                 azimuth: float = -60.0, elevation: float = 30.0, title: str = "",
+                 ffmpeg: str = "ffmpeg", crf: int = 20) -> None: ...
+    def validate(self) -> None: ...
+
+class ViewerOptions:
+    title: str
+    playback_seconds: float
+    autoplay: bool
+    loop: bool
+    show_leader_path: bool
+    trail_points: List[int]
+    azimuth: float
+    elevation: float
+    perspective: bool
+    digits: int
+    def __init__(self, *, title: str = "", playback_seconds: float = 10.0, autoplay: bool = True,
+                 loop: bool = True, show_leader_path: bool = True,
+                 trail_points: Sequence[int] = (), azimuth: float = -60.0,
+                 elevation: float = 25.0, perspective: bool = False, digits: int = 9) -> None: ...
+    def validate(self) -> None: ...
+
+class GltfOptions:
+    steps_per_second: float
+    include_mesh: bool
+    tube_radius: float
+    tube_sides: int
+    scale: float
+    up_axis: str  # "auto", "y" or "z"
+    def __init__(self, *, steps_per_second: float = 30.0, include_mesh: bool = True,
+                 tube_radius: float = 0.0, tube_sides: int = 12, scale: float = 1.0,
+                 up_axis: str = "auto") -> None: ...
+    def validate(self) -> None: ...
+
 def render(result: Result, out_dir: PathLike,
            formats: Union[str, Sequence[str]] = ("svg", "png", "plots"), *,
-           stem: str = "result", every: int = 0, width: Optional[int] = None,
+           stem: str = "result", every: Optional[int] = None, width: Optional[int] = None,
            height: Optional[int] = None, azimuth: Optional[float] = None,
            elevation: Optional[float] = None, fps: Optional[int] = None,
-           max_frames: Optional[int] = None, title: str = "",
-           ffmpeg: str = "ffmpeg") -> List[str]: ...
+           max_frames: Optional[int] = None, title: Optional[str] = None,
+           ffmpeg: Optional[str] = None,
+           figure: Union[None, FigureOptions, Dict[str, Any]] = None,
+           plot: Union[None, PlotOptions, Dict[str, Any]] = None,
+           animation: Union[None, AnimationOptions, Dict[str, Any]] = None,
+           viewer: Union[None, ViewerOptions, Dict[str, Any]] = None,
+           gltf: Union[None, GltfOptions, Dict[str, Any]] = None) -> List[str]: ...
 
 class ArmModel:
     def __init__(self, link_lengths: ArrayLike, *, dim: int = 2, base: Optional[ArrayLike] = None,
@@ -227,10 +316,16 @@ class ArmModel:
                  initial_azimuths: Optional[ArrayLike] = None) -> None: ...
     @staticmethod
     def straight(dim: int, links: int, link_length: float) -> "ArmModel": ...
+    def validate(self) -> None: ...
     dim: int
     link_lengths: Float64Array
     base: Float64Array
     base_direction: Float64Array
+    joint_min: Optional[Float64Array]
+    joint_max: Optional[Float64Array]
+    max_bend: Optional[Float64Array]
+    joint_axes: Optional[Float64Array]  # (n, 3)
+    link_directions: Optional[Float64Array]  # (n, 3)
     initial_angles: Float64Array
     initial_azimuths: Optional[Float64Array]
     joint: str
@@ -249,6 +344,7 @@ class ArmOptions:
     def __init__(self, *, method: str = "newton", tolerance: float = 1e-10,
                  max_iterations: int = 100, max_fixed_point_iterations: int = 100000,
                  restarts: int = 8, substeps: int = 1, edge_margin: float = 1e-9) -> None: ...
+    def validate(self) -> None: ...
 
 class ArmStepReport:
     points: Float64Array
@@ -268,11 +364,28 @@ class ArmStepReport:
     restarts: int
     def brief_report(self) -> str: ...
 
+class RobotScenario:
+    name: str
+    model: ArmModel
+    path: Float64Array  # (T, dim)
+    options: ArmOptions
+    def __init__(self, model: ArmModel, path: ArrayLike, *, options: ArmOptionsArg = None,
+                 name: str = "") -> None: ...
+    def summary(self) -> str: ...
+    def estimate_output(self) -> Dict[str, int]: ...
+
 def forward_kinematics(model: ArmModel, angles: ArrayLike,
                        azimuths: Optional[ArrayLike] = None) -> Float64Array: ...
+def joint_quaternions(model: ArmModel, angles: ArrayLike,
+                      azimuths: Optional[ArrayLike] = None) -> Float64Array: ...  # (n, 4) w,x,y,z
+def within_limits(model: ArmModel, angles: ArrayLike, azimuths: Optional[ArrayLike] = None, *,
+                  slack: float = 0.0) -> bool: ...
 def joint_angles_from_points(model: ArmModel, points: ArrayLike
                              ) -> Tuple[Float64Array, Optional[Float64Array]]: ...
 def arm_step(model: ArmModel, target: ArrayLike, *, state: Optional[ArmStepReport] = None,
-             options: Optional[ArmOptions] = None) -> ArmStepReport: ...
-def track_path(model: ArmModel, path: ArrayLike, *,
-               options: Optional[ArmOptions] = None) -> RobotResult: ...
+             options: ArmOptionsArg = None) -> ArmStepReport: ...
+def track_path(model: ArmModel, path: ArrayLike, *, options: ArmOptionsArg = None,
+               progress: Progress = None, output: Optional[PathLike] = None,
+               csv: Optional[PathLike] = None) -> RobotResult: ...
+def arm_from_urdf(source: PathLike, *, base_link: str = "", tip_link: str = "") -> ArmModel: ...
+def urdf_from_arm(model: ArmModel, robot_name: str = "flexkin_arm") -> str: ...

@@ -8,6 +8,8 @@
 #include <string>
 
 #include "convert.h"
+#include "fields.h"
+#include "flexkin/curves.h"
 
 namespace flexkin::python {
 namespace {
@@ -38,27 +40,20 @@ py::object AzimuthsOrNone(const Eigen::VectorXd& azimuth) {
   return azimuth.size() > 0 ? py::object(ToArray(azimuth)) : py::none();
 }
 
-std::string ArmOptionsRepr(const ArmOptions& o) {
-  return "ArmOptions(method=" + Quoted(FixedBaseMethodName(o.method)) +
-         ", tolerance=" + Num(o.tolerance) +
-         ", max_iterations=" + std::to_string(o.max_iterations) +
-         ", max_fixed_point_iterations=" + std::to_string(o.max_fixed_point_iterations) +
-         ", restarts=" + std::to_string(o.restarts) + ", substeps=" + std::to_string(o.substeps) +
-         ", edge_margin=" + Num(o.edge_margin) + ")";
-}
-
-ArmOptions OptionsArg(py::handle options) {
-  if (options.is_none()) return ArmOptions();
-  if (!py::isinstance<ArmOptions>(options)) {
-    ThrowInput("options", "is not an ArmOptions; expected flexkin.ArmOptions or None");
-  }
-  return py::cast<ArmOptions>(options);
-}
-
 }  // namespace
 
+const ArmModel& ModelArg(py::handle model) {
+  if (!py::isinstance<ArmModel>(model)) {
+    const std::string type = py::str(py::type::of(model).attr("__name__"));
+    ThrowInput("model", "is a " + type + "; expected a flexkin.ArmModel", type, "ArmModel");
+  }
+  return py::cast<const ArmModel&>(model);
+}
+
+namespace {}  // namespace
+
 void BindArms(py::module_& m) {
-  py::class_<ArmModel>(m, "ArmModel", R"doc(
+  py::class_<ArmModel> model(m, "ArmModel", R"doc(
 A fixed-base arm (flexkin::ArmModel, docs/robots.md), robot order: link 1 at the base.
 
 ArmModel(link_lengths, *, dim=2, base=None, base_direction=None, joint_min=None,
@@ -70,7 +65,8 @@ ArmModel(link_lengths, *, dim=2, base=None, base_direction=None, joint_min=None,
   joint_axes, link_directions: (n, 3) spatial revolute joints (URDF arms);
   initial_angles, initial_azimuths: (n,) the start (default 0).
 Planar arms (dim 2) and arms with joint_axes have revolute joints, other spatial arms spherical.
-)doc")
+)doc");
+  model
       .def(py::init([](py::handle link_lengths, int dim, py::handle base, py::handle direction,
                        py::handle joint_min, py::handle joint_max, py::handle max_bend,
                        py::handle joint_axes, py::handle link_directions, py::handle angles,
@@ -105,180 +101,291 @@ Planar arms (dim 2) and arms with joint_axes have revolute joints, other spatial
            py::arg("joint_max") = py::none(), py::arg("max_bend") = py::none(),
            py::arg("joint_axes") = py::none(), py::arg("link_directions") = py::none(),
            py::arg("initial_angles") = py::none(), py::arg("initial_azimuths") = py::none())
-      .def_static("straight", &StraightArm, py::arg("dim"), py::arg("links"),
-                  py::arg("link_length"),
-                  "A straight arm of `links` links from the origin along +x, no limits.")
-      .def_readonly("dim", &ArmModel::dim)
-      .def_property_readonly("link_lengths",
-                             [](const ArmModel& a) { return ToArray(a.link_lengths); })
-      .def_property_readonly("base", [](const ArmModel& a) { return ToArray(a.base); })
-      .def_property_readonly("base_direction",
-                             [](const ArmModel& a) { return ToArray(a.base_direction); })
-      .def_property_readonly("initial_angles",
-                             [](const ArmModel& a) { return ToArray(a.initial.angle); })
-      .def_property_readonly("initial_azimuths",
-                             [](const ArmModel& a) { return AzimuthsOrNone(a.initial.azimuth); })
-      .def_property_readonly("joint", [](const ArmModel& a) { return NameOf(a.joint()); })
-      .def_property_readonly("num_links", &ArmModel::num_links)
-      .def_property_readonly("reach", &ArmModel::reach)
-      .def_property_readonly("has_limits", &ArmModel::has_limits)
-      .def("__repr__",
-           [](const ArmModel& a) {
-             return "ArmModel(" + std::to_string(a.dim) + "D " + NameOf(a.joint()) + ", " +
-                    std::to_string(a.num_links()) + " links, reach " + Num(a.reach()) +
-                    (a.has_limits() ? ", with limits" : "") + ")";
-           })
-      .def(py::pickle(
-          [](const ArmModel& a) {
-            return py::make_tuple(a.dim, a.link_lengths, a.base, a.base_direction, a.joint_min,
-                                  a.joint_max, a.max_bend, a.joint_axes, a.link_directions,
-                                  a.initial.angle, a.initial.azimuth);
-          },
-          [](const py::tuple& state) {
-            StateTuple(state, 11, "ArmModel");
-            ArmModel a;
-            a.dim = py::cast<int>(state[0]);
-            a.link_lengths = py::cast<Eigen::VectorXd>(state[1]);
-            a.base = py::cast<Eigen::VectorXd>(state[2]);
-            a.base_direction = py::cast<Eigen::VectorXd>(state[3]);
-            a.joint_min = py::cast<Eigen::VectorXd>(state[4]);
-            a.joint_max = py::cast<Eigen::VectorXd>(state[5]);
-            a.max_bend = py::cast<Eigen::VectorXd>(state[6]);
-            a.joint_axes = py::cast<Eigen::MatrixXd>(state[7]);
-            a.link_directions = py::cast<Eigen::MatrixXd>(state[8]);
-            a.initial.angle = py::cast<Eigen::VectorXd>(state[9]);
-            a.initial.azimuth = py::cast<Eigen::VectorXd>(state[10]);
+      .def_static(
+          "straight",
+          [](int dim, int links, double link_length) {
+            if (dim != 2 && dim != 3) {
+              throw InputError(Problem::Invalid("dim", std::to_string(dim), "2 or 3"));
+            }
+            if (links < 1 || links > kMaxGeneratedLinks) {
+              throw InputError(
+                  Problem::Invalid("links", std::to_string(links),
+                                   "an integer from 1 to " + std::to_string(kMaxGeneratedLinks)));
+            }
+            ArmModel a = StraightArm(dim, links, link_length);
             ThrowIfAny(a.Validate());
             return a;
-          }));
+          },
+          py::arg("dim"), py::arg("links"), py::arg("link_length"),
+          "A straight arm of `links` links of `link_length` from the origin along +x, all "
+          "joint angles 0, no limits.")
+      .def_property_readonly(
+          "joint", [](const ArmModel& a) { return std::string(NameOf(a.joint())); },
+          "'revolute' (planar arms, or spatial arms with joint_axes) or 'spherical'.")
+      .def_property_readonly("num_links", &ArmModel::num_links, "n, the number of links.")
+      .def_property_readonly("reach", &ArmModel::reach,
+                             "The sum of the link lengths (length unit).")
+      .def_property_readonly("has_limits", &ArmModel::has_limits,
+                             "Whether the joints have limits (joint_min/joint_max or max_bend).")
+      .def(
+          "__repr__",
+          [](const ArmModel& a) {
+            return "ArmModel(" + std::to_string(a.dim) + "D " + NameOf(a.joint()) + ", " +
+                   std::to_string(a.num_links()) + " links, reach " + Num(a.reach()) +
+                   (a.has_limits() ? ", with limits" : "") + ")";
+          },
+          "A summary: dimension, joint kind, links, reach, limits.");
+  Fields<ArmModel>(model, "ArmModel")
+      .Validate("joint_min[2]")
+      .Member("dim", &ArmModel::dim, "2 (planar) or 3 (spatial).")
+      .Array("link_lengths", &ArmModel::link_lengths,
+             "(n,) float64: the link lengths, base link first (length unit).")
+      .Array("base", &ArmModel::base, "(dim,) float64: where the base is bolted (length unit).")
+      .Array("base_direction", &ArmModel::base_direction,
+             "(dim,) float64: the direction of \"link 0\", which joint 0 turns link 1 from.")
+      .Array("joint_min", &ArmModel::joint_min,
+             "(n,) float64: revolute lower limits (radians, >= -pi), or None (no limits).", true)
+      .Array("joint_max", &ArmModel::joint_max,
+             "(n,) float64: revolute upper limits (radians, <= pi), or None.", true)
+      .Array("max_bend", &ArmModel::max_bend,
+             "(n,) float64: spherical limits, the largest bend angle of each joint (radians, "
+             "(0, pi]), or None.",
+             true)
+      .Array("joint_axes", &ArmModel::joint_axes,
+             "(n, 3) float64: spatial revolute joints' unit axes, row j in link j's frame (as "
+             "from a URDF), or None (spherical joints).",
+             true)
+      .Array("link_directions", &ArmModel::link_directions,
+             "(n, 3) float64: with joint_axes, each link's unit direction in its own frame, or "
+             "None (every link along base_direction).",
+             true)
+      .Property(
+          "initial_angles", [](const ArmModel& a) { return ToArray(a.initial.angle); },
+          [](ArmModel& a, py::handle v) { a.initial.angle = EigenIn<Eigen::VectorXd>(v); },
+          "(n,) float64: the joint angles at the start (radians).")
+      .Property(
+          "initial_azimuths", [](const ArmModel& a) { return EigenOut(a.initial.azimuth, true); },
+          [](ArmModel& a, py::handle v) { a.initial.azimuth = EigenIn<Eigen::VectorXd>(v); },
+          "(n,) float64: spherical joints' bend directions at the start (radians), or None.")
+      .Finish(false, [](ArmModel& a) { ThrowIfAny(a.Validate()); });
 
-  py::class_<ArmOptions>(m, "ArmOptions", R"doc(
+  py::class_<ArmOptions> options(m, "ArmOptions", R"doc(
 Options of the fixed-base solver (flexkin::ArmOptions; a robot scenario's "solver").
 ArmOptions(method="newton", tolerance=1e-10, max_iterations=100,
            max_fixed_point_iterations=100000, restarts=8, substeps=1, edge_margin=1e-9)
-)doc")
-      .def(py::init([](const std::string& method, double tolerance, int max_iterations,
-                       int max_fixed_point_iterations, int restarts, int substeps,
-                       double edge_margin) {
-             ArmOptions o;
-             o.method = ParseFixedBaseMethod(method);
-             o.tolerance = tolerance;
-             o.max_iterations = max_iterations;
-             o.max_fixed_point_iterations = max_fixed_point_iterations;
-             o.restarts = restarts;
-             o.substeps = substeps;
-             o.edge_margin = edge_margin;
-             ThrowIfAny(o.Validate());
-             return o;
-           }),
-           py::kw_only(), py::arg("method") = "newton", py::arg("tolerance") = 1e-10,
-           py::arg("max_iterations") = 100, py::arg("max_fixed_point_iterations") = 100000,
-           py::arg("restarts") = 8, py::arg("substeps") = 1, py::arg("edge_margin") = 1e-9)
-      .def_property(
-          "method", [](const ArmOptions& o) { return FixedBaseMethodName(o.method); },
-          [](ArmOptions& o, const std::string& name) { o.method = ParseFixedBaseMethod(name); })
-      .def_readwrite("tolerance", &ArmOptions::tolerance)
-      .def_readwrite("max_iterations", &ArmOptions::max_iterations)
-      .def_readwrite("max_fixed_point_iterations", &ArmOptions::max_fixed_point_iterations)
-      .def_readwrite("restarts", &ArmOptions::restarts)
-      .def_readwrite("substeps", &ArmOptions::substeps)
-      .def_readwrite("edge_margin", &ArmOptions::edge_margin)
-      .def("__repr__", &ArmOptionsRepr)
-      .def(py::pickle(
-          [](const ArmOptions& o) {
-            return py::make_tuple(std::string(FixedBaseMethodName(o.method)), o.tolerance,
-                                  o.max_iterations, o.max_fixed_point_iterations, o.restarts,
-                                  o.substeps, o.edge_margin);
+)doc");
+  options.def(
+      py::init([](const std::string& method, double tolerance, int max_iterations,
+                  int max_fixed_point_iterations, int restarts, int substeps, double edge_margin) {
+        ArmOptions o;
+        o.method = ParseFixedBaseMethod(method);
+        o.tolerance = tolerance;
+        o.max_iterations = max_iterations;
+        o.max_fixed_point_iterations = max_fixed_point_iterations;
+        o.restarts = restarts;
+        o.substeps = substeps;
+        o.edge_margin = edge_margin;
+        ThrowIfAny(o.Validate());
+        return o;
+      }),
+      py::kw_only(), py::arg("method") = "newton", py::arg("tolerance") = 1e-10,
+      py::arg("max_iterations") = 100, py::arg("max_fixed_point_iterations") = 100000,
+      py::arg("restarts") = 8, py::arg("substeps") = 1, py::arg("edge_margin") = 1e-9);
+  Fields<ArmOptions>(options, "ArmOptions")
+      .Validate("max_iterations")
+      .Property(
+          "method", [](const ArmOptions& o) { return std::string(FixedBaseMethodName(o.method)); },
+          [](ArmOptions& o, py::handle name) {
+            o.method = ParseFixedBaseMethod(py::cast<std::string>(name));
           },
-          [](const py::tuple& state) {
-            StateTuple(state, 7, "ArmOptions");
-            ArmOptions o;
-            o.method = ParseFixedBaseMethod(py::cast<std::string>(state[0]));
-            o.tolerance = py::cast<double>(state[1]);
-            o.max_iterations = py::cast<int>(state[2]);
-            o.max_fixed_point_iterations = py::cast<int>(state[3]);
-            o.restarts = py::cast<int>(state[4]);
-            o.substeps = py::cast<int>(state[5]);
-            o.edge_margin = py::cast<double>(state[6]);
-            return o;
-          }));
+          "How the base is brought back after each sweep: 'newton' (default) or 'fixed_point'.",
+          true)
+      .Member("tolerance", &ArmOptions::tolerance,
+              "Base residual at which the solver stops, relative to the mean link length "
+              "(default 1e-10).",
+              true)
+      .Member("max_iterations", &ArmOptions::max_iterations,
+              "Newton iterations at most per step (default 100).", true)
+      .Member("max_fixed_point_iterations", &ArmOptions::max_fixed_point_iterations,
+              "Fixed-point sweeps at most per step (default 100000).", true)
+      .Member("restarts", &ArmOptions::restarts,
+              "Restarts of a joint-space solve that stalls short of the target (default 8; 0 "
+              "none).",
+              true)
+      .Member("substeps", &ArmOptions::substeps,
+              "Straight pieces the end effector's move is split into (default 1).", true)
+      .Member("edge_margin", &ArmOptions::edge_margin,
+              "Targets beyond (1 - edge_margin) times the reach are out of reach: the arm is "
+              "stretched toward them (dimensionless; default 1e-9).",
+              true)
+      .Finish();
 
-  py::class_<ArmStepReport>(m, "ArmStepReport", R"doc(
+  py::class_<ArmStepReport> step(m, "ArmStepReport", R"doc(
 One step of a fixed-base arm (flexkin.arm_step): points (n+1, dim) base first, angles (n,),
 azimuths (n,) or None, ee_error, base_error, iterations, sweeps, passes, converged, reached,
 stretched, limited, joint_space, legs, restarts. Pass it as `state` to the next arm_step to
-continue from it (with the solver's memory).
-)doc")
-      .def_property_readonly("points",
-                             [](const ArmStepReport& r) { return ToArray(Points(r.state.points)); })
-      .def_property_readonly("angles",
-                             [](const ArmStepReport& r) { return ToArray(r.state.angles.angle); })
-      .def_property_readonly(
-          "azimuths", [](const ArmStepReport& r) { return AzimuthsOrNone(r.state.angles.azimuth); })
-      .def_readonly("ee_error", &ArmStepReport::ee_error)
-      .def_readonly("base_error", &ArmStepReport::base_error)
-      .def_readonly("iterations", &ArmStepReport::iterations)
-      .def_readonly("sweeps", &ArmStepReport::sweeps)
-      .def_readonly("passes", &ArmStepReport::passes)
-      .def_readonly("converged", &ArmStepReport::converged)
-      .def_readonly("reached", &ArmStepReport::reached)
-      .def_readonly("stretched", &ArmStepReport::stretched)
-      .def_readonly("limited", &ArmStepReport::limited)
-      .def_readonly("joint_space", &ArmStepReport::joint_space)
-      .def_readonly("legs", &ArmStepReport::legs)
-      .def_readonly("restarts", &ArmStepReport::restarts)
-      .def("brief_report", &ArmStepReport::BriefReport)
-      .def("__repr__",
-           [](const ArmStepReport& r) { return "ArmStepReport(" + r.BriefReport() + ")"; });
+continue from it (with the solver's memory, which pickles with it).
+)doc");
+  Fields<ArmStepReport>(step, "ArmStepReport")
+      .Property(
+          "points", [](const ArmStepReport& r) { return ToArray(Points(r.state.points)); },
+          [](ArmStepReport& r, py::handle v) { r.state.points = py::cast<Points>(v); },
+          "(n+1, dim) float64: the link points after the step, base first (length unit).")
+      .Property(
+          "angles", [](const ArmStepReport& r) { return ToArray(r.state.angles.angle); },
+          [](ArmStepReport& r, py::handle v) {
+            r.state.angles.angle = EigenIn<Eigen::VectorXd>(v);
+          },
+          "(n,) float64: the joint angles after the step (radians).")
+      .Property(
+          "azimuths", [](const ArmStepReport& r) { return EigenOut(r.state.angles.azimuth, true); },
+          [](ArmStepReport& r, py::handle v) {
+            r.state.angles.azimuth = EigenIn<Eigen::VectorXd>(v);
+          },
+          "(n,) float64: spherical joints' bend directions (radians), or None.")
+      .Member("ee_error", &ArmStepReport::ee_error,
+              "|end effector - target| after the step (length unit).")
+      .Member("base_error", &ArmStepReport::base_error,
+              "The solver's last base residual before the base was re-anchored (length unit).")
+      .Member("iterations", &ArmStepReport::iterations,
+              "Solver iterations (Newton steps or fixed-point sweeps).")
+      .Member("sweeps", &ArmStepReport::sweeps, "Sweeps from the end effector, all included.")
+      .Member("passes", &ArmStepReport::passes,
+              "Passes over the links (cost ~ passes * n): sweeps done together count once.")
+      .Member("converged", &ArmStepReport::converged, "The base residual reached the tolerance.")
+      .Member("reached", &ArmStepReport::reached,
+              "Converged and ee_error within the tolerance: the target was reached.")
+      .Member("stretched", &ArmStepReport::stretched,
+              "Out of reach: the arm was stretched straight toward the target.")
+      .Member("limited", &ArmStepReport::limited, "A joint limit was active.")
+      .Member("joint_space", &ArmStepReport::joint_space,
+              "The step was solved in joint space (docs/robots.md).")
+      .Member("legs", &ArmStepReport::legs,
+              "Legs a far move was tracked in (0: one sweep; docs/robots.md).")
+      .Member("restarts", &ArmStepReport::restarts, "Joint-space solves after the first.")
+      .Hidden(
+          "memory_translation", [](const ArmStepReport& r) { return r.state.memory.translation; },
+          [](ArmStepReport& r, py::handle v) {
+            r.state.memory.translation = EigenIn<Eigen::VectorXd>(v);
+          })
+      .Hidden(
+          "memory_earlier_translations",
+          [](const ArmStepReport& r) { return r.state.memory.earlier_translations; },
+          [](ArmStepReport& r, py::handle v) {
+            r.state.memory.earlier_translations = EigenIn<Eigen::MatrixXd>(v);
+          })
+      .Hidden(
+          "memory_move_lengths", [](const ArmStepReport& r) { return r.state.memory.move_lengths; },
+          [](ArmStepReport& r, py::handle v) {
+            r.state.memory.move_lengths = EigenIn<Eigen::VectorXd>(v);
+          })
+      .Hidden(
+          "memory_prediction_error",
+          [](const ArmStepReport& r) { return r.state.memory.prediction_error; },
+          [](ArmStepReport& r, py::handle v) {
+            r.state.memory.prediction_error = EigenIn<Eigen::VectorXd>(v);
+          })
+      .Finish(false);
+  step.def("brief_report", &ArmStepReport::BriefReport,
+           "One line: reached or not, errors, iterations, sweeps, flags.");
+  step.def(
+      "__repr__", [](const ArmStepReport& r) { return "ArmStepReport(" + r.BriefReport() + ")"; },
+      "ArmStepReport(<brief report>).");
 
   m.def(
       "forward_kinematics",
-      [](const ArmModel& model, py::handle angles, py::handle azimuths) {
-        return ToArray(ForwardKinematics(model, AnglesArg(model, angles, azimuths)));
+      [](py::handle model, py::handle angles, py::handle azimuths) {
+        const ArmModel& a = ModelArg(model);
+        return ToArray(ForwardKinematics(a, AnglesArg(a, angles, azimuths)));
       },
       py::arg("model"), py::arg("angles"), py::arg("azimuths") = py::none(),
-      "The (n+1, dim) points (base first) of the arm at the joint angles (n,) (and azimuths "
-      "(n,) for spherical joints).");
+      "The (n+1, dim) float64 points (base first, length unit) of the arm at the joint angles "
+      "(n,) (radians; and azimuths (n,) for spherical joints).");
   m.def(
       "joint_angles_from_points",
-      [](const ArmModel& model, py::handle points) {
-        const Points p = ReadPoints(points, "points", model.num_links() + 1, model.dim);
-        if (p.rows() != model.num_links() + 1) {
+      [](py::handle model, py::handle points) {
+        const ArmModel& a = ModelArg(model);
+        const Points p = ReadPoints(points, "points", a.num_links() + 1, a.dim);
+        if (p.rows() != a.num_links() + 1) {
           ThrowInput("points", "has " + std::to_string(p.rows()) + " rows; expected " +
-                                   std::to_string(model.num_links() + 1) + " (n+1)");
+                                   std::to_string(a.num_links() + 1) + " (n+1)");
         }
-        const JointAngles a = JointAnglesFromPoints(model, p);
-        return py::make_tuple(ToArray(a.angle), AzimuthsOrNone(a.azimuth));
+        const JointAngles angles = JointAnglesFromPoints(a, p);
+        return py::make_tuple(ToArray(angles.angle), AzimuthsOrNone(angles.azimuth));
       },
       py::arg("model"), py::arg("points"),
-      "The joint angles (angles, azimuths or None) of the arm whose points (base first) are "
-      "given.");
+      "The joint angles (angles (n,), azimuths (n,) or None; radians) of the arm whose points "
+      "(n+1, dim) (base first) are given.");
+  m.def(
+      "joint_quaternions",
+      [](py::handle model, py::handle angles, py::handle azimuths) {
+        const ArmModel& a = ModelArg(model);
+        return ToArray(Points(JointQuaternions(a, AnglesArg(a, angles, azimuths))));
+      },
+      py::arg("model"), py::arg("angles"), py::arg("azimuths") = py::none(),
+      "Each joint's rotation as a unit quaternion in the frame of the link before it: an (n, 4) "
+      "float64 array of rows (w, x, y, z), scalar first, at the joint angles (n,) (radians; and "
+      "azimuths (n,) for spherical joints). Planar arms: rotations about z.");
+  m.def(
+      "within_limits",
+      [](py::handle model, py::handle angles, py::handle azimuths, double slack) {
+        const ArmModel& a = ModelArg(model);
+        const JointAngles joint = AnglesArg(a, angles, azimuths);
+        return WithinLimits(a, joint, CheckFinite(slack, "slack"));
+      },
+      py::arg("model"), py::arg("angles"), py::arg("azimuths") = py::none(), py::kw_only(),
+      py::arg("slack") = 0.0,
+      "Whether every joint angle (n,) (radians) is within the model's limits, with `slack` "
+      "radians of tolerance (default 0). True for a model without limits.");
   m.def(
       "arm_step",
-      [](const ArmModel& model, py::handle target, py::object state, py::handle options) {
-        ThrowIfAny(model.Validate());
-        const Eigen::VectorXd t = ReadVector(target, "target", model.dim);
-        const ArmOptions o = OptionsArg(options);
+      [](py::handle model, py::handle target, py::handle state, py::handle options) {
+        const ArmModel& a = ModelArg(model);
+        ThrowIfAny(a.Validate());
+        const Eigen::VectorXd t = ReadVector(target, "target", a.dim);
+        const ArmOptions o = OptionsArg<ArmOptions>(options, "options");
+        if (!state.is_none() && !py::isinstance<ArmStepReport>(state)) {
+          const std::string type = py::str(py::type::of(state).attr("__name__"));
+          ThrowInput("state",
+                     "is a " + type + "; expected None or the ArmStepReport of the last step", type,
+                     "ArmStepReport");
+        }
         ArmState s =
-            state.is_none() ? InitialState(model) : py::cast<const ArmStepReport&>(state).state;
+            state.is_none() ? InitialState(a) : py::cast<const ArmStepReport&>(state).state;
         py::gil_scoped_release release;
-        return ArmStep(model, s, t, o);
+        return ArmStep(a, s, t, o);
       },
       py::arg("model"), py::arg("target"), py::kw_only(), py::arg("state") = py::none(),
       py::arg("options") = py::none(),
       "Moves the end effector to target (dim,) with the base held, from `state` (the "
-      "ArmStepReport of the previous step; None: the model's initial angles). Returns an "
-      "ArmStepReport.");
+      "ArmStepReport of the previous step; None: the model's initial angles). options: "
+      "ArmOptions, a dict of its fields or None. Returns an ArmStepReport.");
   m.def(
       "track_path",
-      [](const ArmModel& model, py::handle path, py::handle options) {
-        ThrowIfAny(model.Validate());
-        const Points p = ReadPoints(path, "path", 1, model.dim);
-        return TrackToResult(model, p, OptionsArg(options), "");
+      [](py::handle model, py::handle path, py::handle options, py::object progress,
+         py::handle output, py::handle csv) {
+        RobotScenario s;
+        s.model = ModelArg(model);
+        ThrowIfAny(s.model.Validate());
+        s.path = ReadPoints(path, "path", 1, s.model.dim);
+        s.options = OptionsArg<ArmOptions>(options, "options");
+        return TrackToResult(s, std::move(progress), output, csv);
       },
       py::arg("model"), py::arg("path"), py::kw_only(), py::arg("options") = py::none(),
-      "Tracks the path (T, dim) of end-effector targets from the model's initial state, one "
-      "arm_step per row, with the GIL released. Returns a RobotResult.");
+      py::arg("progress") = py::none(), py::arg("output") = py::none(), py::arg("csv") = py::none(),
+      R"doc(
+Tracks a path of end-effector targets from the model's initial state, one arm_step per row,
+with the GIL released. Returns a RobotResult.
+
+track_path(model, path, *, options=None, progress=None, output=None, csv=None)
+  model: ArmModel.  path: (T, dim) targets (length unit), T >= 1.
+  options: ArmOptions, a dict of its fields or None (the defaults).
+  progress: callable(done, total) called about every 0.1 s with the targets done.
+  output: a path: also write the trajectory JSON there (docs/robot-format.md), streamed.
+  csv: a path: also write the joint angles as CSV there.
+The files are written whole or not at all (Ctrl-C, an error: no file, an existing one left
+untouched). Ctrl-C raises KeyboardInterrupt within about 0.1 s.
+)doc");
 }
 
 }  // namespace flexkin::python

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "convert.h"
+#include "fields.h"
 #include "flexkin/curves.h"
 #include "flexkin/leader.h"
 #include "flexkin/link_step.h"
@@ -67,7 +68,7 @@ Chain ChainArg(py::handle object, const std::string& name) {
 }
 
 void BindChains(py::module_& m) {
-  py::class_<Chain>(m, "Chain", R"doc(
+  py::class_<Chain> chain(m, "Chain", R"doc(
 A chain of rigid links: points (n+1, dim) float64, row 0 the leading end; link i joins points
 i-1 and i and keeps its length lengths[i-1], fixed when the chain is made.
 
@@ -76,7 +77,8 @@ Chain(points, *, link_length=None, lengths=None)
   link_length: every link exactly this long (points from the curve generators, whose chords
                equal it to rounding); else
   lengths: the n link lengths; else the distances between consecutive points.
-)doc")
+)doc");
+  chain
       .def(py::init([](py::handle points, py::object link_length, py::object lengths) {
              Points p = ReadPoints(points, "points", 2);
              if (!link_length.is_none() && !lengths.is_none()) {
@@ -98,15 +100,10 @@ Chain(points, *, link_length=None, lengths=None)
            }),
            py::arg("points"), py::kw_only(), py::arg("link_length") = py::none(),
            py::arg("lengths") = py::none())
-      .def_property_readonly(
-          "points", [](const Chain& c) { return ToArray(Points(c.points)); },
-          "(n+1, dim) float64, a copy; row 0 the leading end")
-      .def_property_readonly(
-          "lengths", [](const Chain& c) { return ToArray(c.lengths); }, "(n,) link lengths, a copy")
-      .def_property_readonly("dim", &Chain::dim)
-      .def_property_readonly("num_links", &Chain::num_links)
+      .def_property_readonly("dim", &Chain::dim, "2 or 3: the columns of points.")
+      .def_property_readonly("num_links", &Chain::num_links, "n, the number of links.")
       .def("max_relative_length_error", &MaxRelativeLengthError,
-           "Largest |(|p_i - p_{i-1}| - L_i)| / L_i over the links.")
+           "Largest |(|p_i - p_{i-1}| - L_i)| / L_i over the links (dimensionless).")
       .def(
           "move_leader",
           [](Chain& c, py::handle target, const std::string& method, int substeps) {
@@ -124,21 +121,21 @@ Chain(points, *, link_length=None, lengths=None)
           "One overall step in place: the leading end to head, the other points to the "
           "minimizer of the objective under the length constraints. options: OverallOptions, "
           "ObjectiveWeights or a dict of term weights. Returns an OverallReport.")
-      .def("__repr__", &ChainRepr)
-      .def(py::pickle(
-          [](const Chain& c) {
-            return py::make_tuple(ToArray(Points(c.points)), ToArray(c.lengths));
-          },
-          [](const py::tuple& state) {
-            StateTuple(state, 2, "Chain");
-            Chain c;
-            c.points = ReadPoints(state[0], "points", 2);
+      .def("__repr__", &ChainRepr, "A summary: dimension, links, total length, leading end.");
+  Fields<Chain>(chain, "Chain")
+      .Property(
+          "points", [](const Chain& c) { return ToArray(Points(c.points)); },
+          [](Chain& c, py::handle points) { c.points = ReadPoints(points, "points", 2); },
+          "(n+1, dim) float64, a copy; row 0 the leading end (length unit).")
+      .Property(
+          "lengths", [](const Chain& c) { return ToArray(c.lengths); },
+          [](Chain& c, py::handle lengths) {
             c.lengths =
-                ReadArray(state[1], "lengths", 1, 1, 0, static_cast<int>(c.points.rows() - 1))
+                ReadArray(lengths, "lengths", 1, 1, 0, static_cast<int>(c.points.rows() - 1))
                     .cast<Eigen::VectorXd>();
-            ValidateChain(c, "lengths");
-            return c;
-          }));
+          },
+          "(n,) float64, a copy: the link lengths, fixed when the chain was made (length unit).")
+      .Finish(false, [](Chain& c) { ValidateChain(c, "lengths"); });
 
   m.def(
       "line",

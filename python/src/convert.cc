@@ -1,5 +1,7 @@
 #include "convert.h"
 
+#include <pybind11/eigen.h>
+
 #include <cmath>
 #include <cstring>
 #include <system_error>
@@ -220,6 +222,33 @@ py::tuple StateTuple(const py::tuple& state, size_t size, const char* type) {
 
 Method MethodArg(const std::string& name, const std::string& field) {
   return ParseMethod(name, field);
+}
+
+}  // namespace flexkin::python
+
+namespace flexkin::python {
+
+std::string ArrayText(py::handle object) {
+  if (object.is_none()) return "None";
+  if (!py::isinstance<py::array>(object)) return py::repr(object);
+  const auto array = py::reinterpret_borrow<py::array>(object);
+  const char kind = array.dtype().kind();
+  if (array.ndim() == 1 && array.shape(0) <= 6 && (kind == 'f' || kind == 'i' || kind == 'u')) {
+    return VectorText(py::cast<Eigen::VectorXd>(object));
+  }
+  return "<" + ShapeText(array) + " array>";
+}
+
+bool SameObjects(py::handle a, py::handle b) {
+  if (a.is_none() || b.is_none()) return a.is_none() && b.is_none();
+  const bool a_array = py::isinstance<py::array>(a), b_array = py::isinstance<py::array>(b);
+  if (a_array || b_array) {
+    if (!a_array || !b_array) return false;
+    const auto x = py::reinterpret_borrow<py::array>(a), y = py::reinterpret_borrow<py::array>(b);
+    if (!x.dtype().equal(y.dtype())) return false;
+    return py::module_::import("numpy").attr("array_equal")(x, y).cast<bool>();
+  }
+  return a.equal(b);
 }
 
 }  // namespace flexkin::python

@@ -19,6 +19,7 @@
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
 #include "flexkin/result_io.h"
+#include "flexkin/robot_scenario.h"
 #include "flexkin/run.h"
 
 namespace flexkin::python {
@@ -69,14 +70,24 @@ void BindChains(py::module_& m);
 void BindRun(py::module_& m);
 void BindRobot(py::module_& m);
 void BindArms(py::module_& m);
-// TrackPath of `model` along `path` with the GIL released, as a flexkin.RobotResult (robot.cc).
-py::object TrackToResult(const ArmModel& model, const Points& path, const ArmOptions& options,
-                         const std::string& scenario);
+// TrackPath of a robot scenario's model along its path with the GIL released, as a
+// flexkin.RobotResult (robot.cc): `progress` a callable(done, total) or None; `output`, `csv`
+// None or the paths of the trajectory JSON and the joint CSV, written while the steps come and
+// renamed into place only when complete.
+py::object TrackToResult(const RobotScenario& scenario, py::object progress, py::handle output,
+                         py::handle csv);
+// The model argument: an ArmModel, else InputError naming "model" (arm.cc).
+const ArmModel& ModelArg(py::handle model);
+// The robot scenario readers' options: URDF arms read where the URDF component is built,
+// relative "urdf" files looked up in `directory` (None: the default).
+RobotScenarioOptions RobotReaderOptions(py::handle directory);
 // A flexkin.Result as the ResultFile the render, viewer and glTF writers take (run.cc); InputError
 // for another object.
 ResultFile ResultFileOfObject(py::handle object);
 // flexkin.render (render.cc; built where the render, viewer and glTF components are).
 void BindRender(py::module_& m);
+// flexkin.arm_from_urdf, urdf_from_arm (urdf.cc; built where the URDF component is).
+void BindUrdf(py::module_& m);
 
 }  // namespace flexkin::python
 
@@ -88,7 +99,9 @@ Method MethodArg(const std::string& name, const std::string& field = "method");
 // The overall options from an `overall` argument: None (the defaults), OverallOptions,
 // ObjectiveWeights or a dict of term weights (only the terms given count).
 OverallOptions OverallArg(py::handle object);
-std::string RunOptionsRepr(const RunOptions& options);
+// RunOptions from the keyword arguments of flexkin.run (options.cc).
+RunOptions MakeRunOptions(const std::string& method, int substeps, int record_every,
+                          double tolerance, int max_substeps, bool link_angles, py::handle overall);
 // A chain from a `Chain` or from points (link lengths the distances between them; MakeChain).
 Chain ChainArg(py::handle object, const std::string& name = "points");
 }  // namespace flexkin::python

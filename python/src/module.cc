@@ -12,6 +12,9 @@ PYBIND11_MODULE(_flexkin, m) {
   flexkin::python::BindRun(m);
   flexkin::python::BindRobot(m);
   flexkin::python::BindArms(m);
+#ifdef FLEXKIN_PYTHON_URDF
+  flexkin::python::BindUrdf(m);
+#endif
 #ifdef FLEXKIN_PYTHON_RENDER
   flexkin::python::BindRender(m);
 #endif

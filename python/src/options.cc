@@ -1,16 +1,33 @@
 // Option and report classes: flexkin.ObjectiveWeights, OverallOptions, RunOptions (inputs, with
 // the C++ field names), Metrics, AccuracyReport, OverallRunReport, OverallReport (outputs, read
-// only). Every one prints readably and pickles.
+// only), and flexkin.overall_objective. Every class prints readably, compares and pickles
+// (fields.h).
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
 #include <string>
 
 #include "convert.h"
+#include "fields.h"
 #include "flexkin/overall.h"
 #include "flexkin/run.h"
 
 namespace flexkin::python {
+
+RunOptions MakeRunOptions(const std::string& method, int substeps, int record_every,
+                          double tolerance, int max_substeps, bool link_angles,
+                          py::handle overall) {
+  RunOptions o;
+  o.method = MethodArg(method);
+  o.substeps = substeps;
+  o.record_every = record_every;
+  o.tolerance = tolerance;
+  o.max_substeps = max_substeps;
+  o.link_angles = link_angles;
+  o.overall = OverallArg(overall);
+  return o;
+}
+
 namespace {
 
 std::string WeightsRepr(const ObjectiveWeights& w) {
@@ -22,13 +39,6 @@ std::string WeightsRepr(const ObjectiveWeights& w) {
     first = false;
   }
   return text + ")";
-}
-
-std::string OverallOptionsRepr(const OverallOptions& o) {
-  return "OverallOptions(weights=" + WeightsRepr(o.weights) +
-         ", constraint_tolerance=" + Num(o.constraint_tolerance) +
-         ", optimality_tolerance=" + Num(o.optimality_tolerance) +
-         ", max_iterations=" + std::to_string(o.max_iterations) + ")";
 }
 
 // Weights from keyword arguments named as the objective terms (scenario files' "objective"):
@@ -69,14 +79,66 @@ OverallOptions OverallArg(py::handle object) {
   return options;
 }
 
-std::string RunOptionsRepr(const RunOptions& o) {
-  return "RunOptions(method=" + Quoted(MethodName(o.method)) +
-         ", substeps=" + std::to_string(o.substeps) +
-         ", record_every=" + std::to_string(o.record_every) + ", tolerance=" + Num(o.tolerance) +
-         ", max_substeps=" + std::to_string(o.max_substeps) +
-         ", link_angles=" + (o.link_angles ? "True" : "False") +
-         ", overall=" + OverallOptionsRepr(o.overall) + ")";
+namespace {
+
+ObjectiveWeights WeightsArg(py::handle object) {
+  ObjectiveWeights w;
+  if (py::isinstance<ObjectiveWeights>(object)) {
+    w = py::cast<ObjectiveWeights>(object);
+  } else if (py::isinstance<py::dict>(object)) {
+    w = WeightsFromKwargs(py::reinterpret_borrow<py::kwargs>(object));
+  } else {
+    ThrowInput("weights", "is a " + std::string(py::str(py::type::of(object).attr("__name__"))) +
+                              "; expected ObjectiveWeights or a dict of objective term weights");
+  }
+  for (const auto& entry : Vocabulary<ObjectiveTerm>::kEntries) {
+    CheckFinite(w[entry.value], std::string("weights.") + entry.name);
+  }
+  return w;
 }
+
+// OverallObjective of checked arguments: the value, and with `gradient` or `hessian` a tuple of
+// it and the gradient (n dim,) (and the Hessian (n dim, n dim)).
+py::object Objective(py::handle weights, py::handle lengths, py::handle old_points,
+                     py::handle new_points, bool gradient, bool hessian) {
+  const ObjectiveWeights w = WeightsArg(weights);
+  const Points old_p = ReadPoints(old_points, "old_points", 2);
+  const Points new_p = ReadPoints(new_points, "new_points", 2, static_cast<int>(old_p.cols()));
+  if (new_p.rows() != old_p.rows()) {
+    ThrowInput("new_points",
+               "has " + std::to_string(new_p.rows()) + " points; expected " +
+                   std::to_string(old_p.rows()) + ", as old_points",
+               std::to_string(new_p.rows()), std::to_string(old_p.rows()));
+  }
+  const Eigen::VectorXd l =
+      ReadArray(lengths, "lengths", 1, 1, 0, static_cast<int>(old_p.rows() - 1))
+          .cast<Eigen::VectorXd>();
+  for (Eigen::Index i = 0; i < l.size(); ++i) {
+    CheckPositive(l[i], "lengths[" + std::to_string(i) + "]");
+  }
+  Eigen::VectorXd g;
+  Eigen::MatrixXd h;
+  double value = 0.0;
+  {
+    py::gil_scoped_release release;
+    value = OverallObjective(w, l, old_p, new_p, gradient || hessian ? &g : nullptr,
+                             hessian ? &h : nullptr);
+  }
+  if (hessian) return py::make_tuple(value, ToArray(g), py::cast(h));
+  if (gradient) return py::make_tuple(value, ToArray(g));
+  return py::float_(value);
+}
+
+OverallStatus StatusArg(const std::string& name) {
+  for (OverallStatus s : {OverallStatus::kConverged, OverallStatus::kMaxIterations,
+                          OverallStatus::kStalled, OverallStatus::kFailed}) {
+    if (name == OverallStatusName(s)) return s;
+  }
+  ThrowInput("status", "is not an overall status", Quoted(name),
+             "converged, max_iterations, stalled or failed");
+}
+
+}  // namespace
 
 void BindOptions(py::module_& m) {
   py::class_<ObjectiveWeights> weights(m, "ObjectiveWeights", R"doc(
@@ -88,46 +150,29 @@ As in a scenario file's "objective", only the terms given count: ObjectiveWeight
 is the rotation metric alone. With no keyword: the C++ default, squared=1.
 )doc");
   weights.def(py::init([](const py::kwargs& terms) { return WeightsFromKwargs(terms); }));
+  Fields<ObjectiveWeights> weight_fields(weights, "ObjectiveWeights");
   for (const auto& entry : Vocabulary<ObjectiveTerm>::kEntries) {
     const ObjectiveTerm term = entry.value;
-    weights.def_property(
+    weight_fields.Property(
         entry.name, [term](const ObjectiveWeights& w) { return w[term]; },
-        [term](ObjectiveWeights& w, double value) { w[term] = value; }, entry.summary);
+        [term](ObjectiveWeights& w, py::handle value) { w[term] = py::cast<double>(value); },
+        entry.summary, true);
   }
+  weight_fields.Validate("l2").Finish(false);
   weights.def(
-      "validate", [](const ObjectiveWeights& w) { ThrowIfAny(w.Validate()); },
-      "Raises InputError for the first problem (a weight < 0 or not finite, all zero, L2 "
-      "with joint_angle).");
-  weights.def("as_dict", [](const ObjectiveWeights& w) {
-    py::dict d;
-    for (const auto& entry : Vocabulary<ObjectiveTerm>::kEntries) d[entry.name] = w[entry.value];
-    return d;
-  });
-  weights.def("__repr__", &WeightsRepr);
-  weights.def("__eq__", [](const ObjectiveWeights& a, const ObjectiveWeights& b) {
-    for (const auto& entry : Vocabulary<ObjectiveTerm>::kEntries) {
-      if (a[entry.value] != b[entry.value]) return false;
-    }
-    return true;
-  });
-  weights.def(py::pickle(
+      "as_dict",
       [](const ObjectiveWeights& w) {
-        py::tuple state(std::size(Vocabulary<ObjectiveTerm>::kEntries));
-        size_t i = 0;
-        for (const auto& entry : Vocabulary<ObjectiveTerm>::kEntries) state[i++] = w[entry.value];
-        return state;
-      },
-      [](const py::tuple& state) {
-        StateTuple(state, std::size(Vocabulary<ObjectiveTerm>::kEntries), "ObjectiveWeights");
-        ObjectiveWeights w;
-        size_t i = 0;
+        py::dict d;
         for (const auto& entry : Vocabulary<ObjectiveTerm>::kEntries) {
-          w[entry.value] = py::cast<double>(state[i++]);
+          d[entry.name] = w[entry.value];
         }
-        return w;
-      }));
+        return d;
+      },
+      "Every term's weight, zero or not: {'l2': 0.0, ..., 'squared': 1.0, ...}.");
+  weights.def("__repr__", &WeightsRepr,
+              "The terms with a non-zero weight: ObjectiveWeights(squared=1).");
 
-  py::class_<OverallOptions>(m, "OverallOptions", R"doc(
+  py::class_<OverallOptions> overall(m, "OverallOptions", R"doc(
 Options of the overall solver (method "overall"; docs/scenario-format.md, "solver").
 
 OverallOptions(weights=None, constraint_tolerance=1e-12, optimality_tolerance=1e-12,
@@ -137,44 +182,38 @@ OverallOptions(weights=None, constraint_tolerance=1e-12, optimality_tolerance=1e
   constraint_tolerance: stop when every relative link-length residual is below it.
   optimality_tolerance: ... and the relative first-order optimality is below it.
   max_iterations: Newton iterations at most per step.
-)doc")
-      .def(py::init([](py::object weights, double constraint_tolerance, double optimality_tolerance,
-                       int max_iterations) {
-             OverallOptions o = weights.is_none() ? OverallOptions() : OverallArg(weights);
-             if (py::isinstance<OverallOptions>(weights)) {
-               ThrowInput("weights", "is an OverallOptions; expected ObjectiveWeights or a dict");
-             }
-             o.constraint_tolerance = constraint_tolerance;
-             o.optimality_tolerance = optimality_tolerance;
-             o.max_iterations = max_iterations;
-             return o;
-           }),
-           py::kw_only(), py::arg("weights") = py::none(), py::arg("constraint_tolerance") = 1e-12,
-           py::arg("optimality_tolerance") = 1e-12, py::arg("max_iterations") = 50)
-      .def_readwrite("weights", &OverallOptions::weights)
-      .def_readwrite("constraint_tolerance", &OverallOptions::constraint_tolerance)
-      .def_readwrite("optimality_tolerance", &OverallOptions::optimality_tolerance)
-      .def_readwrite("max_iterations", &OverallOptions::max_iterations)
-      .def(
-          "validate", [](const OverallOptions& o) { ThrowIfAny(o.Validate()); },
-          "Raises InputError for the first problem.")
-      .def("__repr__", &OverallOptionsRepr)
-      .def(py::pickle(
-          [](const OverallOptions& o) {
-            return py::make_tuple(o.weights, o.constraint_tolerance, o.optimality_tolerance,
-                                  o.max_iterations);
-          },
-          [](const py::tuple& state) {
-            StateTuple(state, 4, "OverallOptions");
-            OverallOptions o;
-            o.weights = py::cast<ObjectiveWeights>(state[0]);
-            o.constraint_tolerance = py::cast<double>(state[1]);
-            o.optimality_tolerance = py::cast<double>(state[2]);
-            o.max_iterations = py::cast<int>(state[3]);
-            return o;
-          }));
+)doc");
+  overall.def(
+      py::init([](py::object weights, double constraint_tolerance, double optimality_tolerance,
+                  int max_iterations) {
+        if (py::isinstance<OverallOptions>(weights)) {
+          ThrowInput("weights", "is an OverallOptions; expected ObjectiveWeights or a dict");
+        }
+        OverallOptions o = weights.is_none() ? OverallOptions() : OverallArg(weights);
+        o.constraint_tolerance = constraint_tolerance;
+        o.optimality_tolerance = optimality_tolerance;
+        o.max_iterations = max_iterations;
+        return o;
+      }),
+      py::kw_only(), py::arg("weights") = py::none(), py::arg("constraint_tolerance") = 1e-12,
+      py::arg("optimality_tolerance") = 1e-12, py::arg("max_iterations") = 50);
+  Fields<OverallOptions>(overall, "OverallOptions")
+      .Validate("weights.l2")
+      .Member("weights", &OverallOptions::weights,
+              "ObjectiveWeights: the metric each step minimizes (default squared=1).", true)
+      .Member("constraint_tolerance", &OverallOptions::constraint_tolerance,
+              "Stop when every |(|x_i - x_{i-1}|^2 - L_i^2)| / (2 L_i^2) is below this "
+              "(dimensionless; default 1e-12).",
+              true)
+      .Member("optimality_tolerance", &OverallOptions::optimality_tolerance,
+              "... and the relative first-order optimality is below this (dimensionless; "
+              "default 1e-12).",
+              true)
+      .Member("max_iterations", &OverallOptions::max_iterations,
+              "Newton iterations at most per step (default 50).", true)
+      .Finish();
 
-  py::class_<RunOptions>(m, "RunOptions", R"doc(
+  py::class_<RunOptions> run(m, "RunOptions", R"doc(
 Options of a whole run (flexkin::RunOptions), the keyword arguments of flexkin.run.
 
 RunOptions(method="tractrix", substeps=1, record_every=1, tolerance=0.0, max_substeps=65536,
@@ -187,199 +226,159 @@ RunOptions(method="tractrix", substeps=1, record_every=1, tolerance=0.0, max_sub
   max_substeps: upper bound of the automatic sub-steps.
   link_angles: compute each frame's link angles to the pull.
   overall: OverallOptions, ObjectiveWeights or a dict of term weights (method "overall").
-)doc")
-      .def(py::init([](const std::string& method, int substeps, int record_every, double tolerance,
-                       int max_substeps, bool link_angles, py::object overall) {
-             RunOptions o;
-             o.method = MethodArg(method);
-             o.substeps = substeps;
-             o.record_every = record_every;
-             o.tolerance = tolerance;
-             o.max_substeps = max_substeps;
-             o.link_angles = link_angles;
-             o.overall = OverallArg(overall);
-             return o;
-           }),
-           py::kw_only(), py::arg("method") = "tractrix", py::arg("substeps") = 1,
-           py::arg("record_every") = 1, py::arg("tolerance") = 0.0,
-           py::arg("max_substeps") = 1 << 16, py::arg("link_angles") = true,
-           py::arg("overall") = py::none())
-      .def_property(
+)doc");
+  run.def(py::init(&MakeRunOptions), py::kw_only(), py::arg("method") = "tractrix",
+          py::arg("substeps") = 1, py::arg("record_every") = 1, py::arg("tolerance") = 0.0,
+          py::arg("max_substeps") = 1 << 16, py::arg("link_angles") = true,
+          py::arg("overall") = py::none());
+  Fields<RunOptions>(run, "RunOptions")
+      .Validate("substeps")
+      .Property(
           "method", [](const RunOptions& o) { return std::string(MethodName(o.method)); },
-          [](RunOptions& o, const std::string& name) { o.method = MethodArg(name); })
-      .def_readwrite("substeps", &RunOptions::substeps)
-      .def_readwrite("record_every", &RunOptions::record_every)
-      .def_readwrite("tolerance", &RunOptions::tolerance)
-      .def_readwrite("max_substeps", &RunOptions::max_substeps)
-      .def_readwrite("link_angles", &RunOptions::link_angles)
-      .def_property(
+          [](RunOptions& o, py::handle name) { o.method = MethodArg(py::cast<std::string>(name)); },
+          "How the chain follows its leading end: 'tractrix' (default), 'ftl', 'min_rotation', "
+          "'min_joint_angle' or 'overall'.",
+          true)
+      .Member("substeps", &RunOptions::substeps,
+              "Equal sub-steps per leader step, >= 1 (default 1; with tolerance > 0 the start of "
+              "the automatic choice).",
+              true)
+      .Member("record_every", &RunOptions::record_every,
+              "Keep frame 0, every record_every-th leader step and the last, >= 1 (default 1).",
+              true)
+      .Member("tolerance", &RunOptions::tolerance,
+              "Accuracy control: if > 0, sub-steps are doubled until the estimated largest "
+              "distance to the continuous motion is at most this (length unit; default 0 = off).",
+              true)
+      .Member("max_substeps", &RunOptions::max_substeps,
+              "Upper bound of the automatic sub-steps (default 65536).", true)
+      .Member("link_angles", &RunOptions::link_angles,
+              "Compute each frame's link angles to the pull (default True).", true)
+      .Property(
           "overall", [](const RunOptions& o) { return o.overall; },
-          [](RunOptions& o, py::object overall) { o.overall = OverallArg(overall); })
-      .def(
-          "validate", [](const RunOptions& o) { ThrowIfAny(o.Validate()); },
-          "Raises InputError for the first problem, naming the member ('substeps').")
-      .def("__repr__", &RunOptionsRepr)
-      .def(py::pickle(
-          [](const RunOptions& o) {
-            return py::make_tuple(std::string(MethodName(o.method)), o.substeps, o.record_every,
-                                  o.tolerance, o.max_substeps, o.link_angles, o.overall);
-          },
-          [](const py::tuple& state) {
-            StateTuple(state, 7, "RunOptions");
-            RunOptions o;
-            o.method = MethodArg(py::cast<std::string>(state[0]));
-            o.substeps = py::cast<int>(state[1]);
-            o.record_every = py::cast<int>(state[2]);
-            o.tolerance = py::cast<double>(state[3]);
-            o.max_substeps = py::cast<int>(state[4]);
-            o.link_angles = py::cast<bool>(state[5]);
-            o.overall = py::cast<OverallOptions>(state[6]);
-            return o;
-          }));
+          [](RunOptions& o, py::handle overall) { o.overall = OverallArg(overall); },
+          "OverallOptions of method 'overall' (set from OverallOptions, ObjectiveWeights, a dict "
+          "of term weights or None).",
+          true)
+      .Finish();
 
-  py::class_<Metrics>(m, "Metrics", R"doc(
+  py::class_<Metrics> metrics(m, "Metrics", R"doc(
 Measures of a run's motion (paper eq. 6, Sec. 3.2); read only.
   l2_per_step: (num_steps,) sum over the points of the distance each travels in the step.
   l2_weighted_per_step: (num_steps,) the same weighted by arc length (eq. 6).
   l2_total, l2_weighted_total: their sums.
   max_relative_length_error: largest |(|x_i - x_{i-1}| - L_i)| / L_i after any leader step.
   path_length: (n+1,) distance travelled by each point over the run, leading end first.
-)doc")
-      .def_readonly("l2_per_step", &Metrics::l2_per_step)
-      .def_readonly("l2_weighted_per_step", &Metrics::l2_weighted_per_step)
-      .def_readonly("l2_total", &Metrics::l2_total)
-      .def_readonly("l2_weighted_total", &Metrics::l2_weighted_total)
-      .def_readonly("max_relative_length_error", &Metrics::max_relative_length_error)
-      .def_readonly("path_length", &Metrics::path_length)
-      .def("__repr__",
-           [](const Metrics& x) {
-             return "Metrics(l2_total=" + Num(x.l2_total) +
-                    ", l2_weighted_total=" + Num(x.l2_weighted_total) +
-                    ", max_relative_length_error=" + Num(x.max_relative_length_error) +
-                    ", l2_per_step=" + VectorText(x.l2_per_step) +
-                    ", path_length=" + VectorText(x.path_length) + ")";
-           })
-      .def(py::pickle(
-          [](const Metrics& x) {
-            return py::make_tuple(x.l2_per_step, x.l2_weighted_per_step, x.l2_total,
-                                  x.l2_weighted_total, x.max_relative_length_error, x.path_length);
-          },
-          [](const py::tuple& state) {
-            StateTuple(state, 6, "Metrics");
-            Metrics x;
-            x.l2_per_step = py::cast<Eigen::VectorXd>(state[0]);
-            x.l2_weighted_per_step = py::cast<Eigen::VectorXd>(state[1]);
-            x.l2_total = py::cast<double>(state[2]);
-            x.l2_weighted_total = py::cast<double>(state[3]);
-            x.max_relative_length_error = py::cast<double>(state[4]);
-            x.path_length = py::cast<Eigen::VectorXd>(state[5]);
-            return x;
-          }));
+)doc");
+  Fields<Metrics>(metrics, "Metrics")
+      .Member("l2_per_step", &Metrics::l2_per_step,
+              "(num_steps,) float64: per leader step, the sum over the points of the distance "
+              "each travels (length unit), sub-steps included.")
+      .Member("l2_weighted_per_step", &Metrics::l2_weighted_per_step,
+              "(num_steps,) float64: the same weighted by arc length (eq. 6; length unit^2).")
+      .Member("l2_total", &Metrics::l2_total, "Sum of l2_per_step (length unit).")
+      .Member("l2_weighted_total", &Metrics::l2_weighted_total,
+              "Sum of l2_weighted_per_step (length unit^2).")
+      .Member("max_relative_length_error", &Metrics::max_relative_length_error,
+              "Largest |(|x_i - x_{i-1}| - L_i)| / L_i over every link after every leader step "
+              "(dimensionless).")
+      .Member("path_length", &Metrics::path_length,
+              "(n+1,) float64: the distance each point travelled over the run (length unit), "
+              "leading end first.")
+      .Finish();
 
-  py::class_<AccuracyReport>(m, "AccuracyReport", R"doc(
+  py::class_<AccuracyReport> accuracy(m, "AccuracyReport", R"doc(
 What the accuracy control did (RunOptions.tolerance > 0); read only.
   enabled, tolerance, max_substeps, substeps (used), order (2 tractrix, 1 ftl),
   estimated_error (Richardson estimate of the largest distance to the continuous motion),
   met (estimated_error <= tolerance; True when not enabled).
-)doc")
-      .def_readonly("enabled", &AccuracyReport::enabled)
-      .def_readonly("tolerance", &AccuracyReport::tolerance)
-      .def_readonly("max_substeps", &AccuracyReport::max_substeps)
-      .def_readonly("substeps", &AccuracyReport::substeps)
-      .def_readonly("order", &AccuracyReport::order)
-      .def_readonly("estimated_error", &AccuracyReport::estimated_error)
-      .def_readonly("met", &AccuracyReport::met)
-      .def("__repr__",
-           [](const AccuracyReport& a) {
-             return std::string("AccuracyReport(enabled=") + (a.enabled ? "True" : "False") +
-                    ", tolerance=" + Num(a.tolerance) +
-                    ", max_substeps=" + std::to_string(a.max_substeps) +
-                    ", substeps=" + std::to_string(a.substeps) +
-                    ", order=" + std::to_string(a.order) +
-                    ", estimated_error=" + Num(a.estimated_error) +
-                    ", met=" + (a.met ? "True" : "False") + ")";
-           })
-      .def(py::pickle(
-          [](const AccuracyReport& a) {
-            return py::make_tuple(a.enabled, a.tolerance, a.max_substeps, a.substeps, a.order,
-                                  a.estimated_error, a.met);
-          },
-          [](const py::tuple& state) {
-            StateTuple(state, 7, "AccuracyReport");
-            AccuracyReport a;
-            a.enabled = py::cast<bool>(state[0]);
-            a.tolerance = py::cast<double>(state[1]);
-            a.max_substeps = py::cast<int>(state[2]);
-            a.substeps = py::cast<int>(state[3]);
-            a.order = py::cast<int>(state[4]);
-            a.estimated_error = py::cast<double>(state[5]);
-            a.met = py::cast<bool>(state[6]);
-            return a;
-          }));
+)doc");
+  Fields<AccuracyReport>(accuracy, "AccuracyReport")
+      .Member("enabled", &AccuracyReport::enabled, "Whether tolerance > 0 was asked for.")
+      .Member("tolerance", &AccuracyReport::tolerance,
+              "The tolerance asked for (length unit; RunOptions.tolerance).")
+      .Member("max_substeps", &AccuracyReport::max_substeps,
+              "The bound on the sub-steps (RunOptions.max_substeps).")
+      .Member("substeps", &AccuracyReport::substeps, "Sub-steps per leader step actually used.")
+      .Member("order", &AccuracyReport::order,
+              "Convergence order assumed in the estimate (2 tractrix, 1 ftl).")
+      .Member("estimated_error", &AccuracyReport::estimated_error,
+              "Richardson estimate of the largest distance to the continuous motion (length "
+              "unit); meaningful only if enabled.")
+      .Member("met", &AccuracyReport::met, "estimated_error <= tolerance (True when not enabled).")
+      .Finish();
 
-  py::class_<OverallRunReport>(m, "OverallRunReport", R"doc(
+  py::class_<OverallRunReport> run_report(m, "OverallRunReport", R"doc(
 What the overall solver did over a run (method "overall"); read only.
   solves, failures (sub-steps whose solve did not converge), iterations, max_iterations,
   constraint_violation and optimality (worst over the run), first_failure ('' if none).
-)doc")
-      .def_readonly("solves", &OverallRunReport::solves)
-      .def_readonly("failures", &OverallRunReport::failures)
-      .def_readonly("iterations", &OverallRunReport::iterations)
-      .def_readonly("max_iterations", &OverallRunReport::max_iterations)
-      .def_readonly("constraint_violation", &OverallRunReport::constraint_violation)
-      .def_readonly("optimality", &OverallRunReport::optimality)
-      .def_readonly("first_failure", &OverallRunReport::first_failure)
-      .def("__repr__",
-           [](const OverallRunReport& r) {
-             return "OverallRunReport(solves=" + std::to_string(r.solves) +
-                    ", failures=" + std::to_string(r.failures) +
-                    ", iterations=" + std::to_string(r.iterations) +
-                    ", max_iterations=" + std::to_string(r.max_iterations) +
-                    ", constraint_violation=" + Num(r.constraint_violation) +
-                    ", optimality=" + Num(r.optimality) +
-                    ", first_failure=" + Quoted(r.first_failure) + ")";
-           })
-      .def(py::pickle(
-          [](const OverallRunReport& r) {
-            return py::make_tuple(r.solves, r.failures, r.iterations, r.max_iterations,
-                                  r.constraint_violation, r.optimality, r.first_failure);
-          },
-          [](const py::tuple& state) {
-            StateTuple(state, 7, "OverallRunReport");
-            OverallRunReport r;
-            r.solves = py::cast<int64_t>(state[0]);
-            r.failures = py::cast<int64_t>(state[1]);
-            r.iterations = py::cast<int64_t>(state[2]);
-            r.max_iterations = py::cast<int>(state[3]);
-            r.constraint_violation = py::cast<double>(state[4]);
-            r.optimality = py::cast<double>(state[5]);
-            r.first_failure = py::cast<std::string>(state[6]);
-            return r;
-          }));
+)doc");
+  Fields<OverallRunReport>(run_report, "OverallRunReport")
+      .Member("solves", &OverallRunReport::solves, "Sub-steps solved.")
+      .Member("failures", &OverallRunReport::failures,
+              "Sub-steps whose solve did not converge (0 for a good run).")
+      .Member("iterations", &OverallRunReport::iterations, "Newton iterations in all.")
+      .Member("max_iterations", &OverallRunReport::max_iterations,
+              "Most Newton iterations of one sub-step.")
+      .Member("constraint_violation", &OverallRunReport::constraint_violation,
+              "Worst relative link-length residual over the run (dimensionless).")
+      .Member("optimality", &OverallRunReport::optimality,
+              "Worst relative first-order optimality over the run (dimensionless).")
+      .Member("first_failure", &OverallRunReport::first_failure,
+              "'leader step s, sub-step j: <report>' of the first failure; '' if none.")
+      .Finish();
 
-  py::class_<OverallReport>(m, "OverallReport", R"doc(
+  py::class_<OverallReport> report(m, "OverallReport", R"doc(
 What the overall solver did in one step (flexkin.overall_step); read only.
   status ("converged", "max_iterations", "stalled", "failed"), converged, iterations,
   objective, constraint_violation, optimality, start (how the minimizer was reached),
   moving_points (points 1..moving_points moved).
-)doc")
-      .def_property_readonly("status",
-                             [](const OverallReport& r) { return OverallStatusName(r.status); })
-      .def_property_readonly("converged", &OverallReport::converged)
-      .def_readonly("iterations", &OverallReport::iterations)
-      .def_readonly("objective", &OverallReport::objective)
-      .def_readonly("constraint_violation", &OverallReport::constraint_violation)
-      .def_readonly("optimality", &OverallReport::optimality)
-      .def_readonly("start", &OverallReport::start)
-      .def_readonly("moving_points", &OverallReport::moving_points)
-      .def("brief_report", &OverallReport::BriefReport)
-      .def("__repr__", [](const OverallReport& r) {
-        return std::string("OverallReport(status=") + Quoted(OverallStatusName(r.status)) +
-               ", iterations=" + std::to_string(r.iterations) + ", objective=" + Num(r.objective) +
-               ", constraint_violation=" + Num(r.constraint_violation) +
-               ", optimality=" + Num(r.optimality) +
-               ", moving_points=" + std::to_string(r.moving_points) + ")";
-      });
+)doc");
+  Fields<OverallReport>(report, "OverallReport")
+      .Property(
+          "status", [](const OverallReport& r) { return std::string(OverallStatusName(r.status)); },
+          [](OverallReport& r, py::handle name) {
+            r.status = StatusArg(py::cast<std::string>(name));
+          },
+          "'converged' (both tolerances met), 'max_iterations', 'stalled' (the line search made "
+          "no progress) or 'failed' (a singular system or a value not finite).")
+      .Member("iterations", &OverallReport::iterations, "Newton iterations.")
+      .Member("objective", &OverallReport::objective,
+              "The step's metric at the returned configuration.")
+      .Member("constraint_violation", &OverallReport::constraint_violation,
+              "Largest |(|D_i|^2 - L_i^2)| / (2 L_i^2) (dimensionless).")
+      .Member("optimality", &OverallReport::optimality,
+              "Relative first-order optimality (dimensionless; OverallOptions."
+              "optimality_tolerance).")
+      .Member("start", &OverallReport::start,
+              "How the returned local minimizer was reached (continuation in head sub-steps, or "
+              "the sequential tractrix step).")
+      .Member("moving_points", &OverallReport::moving_points,
+              "Points 1..moving_points moved, the others stayed exactly still (n for the smooth "
+              "metrics; often fewer with an L2 term).")
+      .Finish();
+  report.def_property_readonly("converged", &OverallReport::converged, "status == 'converged'.");
+  report.def("brief_report", &OverallReport::BriefReport,
+             "One line: status, iterations, objective, residuals.");
+
+  m.def("overall_objective", &Objective, py::arg("weights"), py::arg("lengths"),
+        py::arg("old_points"), py::arg("new_points"), py::kw_only(), py::arg("gradient") = false,
+        py::arg("hessian") = false, R"doc(
+The metric of one overall step (flexkin::OverallObjective), as the overall solver evaluates it.
+
+overall_objective(weights, lengths, old_points, new_points, *, gradient=False, hessian=False)
+  weights: ObjectiveWeights or a dict of term weights ({"squared": 1, "rotation": 0.5}).
+  lengths: (n,) the link lengths L_i (> 0; the joint-angle and weighted terms use them).
+  old_points: (n+1, dim) the configuration before the step a_0..a_n, dim 2 or 3.
+  new_points: (n+1, dim) the configuration after it x_0..x_n (x_0 is held fixed).
+  gradient, hessian: also return the gradient and the (dense) Hessian with respect to
+    x_1..x_n, flattened point by point: component (j-1)*dim + k is coordinate k of x_j.
+Returns the value (float); with gradient=True a tuple (value, gradient (n*dim,)); with
+hessian=True (value, gradient (n*dim,), hessian (n*dim, n*dim)). The joint-angle term is
+ignored for 3D chains; at a point that has not moved the L2 terms add the subgradient 0 and no
+Hessian. Raises InputError naming the argument for shapes that do not match, values that are
+not finite, or lengths <= 0.
+)doc");
 }
 
 }  // namespace flexkin::python

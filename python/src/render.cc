@@ -1,6 +1,8 @@
 // flexkin.render: the pictures, viewer page and glTF files of a Result, as `flexkin render`
 // writes them (apps/render_command.cc): one writer per format of the vocabulary of
-// src/render/render.h, each file written whole or not at all, with the GIL released.
+// src/render/render.h, each file written whole or not at all, with the GIL released. Every member
+// of the components' options is reachable through FigureOptions, PlotOptions, AnimationOptions,
+// ViewerOptions and GltfOptions (or dicts of their fields).
 #include "render/render.h"
 
 #include <pybind11/stl.h>
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "convert.h"
+#include "fields.h"
 #include "flexkin/vocabulary.h"
 #include "gltf/gltf.h"
 #include "viewer/viewer.h"
@@ -24,6 +27,8 @@ struct RenderJob {
   FigureOptions figure;
   PlotOptions plot;
   AnimationOptions animation;
+  ViewerOptions viewer;
+  GltfOptions gltf;
   std::vector<std::string> written;
 };
 
@@ -60,16 +65,14 @@ void WriteFormat(OutputFormat format, RenderJob* job) {
     }
     case OutputFormat::kHtml: {
       const std::string path = base + ".html";
-      ViewerOptions options;
-      options.title = job->figure.title;
-      WriteViewerHtml(*job->file, options, path);
+      WriteViewerHtml(*job->file, job->viewer, path);
       add(path);
       return;
     }
     case OutputFormat::kGltf:
     case OutputFormat::kGlb: {
       const std::string path = base + "." + NameOf(format);
-      WriteGltf(*job->file, GltfOptions{}, path);
+      WriteGltf(*job->file, job->gltf, path);
       add(path);
       return;
     }
@@ -113,18 +116,29 @@ std::vector<OutputFormat> FormatsArg(py::handle formats) {
   return out;
 }
 
-void CheckOptions(const Problems& problems) {
+// The first problem of options, its field the keyword that set the member ("every" for every_k)
+// or, for an options object, `prefix` and the member ("gltf.tube_sides").
+void CheckOptions(const Problems& problems, const std::string& prefix = "") {
   if (problems.empty()) return;
   Problem p = problems.front();
-  if (p.field == "every_k") p.field = "every";
+  if (prefix.empty() && p.field == "every_k") p.field = "every";
+  p.field = prefix + p.field;
   throw InputError(p);
 }
 
+template <typename T>
+T CheckedOptions(py::handle object, const std::string& name) {
+  T options = OptionsArg<T>(object, name);
+  CheckOptions(options.Validate(), name + ".");
+  return options;
+}
+
 std::vector<std::string> Render(py::handle result, py::handle out_dir, py::handle formats,
-                                const std::string& stem, int every, py::object width,
+                                const std::string& stem, py::object every, py::object width,
                                 py::object height, py::object azimuth, py::object elevation,
-                                py::object fps, py::object max_frames, const std::string& title,
-                                const std::string& ffmpeg) {
+                                py::object fps, py::object max_frames, py::object title,
+                                py::object ffmpeg, py::handle figure, py::handle plot,
+                                py::handle animation, py::handle viewer, py::handle gltf) {
   const std::vector<OutputFormat> chosen = FormatsArg(formats);
   const std::string dir = PathArg(out_dir);
   if (dir.empty()) ThrowInput("out_dir", "is not a path; expected a str or os.PathLike");
@@ -132,10 +146,17 @@ std::vector<std::string> Render(py::handle result, py::handle out_dir, py::handl
     ThrowInput("stem", "must be a file name without '/'", Quoted(stem));
   }
   RenderJob job;
-  job.figure.every_k = every;
-  job.figure.title = job.animation.title = title;
-  if (!width.is_none())
+  job.figure = CheckedOptions<FigureOptions>(figure, "figure");
+  job.plot = CheckedOptions<PlotOptions>(plot, "plot");
+  job.animation = CheckedOptions<AnimationOptions>(animation, "animation");
+  job.viewer = CheckedOptions<ViewerOptions>(viewer, "viewer");
+  job.gltf = CheckedOptions<GltfOptions>(gltf, "gltf");
+  // The keywords of `flexkin render`, set as the command sets them.
+  if (!every.is_none()) job.figure.every_k = py::cast<int>(every);
+  if (!title.is_none()) job.figure.title = job.animation.title = py::cast<std::string>(title);
+  if (!width.is_none()) {
     job.figure.width = job.plot.width = job.animation.width = py::cast<int>(width);
+  }
   if (!height.is_none()) {
     job.figure.height = job.animation.height = py::cast<int>(height);
     if (job.figure.height != 0) job.plot.height = job.figure.height;
@@ -146,12 +167,21 @@ std::vector<std::string> Render(py::handle result, py::handle out_dir, py::handl
   }
   if (!fps.is_none()) job.animation.fps = py::cast<int>(fps);
   if (!max_frames.is_none()) job.animation.max_frames = py::cast<int>(max_frames);
-  job.animation.ffmpeg = ffmpeg;
+  if (!ffmpeg.is_none()) job.animation.ffmpeg = py::cast<std::string>(ffmpeg);
+  if (job.viewer.title.empty()) job.viewer.title = job.figure.title;
   CheckOptions(job.figure.Validate());
   CheckOptions(job.plot.Validate());
   CheckOptions(job.animation.Validate());
   const ResultFile file = ResultFileOfObject(result);
   if (file.result.frames.empty()) ThrowInput("result.frames", "no frames; nothing to draw");
+  for (size_t i = 0; i < job.viewer.trail_points.size(); ++i) {
+    if (job.viewer.trail_points[i] > file.result.lengths.size()) {
+      ThrowInput("viewer.trail_points[" + std::to_string(i) + "]",
+                 "is not a point of the result; expected a point index <= n = " +
+                     std::to_string(file.result.lengths.size()),
+                 std::to_string(job.viewer.trail_points[i]));
+    }
+  }
   job.file = &file;
   job.base = dir + "/" + stem;
   {
@@ -164,28 +194,182 @@ std::vector<std::string> Render(py::handle result, py::handle out_dir, py::handl
   return job.written;
 }
 
+void BindOptionClasses(py::module_& m) {
+  py::class_<FigureOptions> figure(m, "FigureOptions", R"doc(
+Options of the snapshot figure (formats svg, png, pdf; docs/rendering.md).
+FigureOptions(**fields): every field below by keyword, the rest at their defaults.
+)doc");
+  Fields<FigureOptions>(figure, "FigureOptions")
+      .KeywordInit()
+      .Validate("width")
+      .Member("every_k", &FigureOptions::every_k,
+              "Draw recorded frames 0, k, 2k, ... and the last; 0 (default) = automatic, at most "
+              "16 frames.",
+              true)
+      .Member("width", &FigureOptions::width,
+              "Pixels (SVG px, PDF points), 64 to 8192 (default 960).", true)
+      .Member("height", &FigureOptions::height,
+              "Pixels; 0 (default) = from the data's aspect ratio.", true)
+      .Member("azimuth", &FigureOptions::azimuth, "3D view: degrees about z from +x (default -60).",
+              true)
+      .Member("elevation", &FigureOptions::elevation,
+              "3D view: degrees above the x-y plane, -90 to 90 (default 30).", true)
+      .Member("title", &FigureOptions::title,
+              "The title's first line; '' (default) = the scenario's name.", true)
+      .Member("show_leader_path", &FigureOptions::show_leader_path,
+              "Draw the leading end's path with an arrowhead (default True).", true)
+      .Member("show_legend", &FigureOptions::show_legend, "Draw the legend (default True).", true)
+      .Finish();
+
+  py::class_<PlotOptions> plot(m, "PlotOptions", R"doc(
+Options of the plots (format plots: path_length, link_angles, length_error; docs/rendering.md).
+PlotOptions(**fields): every field below by keyword, the rest at their defaults.
+)doc");
+  Fields<PlotOptions>(plot, "PlotOptions")
+      .KeywordInit()
+      .Validate("height")
+      .Member("width", &PlotOptions::width, "Pixels, 64 to 8192 (default 800).", true)
+      .Member("height", &PlotOptions::height, "Pixels, 64 to 8192 (default 500).", true)
+      .Member("title", &PlotOptions::title,
+              "The title; '' (default) = what is plotted and the scenario's name.", true)
+      .Finish();
+
+  py::class_<AnimationOptions> animation(m, "AnimationOptions", R"doc(
+Options of the animations (formats mp4, gif; need ffmpeg; docs/rendering.md).
+AnimationOptions(**fields): every field below by keyword, the rest at their defaults.
+)doc");
+  Fields<AnimationOptions>(animation, "AnimationOptions")
+      .KeywordInit()
+      .Validate("fps")
+      .Member("width", &AnimationOptions::width,
+              "Pixels, 64 to 8192, odd rounded up to even (default 640).", true)
+      .Member("height", &AnimationOptions::height,
+              "Pixels; 0 (default) = from the data's aspect ratio.", true)
+      .Member("fps", &AnimationOptions::fps, "Frames per second, 1 to 120 (default 30).", true)
+      .Member("every_k", &AnimationOptions::every_k,
+              "Draw recorded frames 0, k, 2k, ... and the last; 0 (default) = automatic, at most "
+              "max_frames.",
+              true)
+      .Member("max_frames", &AnimationOptions::max_frames,
+              "Pictures at most when every_k is 0, >= 2 (default 300).", true)
+      .Member("min_seconds", &AnimationOptions::min_seconds,
+              "Short runs play at least this long (seconds, default 3; 0 = one video frame per "
+              "picture).",
+              true)
+      .Member("end_pause", &AnimationOptions::end_pause,
+              "The last picture is held this long (seconds, default 1).", true)
+      .Member("azimuth", &AnimationOptions::azimuth,
+              "3D view: degrees about z from +x (default -60).", true)
+      .Member("elevation", &AnimationOptions::elevation,
+              "3D view: degrees above the x-y plane (default 30).", true)
+      .Member("title", &AnimationOptions::title,
+              "The title's first line; '' (default) = the scenario's name.", true)
+      .Member("ffmpeg", &AnimationOptions::ffmpeg,
+              "The ffmpeg program: a name looked up in PATH or a path (default 'ffmpeg').", true)
+      .Member("crf", &AnimationOptions::crf,
+              "H.264 constant rate factor of mp4, 0 (lossless) to 51 (default 20).", true)
+      .Finish();
+
+  py::class_<ViewerOptions> viewer(m, "ViewerOptions", R"doc(
+Options of the interactive viewer page (format html; docs/viewer.md).
+ViewerOptions(**fields): every field below by keyword, the rest at their defaults.
+)doc");
+  Fields<ViewerOptions>(viewer, "ViewerOptions")
+      .KeywordInit()
+      .Validate("digits")
+      .Member("title", &ViewerOptions::title,
+              "Page title and heading; '' (default) = the figure's title, else the scenario's "
+              "name.",
+              true)
+      .Member("playback_seconds", &ViewerOptions::playback_seconds,
+              "Wall time of one play-through at 1x (seconds, > 0, <= 86400; default 10).", true)
+      .Member("autoplay", &ViewerOptions::autoplay, "Start playing when opened (default True).",
+              true)
+      .Member("loop", &ViewerOptions::loop, "Start again after the last frame (default True).",
+              true)
+      .Member("show_leader_path", &ViewerOptions::show_leader_path,
+              "Show the leading end's path at the start (default True).", true)
+      .Member("trail_points", &ViewerOptions::trail_points,
+              "list of int: points (0 = leading end, <= n) whose trails are shown at the start "
+              "(default []).",
+              true)
+      .Member("azimuth", &ViewerOptions::azimuth,
+              "Initial 3D view: degrees about z from +x (default -60).", true)
+      .Member("elevation", &ViewerOptions::elevation,
+              "Initial 3D view: degrees above the x-y plane, -90 to 90 (default 25).", true)
+      .Member("perspective", &ViewerOptions::perspective,
+              "Initial 3D projection perspective, else orthographic (default False).", true)
+      .Member("digits", &ViewerOptions::digits,
+              "Significant digits of the embedded coordinates, 6 to 17 (default 9; 17 exact).",
+              true)
+      .Finish();
+
+  py::class_<GltfOptions> gltf(m, "GltfOptions", R"doc(
+Options of the glTF 2.0 export (formats gltf, glb; docs/gltf-export.md).
+GltfOptions(**fields): every field below by keyword, the rest at their defaults.
+)doc");
+  Fields<GltfOptions>(gltf, "GltfOptions")
+      .KeywordInit()
+      .Validate("tube_sides")
+      .Member("steps_per_second", &GltfOptions::steps_per_second,
+              "Playback speed: leader steps per second of animation, > 0 (default 30).", true)
+      .Member("include_mesh", &GltfOptions::include_mesh,
+              "Include a tube mesh skinned to the joints (default True).", true)
+      .Member("tube_radius", &GltfOptions::tube_radius,
+              "Radius of the tube (length unit, before scale); 0 (default) = min(0.25 mean link "
+              "length, 0.02 total length).",
+              true)
+      .Member("tube_sides", &GltfOptions::tube_sides,
+              "Vertices around the tube, 3 to 64 (default 12).", true)
+      .Member("scale", &GltfOptions::scale,
+              "Metres (glTF's unit) per length unit of the chain, > 0 (default 1).", true)
+      .Property(
+          "up_axis", [](const GltfOptions& o) { return std::string(GltfUpAxisName(o.up_axis)); },
+          [](GltfOptions& o, py::handle name) {
+            o.up_axis = ParseGltfUpAxis(py::cast<std::string>(name));
+          },
+          "Which flexkin axis points up in glTF: 'auto' (default: y for 2D, z for 3D), 'y' or "
+          "'z'.",
+          true)
+      .Finish();
+}
+
 }  // namespace
 
 void BindRender(py::module_& m) {
+  BindOptionClasses(m);
   std::string formats_doc;
   for (const auto& entry : Vocabulary<OutputFormat>::kEntries) {
     formats_doc += std::string("\n  ") + entry.name + ": " + entry.summary;
   }
   m.def("render", &Render, py::arg("result"), py::arg("out_dir"),
         py::arg("formats") = std::vector<std::string>{"svg", "png", "plots"}, py::kw_only(),
-        py::arg("stem") = "result", py::arg("every") = 0, py::arg("width") = py::none(),
+        py::arg("stem") = "result", py::arg("every") = py::none(), py::arg("width") = py::none(),
         py::arg("height") = py::none(), py::arg("azimuth") = py::none(),
         py::arg("elevation") = py::none(), py::arg("fps") = py::none(),
-        py::arg("max_frames") = py::none(), py::arg("title") = "", py::arg("ffmpeg") = "ffmpeg",
-        ("Draws a Result as `flexkin render` does (docs/rendering.md): the chosen formats (a "
-         "list of names or a comma-separated string; default svg, png, plots) written to "
-         "out_dir/<stem>.<ext>, out_dir created if missing, each file whole or not at all. "
-         "Options as the command's: every (figures: every K-th frame, 0 automatic), width, "
-         "height (0 = from the data), azimuth, elevation (3D view, degrees), fps, max_frames "
-         "(animations), title, ffmpeg (the program for mp4 and gif). The GIL is released while "
-         "drawing. Returns the paths written. Raises InputError for an unknown format (listing "
-         "the valid names) or an invalid option, OSError for a file that cannot be written, "
-         "RuntimeError when ffmpeg is missing or fails. Formats:" +
+        py::arg("max_frames") = py::none(), py::arg("title") = py::none(),
+        py::arg("ffmpeg") = py::none(), py::arg("figure") = py::none(),
+        py::arg("plot") = py::none(), py::arg("animation") = py::none(),
+        py::arg("viewer") = py::none(), py::arg("gltf") = py::none(),
+        (R"doc(
+Draws a Result as `flexkin render` does (docs/rendering.md) and returns the paths written.
+
+render(result, out_dir, formats=("svg", "png", "plots"), *, stem="result", every=None,
+       width=None, height=None, azimuth=None, elevation=None, fps=None, max_frames=None,
+       title=None, ffmpeg=None, figure=None, plot=None, animation=None, viewer=None, gltf=None)
+  formats: a list of names or a comma-separated string, written to out_dir/<stem>.<ext>
+    (out_dir created if missing), each file whole or not at all.
+  The command's options, None = its default: every (figures: every K-th frame, 0 automatic),
+    width, height (pixels; height 0 = from the data), azimuth, elevation (3D view, degrees),
+    fps, max_frames (animations), title, ffmpeg (the program for mp4 and gif).
+  Every other member of the components' options: figure (FigureOptions), plot (PlotOptions),
+    animation (AnimationOptions), viewer (ViewerOptions: playback, trails, digits, ...), gltf
+    (GltfOptions: tube_radius, tube_sides, scale, up_axis, ...), each an options object or a
+    dict of its fields; the keywords above are applied on top of them.
+The GIL is released while drawing. Raises InputError for an unknown format (listing the valid
+names) or an invalid option (field the keyword, or "gltf.tube_sides" for an options object),
+OSError for a file that cannot be written, RuntimeError when ffmpeg is missing or fails.
+Formats:)doc" +
          formats_doc)
             .c_str());
 }

@@ -1,15 +1,18 @@
-// Fixed-base arms: flexkin.run_robot (the `flexkin robot` of a robot scenario file or dict) and
-// its RobotResult: TrackPath with the GIL released, its steps turned into numpy arrays.
+// Fixed-base arms: flexkin.run_robot (the `flexkin robot` of a robot scenario file or dict),
+// RobotScenario, load_robot_scenario and the RobotResult: TrackPath with the GIL released, its
+// steps streamed into numpy arrays (and the trajectory files), Ctrl-C and progress checked.
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
 #include <cstring>
 #include <iterator>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "convert.h"
+#include "fields.h"
 #include "flexkin/arm.h"
 #include "flexkin/robot_scenario.h"
 #include "progress.h"
@@ -106,32 +109,28 @@ class StepArrays : public ArmStepSink {
   std::vector<bool*> bool_data_;
 };
 
-RobotScenarioOptions ReaderOptions(const std::string& directory) {
-#ifdef FLEXKIN_PYTHON_URDF
-  RobotScenarioOptions options = UrdfRobotScenarioOptions();
-#else
-  RobotScenarioOptions options;
-#endif
-  options.directory = directory;
-  return options;
+// A path argument that may be None ("").
+std::string OptionalPath(py::handle object, const std::string& name) {
+  if (object.is_none()) return "";
+  const std::string path = PathArg(object);
+  if (path.empty()) ThrowInput(name, "is not a path; expected a str or os.PathLike, or None");
+  return path;
 }
 
 RobotScenario RobotScenarioArg(py::handle scenario, py::handle directory) {
-  const std::string dir = directory.is_none() ? "" : PathArg(directory);
-  if (!directory.is_none() && dir.empty()) {
-    ThrowInput("directory", "is not a path; expected a str or os.PathLike, or None");
-  }
+  if (py::isinstance<RobotScenario>(scenario)) return py::cast<RobotScenario>(scenario);
   if (py::isinstance<py::dict>(scenario)) {
-    return ParseRobotScenarioText(JsonOfDict(scenario, "scenario"), ReaderOptions(dir));
+    return ParseRobotScenarioText(JsonOfDict(scenario, "scenario"), RobotReaderOptions(directory));
   }
   const std::string path = PathArg(scenario);
   if (path.empty()) {
     ThrowInput("scenario",
                "is a " + std::string(py::str(py::type::of(scenario).attr("__name__"))) +
-                   "; expected a path to a robot scenario file or a dict of its JSON form");
+                   "; expected a path to a robot scenario file, a dict of its JSON form or a "
+                   "RobotScenario");
   }
   try {
-    return LoadRobotScenarioFile(path, ReaderOptions(dir));
+    return LoadRobotScenarioFile(path, RobotReaderOptions(directory));
   } catch (const InputError& e) {
     Problem p = e.problem();  // the file's name before the JSON pointer, as `flexkin robot`
     p.field = p.field.empty() ? path : path + ": " + p.field;
@@ -139,47 +138,61 @@ RobotScenario RobotScenarioArg(py::handle scenario, py::handle directory) {
   }
 }
 
-RobotResult Track(const ArmModel& model, const Points& path, const ArmOptions& options,
-                  const std::string& scenario) {
+// TrackPath of the scenario into the arrays of a RobotResult, and into the trajectory JSON at
+// `output` and the joint CSV at `csv` where they are not "" (each renamed into place only when
+// complete: on Ctrl-C or an error the writers remove their temporary files).
+RobotResult Track(const RobotScenario& s, py::object progress, const std::string& output,
+                  const std::string& csv) {
+  const ArmModel& model = s.model;
   ThrowIfAny(model.Validate());
-  ThrowIfAny(options.Validate());
+  ThrowIfAny(s.options.Validate());
   const int64_t links = model.num_links(), dim = model.dim;
   const bool spherical = model.joint() == ArmJoint::kSpherical;
   RobotResult r;
-  r.scenario = scenario;
-  r.method = FixedBaseMethodName(options.method);
+  r.scenario = s.name;
+  r.method = FixedBaseMethodName(s.options.method);
   r.joint = NameOf(model.joint());
   r.dim = static_cast<int>(dim);
   r.data["link_lengths"] = ToArray(model.link_lengths);
   r.data["base"] = ToArray(model.base);
-  r.data["path"] = ToArray(Points(path));
+  r.data["path"] = ToArray(Points(s.path));
   const ArmState initial = InitialState(model);
   r.data["initial_angles"] = ToArray(initial.angles.angle);
   r.data["initial_azimuths"] = spherical ? py::object(ToArray(initial.angles.azimuth)) : py::none();
   r.data["initial_points"] = ToArray(Points(initial.points));
-  const int64_t count = static_cast<int64_t>(path.rows());
-  ProgressHook hook{py::none()};  // Ctrl-C only
-  StepArrays sink(count, links, dim, spherical, &hook);
+  const int64_t count = static_cast<int64_t>(s.path.rows());
+  ProgressHook hook(std::move(progress));
+  StepArrays arrays(count, links, dim, spherical, &hook);
   try {
     py::gil_scoped_release release;
-    r.summary = TrackPath(model, path, options, &sink);
+    std::optional<RobotTrajectoryWriter> json;
+    std::optional<RobotJointsCsvWriter> table;
+    std::vector<ArmStepSink*> sinks;
+    if (!output.empty()) sinks.push_back(&json.emplace(s, output));
+    if (!csv.empty()) sinks.push_back(&table.emplace(s, csv));
+    sinks.push_back(&arrays);
+    ArmStepFanOut sink(sinks);
+    r.summary = TrackPath(model, s.path, s.options, &sink);
+    if (json) json->Commit(r.summary);
+    if (table) table->Commit(r.summary);
   } catch (const StopRun&) {
     hook.Rethrow();
   }
-  if (sink.done() != count) {
-    throw std::logic_error("flexkin: TrackPath produced " + std::to_string(sink.done()) +
+  if (arrays.done() != count) {
+    throw std::logic_error("flexkin: TrackPath produced " + std::to_string(arrays.done()) +
                            " steps for " + std::to_string(count) + " path rows");
   }
-  sink.MoveTo(&r);
+  arrays.MoveTo(&r);
   r.num_steps = count;
   r.brief = r.summary.BriefReport();
   return r;
 }
 
-RobotResult RunRobot(py::handle scenario, py::handle directory, py::object method) {
+RobotResult RunRobot(py::handle scenario, py::handle directory, py::object method,
+                     py::object progress, py::handle output, py::handle csv) {
   RobotScenario s = RobotScenarioArg(scenario, directory);
   if (!method.is_none()) s.options.method = ParseFixedBaseMethod(py::cast<std::string>(method));
-  return Track(s.model, s.path, s.options, s.name);
+  return Track(s, std::move(progress), OptionalPath(output, "output"), OptionalPath(csv, "csv"));
 }
 
 std::string RobotRepr(const RobotResult& r) {
@@ -190,25 +203,66 @@ std::string RobotRepr(const RobotResult& r) {
          (r.scenario.empty() ? "" : ", scenario=" + Quoted(r.scenario)) + ")";
 }
 
-constexpr const char* kArrayNames[] = {
-    "link_lengths",   "base",       "path",     "initial_angles", "initial_azimuths",
-    "initial_points", "angles",     "azimuths", "points",         "ee_error",
-    "base_error",     "iterations", "sweeps",   "passes",         "legs",
-    "restarts",       "converged",  "reached",  "stretched",      "limited",
-    "joint_space"};
+// The arrays of a RobotResult and their docs.
+struct ArrayDoc {
+  const char* name;
+  const char* doc;
+};
+constexpr ArrayDoc kArrays[] = {
+    {"link_lengths", "(n,) float64: the link lengths, base link first (length unit)."},
+    {"base", "(dim,) float64: where the base is bolted (length unit)."},
+    {"path", "(T, dim) float64: the end effector's targets, one per step (length unit)."},
+    {"initial_angles", "(n,) float64: the joint angles before the path (radians)."},
+    {"initial_azimuths", "(n,) float64: spherical joints' azimuths before the path, or None."},
+    {"initial_points", "(n+1, dim) float64: the link points before the path, base first."},
+    {"angles", "(T, n) float64: the joint angles after each step (radians)."},
+    {"azimuths", "(T, n) float64: spherical joints' azimuths after each step (radians), or None."},
+    {"points", "(T, n+1, dim) float64: the link points after each step, base first."},
+    {"ee_error", "(T,) float64: |end effector - target| after each step (length unit)."},
+    {"base_error", "(T,) float64: each step's last base residual (length unit)."},
+    {"iterations", "(T,) int64: solver iterations of each step."},
+    {"sweeps", "(T,) int64: sweeps from the end effector of each step."},
+    {"passes", "(T,) int64: passes over the links of each step."},
+    {"legs", "(T,) int64: legs a far move was tracked in (0: one sweep)."},
+    {"restarts", "(T,) int64: joint-space solves after the first."},
+    {"converged", "(T,) bool: the base residual reached the tolerance."},
+    {"reached", "(T,) bool: the target was reached."},
+    {"stretched", "(T,) bool: out of reach, the arm stretched toward the target."},
+    {"limited", "(T,) bool: a joint limit was active."},
+    {"joint_space", "(T,) bool: the step was solved in joint space."},
+};
+
+py::dict EstimateRobot(const RobotScenario& s) {
+  const RobotOutputEstimate e = EstimateRobotOutput(s);
+  py::dict d;
+  d["json_bytes"] = e.json_bytes;
+  d["csv_bytes"] = e.csv_bytes;
+  return d;
+}
 
 }  // namespace
 
-py::object TrackToResult(const ArmModel& model, const Points& path, const ArmOptions& options,
-                         const std::string& scenario) {
-  return py::cast(Track(model, path, options, scenario));
+RobotScenarioOptions RobotReaderOptions(py::handle directory) {
+#ifdef FLEXKIN_PYTHON_URDF
+  RobotScenarioOptions options = UrdfRobotScenarioOptions();
+#else
+  RobotScenarioOptions options;
+#endif
+  options.directory = OptionalPath(directory, "directory");
+  return options;
+}
+
+py::object TrackToResult(const RobotScenario& scenario, py::object progress, py::handle output,
+                         py::handle csv) {
+  return py::cast(Track(scenario, std::move(progress), OptionalPath(output, "output"),
+                        OptionalPath(csv, "csv")));
 }
 
 void BindRobot(py::module_& m) {
   py::class_<RobotResult> c(m, "RobotResult", R"doc(
-The trajectory of a fixed-base arm (flexkin.run_robot), as `flexkin robot` writes it
-(docs/robot-format.md). Robot order: point 0 the base, point n the end effector. T = the
-number of path targets; row t is the state after the step to path[t].
+The trajectory of a fixed-base arm (flexkin.run_robot, flexkin.track_path), as `flexkin robot`
+writes it (docs/robot-format.md). Robot order: point 0 the base, point n the end effector.
+T = the number of path targets; row t is the state after the step to path[t].
   angles: (T, n) joint angles (radians); azimuths: (T, n) for spherical joints, else None
   points: (T, n+1, dim) link points, base first
   initial_angles (n,), initial_azimuths (n,) or None, initial_points (n+1, dim): before the path
@@ -218,73 +272,114 @@ number of path targets; row t is the state after the step to path[t].
   summary: num_steps, unreached, max_ee_error, max_base_error, max_iterations, total_sweeps,
     total_passes, seconds; scenario, method ("newton", "fixed_point"), joint, dim
 )doc");
-  for (const char* name : kArrayNames) {
-    const std::string key = name;
-    c.def_property_readonly(name, [key](const RobotResult& r) { return r.data.at(key); });
+  Fields<RobotResult> fields(c, "RobotResult");
+  for (const ArrayDoc& array : kArrays) {
+    const std::string key = array.name;
+    fields.Property(
+        array.name, [key](const RobotResult& r) { return r.data.at(key); },
+        [key](RobotResult& r, py::handle value) {
+          r.data[key] = py::reinterpret_borrow<py::object>(value);
+        },
+        array.doc);
   }
-  c.def_readonly("scenario", &RobotResult::scenario)
-      .def_readonly("method", &RobotResult::method)
-      .def_readonly("joint", &RobotResult::joint)
-      .def_readonly("dim", &RobotResult::dim)
-      .def_property_readonly("num_steps", [](const RobotResult& r) { return r.num_steps; })
-      .def_property_readonly("unreached", [](const RobotResult& r) { return r.summary.unreached; })
-      .def_property_readonly("max_ee_error",
-                             [](const RobotResult& r) { return r.summary.max_ee_error; })
-      .def_property_readonly("max_base_error",
-                             [](const RobotResult& r) { return r.summary.max_base_error; })
-      .def_property_readonly("max_iterations",
-                             [](const RobotResult& r) { return r.summary.max_iterations; })
-      .def_property_readonly("total_sweeps",
-                             [](const RobotResult& r) { return r.summary.total_sweeps; })
-      .def_property_readonly("total_passes",
-                             [](const RobotResult& r) { return r.summary.total_passes; })
-      .def_property_readonly("seconds", [](const RobotResult& r) { return r.summary.seconds; })
-      .def("brief_report", [](const RobotResult& r) { return r.brief; })
-      .def("__repr__", &RobotRepr)
-      .def(py::pickle(
-          [](const RobotResult& r) {
-            py::dict arrays;
-            for (const auto& [key, value] : r.data) arrays[key.c_str()] = value;
-            const ArmTrajectory& t = r.summary;
-            return py::make_tuple(
-                r.scenario, r.method, r.joint, r.dim, arrays,
-                py::make_tuple(r.num_steps, t.max_ee_error, t.max_base_error, t.unreached,
-                               t.max_iterations, t.total_sweeps, t.total_passes, t.seconds),
-                r.brief);
-          },
-          [](const py::tuple& state) {
-            StateTuple(state, 7, "RobotResult");
-            RobotResult r;
-            r.scenario = py::cast<std::string>(state[0]);
-            r.method = py::cast<std::string>(state[1]);
-            r.joint = py::cast<std::string>(state[2]);
-            r.dim = py::cast<int>(state[3]);
-            const auto arrays = py::cast<py::dict>(state[4]);
-            for (const char* name : kArrayNames) {
-              if (!arrays.contains(name)) ThrowInput("state", std::string("lacks ") + name);
-              r.data[name] = arrays[name];
-            }
-            const auto t = StateTuple(py::cast<py::tuple>(state[5]), 8, "RobotResult summary");
-            r.num_steps = py::cast<long long>(t[0]);
-            r.summary.max_ee_error = py::cast<double>(t[1]);
-            r.summary.max_base_error = py::cast<double>(t[2]);
-            r.summary.unreached = py::cast<int>(t[3]);
-            r.summary.max_iterations = py::cast<int>(t[4]);
-            r.summary.total_sweeps = py::cast<long long>(t[5]);
-            r.summary.total_passes = py::cast<long long>(t[6]);
-            r.summary.seconds = py::cast<double>(t[7]);
-            r.brief = py::cast<std::string>(state[6]);
-            return r;
-          }));
+  fields.Member("scenario", &RobotResult::scenario, "The scenario's name; '' if none.")
+      .Member("method", &RobotResult::method, "The fixed-base method: 'newton' or 'fixed_point'.")
+      .Member("joint", &RobotResult::joint, "'revolute' or 'spherical'.")
+      .Member("dim", &RobotResult::dim, "2 or 3.")
+      .Member("num_steps", &RobotResult::num_steps, "T, the steps tracked (one per target).")
+      .Nested("unreached", &RobotResult::summary, &ArmTrajectory::unreached,
+              "Steps whose target was not reached.")
+      .Nested("max_ee_error", &RobotResult::summary, &ArmTrajectory::max_ee_error,
+              "Largest ee_error (length unit).")
+      .Nested("max_base_error", &RobotResult::summary, &ArmTrajectory::max_base_error,
+              "Largest base_error (length unit).")
+      .Nested("max_iterations", &RobotResult::summary, &ArmTrajectory::max_iterations,
+              "Most solver iterations of one step.")
+      .Nested("total_sweeps", &RobotResult::summary, &ArmTrajectory::total_sweeps,
+              "Sweeps of all steps.")
+      .Nested("total_passes", &RobotResult::summary, &ArmTrajectory::total_passes,
+              "Passes over the links of all steps.")
+      .Nested("seconds", &RobotResult::summary, &ArmTrajectory::seconds,
+              "Wall time of the tracking (seconds).")
+      .Hidden(
+          "brief", [](const RobotResult& r) { return r.brief; },
+          [](RobotResult& r, py::handle v) { r.brief = py::cast<std::string>(v); })
+      .Finish(false, [](RobotResult& r) { r.summary.num_steps = r.num_steps; });
+  c.def(
+      "brief_report", [](const RobotResult& r) { return r.brief; },
+      "One line: steps, unreached, errors, iterations, sweeps, time.");
+  c.def("__repr__", &RobotRepr, "A summary: arm, method, steps, unreached, largest error.");
 
+  py::class_<RobotScenario> scenario(m, "RobotScenario", R"doc(
+A robot scenario (docs/robot-format.md) read by flexkin.load_robot_scenario, or made:
+
+RobotScenario(model, path, *, options=None, name="")
+  model: ArmModel; path: (T, dim) the end effector's targets; options: ArmOptions, a dict of
+  its fields or None. Its members may be changed before flexkin.run_robot runs it.
+)doc");
+  scenario.def(
+      py::init([](py::handle model, py::handle path, py::handle options, const std::string& name) {
+        RobotScenario s;
+        s.model = ModelArg(model);
+        ThrowIfAny(s.model.Validate());
+        s.path = ReadPoints(path, "path", 1, s.model.dim);
+        s.options = OptionsArg<ArmOptions>(options, "options");
+        s.name = name;
+        return s;
+      }),
+      py::arg("model"), py::arg("path"), py::kw_only(), py::arg("options") = py::none(),
+      py::arg("name") = "");
+  Fields<RobotScenario>(scenario, "RobotScenario")
+      .Member("name", &RobotScenario::name, "The scenario's \"name\"; '' if absent.", true)
+      .Member("model", &RobotScenario::model, "The ArmModel, from \"arm\" or \"urdf\".", true)
+      .Property(
+          "path", [](const RobotScenario& s) { return ToArray(Points(s.path)); },
+          [](RobotScenario& s, py::handle path) {
+            s.path = ReadPoints(path, "path", 1, s.model.dim);
+          },
+          "(T, dim) float64, a copy: the end effector's targets, one per step (length unit).", true)
+      .Member("options", &RobotScenario::options, "ArmOptions: the \"solver\".", true)
+      .Finish(false);
+  scenario.def("summary", &RobotScenarioSummary,
+               "One line, as `flexkin validate` prints it: arm, joints, reach, targets, method.");
+  scenario.def("estimate_output", &EstimateRobot,
+               "The estimated sizes of the outputs: a dict of json_bytes (the trajectory) and "
+               "csv_bytes (the joint CSV).");
+  scenario.def(
+      "__repr__",
+      [](const RobotScenario& s) {
+        return "RobotScenario(" + (s.name.empty() ? "" : Quoted(s.name) + ": ") +
+               RobotScenarioSummary(s) + ")";
+      },
+      "The name and the summary.");
+
+  m.def("load_robot_scenario", &RobotScenarioArg, py::arg("scenario"), py::kw_only(),
+        py::arg("directory") = py::none(),
+        "Reads a robot scenario: a path (str or os.PathLike) to a robot scenario file or a dict "
+        "of its JSON form (docs/robot-format.md). directory: where a relative \"urdf\" file is "
+        "looked up (default: the scenario file's directory, or the working directory for a "
+        "dict). Raises InputError naming the JSON pointer of the first problem, OSError for a "
+        "file that cannot be read.");
   m.def("run_robot", &RunRobot, py::arg("scenario"), py::kw_only(),
         py::arg("directory") = py::none(), py::arg("method") = py::none(),
-        "Tracks a robot scenario's path (a path to a robot scenario file or a dict of its JSON "
-        "form, docs/robot-format.md) as `flexkin robot` does, with the same numbers. "
-        "directory: where a relative \"urdf\" file is looked up (default: the scenario file's "
-        "directory, or the working directory for a dict). method: overrides the solver's "
-        "method (\"newton\", \"fixed_point\"), as --method. The GIL is released during the "
-        "tracking. Returns a RobotResult.");
+        py::arg("progress") = py::none(), py::arg("output") = py::none(),
+        py::arg("csv") = py::none(), R"doc(
+Tracks a robot scenario's path as `flexkin robot` does, with the same numbers. Returns a
+RobotResult.
+
+run_robot(scenario, *, directory=None, method=None, progress=None, output=None, csv=None)
+  scenario: a path to a robot scenario file, a dict of its JSON form (docs/robot-format.md)
+    or a RobotScenario.
+  directory: where a relative "urdf" file is looked up (default: the scenario file's
+    directory, or the working directory for a dict).
+  method: overrides the solver's method ("newton", "fixed_point"), as --method.
+  progress: callable(done, total) called about every 0.1 s with the targets done.
+  output: a path: also write the trajectory JSON there, as `flexkin robot -o`, streamed.
+  csv: a path: also write the joint angles as CSV there, as --csv.
+The GIL is released during the tracking; Ctrl-C raises KeyboardInterrupt within about 0.1 s.
+The files are written whole or not at all (Ctrl-C, an error: no file, an existing one left
+untouched).
+)doc");
 }
 
 }  // namespace flexkin::python

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "convert.h"
+#include "fields.h"
 #include "flexkin/result_io.h"
 #include "flexkin/scenario.h"
 #include "progress.h"
@@ -304,6 +305,18 @@ void WriteResult(const Result& r, py::handle path_arg) {
   }
 }
 
+void WriteCsv(const Result& r, py::handle path_arg) {
+  const std::string path = PathArg(path_arg);
+  if (path.empty()) ThrowInput("path", "is not a path; expected a str or os.PathLike");
+  const RunResult run = RunResultOf(r);
+  try {
+    py::gil_scoped_release release;
+    WriteFramesCsv(run, path);
+  } catch (const std::system_error& e) {
+    RethrowWithPath(e, path);
+  }
+}
+
 py::list ProblemList(const Problems& problems) {
   py::list out;
   for (const Problem& p : problems) {
@@ -317,15 +330,22 @@ py::list ProblemList(const Problems& problems) {
   return out;
 }
 
-py::list ValidateScenario(py::handle scenario) {
+py::list ValidateScenario(py::handle scenario, py::handle directory) {
   if (py::isinstance<py::dict>(scenario)) {
-    return ProblemList(ValidateScenarioText(JsonOfDict(scenario, "scenario")));
+    const std::string text = JsonOfDict(scenario, "scenario");
+    if (IsRobotScenarioText(text)) {
+      return ProblemList(ValidateRobotScenarioText(text, RobotReaderOptions(directory)));
+    }
+    return ProblemList(ValidateScenarioText(text));
   }
   const std::string path = PathArg(scenario);
   if (path.empty()) {
     ThrowInput("scenario", "is not a path or a dict; expected a path to a scenario file or a dict");
   }
   try {
+    if (IsRobotScenarioFile(path)) {
+      return ProblemList(ValidateRobotScenarioFile(path, RobotReaderOptions(directory)));
+    }
     return ProblemList(ValidateScenarioFile(path));
   } catch (const std::system_error& e) {
     RethrowWithPath(e, path);
@@ -367,7 +387,7 @@ ResultFile ResultFileOfObject(py::handle object) {
 }
 
 void BindRun(py::module_& m) {
-  py::class_<Result>(m, "Result", R"doc(
+  py::class_<Result> result(m, "Result", R"doc(
 The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
 (docs/result-format.md).
   frames: (F, n+1, dim) float64, the recorded configurations, row 0 the leading end
@@ -375,63 +395,72 @@ The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
   link_angles: (F, n) float64 (radians, each link's angle to the pull) or None
   metrics: Metrics; accuracy: AccuracyReport; overall: OverallRunReport (method "overall")
   method, lengths (n,), num_steps, substeps (used), weights, seconds, scenario, dim, num_links
-)doc")
-      .def_readonly("frames", &Result::frames)
-      .def_readonly("steps", &Result::steps)
-      .def_readonly("link_angles", &Result::link_angles)
-      .def_property_readonly("metrics", [](const Result& r) { return r.run.metrics; })
-      .def_property_readonly("accuracy", [](const Result& r) { return r.run.accuracy; })
-      .def_property_readonly("overall", [](const Result& r) { return r.run.overall; })
-      .def_property_readonly("weights", [](const Result& r) { return r.run.weights; })
-      .def_property_readonly("method",
-                             [](const Result& r) { return std::string(MethodName(r.run.method)); })
-      .def_property_readonly("lengths", [](const Result& r) { return ToArray(r.run.lengths); })
-      .def_property_readonly("num_steps", [](const Result& r) { return r.run.num_steps; })
-      .def_property_readonly("substeps", [](const Result& r) { return r.run.accuracy.substeps; })
-      .def_property_readonly("seconds", [](const Result& r) { return r.run.seconds; })
-      .def_readonly("scenario", &Result::scenario)
-      .def_readonly("dim", &Result::dim)
-      .def_property_readonly("num_links",
-                             [](const Result& r) { return static_cast<int>(r.run.lengths.size()); })
+)doc");
+  Fields<Result>(result, "Result")
+      .Property(
+          "method", [](const Result& r) { return std::string(MethodName(r.run.method)); },
+          [](Result& r, py::handle name) { r.run.method = MethodArg(py::cast<std::string>(name)); },
+          "The method of the run: 'tractrix', 'ftl', 'min_rotation', 'min_joint_angle' or "
+          "'overall'.")
+      .Nested("lengths", &Result::run, &RunResult::lengths,
+              "(n,) float64, a copy: the link lengths, fixed at the start (length unit).")
+      .Nested("num_steps", &Result::run, &RunResult::num_steps, "Leader steps of the run.")
+      .Member("frames", &Result::frames,
+              "(F, n+1, dim) float64: the recorded configurations, row 0 the leading end: frame "
+              "0, every record_every-th leader step and the last (length unit).")
+      .Member("steps", &Result::steps,
+              "(F,) int64: the leader steps done at each frame (0: the initial configuration).")
+      .Member("link_angles", &Result::link_angles,
+              "(F, n) float64: each link's angle to the pull (radians, [0, pi]); None if the run "
+              "computed none (link_angles=False).")
+      .Nested("metrics", &Result::run, &RunResult::metrics,
+              "Metrics: L2 per step and total, length error, path length of each point.")
+      .Nested("accuracy", &Result::run, &RunResult::accuracy,
+              "AccuracyReport: what the accuracy control did (RunOptions.tolerance).")
+      .Nested("overall", &Result::run, &RunResult::overall,
+              "OverallRunReport: what the overall solver did (method 'overall'; zeros otherwise).")
+      .Nested("weights", &Result::run, &RunResult::weights,
+              "ObjectiveWeights: the overall method's metric (method 'overall').")
+      .Nested("seconds", &Result::run, &RunResult::seconds,
+              "Wall time of the computation (seconds).")
+      .Member("scenario", &Result::scenario, "The scenario's name; '' if none.")
+      .Finish(false, [](Result& r) {
+        if (r.frames.ndim() != 3 || r.steps.ndim() != 1 || r.frames.shape(0) != r.steps.shape(0) ||
+            r.frames.shape(1) != r.run.lengths.size() + 1 ||
+            (r.frames.shape(2) != 2 && r.frames.shape(2) != 3)) {
+          ThrowInput("state", "the pickled Result's frames, steps and lengths disagree");
+        }
+        if (!r.link_angles.is_none()) {
+          const auto angles =
+              py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(r.link_angles);
+          if (!angles || angles.ndim() != 2 || angles.shape(0) != r.frames.shape(0) ||
+              angles.shape(1) != r.run.lengths.size()) {
+            PyErr_Clear();
+            ThrowInput("state", "the pickled Result's link_angles and frames disagree");
+          }
+          r.link_angles = angles;
+        }
+        r.dim = static_cast<int>(r.frames.shape(2));
+      });
+  result
+      .def_property_readonly(
+          "substeps", [](const Result& r) { return r.run.accuracy.substeps; },
+          "Sub-steps per leader step used (accuracy.substeps).")
+      .def_readonly("dim", &Result::dim, "2 or 3.")
+      .def_property_readonly(
+          "num_links", [](const Result& r) { return static_cast<int>(r.run.lengths.size()); },
+          "n, the number of links.")
       .def(
           "brief_report", [](const Result& r) { return r.run.BriefReport(); },
           "One line: method, steps, length error, L2 total, accuracy, time.")
       .def("full_report", &FullReport, "Several lines, with the path-length profile.")
-      .def("__repr__", &ResultRepr)
+      .def("__repr__", &ResultRepr, "A summary: method, size, frames, L2 total, length error.")
       .def("write", &WriteResult, py::arg("path"),
            "Writes the result file `path`: JSON (.json) or NumPy .npz (.npz) by its extension, "
            "as `flexkin run -o`; all-or-nothing (an existing file is left untouched on error).")
-      .def(py::pickle(
-          [](const Result& r) {
-            return py::make_tuple(std::string(MethodName(r.run.method)), r.run.lengths,
-                                  r.run.num_steps, r.frames, r.steps, r.link_angles, r.run.metrics,
-                                  r.run.accuracy, r.run.overall, r.run.weights, r.run.seconds,
-                                  r.scenario);
-          },
-          [](const py::tuple& state) {
-            StateTuple(state, 12, "Result");
-            Result r;
-            r.run.method = MethodArg(py::cast<std::string>(state[0]));
-            r.run.lengths = py::cast<Eigen::VectorXd>(state[1]);
-            r.run.num_steps = py::cast<int64_t>(state[2]);
-            r.frames = py::cast<py::array_t<double>>(state[3]);
-            r.steps = py::cast<py::array_t<int64_t>>(state[4]);
-            r.link_angles = state[5];
-            r.run.metrics = py::cast<Metrics>(state[6]);
-            r.run.accuracy = py::cast<AccuracyReport>(state[7]);
-            r.run.overall = py::cast<OverallRunReport>(state[8]);
-            r.run.weights = py::cast<ObjectiveWeights>(state[9]);
-            r.run.seconds = py::cast<double>(state[10]);
-            r.scenario = py::cast<std::string>(state[11]);
-            if (r.frames.ndim() != 3 || r.steps.ndim() != 1 ||
-                r.frames.shape(0) != r.steps.shape(0) ||
-                r.frames.shape(1) != r.run.lengths.size() + 1 ||
-                (r.frames.shape(2) != 2 && r.frames.shape(2) != 3)) {
-              ThrowInput("state", "the pickled Result's frames, steps and lengths disagree");
-            }
-            r.dim = static_cast<int>(r.frames.shape(2));
-            return r;
-          }));
+      .def("write_csv", &WriteCsv, py::arg("path"),
+           "Writes the frames as CSV, as `flexkin run --csv`: a header step,point,x,y (,z), "
+           "then one row per point per frame, 17 significant digits; all-or-nothing.");
 
   m.def("read_result", &ReadResult, py::arg("path"),
         "Reads a result file (JSON or .npz, recognised by its content) as a Result. Raises "
@@ -439,10 +468,14 @@ The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
         "not a valid result file.");
   m.def("write_result", &WriteResult, py::arg("result"), py::arg("path"),
         "Writes `result` to `path` (.json or .npz by the extension), as Result.write.");
-  m.def("validate_scenario", &ValidateScenario, py::arg("scenario"),
-        "The problems of a scenario (a path to a scenario file or a dict of its JSON form) as "
-        "`flexkin validate` finds them: a list of dicts (field, message, value, expected), "
-        "empty if the scenario is valid. Raises OSError for a file that cannot be read.");
+  m.def("validate_scenario", &ValidateScenario, py::arg("scenario"), py::kw_only(),
+        py::arg("directory") = py::none(),
+        "The problems of a chain or robot scenario (a path to a scenario file or a dict of its "
+        "JSON form; a robot scenario is told apart as `flexkin validate` does) as `flexkin "
+        "validate` finds them: a list of dicts (field, message, value, expected), empty if the "
+        "scenario is valid. directory: where a robot scenario's relative \"urdf\" file is looked "
+        "up (default: the file's directory, or the working directory for a dict). Raises OSError "
+        "for a file that cannot be read.");
   m.def("estimate_output", &EstimateOutput, py::arg("num_links"), py::arg("dim"),
         py::arg("num_steps"), py::kw_only(), py::arg("record_every") = 1,
         py::arg("link_angles") = true,
@@ -455,55 +488,46 @@ The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
          py::object progress) {
         const Chain chain = ChainArg(points);
         const Points steps = ReadPoints(leader_steps, "leader_steps", 1, chain.dim());
-        RunOptions options;
-        options.method = MethodArg(method);
-        options.substeps = substeps;
-        options.record_every = record_every;
-        options.tolerance = tolerance;
-        options.max_substeps = max_substeps;
-        options.link_angles = link_angles;
-        options.overall = OverallArg(overall);
-        return RunToArrays(chain, steps, options, std::move(progress), "");
+        return RunToArrays(chain, steps,
+                           MakeRunOptions(method, substeps, record_every, tolerance, max_substeps,
+                                          link_angles, overall),
+                           std::move(progress), "");
       },
       kRunDoc, py::arg("points"), py::arg("leader_steps"), py::kw_only(),
       py::arg("method") = "tractrix", py::arg("substeps") = 1, py::arg("record_every") = 1,
       py::arg("tolerance") = 0.0, py::arg("max_substeps") = 1 << 16, py::arg("link_angles") = true,
       py::arg("overall") = py::none(), py::arg("progress") = py::none());
 
-  py::class_<Scenario>(m, "Scenario", R"doc(
+  py::class_<Scenario> scenario(m, "Scenario", R"doc(
 A scenario (docs/scenario-format.md) read by flexkin.load_scenario: name, description,
-chain (Chain), leader_steps ((m, dim) float64), options (RunOptions).
-)doc")
-      .def_readwrite("name", &Scenario::name)
-      .def_readwrite("description", &Scenario::description)
-      .def_readwrite("chain", &Scenario::chain)
-      .def_property(
+chain (Chain), leader_steps ((m, dim) float64), options (RunOptions). Its members may be
+changed before flexkin.run_scenario runs it.
+)doc");
+  Fields<Scenario>(scenario, "Scenario")
+      .Member("name", &Scenario::name, "The scenario's \"name\"; '' if absent.", true)
+      .Member("description", &Scenario::description,
+              "The scenario's \"description\"; '' if absent.", true)
+      .Member("chain", &Scenario::chain, "The initial Chain, from \"curve\".", true)
+      .Property(
           "leader_steps", [](const Scenario& s) { return ToArray(Points(s.leader_steps)); },
           [](Scenario& s, py::handle steps) {
             s.leader_steps = ReadPoints(steps, "leader_steps", 1, s.chain.dim());
-          })
-      .def_readwrite("options", &Scenario::options)
-      .def("summary", &ScenarioSummary)
-      .def("__repr__",
-           [](const Scenario& s) {
-             return "Scenario(" + (s.name.empty() ? "" : Quoted(s.name) + ": ") +
-                    ScenarioSummary(s) + ")";
-           })
-      .def(py::pickle(
-          [](const Scenario& s) {
-            return py::make_tuple(s.name, s.description, s.chain, ToArray(Points(s.leader_steps)),
-                                  s.options);
           },
-          [](const py::tuple& state) {
-            StateTuple(state, 5, "Scenario");
-            Scenario s;
-            s.name = py::cast<std::string>(state[0]);
-            s.description = py::cast<std::string>(state[1]);
-            s.chain = py::cast<Chain>(state[2]);
-            s.leader_steps = ReadPoints(state[3], "leader_steps", 1, s.chain.dim());
-            s.options = py::cast<RunOptions>(state[4]);
-            return s;
-          }));
+          "(m, dim) float64, a copy: the targets of the leading end from \"leader\", not "
+          "including its start (length unit).",
+          true)
+      .Member("options", &Scenario::options,
+              "RunOptions: method, sub-steps, recording and accuracy of the run.", true)
+      .Finish(false);
+  scenario.def("summary", &ScenarioSummary,
+               "One line: dimension, links, total length, leader steps, method, sub-steps.");
+  scenario.def(
+      "__repr__",
+      [](const Scenario& s) {
+        return "Scenario(" + (s.name.empty() ? "" : Quoted(s.name) + ": ") + ScenarioSummary(s) +
+               ")";
+      },
+      "The name and the summary.");
 
   m.def("load_scenario", &ScenarioArg, py::arg("scenario"),
         "Reads a scenario: a path (str or os.PathLike) to a scenario file, or a dict of its JSON "

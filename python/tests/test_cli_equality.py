@@ -78,3 +78,30 @@ def test_run_robot_equals_cli(path, cli, tmp_path):
     again = flexkin.run_robot(as_dict, directory=path.parent)
     assert same_bits(again.angles, traj.angles)
     assert same_bits(again.points, traj.points)
+
+
+def without_seconds(value):
+    """A parsed trajectory with its timings left out (they differ from run to run)."""
+    if isinstance(value, dict):
+        return {k: without_seconds(v) for k, v in value.items() if k != "seconds"}
+    if isinstance(value, list):
+        return [without_seconds(v) for v in value]
+    return value
+
+
+@pytest.mark.parametrize("path", ROBOT_SCENARIOS, ids=lambda p: p.stem)
+def test_run_robot_files_equal_cli(path, cli, tmp_path):
+    subprocess.run([cli, "robot", str(path), "-o", str(tmp_path / "cli.json"), "--csv",
+                    str(tmp_path / "cli.csv"), "-q"], check=False)
+    flexkin.run_robot(path, output=tmp_path / "py.json", csv=tmp_path / "py.csv")
+    assert (tmp_path / "py.csv").read_bytes() == (tmp_path / "cli.csv").read_bytes()
+    with open(tmp_path / "cli.json") as a, open(tmp_path / "py.json") as b:
+        assert without_seconds(json.load(a)) == without_seconds(json.load(b))
+
+
+@pytest.mark.parametrize("path", CHAIN_SCENARIOS[:3], ids=lambda p: p.stem)
+def test_result_csv_equals_cli(path, cli, tmp_path):
+    subprocess.run([cli, "run", str(path), "-o", str(tmp_path / "r.json"), "--csv",
+                    str(tmp_path / "cli.csv"), "-q"], check=True)
+    flexkin.run_scenario(path).write_csv(tmp_path / "py.csv")
+    assert (tmp_path / "py.csv").read_bytes() == (tmp_path / "cli.csv").read_bytes()

@@ -46,3 +46,91 @@ def test_unknown_format_and_bad_options_refused(small_result, tmp_path):
     with pytest.raises(flexkin.InputError):
         flexkin.render("not a result", tmp_path, ["png"])
     assert list(tmp_path.iterdir()) == []
+
+
+def test_glb_and_html_hold_the_data(small_result, tmp_path):
+    files = flexkin.render(small_result, tmp_path, "html,glb,gltf")
+    html = (tmp_path / "result.html").read_text()
+    assert f"{small_result.frames[-1, -1, 0]:.6g}"[:6] in html
+    glb = (tmp_path / "result.glb").read_bytes()
+    assert glb[:4] == b"glTF" and int.from_bytes(glb[8:12], "little") == len(glb)
+    import json
+    gltf = json.loads((tmp_path / "result.gltf").read_text())
+    assert gltf["asset"]["version"] == "2.0" and len(gltf["skins"][0]["joints"]) == 7
+    assert len(files) == 3
+
+
+def test_option_objects_and_dicts_reach_the_writers(small_result, tmp_path):
+    plain = flexkin.render(small_result, tmp_path / "a", ["glb", "html"])
+    thin = flexkin.render(small_result, tmp_path / "b", ["glb", "html"],
+                          gltf=flexkin.GltfOptions(tube_radius=0.01, tube_sides=3),
+                          viewer={"playback_seconds": 2.5, "trail_points": [6], "digits": 17,
+                                  "title": "my title"})
+    a, b = (open(p, "rb").read() for p in (plain[1], thin[1]))
+    assert a != b and len(b) < len(a)                           # fewer tube vertices
+    html = open(thin[0]).read()
+    assert "my title" in html and "my title" not in open(plain[0]).read()
+    no_mesh = flexkin.render(small_result, tmp_path / "c", ["gltf"],
+                             gltf={"include_mesh": False, "up_axis": "z", "scale": 2.0})
+    import json
+    doc = json.loads(open(no_mesh[0]).read())
+    assert "meshes" not in doc or not doc["meshes"]
+    legend = flexkin.render(small_result, tmp_path / "d", ["svg", "html"],
+                            figure=flexkin.FigureOptions(width=200), title="keyword title")
+    bare = flexkin.render(small_result, tmp_path / "e", ["svg"],
+                          figure=flexkin.FigureOptions(width=200, show_legend=False))
+    text = open(legend[0]).read()
+    assert 'width="200px"' in text and len(open(bare[0]).read()) < len(text)
+    assert "keyword title" in open(legend[1]).read()        # the viewer takes the title
+
+
+def test_option_classes_check_their_fields(small_result, tmp_path):
+    options = flexkin.GltfOptions(tube_sides=100)
+    with pytest.raises(flexkin.InputError) as info:
+        options.validate()
+    assert info.value.field == "tube_sides"
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.render(small_result, tmp_path, ["glb"], gltf=options)
+    assert info.value.field == "gltf.tube_sides"
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.render(small_result, tmp_path, ["html"], viewer={"digits": 3})
+    assert info.value.field == "viewer.digits"
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.render(small_result, tmp_path, ["html"], viewer={"trail_points": [7]})
+    assert info.value.field == "viewer.trail_points[0]"
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.render(small_result, tmp_path, ["png"], figure={"bogus": 1})
+    assert info.value.field == "figure.bogus" and "show_legend" in info.value.expected
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.render(small_result, tmp_path, ["png"], plot=3)
+    assert info.value.field == "plot"
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.GltfOptions(up_axis="w")
+    assert info.value.field == "up_axis"
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.AnimationOptions(fps="fast")
+    assert info.value.field == "fps"
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.render(small_result, tmp_path, ["png"], every=-1)
+    assert info.value.field == "every"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_render_equals_the_command_line(cli, tmp_path):
+    import subprocess
+    from conftest import EXAMPLES
+    result = flexkin.run_scenario(EXAMPLES / "fig12_spatial_curve.json")
+    path = tmp_path / "result.npz"
+    result.write(path)
+    formats = "svg,html,gltf,glb"
+    subprocess.run([cli, "render", str(path), "--formats", formats, "--width", "300",
+                    "--azimuth", "10", "-o", str(tmp_path / "cli"), "-q"], check=True)
+    files = flexkin.render(flexkin.read_result(path), tmp_path / "py", formats, width=300,
+                           azimuth=10)
+    import re
+    for file in files:                   # bit for bit (but cairo's process-wide surface numbers)
+        name = file.rsplit("/", 1)[1]
+        ours, theirs = open(file, "rb").read(), (tmp_path / "cli" / name).read_bytes()
+        if name.endswith(".svg"):
+            ours, theirs = (re.sub(rb'id="surface\d+"', b"", x) for x in (ours, theirs))
+        assert ours == theirs, name
