@@ -29,9 +29,22 @@ Eigen::MatrixXd OptionalRows(py::handle object, const std::string& name, int row
   return Eigen::MatrixXd(p);
 }
 
-JointAngles AnglesArg(const ArmModel& model, py::handle angles, py::handle azimuths) {
+// Joint angles (n,) and azimuths (n,): given for spherical joints (unless `need_azimuths` is
+// false), None for revolute joints.
+JointAngles AnglesArg(const ArmModel& model, py::handle angles, py::handle azimuths,
+                      bool need_azimuths = true) {
   JointAngles a;
   a.angle = ReadArray(angles, "angles", 1, 1, 0, model.num_links()).cast<Eigen::VectorXd>();
+  const bool spherical = model.joint() == ArmJoint::kSpherical;
+  if (!spherical && !azimuths.is_none()) {
+    ThrowInput("azimuths", "given for an arm with revolute joints; expected None", "", "None");
+  }
+  if (spherical && need_azimuths && azimuths.is_none()) {
+    ThrowInput("azimuths",
+               "is None; expected " + std::to_string(model.num_links()) +
+                   " values, the azimuths of the spherical joints (radians)",
+               "None", std::to_string(model.num_links()) + " values");
+  }
   a.azimuth = OptionalVector(azimuths, "azimuths", model.num_links());
   return a;
 }
@@ -330,7 +343,7 @@ continue from it (with the solver's memory, which pickles with it).
       "within_limits",
       [](py::handle model, py::handle angles, py::handle azimuths, double slack) {
         const ArmModel& a = ModelArg(model);
-        const JointAngles joint = AnglesArg(a, angles, azimuths);
+        const JointAngles joint = AnglesArg(a, angles, azimuths, false);
         return WithinLimits(a, joint, CheckFinite(slack, "slack"));
       },
       py::arg("model"), py::arg("angles"), py::arg("azimuths") = py::none(), py::kw_only(),

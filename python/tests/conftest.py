@@ -17,3 +17,30 @@ def cli():
     if not path or not os.path.exists(path):
         pytest.skip("the flexkin command line is not built (FLEXKIN_CLI)")
     return path
+
+
+@pytest.fixture
+def fake_tqdm(monkeypatch):
+    """A stand-in tqdm module; returns the list of what the bars were told: ("total", n),
+    ("update", n), ("close",)."""
+    import sys
+    import types
+    updates = []
+
+    class FakeBar:
+        def __init__(self, total, unit):
+            updates.append(("total", total))
+
+        def update(self, n):
+            updates.append(("update", n))
+
+        def close(self):
+            updates.append(("close",))
+
+    monkeypatch.setitem(sys.modules, "tqdm", types.SimpleNamespace(tqdm=FakeBar))
+    return updates
+
+
+def updated(updates):
+    """The sum of a fake tqdm bar's updates."""
+    return sum(n for kind, *n in updates if kind == "update" for n in n)

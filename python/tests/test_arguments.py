@@ -115,13 +115,21 @@ def test_scenario_errors():
     assert error(flexkin.run_robot, {"arm": {}}).field.startswith("/")
 
 
-def test_files_that_cannot_be_read_are_oserrors(tmp_path):
-    missing = tmp_path / "missing.json"
-    with pytest.raises(FileNotFoundError) as info:
-        flexkin.run_scenario(missing)
-    assert str(missing) in str(info.value)
-    with pytest.raises(OSError):
-        flexkin.run_robot(str(missing))
+READERS = [flexkin.run_scenario, flexkin.load_scenario, flexkin.validate_scenario,
+           flexkin.run_robot, flexkin.load_robot_scenario, flexkin.read_result]
+if hasattr(flexkin._flexkin, "arm_from_urdf"):
+    READERS.append(flexkin.arm_from_urdf)
+
+
+@pytest.mark.parametrize("reader", READERS, ids=lambda f: f.__name__)
+def test_files_that_cannot_be_read_are_oserrors(reader, tmp_path):
+    for missing in (tmp_path / "missing.json", str(tmp_path / "missing.json")):
+        with pytest.raises(FileNotFoundError) as info:
+            reader(missing)
+        assert str(missing) in str(info.value)
+
+
+def test_a_file_that_is_not_json_names_its_path(tmp_path):
     bad = tmp_path / "bad.json"
     bad.write_text('{"curve": ')
     e = error(flexkin.run_scenario, bad)

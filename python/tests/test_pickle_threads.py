@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import flexkin
-from conftest import EXAMPLES
+from conftest import EXAMPLES, updated
 
 
 def test_pickle_round_trips():
@@ -93,26 +93,11 @@ def test_ctrl_c_stops_a_run():
         timer.cancel()
 
 
-def test_progress_true_uses_tqdm_when_installed(monkeypatch):
-    import sys
-    import types
-    updates = []
-
-    class FakeBar:
-        def __init__(self, total, unit):
-            updates.append(("total", total))
-
-        def update(self, n):
-            updates.append(("update", n))
-
-        def close(self):
-            updates.append(("close",))
-
-    monkeypatch.setitem(sys.modules, "tqdm", types.SimpleNamespace(tqdm=FakeBar))
+def test_progress_true_uses_tqdm_when_installed(fake_tqdm):
     res = flexkin.run(flexkin.parabola(links=5), [[0.1, 0.1], [0.2, 0.2]], progress=True)
     assert res.frames.shape == (3, 6, 2)
-    assert updates[0] == ("total", 2) and updates[-1] == ("close",)
-    assert sum(n for kind, *n in updates if kind == "update" for n in n) == 2
+    assert fake_tqdm[0] == ("total", 2) and fake_tqdm[-1] == ("close",)
+    assert updated(fake_tqdm) == 2
 
 
 def test_the_gil_is_released_during_a_run():
