@@ -74,7 +74,7 @@ _RENDER_WHAT = ("the render, viewer and glTF components are built with the apps 
                 "configure with FLEXKIN_BUILD_APPS=ON")
 _URDF_WHAT = ("the URDF component needs Debian's liburdfdom-dev",
               "install it and configure again")
-for _name in _RENDER_CLASSES + ("render",):
+for _name in _RENDER_CLASSES + ("render", "gltf_joint_positions"):
     globals()[_name] = getattr(_flexkin, _name, None) or _not_built(_name, *_RENDER_WHAT)
 for _name in ("arm_from_urdf", "urdf_from_arm"):
     globals()[_name] = getattr(_flexkin, _name, None) or _not_built(_name, *_URDF_WHAT)
@@ -153,7 +153,7 @@ __all__ = [
     "OverallOptions", "OverallReport", "OverallRunReport", "PlotOptions", "Result",
     "RobotResult", "RobotScenario", "RunOptions", "Scenario", "ViewerOptions",
     "arc", "arm_from_urdf", "arm_step", "estimate_output", "follow_the_leader_step",
-    "forward_kinematics", "helix", "joint_angles_from_points", "joint_quaternions", "line",
+    "forward_kinematics", "gltf_joint_positions", "helix", "joint_angles_from_points", "joint_quaternions", "line",
     "load_robot_scenario", "load_scenario", "move_leader", "overall_objective", "overall_step",
     "parabola", "read_result", "render", "resample_path", "run", "run_robot", "run_scenario",
     "split_pull", "track_path", "tractrix_step", "urdf_from_arm", "validate_scenario",

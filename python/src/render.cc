@@ -7,6 +7,7 @@
 
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <system_error>
@@ -334,10 +335,47 @@ GltfOptions(**fields): every field below by keyword, the rest at their defaults.
       .Finish();
 }
 
+// The joint positions of a glTF file at its keyframes: (times (K,), positions (K, joints, dim)).
+py::tuple GltfJointPositions(py::handle path_arg) {
+  const std::string path = PathArg(path_arg);
+  if (path.empty()) ThrowInput("path", "is not a path; expected a str or os.PathLike");
+  GltfJointMotion motion;
+  try {
+    py::gil_scoped_release release;
+    motion = ReadGltfJointPositions(path);
+  } catch (const InputError& e) {
+    Problem p = e.problem();
+    p.field = p.field.empty() ? path : path + ": " + p.field;
+    throw InputError(p);
+  }
+  const int64_t count = static_cast<int64_t>(motion.positions.size());
+  const int64_t joints = count > 0 ? motion.positions.front().rows() : 0;
+  py::array_t<double> times(count), positions({count, joints, static_cast<int64_t>(motion.dim)});
+  for (int64_t k = 0; k < count; ++k) {
+    const Points& p = motion.positions[static_cast<size_t>(k)];
+    if (p.rows() != joints || p.cols() != motion.dim) {
+      throw std::logic_error("flexkin: glTF keyframes of different shapes");
+    }
+    times.mutable_data()[k] = motion.times[static_cast<size_t>(k)];
+    std::copy(p.data(), p.data() + p.size(), positions.mutable_data() + k * p.size());
+  }
+  return py::make_tuple(times, positions);
+}
+
 }  // namespace
 
 void BindRender(py::module_& m) {
   BindOptionClasses(m);
+  m.def("gltf_joint_positions", &GltfJointPositions, py::arg("path"), R"doc(
+Reads a .gltf or .glb file (told apart by content) and evaluates its first animation at each
+keyframe: returns (times, positions), times (K,) float64 seconds and positions (K, joints, dim)
+float64, the world positions of the first skin's joints. For a file written by flexkin.render
+(formats gltf, glb) they are in flexkin's coordinates and length unit (the axis mapping and
+scale undone; dim the result's), one joint per point, leading end first: the frames to float32
+precision, at the times steps / GltfOptions.steps_per_second. Other files: glTF world
+coordinates, metres, dim 3. Raises OSError for a file that cannot be read, InputError for one
+that is not valid glTF, has no skin, or uses what the reader does not support.
+)doc");
   std::string formats_doc;
   for (const auto& entry : Vocabulary<OutputFormat>::kEntries) {
     formats_doc += std::string("\n  ") + entry.name + ": " + entry.summary;

@@ -1,6 +1,7 @@
 """flexkin.render: the files of `flexkin render` from a Result."""
 import shutil
 
+import numpy as np
 import pytest
 
 import flexkin
@@ -134,3 +135,22 @@ def test_render_equals_the_command_line(cli, tmp_path):
         if name.endswith(".svg"):
             ours, theirs = (re.sub(rb'id="surface\d+"', b"", x) for x in (ours, theirs))
         assert ours == theirs, name
+
+
+@pytest.mark.parametrize("up_axis", ["auto", "y", "z"])
+def test_gltf_animation_reads_back_as_the_frames(tmp_path, up_axis):
+    from conftest import EXAMPLES
+    result = flexkin.run_scenario(EXAMPLES / "fig12_spatial_curve.json")
+    options = flexkin.GltfOptions(steps_per_second=10, scale=2.0, up_axis=up_axis)
+    for fmt in ("glb", "gltf"):
+        (path,) = flexkin.render(result, tmp_path, [fmt], gltf=options)
+        times, positions = flexkin.gltf_joint_positions(path)
+        assert positions.shape == result.frames.shape
+        assert np.allclose(times, result.steps / 10)
+        scale = np.abs(result.frames).max()
+        assert np.abs(positions - result.frames).max() < 1e-6 * scale
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.gltf_joint_positions(EXAMPLES / "fig12_spatial_curve.json")
+    assert str(EXAMPLES / "fig12_spatial_curve.json") in info.value.field
+    with pytest.raises(FileNotFoundError):
+        flexkin.gltf_joint_positions(tmp_path / "missing.glb")
