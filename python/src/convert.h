@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <system_error>
 
 #include "flexkin/arm.h"
 #include "flexkin/chain.h"
@@ -112,4 +113,25 @@ namespace flexkin::python {
 std::string JsonOfDict(py::handle dict, const std::string& name);
 // A path (str or os.PathLike) as a string, or "" if `object` is not one.
 std::string PathArg(py::handle object);
+// A path argument, else InputError naming `name`; with `optional`, None is "".
+std::string RequiredPath(py::handle object, const std::string& name, bool optional = false);
+// A std::system_error with `path` in its message (raised as OSError).
+[[noreturn]] void RethrowWithPath(const std::system_error& error, const std::string& path);
+// An InputError with the file's path before its field, as the command line prints it.
+[[noreturn]] void RethrowInFile(const InputError& error, const std::string& path);
+
+// `access()` on the file the user named at `path` (reading or writing it), with the GIL
+// released: an InputError gets the path before its field, a std::system_error the path in its
+// message. `access` must not touch Python objects.
+template <typename Access>
+auto OnFile(const std::string& path, Access access) -> decltype(access()) {
+  try {
+    py::gil_scoped_release release;
+    return access();
+  } catch (const InputError& e) {
+    RethrowInFile(e, path);
+  } catch (const std::system_error& e) {
+    RethrowWithPath(e, path);
+  }
+}
 }  // namespace flexkin::python

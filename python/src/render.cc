@@ -141,8 +141,7 @@ std::vector<std::string> Render(py::handle result, py::handle out_dir, py::handl
                                 py::object ffmpeg, py::handle figure, py::handle plot,
                                 py::handle animation, py::handle viewer, py::handle gltf) {
   const std::vector<OutputFormat> chosen = FormatsArg(formats);
-  const std::string dir = PathArg(out_dir);
-  if (dir.empty()) ThrowInput("out_dir", "is not a path; expected a str or os.PathLike");
+  const std::string dir = RequiredPath(out_dir, "out_dir");
   if (stem.empty() || stem.find('/') != std::string::npos) {
     ThrowInput("stem", "must be a file name without '/'", Quoted(stem));
   }
@@ -337,17 +336,8 @@ GltfOptions(**fields): every field below by keyword, the rest at their defaults.
 
 // The joint positions of a glTF file at its keyframes: (times (K,), positions (K, joints, dim)).
 py::tuple GltfJointPositions(py::handle path_arg) {
-  const std::string path = PathArg(path_arg);
-  if (path.empty()) ThrowInput("path", "is not a path; expected a str or os.PathLike");
-  GltfJointMotion motion;
-  try {
-    py::gil_scoped_release release;
-    motion = ReadGltfJointPositions(path);
-  } catch (const InputError& e) {
-    Problem p = e.problem();
-    p.field = p.field.empty() ? path : path + ": " + p.field;
-    throw InputError(p);
-  }
+  const std::string path = RequiredPath(path_arg, "path");
+  const GltfJointMotion motion = OnFile(path, [&] { return ReadGltfJointPositions(path); });
   const int64_t count = static_cast<int64_t>(motion.positions.size());
   const int64_t joints = count > 0 ? motion.positions.front().rows() : 0;
   py::array_t<double> times(count), positions({count, joints, static_cast<int64_t>(motion.dim)});

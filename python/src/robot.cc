@@ -109,14 +109,6 @@ class StepArrays : public ArmStepSink {
   std::vector<bool*> bool_data_;
 };
 
-// A path argument that may be None ("").
-std::string OptionalPath(py::handle object, const std::string& name) {
-  if (object.is_none()) return "";
-  const std::string path = PathArg(object);
-  if (path.empty()) ThrowInput(name, "is not a path; expected a str or os.PathLike, or None");
-  return path;
-}
-
 RobotScenario RobotScenarioArg(py::handle scenario, py::handle directory) {
   if (py::isinstance<RobotScenario>(scenario)) return py::cast<RobotScenario>(scenario);
   if (py::isinstance<py::dict>(scenario)) {
@@ -129,13 +121,8 @@ RobotScenario RobotScenarioArg(py::handle scenario, py::handle directory) {
                    "; expected a path to a robot scenario file, a dict of its JSON form or a "
                    "RobotScenario");
   }
-  try {
-    return LoadRobotScenarioFile(path, RobotReaderOptions(directory));
-  } catch (const InputError& e) {
-    Problem p = e.problem();  // the file's name before the JSON pointer, as `flexkin robot`
-    p.field = p.field.empty() ? path : path + ": " + p.field;
-    throw InputError(p);
-  }
+  const RobotScenarioOptions options = RobotReaderOptions(directory);
+  return OnFile(path, [&] { return LoadRobotScenarioFile(path, options); });
 }
 
 // TrackPath of the scenario into the arrays of a RobotResult, and into the trajectory JSON at
@@ -192,7 +179,8 @@ RobotResult RunRobot(py::handle scenario, py::handle directory, py::object metho
                      py::object progress, py::handle output, py::handle csv) {
   RobotScenario s = RobotScenarioArg(scenario, directory);
   if (!method.is_none()) s.options.method = ParseFixedBaseMethod(py::cast<std::string>(method));
-  return Track(s, std::move(progress), OptionalPath(output, "output"), OptionalPath(csv, "csv"));
+  return Track(s, std::move(progress), RequiredPath(output, "output", true),
+               RequiredPath(csv, "csv", true));
 }
 
 std::string RobotRepr(const RobotResult& r) {
@@ -248,14 +236,14 @@ RobotScenarioOptions RobotReaderOptions(py::handle directory) {
 #else
   RobotScenarioOptions options;
 #endif
-  options.directory = OptionalPath(directory, "directory");
+  options.directory = RequiredPath(directory, "directory", true);
   return options;
 }
 
 py::object TrackToResult(const RobotScenario& scenario, py::object progress, py::handle output,
                          py::handle csv) {
-  return py::cast(Track(scenario, std::move(progress), OptionalPath(output, "output"),
-                        OptionalPath(csv, "csv")));
+  return py::cast(Track(scenario, std::move(progress), RequiredPath(output, "output", true),
+                        RequiredPath(csv, "csv", true)));
 }
 
 void BindRobot(py::module_& m) {

@@ -110,18 +110,6 @@ Result RunToArrays(const Chain& chain, const Points& leader_steps, RunOptions op
   return result;
 }
 
-// A scenario file's InputError with the file's path before its JSON pointer, as `flexkin run`
-// prints it; field() stays the pointer.
-Scenario LoadScenarioPath(const std::string& path) {
-  try {
-    return LoadScenarioFile(path);
-  } catch (const InputError& e) {
-    Problem p = e.problem();
-    p.field = p.field.empty() ? path : path + ": " + p.field;
-    throw InputError(p);
-  }
-}
-
 }  // namespace
 
 // JSON text of a dict (numpy arrays and numbers as lists and numbers) for the scenario readers.
@@ -148,6 +136,28 @@ std::string PathArg(py::handle object) {
   return "";
 }
 
+std::string RequiredPath(py::handle object, const std::string& name, bool optional) {
+  if (optional && object.is_none()) return "";
+  const std::string path = PathArg(object);
+  if (path.empty()) {
+    ThrowInput(name, std::string("is not a path; expected a str or os.PathLike") +
+                         (optional ? ", or None" : ""));
+  }
+  return path;
+}
+
+void RethrowWithPath(const std::system_error& error, const std::string& path) {
+  const std::string what = error.what();
+  if (what.find(path) != std::string::npos) throw error;
+  throw std::system_error(error.code(), path + ": " + what);
+}
+
+void RethrowInFile(const InputError& error, const std::string& path) {
+  Problem p = error.problem();
+  p.field = p.field.empty() ? path : path + ": " + p.field;
+  throw InputError(p);
+}
+
 namespace {
 
 Scenario ScenarioArg(py::handle scenario) {
@@ -160,7 +170,7 @@ Scenario ScenarioArg(py::handle scenario) {
                "is a " + std::string(py::str(py::type::of(scenario).attr("__name__"))) +
                    "; expected a path to a scenario file, a dict of its JSON form or a Scenario");
   }
-  return LoadScenarioPath(path);
+  return OnFile(path, [&] { return LoadScenarioFile(path); });
 }
 
 std::string ResultRepr(const Result& r) {
@@ -268,53 +278,22 @@ RunResult RunResultOf(const Result& r) {
   return run;
 }
 
-// A std::system_error with the path in its message (raised as OSError).
-[[noreturn]] void RethrowWithPath(const std::system_error& e, const std::string& path) {
-  const std::string what = e.what();
-  if (what.find(path) != std::string::npos) throw;
-  throw std::system_error(e.code(), path + ": " + what);
-}
-
 Result ReadResult(py::handle path_arg) {
-  const std::string path = PathArg(path_arg);
-  if (path.empty()) ThrowInput("path", "is not a path; expected a str or os.PathLike");
-  ResultFile file;
-  try {
-    py::gil_scoped_release release;
-    file = ReadResultFile(path);
-  } catch (const std::system_error& e) {
-    RethrowWithPath(e, path);
-  } catch (const InputError& e) {
-    Problem p = e.problem();
-    p.field = p.field.empty() ? path : path + ": " + p.field;
-    throw InputError(p);
-  }
-  return ResultOfFile(std::move(file));
+  const std::string path = RequiredPath(path_arg, "path");
+  return ResultOfFile(OnFile(path, [&] { return ReadResultFile(path); }));
 }
 
 void WriteResult(const Result& r, py::handle path_arg) {
-  const std::string path = PathArg(path_arg);
-  if (path.empty()) ThrowInput("path", "is not a path; expected a str or os.PathLike");
+  const std::string path = RequiredPath(path_arg, "path");
   const ResultFileFormat format = ResultFileFormatOfPath(path);
   const RunResult run = RunResultOf(r);
-  try {
-    py::gil_scoped_release release;
-    WriteResultFile(run, path, format, r.scenario);
-  } catch (const std::system_error& e) {
-    RethrowWithPath(e, path);
-  }
+  OnFile(path, [&] { WriteResultFile(run, path, format, r.scenario); });
 }
 
 void WriteCsv(const Result& r, py::handle path_arg) {
-  const std::string path = PathArg(path_arg);
-  if (path.empty()) ThrowInput("path", "is not a path; expected a str or os.PathLike");
+  const std::string path = RequiredPath(path_arg, "path");
   const RunResult run = RunResultOf(r);
-  try {
-    py::gil_scoped_release release;
-    WriteFramesCsv(run, path);
-  } catch (const std::system_error& e) {
-    RethrowWithPath(e, path);
-  }
+  OnFile(path, [&] { WriteFramesCsv(run, path); });
 }
 
 py::list ProblemList(const Problems& problems) {
@@ -342,14 +321,11 @@ py::list ValidateScenario(py::handle scenario, py::handle directory) {
   if (path.empty()) {
     ThrowInput("scenario", "is not a path or a dict; expected a path to a scenario file or a dict");
   }
-  try {
-    if (IsRobotScenarioFile(path)) {
-      return ProblemList(ValidateRobotScenarioFile(path, RobotReaderOptions(directory)));
-    }
-    return ProblemList(ValidateScenarioFile(path));
-  } catch (const std::system_error& e) {
-    RethrowWithPath(e, path);
-  }
+  const RobotScenarioOptions options = RobotReaderOptions(directory);
+  return ProblemList(OnFile(path, [&] {
+    return IsRobotScenarioFile(path) ? ValidateRobotScenarioFile(path, options)
+                                     : ValidateScenarioFile(path);
+  }));
 }
 
 py::dict EstimateOutput(int num_links, int dim, int64_t num_steps, int record_every,

@@ -34,14 +34,7 @@ ArmModel ArmFromUrdfArg(py::handle source, const std::string& base_link,
                "is a " + type + "; expected URDF text (a str starting with '<') or a path", type,
                "str or os.PathLike");
   }
-  try {
-    py::gil_scoped_release release;
-    return ArmFromUrdfFile(path, chain);
-  } catch (const InputError& e) {
-    Problem p = e.problem();  // the file's name before the element, as `flexkin robot`
-    p.field = p.field.empty() ? path : path + ": " + p.field;
-    throw InputError(p);
-  }
+  return OnFile(path, [&] { return ArmFromUrdfFile(path, chain); });
 }
 
 }  // namespace
