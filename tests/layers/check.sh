@@ -13,7 +13,7 @@ declare -A header_layer=(
   [link_step]=sequential [propagate]=sequential
   [overall]=overall
   [run]=run
-  [arm]=arm
+  [arm]=arm [strands]=strands
   [scenario]=io [result_io]=io [robot_scenario]=io [flexkin]=umbrella
   [render]=render [viewer]=viewer [gltf]=gltf [urdf]=urdf
 )
@@ -24,6 +24,7 @@ declare -A allowed=(
   [overall]="chain sequential"
   [run]="chain sequential overall"
   [arm]="chain sequential"
+  [strands]="chain sequential"
   [io]="chain sequential overall run arm"
   [umbrella]="chain sequential overall run arm io"
   [render]="chain sequential overall run arm io"

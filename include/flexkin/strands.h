@@ -1,0 +1,103 @@
+#pragma once
+// Many strands at once (hair, fur, grass): a batch of independent chains, each with its own link
+// count and lengths, all 2D or all 3D, stepped by one call per frame. The batch holds the points
+// in the layout the engine wants (structure of arrays, strands of one link count side by side in
+// SIMD lanes) and is made once and reused: a frame allocates nothing.
+//
+// Each frame the roots move, given either as points (StepStrands(batch, roots)) or by the rigid
+// transform of the body they grow from (StepStrands(batch, pose)). The first `pinned` points of
+// each strand (k = 1 by default: the root alone) are set rigidly from the body; the rest of the
+// strand follows by the method's link rule, with the leading end of link k (point k-1) moving in a
+// straight line from its old to its new position in `substeps` equal sub-steps, exactly as
+// MoveLeader moves a single chain. Each strand's result is, bit for bit on the scalar engine and
+// to about 1e-14 relative on the SIMD ones, MoveLeader of its chain from point k-1 on to the new
+// point k-1 (docs/strands.md). Results do not depend on the number of threads, bit for bit.
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "flexkin/chain.h"
+#include "flexkin/error.h"
+#include "flexkin/propagate.h"
+
+namespace flexkin {
+
+struct StrandOptions {
+  // "tractrix" or "ftl" (follow-the-leader, the baseline of hair simulators).
+  Method method = Method::kTractrix;
+  // Sub-steps per frame (>= 1): the leading end of the first free link moves in this many equal
+  // straight pieces, as MoveLeader's substeps.
+  int substeps = 1;
+  // Points of each strand moved rigidly with the body (>= 1); a strand with fewer points is
+  // rigid as a whole. 1: the root point only. k > 1: the root link(s) leave the body along their
+  // rest direction.
+  int pinned = 1;
+  // Threads stepping the strands (>= 0; 0: std::thread::hardware_concurrency()). Only the speed
+  // depends on it, never the result.
+  int threads = 1;
+
+  // Problems with fields "method", "substeps", "pinned", "threads".
+  Problems Validate() const;
+};
+
+// The pose of the body the strands grow from: x -> rotation x + translation. In 2D the top-left
+// 2x2 block of `rotation` and the first two components of `translation` are used. `rotation`
+// must be a rotation (orthonormal, determinant +1) to within 1e-9.
+struct BodyPose {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+  // From a unit quaternion (w, x, y, z) (normalized here; it must not be zero) and a translation.
+  static BodyPose FromQuaternion(double w, double x, double y, double z,
+                                 const Eigen::Vector3d& translation);
+  // A planar pose: rotation by `angle` (radians) about z, then the translation (tx, ty).
+  static BodyPose Planar(double angle, double tx, double ty);
+};
+
+namespace internal {
+struct StrandBatchImpl;
+}
+
+// The strands and everything the engine needs between frames. Move-only.
+class StrandBatch {
+ public:
+  // `strands[i]` is strand i's points, (n_i + 1) by dim, row 0 its root; every strand must be a
+  // valid chain (ValidateChain: n_i >= 1, finite, links of positive length) and all of one dim
+  // (2 or 3). The strands are taken to be at the body pose `rest` (identity by default): their
+  // first `pinned` points are kept in body coordinates from these. Throws InputError naming
+  // "strands[i]" or an option's field.
+  StrandBatch(const std::vector<Points>& strands, const StrandOptions& options = {},
+              const BodyPose& rest = {});
+  StrandBatch(StrandBatch&&) noexcept;
+  StrandBatch& operator=(StrandBatch&&) noexcept;
+  ~StrandBatch();
+
+  int size() const;                 // number of strands
+  int dim() const;                  // 2 or 3 (0 for an empty batch)
+  int num_links(int strand) const;  // n_i
+  const StrandOptions& options() const;
+  // The engine that steps the batch: "avx512", "avx2" or "scalar" (FLEXKIN_SIMD caps it).
+  const char* engine() const;
+
+  // Strand `strand`'s points now, (n_i + 1) by dim. Throws InputError ("strand") out of range.
+  Points strand(int strand) const;
+  void CopyStrand(int strand, Points* out) const;  // the same into a reused matrix
+
+  internal::StrandBatchImpl& impl() { return *impl_; }
+
+ private:
+  std::unique_ptr<internal::StrandBatchImpl> impl_;
+};
+
+// One frame: the body moves to `pose`; each strand's first k points go to pose(their body
+// coordinates) and the rest follows. Allocates nothing. Throws InputError ("pose.rotation",
+// "pose.translation") for a non-finite pose or a rotation that is not one.
+void StepStrands(StrandBatch* batch, const BodyPose& pose);
+
+// One frame: root i moves to `roots.row(i)` (S by dim); the strand's other pinned points (k > 1)
+// translate with it. Allocates nothing. Throws InputError ("roots") for a wrong shape or a
+// non-finite value.
+void StepStrands(StrandBatch* batch, const Eigen::Ref<const Points>& roots);
+
+}  // namespace flexkin
