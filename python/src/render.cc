@@ -114,6 +114,7 @@ std::vector<OutputFormat> FormatsArg(py::handle formats) {
   for (size_t i = 0; i < chosen.size(); ++i) {
     if (chosen[i]) out.push_back(Vocabulary<OutputFormat>::kEntries[i].value);
   }
+  if (out.empty()) ThrowInput("formats", "is empty; expected at least one format name");
   return out;
 }
 

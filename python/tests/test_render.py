@@ -111,6 +111,10 @@ def test_option_classes_check_their_fields(small_result, tmp_path):
     with pytest.raises(flexkin.InputError) as info:
         flexkin.AnimationOptions(fps="fast")
     assert info.value.field == "fps"
+    for empty in ([], ()):
+        with pytest.raises(flexkin.InputError) as info:
+            flexkin.render(small_result, tmp_path, empty)
+        assert info.value.field == "formats"
     with pytest.raises(flexkin.InputError) as info:
         flexkin.render(small_result, tmp_path, ["png"], every=-1)
     assert info.value.field == "every"
