@@ -49,6 +49,16 @@ JointAngles AnglesArg(const ArmModel& model, py::handle angles, py::handle azimu
   return a;
 }
 
+// The getter and setter of a member of an ArmStepReport's solver memory (pickled, not shown).
+template <typename E>
+auto MemoryGet(E ArmSolverMemory::*member) {
+  return [member](const ArmStepReport& r) { return r.state.memory.*member; };
+}
+template <typename E>
+auto MemorySet(E ArmSolverMemory::*member) {
+  return [member](ArmStepReport& r, py::handle v) { r.state.memory.*member = EigenIn<E>(v); };
+}
+
 py::object AzimuthsOrNone(const Eigen::VectorXd& azimuth) {
   return azimuth.size() > 0 ? py::object(ToArray(azimuth)) : py::none();
 }
@@ -276,28 +286,14 @@ continue from it (with the solver's memory, which pickles with it).
       .Member("legs", &ArmStepReport::legs,
               "Legs a far move was tracked in (0: one sweep; docs/robots.md).")
       .Member("restarts", &ArmStepReport::restarts, "Joint-space solves after the first.")
-      .Hidden(
-          "memory_translation", [](const ArmStepReport& r) { return r.state.memory.translation; },
-          [](ArmStepReport& r, py::handle v) {
-            r.state.memory.translation = EigenIn<Eigen::VectorXd>(v);
-          })
-      .Hidden(
-          "memory_earlier_translations",
-          [](const ArmStepReport& r) { return r.state.memory.earlier_translations; },
-          [](ArmStepReport& r, py::handle v) {
-            r.state.memory.earlier_translations = EigenIn<Eigen::MatrixXd>(v);
-          })
-      .Hidden(
-          "memory_move_lengths", [](const ArmStepReport& r) { return r.state.memory.move_lengths; },
-          [](ArmStepReport& r, py::handle v) {
-            r.state.memory.move_lengths = EigenIn<Eigen::VectorXd>(v);
-          })
-      .Hidden(
-          "memory_prediction_error",
-          [](const ArmStepReport& r) { return r.state.memory.prediction_error; },
-          [](ArmStepReport& r, py::handle v) {
-            r.state.memory.prediction_error = EigenIn<Eigen::VectorXd>(v);
-          })
+      .Hidden("memory_translation", MemoryGet(&ArmSolverMemory::translation),
+              MemorySet(&ArmSolverMemory::translation))
+      .Hidden("memory_earlier_translations", MemoryGet(&ArmSolverMemory::earlier_translations),
+              MemorySet(&ArmSolverMemory::earlier_translations))
+      .Hidden("memory_move_lengths", MemoryGet(&ArmSolverMemory::move_lengths),
+              MemorySet(&ArmSolverMemory::move_lengths))
+      .Hidden("memory_prediction_error", MemoryGet(&ArmSolverMemory::prediction_error),
+              MemorySet(&ArmSolverMemory::prediction_error))
       .Finish(false);
   step.def("brief_report", &ArmStepReport::BriefReport,
            "One line: reached or not, errors, iterations, sweeps, flags.");
