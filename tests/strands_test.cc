@@ -207,6 +207,14 @@ TEST(Strands, RootPointsTranslatePinnedPoints) {
   }
 }
 
+// The strands after 30 frames of the wobbling body (3D).
+std::vector<Points> ThirtyFrames(StrandBatch* batch) {
+  for (int frame = 1; frame <= 30; ++frame) StepStrands(batch, PoseAt(frame, 3));
+  std::vector<Points> out;
+  for (int s = 0; s < batch->size(); ++s) out.push_back(batch->strand(s));
+  return out;
+}
+
 // Bit for bit the same whatever the number of threads.
 TEST(Strands, DeterministicAcrossThreads) {
   const std::vector<Points> strands = MakeStrands(300, 3, {3, 16, 31, 32}, 5);
@@ -216,10 +224,7 @@ TEST(Strands, DeterministicAcrossThreads) {
     options.threads = threads;
     options.pinned = 2;
     StrandBatch batch(strands, options);
-    for (int frame = 1; frame <= 30; ++frame) StepStrands(&batch, PoseAt(frame, 3));
-    std::vector<Points> out;
-    for (int s = 0; s < batch.size(); ++s) out.push_back(batch.strand(s));
-    results.push_back(out);
+    results.push_back(ThirtyFrames(&batch));
   }
   for (size_t r = 1; r < results.size(); ++r) {
     for (size_t s = 0; s < strands.size(); ++s) {
@@ -236,10 +241,7 @@ TEST(Strands, SimdWidthsAgree) {
     StrandBatch batch(strands);
     ASSERT_TRUE(internal::SetStrandEngine(&batch, engine.c_str()));
     EXPECT_EQ(std::string(batch.engine()), engine);
-    for (int frame = 1; frame <= 30; ++frame) StepStrands(&batch, PoseAt(frame, 3));
-    std::vector<Points> out;
-    for (int s = 0; s < batch.size(); ++s) out.push_back(batch.strand(s));
-    results.push_back(out);
+    results.push_back(ThirtyFrames(&batch));
   }
   for (size_t r = 1; r < results.size(); ++r) {
     for (size_t s = 0; s < strands.size(); ++s) {
