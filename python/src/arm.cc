@@ -90,10 +90,10 @@ ArmModel(link_lengths, *, dim=2, base=None, base_direction=None, joint_min=None,
 Planar arms (dim 2) and arms with joint_axes have revolute joints, other spatial arms spherical.
 )doc");
   model
-      .def(py::init([](py::handle link_lengths, int dim, py::handle base, py::handle direction,
-                       py::handle joint_min, py::handle joint_max, py::handle max_bend,
-                       py::handle joint_axes, py::handle link_directions, py::handle angles,
-                       py::handle azimuths) {
+      .def(py::init([](ArrayLike link_lengths, int dim, OptionalArray base, OptionalArray direction,
+                       OptionalArray joint_min, OptionalArray joint_max, OptionalArray max_bend,
+                       OptionalArray joint_axes, OptionalArray link_directions,
+                       OptionalArray angles, OptionalArray azimuths) {
              ArmModel a;
              a.dim = dim;
              if (dim != 2 && dim != 3) {
@@ -303,7 +303,7 @@ continue from it (with the solver's memory, which pickles with it).
 
   m.def(
       "forward_kinematics",
-      [](py::handle model, py::handle angles, py::handle azimuths) {
+      [](ModelObject model, ArrayLike angles, OptionalArray azimuths) {
         const ArmModel& a = ModelArg(model);
         return ToArray(ForwardKinematics(a, AnglesArg(a, angles, azimuths)));
       },
@@ -312,7 +312,7 @@ continue from it (with the solver's memory, which pickles with it).
       "(n,) (radians; and azimuths (n,) for spherical joints).");
   m.def(
       "joint_angles_from_points",
-      [](py::handle model, py::handle points) {
+      [](ModelObject model, ArrayLike points) {
         const ArmModel& a = ModelArg(model);
         const Points p = ReadPoints(points, "points", a.num_links() + 1, a.dim);
         if (p.rows() != a.num_links() + 1) {
@@ -327,7 +327,7 @@ continue from it (with the solver's memory, which pickles with it).
       "(n+1, dim) (base first) are given.");
   m.def(
       "joint_quaternions",
-      [](py::handle model, py::handle angles, py::handle azimuths) {
+      [](ModelObject model, ArrayLike angles, OptionalArray azimuths) {
         const ArmModel& a = ModelArg(model);
         return ToArray(Points(JointQuaternions(a, AnglesArg(a, angles, azimuths))));
       },
@@ -337,7 +337,7 @@ continue from it (with the solver's memory, which pickles with it).
       "azimuths (n,) for spherical joints). Planar arms: rotations about z.");
   m.def(
       "within_limits",
-      [](py::handle model, py::handle angles, py::handle azimuths, double slack) {
+      [](ModelObject model, ArrayLike angles, OptionalArray azimuths, double slack) {
         const ArmModel& a = ModelArg(model);
         const JointAngles joint = AnglesArg(a, angles, azimuths, false);
         return WithinLimits(a, joint, CheckFinite(slack, "slack"));
@@ -348,7 +348,7 @@ continue from it (with the solver's memory, which pickles with it).
       "radians of tolerance (default 0). True for a model without limits.");
   m.def(
       "arm_step",
-      [](py::handle model, py::handle target, py::handle state, py::handle options) {
+      [](ModelObject model, ArrayLike target, StepState state, ArmOptionsLike options) {
         const ArmModel& a = ModelArg(model);
         ThrowIfAny(a.Validate());
         const Eigen::VectorXd t = ReadVector(target, "target", a.dim);
@@ -371,8 +371,8 @@ continue from it (with the solver's memory, which pickles with it).
       "ArmOptions, a dict of its fields or None. Returns an ArmStepReport.");
   m.def(
       "track_path",
-      [](py::handle model, py::handle path, py::handle options, py::object progress,
-         py::handle output, py::handle csv) {
+      [](ModelObject model, ArrayLike path, ArmOptionsLike options, ProgressCallback progress,
+         OptionalPath output, OptionalPath csv) {
         RobotScenario s;
         s.model = ModelArg(model);
         ThrowIfAny(s.model.Validate());

@@ -79,7 +79,7 @@ Chain(points, *, link_length=None, lengths=None)
   lengths: the n link lengths; else the distances between consecutive points.
 )doc");
   chain
-      .def(py::init([](py::handle points, py::object link_length, py::object lengths) {
+      .def(py::init([](ArrayLike points, OptionalFloat link_length, OptionalArray lengths) {
              Points p = ReadPoints(points, "points", 2);
              if (!link_length.is_none() && !lengths.is_none()) {
                ThrowInput("lengths", "given with link_length; give one of them");
@@ -106,7 +106,7 @@ Chain(points, *, link_length=None, lengths=None)
            "Largest |(|p_i - p_{i-1}| - L_i)| / L_i over the links (dimensionless).")
       .def(
           "move_leader",
-          [](Chain& c, py::handle target, const std::string& method, int substeps) {
+          [](Chain& c, ArrayLike target, const std::string& method, int substeps) {
             MoveChain(&c, target, method, substeps);
           },
           py::arg("target"), py::kw_only(), py::arg("method") = "tractrix", py::arg("substeps") = 1,
@@ -114,7 +114,7 @@ Chain(points, *, link_length=None, lengths=None)
           "sub-steps, every link following by `method`; in place.")
       .def(
           "overall_step",
-          [](Chain& c, py::handle head, py::handle options) {
+          [](Chain& c, ArrayLike head, OverallLike options) {
             return StepChainOverall(&c, head, options);
           },
           py::arg("head"), py::kw_only(), py::arg("options") = py::none(),
@@ -139,7 +139,7 @@ Chain(points, *, link_length=None, lengths=None)
 
   m.def(
       "line",
-      [](py::handle start, py::handle direction, int links, double link_length) {
+      [](ArrayLike start, ArrayLike direction, int links, double link_length) {
         LineDef d;
         d.start = ReadVector(start, "start");
         d.direction = ReadVector(direction, "direction", static_cast<int>(d.start.size()));
@@ -169,7 +169,7 @@ Chain(points, *, link_length=None, lengths=None)
       "of 0.25).");
   m.def(
       "arc",
-      [](double radius, py::handle center, double start_angle, bool clockwise, int links,
+      [](double radius, ArrayLike center, double start_angle, bool clockwise, int links,
          double link_length) {
         ArcDef d;
         d.radius = radius;
@@ -187,7 +187,7 @@ Chain(points, *, link_length=None, lengths=None)
       "(links+1, 2) float64.");
   m.def(
       "helix",
-      [](double radius, double pitch, py::handle center, double start_angle, bool clockwise,
+      [](double radius, double pitch, ArrayLike center, double start_angle, bool clockwise,
          int links, double link_length) {
         HelixDef d;
         d.radius = radius;
@@ -207,7 +207,7 @@ Chain(points, *, link_length=None, lengths=None)
 
   m.def(
       "split_pull",
-      [](py::handle start, py::handle pull, int64_t steps) {
+      [](ArrayLike start, ArrayLike pull, int64_t steps) {
         const Eigen::VectorXd s = ReadVector(start, "start");
         return ToArray(SplitPull(s, ReadVector(pull, "pull", static_cast<int>(s.size())), steps));
       },
@@ -216,7 +216,7 @@ Chain(points, *, link_length=None, lengths=None)
       "last exactly start + pull.");
   m.def(
       "resample_path",
-      [](py::handle start, py::handle path, double max_step) {
+      [](ArrayLike start, ArrayLike path, double max_step) {
         const Eigen::VectorXd s = ReadVector(start, "start");
         return ToArray(
             ResamplePath(s, ReadPoints(path, "path", 1, static_cast<int>(s.size())), max_step));
@@ -227,7 +227,7 @@ Chain(points, *, link_length=None, lengths=None)
 
   m.def(
       "tractrix_step",
-      [](py::handle head_old, py::handle head_new, py::handle tail, double length) {
+      [](ArrayLike head_old, ArrayLike head_new, ArrayLike tail, double length) {
         return LinkStep(
             head_old, head_new, tail, length,
             [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& t,
@@ -241,7 +241,7 @@ Chain(points, *, link_length=None, lengths=None)
       "the link (closed form). Returns (dim,) float64.");
   m.def(
       "follow_the_leader_step",
-      [](py::handle head_old, py::handle head_new, py::handle tail, double length) {
+      [](ArrayLike head_old, ArrayLike head_new, ArrayLike tail, double length) {
         return LinkStep(
             head_old, head_new, tail, length,
             [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& t,
@@ -255,7 +255,7 @@ Chain(points, *, link_length=None, lengths=None)
 
   m.def(
       "move_leader",
-      [](py::handle points, py::handle target, const std::string& method, int substeps) {
+      [](PointsOrChain points, ArrayLike target, const std::string& method, int substeps) {
         Chain chain = ChainArg(points);
         MoveChain(&chain, target, method, substeps);
         return ToArray(std::move(chain.points));
@@ -268,7 +268,7 @@ Chain(points, *, link_length=None, lengths=None)
       "(n+1, dim) points; the input is not changed (Chain.move_leader moves a chain in place).");
   m.def(
       "overall_step",
-      [](py::handle points, py::handle head, py::handle options) {
+      [](PointsOrChain points, ArrayLike head, OverallLike options) {
         Chain chain = ChainArg(points);
         OverallReport report = StepChainOverall(&chain, head, options);
         return py::make_tuple(ToArray(std::move(chain.points)), report);

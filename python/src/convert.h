@@ -27,6 +27,61 @@ namespace flexkin::python {
 
 namespace py = pybind11;
 
+// Argument types of the bound functions: any Python object, taken as it is and checked by the
+// binding (ReadArray, PathArg, ...), named in help()'s signatures by what is expected: Typed<Tag>
+// shows as Tag::kText ("ArrayLike", "Union[ArmOptions, dict, None]").
+inline bool AnyObject(PyObject*) { return true; }
+template <typename Tag>
+class Typed : public py::object {
+ public:
+  PYBIND11_OBJECT_DEFAULT(Typed, object, AnyObject)
+};
+
+#define FLEXKIN_PYTHON_ARG(Name, Text)    \
+  struct Name##Tag {                      \
+    static constexpr char kText[] = Text; \
+  };                                      \
+  using Name = Typed<Name##Tag>;
+
+FLEXKIN_PYTHON_ARG(ArrayLike, "ArrayLike")
+FLEXKIN_PYTHON_ARG(PathLike, "PathLike")
+FLEXKIN_PYTHON_ARG(ModelObject, "ArmModel")
+FLEXKIN_PYTHON_ARG(ResultObject, "Result")
+FLEXKIN_PYTHON_ARG(StepState, "Optional[ArmStepReport]")
+FLEXKIN_PYTHON_ARG(ScenarioSource, "Union[PathLike, dict, Scenario]")
+FLEXKIN_PYTHON_ARG(RobotScenarioSource, "Union[PathLike, dict, RobotScenario]")
+FLEXKIN_PYTHON_ARG(UrdfSource, "Union[str, PathLike]")
+FLEXKIN_PYTHON_ARG(ArmOptionsLike, "Union[ArmOptions, dict, None]")
+FLEXKIN_PYTHON_ARG(OverallLike, "Union[OverallOptions, ObjectiveWeights, dict, None]")
+FLEXKIN_PYTHON_ARG(WeightsLike, "Union[ObjectiveWeights, dict]")
+FLEXKIN_PYTHON_ARG(FormatList, "Union[str, Sequence[str]]")
+FLEXKIN_PYTHON_ARG(ProgressCallback, "Optional[Callable[[int, int], object]]")
+FLEXKIN_PYTHON_ARG(OptionalInt, "Optional[int]")
+FLEXKIN_PYTHON_ARG(OptionalFloat, "Optional[float]")
+FLEXKIN_PYTHON_ARG(OptionalStr, "Optional[str]")
+FLEXKIN_PYTHON_ARG(OptionalArray, "Optional[ArrayLike]")
+FLEXKIN_PYTHON_ARG(PointsOrChain, "Union[ArrayLike, Chain]")
+FLEXKIN_PYTHON_ARG(OptionalWeights, "Union[ObjectiveWeights, dict, None]")
+FLEXKIN_PYTHON_ARG(ScenarioFile, "Union[PathLike, dict]")
+FLEXKIN_PYTHON_ARG(OptionalPath, "Optional[PathLike]")
+FLEXKIN_PYTHON_ARG(FigureLike, "Union[FigureOptions, dict, None]")
+FLEXKIN_PYTHON_ARG(PlotLike, "Union[PlotOptions, dict, None]")
+FLEXKIN_PYTHON_ARG(AnimationLike, "Union[AnimationOptions, dict, None]")
+FLEXKIN_PYTHON_ARG(ViewerLike, "Union[ViewerOptions, dict, None]")
+FLEXKIN_PYTHON_ARG(GltfLike, "Union[GltfOptions, dict, None]")
+#undef FLEXKIN_PYTHON_ARG
+
+}  // namespace flexkin::python
+
+namespace pybind11::detail {
+template <typename Tag>
+struct handle_type_name<flexkin::python::Typed<Tag>> {
+  static constexpr auto name = const_name(Tag::kText);
+};
+}  // namespace pybind11::detail
+
+namespace flexkin::python {
+
 // The float64, C-contiguous form of `object`, checked: `ndim` dimensions (1 or 2); with ndim 2,
 // at least `min_rows` rows and 2 or 3 columns (`cols` if it is not 0); with ndim 1, `size`
 // values if it is > 0 (2 or 3 if it is 0, any number >= 1 if it is < 0). Every value finite. Throws
@@ -102,7 +157,8 @@ Method MethodArg(const std::string& name, const std::string& field = "method");
 OverallOptions OverallArg(py::handle object);
 // RunOptions from the keyword arguments of flexkin.run (options.cc).
 RunOptions MakeRunOptions(const std::string& method, int substeps, int record_every,
-                          double tolerance, int max_substeps, bool link_angles, py::handle overall);
+                          double tolerance, int max_substeps, bool link_angles,
+                          OverallLike overall);
 // A chain from a `Chain` or from points (link lengths the distances between them; MakeChain).
 Chain ChainArg(py::handle object, const std::string& name = "points");
 }  // namespace flexkin::python

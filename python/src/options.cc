@@ -16,7 +16,7 @@ namespace flexkin::python {
 
 RunOptions MakeRunOptions(const std::string& method, int substeps, int record_every,
                           double tolerance, int max_substeps, bool link_angles,
-                          py::handle overall) {
+                          OverallLike overall) {
   RunOptions o;
   o.method = MethodArg(method);
   o.substeps = substeps;
@@ -99,8 +99,8 @@ ObjectiveWeights WeightsArg(py::handle object) {
 
 // OverallObjective of checked arguments: the value, and with `gradient` or `hessian` a tuple of
 // it and the gradient (n dim,) (and the Hessian (n dim, n dim)).
-py::object Objective(py::handle weights, py::handle lengths, py::handle old_points,
-                     py::handle new_points, bool gradient, bool hessian) {
+py::object Objective(WeightsLike weights, ArrayLike lengths, ArrayLike old_points,
+                     ArrayLike new_points, bool gradient, bool hessian) {
   const ObjectiveWeights w = WeightsArg(weights);
   const Points old_p = ReadPoints(old_points, "old_points", 2);
   const Points new_p = ReadPoints(new_points, "new_points", 2, static_cast<int>(old_p.cols()));
@@ -184,7 +184,7 @@ OverallOptions(weights=None, constraint_tolerance=1e-12, optimality_tolerance=1e
   max_iterations: Newton iterations at most per step.
 )doc");
   overall.def(
-      py::init([](py::object weights, double constraint_tolerance, double optimality_tolerance,
+      py::init([](OptionalWeights weights, double constraint_tolerance, double optimality_tolerance,
                   int max_iterations) {
         if (py::isinstance<OverallOptions>(weights)) {
           ThrowInput("weights", "is an OverallOptions; expected ObjectiveWeights or a dict");

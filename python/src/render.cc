@@ -135,12 +135,12 @@ T CheckedOptions(py::handle object, const std::string& name) {
   return options;
 }
 
-std::vector<std::string> Render(py::handle result, py::handle out_dir, py::handle formats,
-                                const std::string& stem, py::object every, py::object width,
-                                py::object height, py::object azimuth, py::object elevation,
-                                py::object fps, py::object max_frames, py::object title,
-                                py::object ffmpeg, py::handle figure, py::handle plot,
-                                py::handle animation, py::handle viewer, py::handle gltf) {
+std::vector<std::string> Render(ResultObject result, PathLike out_dir, FormatList formats,
+                                const std::string& stem, OptionalInt every, OptionalInt width,
+                                OptionalInt height, OptionalFloat azimuth, OptionalFloat elevation,
+                                OptionalInt fps, OptionalInt max_frames, OptionalStr title,
+                                OptionalStr ffmpeg, FigureLike figure, PlotLike plot,
+                                AnimationLike animation, ViewerLike viewer, GltfLike gltf) {
   const std::vector<OutputFormat> chosen = FormatsArg(formats);
   const std::string dir = RequiredPath(out_dir, "out_dir");
   if (stem.empty() || stem.find('/') != std::string::npos) {
@@ -336,7 +336,7 @@ GltfOptions(**fields): every field below by keyword, the rest at their defaults.
 }
 
 // The joint positions of a glTF file at its keyframes: (times (K,), positions (K, joints, dim)).
-py::tuple GltfJointPositions(py::handle path_arg) {
+py::tuple GltfJointPositions(PathLike path_arg) {
   const std::string path = RequiredPath(path_arg, "path");
   const GltfJointMotion motion = OnFile(path, [&] { return ReadGltfJointPositions(path); });
   const int64_t count = static_cast<int64_t>(motion.positions.size());

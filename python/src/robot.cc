@@ -109,7 +109,7 @@ class StepArrays : public ArmStepSink {
   std::vector<bool*> bool_data_;
 };
 
-RobotScenario RobotScenarioArg(py::handle scenario, py::handle directory) {
+RobotScenario RobotScenarioArg(RobotScenarioSource scenario, OptionalPath directory) {
   if (py::isinstance<RobotScenario>(scenario)) return py::cast<RobotScenario>(scenario);
   if (py::isinstance<py::dict>(scenario)) {
     return ParseRobotScenarioText(JsonOfDict(scenario, "scenario"), RobotReaderOptions(directory));
@@ -175,8 +175,8 @@ RobotResult Track(const RobotScenario& s, py::object progress, const std::string
   return r;
 }
 
-RobotResult RunRobot(py::handle scenario, py::handle directory, py::object method,
-                     py::object progress, py::handle output, py::handle csv) {
+RobotResult RunRobot(RobotScenarioSource scenario, OptionalPath directory, OptionalStr method,
+                     ProgressCallback progress, OptionalPath output, OptionalPath csv) {
   RobotScenario s = RobotScenarioArg(scenario, directory);
   if (!method.is_none()) s.options.method = ParseFixedBaseMethod(py::cast<std::string>(method));
   return Track(s, std::move(progress), RequiredPath(output, "output", true),
@@ -305,18 +305,18 @@ RobotScenario(model, path, *, options=None, name="")
   model: ArmModel; path: (T, dim) the end effector's targets; options: ArmOptions, a dict of
   its fields or None. Its members may be changed before flexkin.run_robot runs it.
 )doc");
-  scenario.def(
-      py::init([](py::handle model, py::handle path, py::handle options, const std::string& name) {
-        RobotScenario s;
-        s.model = ModelArg(model);
-        ThrowIfAny(s.model.Validate());
-        s.path = ReadPoints(path, "path", 1, s.model.dim);
-        s.options = OptionsArg<ArmOptions>(options, "options");
-        s.name = name;
-        return s;
-      }),
-      py::arg("model"), py::arg("path"), py::kw_only(), py::arg("options") = py::none(),
-      py::arg("name") = "");
+  scenario.def(py::init([](ModelObject model, ArrayLike path, ArmOptionsLike options,
+                           const std::string& name) {
+                 RobotScenario s;
+                 s.model = ModelArg(model);
+                 ThrowIfAny(s.model.Validate());
+                 s.path = ReadPoints(path, "path", 1, s.model.dim);
+                 s.options = OptionsArg<ArmOptions>(options, "options");
+                 s.name = name;
+                 return s;
+               }),
+               py::arg("model"), py::arg("path"), py::kw_only(), py::arg("options") = py::none(),
+               py::arg("name") = "");
   Fields<RobotScenario>(scenario, "RobotScenario")
       .Member("name", &RobotScenario::name, "The scenario's \"name\"; '' if absent.", true)
       .Member("model", &RobotScenario::model, "The ArmModel, from \"arm\" or \"urdf\".", true)

@@ -160,7 +160,7 @@ void RethrowInFile(const InputError& error, const std::string& path) {
 
 namespace {
 
-Scenario ScenarioArg(py::handle scenario) {
+Scenario ScenarioArg(ScenarioSource scenario) {
   if (py::isinstance<Scenario>(scenario)) return py::cast<Scenario>(scenario);
   if (py::isinstance<py::dict>(scenario))
     return ParseScenarioText(JsonOfDict(scenario, "scenario"));
@@ -278,19 +278,19 @@ RunResult RunResultOf(const Result& r) {
   return run;
 }
 
-Result ReadResult(py::handle path_arg) {
+Result ReadResult(PathLike path_arg) {
   const std::string path = RequiredPath(path_arg, "path");
   return ResultOfFile(OnFile(path, [&] { return ReadResultFile(path); }));
 }
 
-void WriteResult(const Result& r, py::handle path_arg) {
+void WriteResult(const Result& r, PathLike path_arg) {
   const std::string path = RequiredPath(path_arg, "path");
   const ResultFileFormat format = ResultFileFormatOfPath(path);
   const RunResult run = RunResultOf(r);
   OnFile(path, [&] { WriteResultFile(run, path, format, r.scenario); });
 }
 
-void WriteCsv(const Result& r, py::handle path_arg) {
+void WriteCsv(const Result& r, PathLike path_arg) {
   const std::string path = RequiredPath(path_arg, "path");
   const RunResult run = RunResultOf(r);
   OnFile(path, [&] { WriteFramesCsv(run, path); });
@@ -309,7 +309,7 @@ py::list ProblemList(const Problems& problems) {
   return out;
 }
 
-py::list ValidateScenario(py::handle scenario, py::handle directory) {
+py::list ValidateScenario(ScenarioFile scenario, OptionalPath directory) {
   if (py::isinstance<py::dict>(scenario)) {
     const std::string text = JsonOfDict(scenario, "scenario");
     if (IsRobotScenarioText(text)) {
@@ -459,9 +459,9 @@ The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
         "json_bytes, npz_bytes, csv_bytes and recorder_bytes (estimates).");
   m.def(
       "run",
-      [](py::handle points, py::handle leader_steps, const std::string& method, int substeps,
-         int record_every, double tolerance, int max_substeps, bool link_angles, py::handle overall,
-         py::object progress) {
+      [](PointsOrChain points, ArrayLike leader_steps, const std::string& method, int substeps,
+         int record_every, double tolerance, int max_substeps, bool link_angles,
+         OverallLike overall, ProgressCallback progress) {
         const Chain chain = ChainArg(points);
         const Points steps = ReadPoints(leader_steps, "leader_steps", 1, chain.dim());
         return RunToArrays(chain, steps,
@@ -511,7 +511,7 @@ changed before flexkin.run_scenario runs it.
         "problem (field '/leader/steps'), OSError for a file that cannot be read.");
   m.def(
       "run_scenario",
-      [](py::handle scenario, py::object progress) {
+      [](ScenarioSource scenario, ProgressCallback progress) {
         const Scenario s = ScenarioArg(scenario);
         return RunToArrays(s.chain, s.leader_steps, s.options, std::move(progress), s.name);
       },

@@ -19,7 +19,7 @@ bool IsUrdfText(py::handle source) {
   return first != std::string::npos && text[first] == '<';
 }
 
-ArmModel ArmFromUrdfArg(py::handle source, const std::string& base_link,
+ArmModel ArmFromUrdfArg(UrdfSource source, const std::string& base_link,
                         const std::string& tip_link) {
   const UrdfChain chain{base_link, tip_link};
   if (IsUrdfText(source)) {
@@ -61,7 +61,7 @@ the path for a file that cannot be read.
 )doc");
   m.def(
       "urdf_from_arm",
-      [](py::handle model, const std::string& robot_name) {
+      [](ModelObject model, const std::string& robot_name) {
         return UrdfFromArm(ModelArg(model), robot_name);
       },
       py::arg("model"), py::arg("robot_name") = "flexkin_arm", R"doc(

@@ -61,6 +61,14 @@ def test_help_shows_parameters_shapes_and_defaults():
     assert "(n*dim,)" in flexkin.overall_objective.__doc__
     assert "default 1e-12" in flexkin.OverallOptions.constraint_tolerance.__doc__
     assert "radians" in flexkin.ArmModel.joint_min.__doc__
+    # the signatures name what each argument takes, not pybind11's "handle"
+    for name in flexkin.__all__:
+        obj = getattr(flexkin._flexkin, name, None)
+        members = vars(obj).values() if isinstance(obj, type) else [obj]
+        for member in members:
+            if callable(member) and getattr(member, "__doc__", None):
+                assert ": handle" not in member.__doc__.splitlines()[0], (name, member)
+    assert "points: Union[ArrayLike, Chain]" in flexkin._flexkin.run.__doc__
 
 
 def samples():
@@ -242,8 +250,17 @@ def pybind_parameters(function):
     """The parameter names of a pybind11 function, from the signature line of its doc."""
     first = function.__doc__.splitlines()[0]
     inside = first[first.index("(") + 1:first.rindex(")")]
+    parts, depth, current = [], 0, ""
+    for char in inside:                              # split at the commas outside brackets
+        depth += {"[": 1, "]": -1}.get(char, 0)
+        if char == "," and depth == 0:
+            parts.append(current)
+            current = ""
+        else:
+            current += char
+    parts.append(current)
     names = []
-    for part in re.split(r",\s*(?![^\[]*\])", inside):
+    for part in parts:
         name = part.split(":")[0].split("=")[0].strip()
         if name and name not in ("*", "self"):
             names.append(name)
