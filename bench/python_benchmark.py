@@ -1,7 +1,8 @@
 """The Python module against the C++ library, in one run (docs/BENCHMARKS.md, section 9).
 
 The same four calls are timed from Python (flexkin, the module built in the tree) and from C++
-(bench/python_baseline.cc, which calls the library directly), alternately, round after round:
+(bench/python_baseline.cc, which calls the library directly), alternately, round after round,
+each side in a fresh process every round:
   link_step   flexkin.tractrix_step of one 2D link, against TractrixStep
   move10      flexkin.Chain.move_leader of a 10-link chain, 8 sub-steps, against MoveLeader
   fig12       flexkin.run_scenario("examples/fig12_spatial_curve.json"), against
@@ -107,6 +108,8 @@ def main():
     parser.add_argument("--rounds", type=int, default=7)
     parser.add_argument("--samples", type=int, default=5)
     parser.add_argument("--json", help="also write the raw figures here")
+    parser.add_argument("--worker", action="store_true",
+                        help="time the Python side once and print it as JSON (used by the rounds)")
     args = parser.parse_args()
 
     build = pathlib.Path(args.build)
@@ -119,15 +122,22 @@ def main():
                  "--target python_baseline)")
     cases = python_cases(flexkin, np)
 
+    if args.worker:
+        print(json.dumps({name: per_call(call, args.samples) for name, call in cases.items()}))
+        return
+
+    # Each round times both sides in fresh processes, the same way: one Python process (this
+    # script with --worker) and one run of the C++ baseline, each timing the cases in turn.
     py = {name: [] for name in cases}
     cc = {name: [] for name in cases}
+    worker = [sys.executable, __file__, "--worker", "--build", str(build),
+              "--samples", str(args.samples)]
     for round_ in range(args.rounds):
-        for name, call in cases.items():
-            py[name].append(statistics.median(per_call(call, args.samples)))
-        out = subprocess.run([str(baseline), str(ROOT / "examples"), str(args.samples)],
-                             check=True, capture_output=True, text=True).stdout
-        for name, seconds in json.loads(out).items():
-            cc.setdefault(name, []).append(statistics.median(seconds))
+        for command, into in ((worker, py),
+                              ([str(baseline), str(ROOT / "examples"), str(args.samples)], cc)):
+            out = subprocess.run(command, check=True, capture_output=True, text=True).stdout
+            for name, seconds in json.loads(out).items():
+                into.setdefault(name, []).append(statistics.median(seconds))
         print(f"round {round_ + 1} of {args.rounds} done", file=sys.stderr, flush=True)
 
     print(f"machine: {machine()}")
