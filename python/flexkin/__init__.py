@@ -20,6 +20,7 @@ from ._flexkin import (
     ArmModel,
     ArmOptions,
     ArmStepReport,
+    BodyPose,
     Chain,
     InputError,
     Metrics,
@@ -32,6 +33,8 @@ from ._flexkin import (
     RobotScenario,
     RunOptions,
     Scenario,
+    StrandBatch,
+    StrandOptions,
     arc,
     arm_step,
     estimate_output,
@@ -49,6 +52,7 @@ from ._flexkin import (
     parabola,
     read_result,
     resample_path,
+    run_strands,
     split_pull,
     tractrix_step,
     validate_scenario,
@@ -80,9 +84,10 @@ for _name in ("arm_from_urdf", "urdf_from_arm"):
     globals()[_name] = getattr(_flexkin, _name, None) or _not_built(_name, *_URDF_WHAT)
 
 # The C++ classes are defined in flexkin._flexkin; they are documented and pickled as flexkin's.
-_CLASSES = ("AccuracyReport", "ArmModel", "ArmOptions", "ArmStepReport", "Chain", "Metrics",
-            "ObjectiveWeights", "OverallOptions", "OverallReport", "OverallRunReport", "Result",
-            "RobotResult", "RobotScenario", "RunOptions", "Scenario") + _RENDER_CLASSES
+_CLASSES = ("AccuracyReport", "ArmModel", "ArmOptions", "ArmStepReport", "BodyPose", "Chain",
+            "Metrics", "ObjectiveWeights", "OverallOptions", "OverallReport", "OverallRunReport",
+            "Result", "RobotResult", "RobotScenario", "RunOptions", "Scenario", "StrandBatch",
+            "StrandOptions") + _RENDER_CLASSES
 for _name in _CLASSES:
     if isinstance(globals()[_name], type):
         globals()[_name].__module__ = __name__
@@ -148,14 +153,17 @@ for _function in (run, run_scenario, run_robot, track_path):
 del _function
 
 __all__ = [
-    "AccuracyReport", "AnimationOptions", "ArmModel", "ArmOptions", "ArmStepReport", "Chain",
+    "AccuracyReport", "AnimationOptions", "ArmModel", "ArmOptions", "ArmStepReport", "BodyPose",
+    "Chain",
     "FigureOptions", "GltfOptions", "InputError", "Metrics", "ObjectiveWeights",
     "OverallOptions", "OverallReport", "OverallRunReport", "PlotOptions", "Result",
-    "RobotResult", "RobotScenario", "RunOptions", "Scenario", "ViewerOptions",
+    "RobotResult", "RobotScenario", "RunOptions", "Scenario", "StrandBatch", "StrandOptions",
+    "ViewerOptions",
     "arc", "arm_from_urdf", "arm_step", "estimate_output", "follow_the_leader_step",
     "forward_kinematics", "gltf_joint_positions", "helix", "joint_angles_from_points", "joint_quaternions", "line",
     "load_robot_scenario", "load_scenario", "move_leader", "overall_objective", "overall_step",
     "parabola", "read_result", "render", "resample_path", "run", "run_robot", "run_scenario",
+    "run_strands",
     "split_pull", "track_path", "tractrix_step", "urdf_from_arm", "validate_scenario",
     "within_limits", "write_result",
 ]

@@ -69,6 +69,9 @@ FLEXKIN_PYTHON_ARG(PlotLike, "Union[PlotOptions, dict, None]")
 FLEXKIN_PYTHON_ARG(AnimationLike, "Union[AnimationOptions, dict, None]")
 FLEXKIN_PYTHON_ARG(ViewerLike, "Union[ViewerOptions, dict, None]")
 FLEXKIN_PYTHON_ARG(GltfLike, "Union[GltfOptions, dict, None]")
+FLEXKIN_PYTHON_ARG(StrandList, "Sequence[ArrayLike]")
+FLEXKIN_PYTHON_ARG(PoseLike, "Union[BodyPose, ArrayLike, Tuple[ArrayLike, ArrayLike], dict, None]")
+FLEXKIN_PYTHON_ARG(StrandOptionsLike, "Union[StrandOptions, dict, None]")
 #undef FLEXKIN_PYTHON_ARG
 
 }  // namespace flexkin::python
@@ -126,6 +129,8 @@ void BindChains(py::module_& m);
 void BindRun(py::module_& m);
 void BindRobot(py::module_& m);
 void BindArms(py::module_& m);
+// The strand engine: StrandOptions, BodyPose, StrandBatch, run_strands (strands.cc).
+void BindStrands(py::module_& m);
 // TrackPath of a robot scenario's model along its path with the GIL released, as a
 // flexkin.RobotResult (robot.cc): `progress` a callable(done, total) or None; `output`, `csv`
 // None or the paths of the trajectory JSON and the joint CSV, written while the steps come and

@@ -12,6 +12,7 @@ PYBIND11_MODULE(_flexkin, m) {
   flexkin::python::BindRun(m);
   flexkin::python::BindRobot(m);
   flexkin::python::BindArms(m);
+  flexkin::python::BindStrands(m);
 #ifdef FLEXKIN_PYTHON_URDF
   flexkin::python::BindUrdf(m);
 #endif

@@ -15,6 +15,8 @@ from conftest import EXAMPLES, SOURCE_DIR
 
 CLASSES = sorted(name for name in flexkin.__all__
                  if isinstance(getattr(flexkin, name), type) and name != "InputError")
+# Engines with state, not values: they neither pickle nor copy (a StrandBatch owns its threads).
+ENGINES = {"StrandBatch"}
 RENDER_CLASSES = {"AnimationOptions", "FigureOptions", "GltfOptions", "PlotOptions",
                   "ViewerOptions"}
 
@@ -110,6 +112,9 @@ def samples():
                                           tolerance=0.0, max_substeps=8, link_angles=False,
                                           overall={"rotation": 0.5})],
         "Scenario": [flexkin.load_scenario(EXAMPLES / "fig12_spatial_curve.json")],
+        "StrandOptions": [flexkin.StrandOptions(method="ftl", substeps=3, pinned=2, threads=0)],
+        "BodyPose": [flexkin.BodyPose.from_quaternion(0.9, 0.1, -0.3, 0.2, [1.0, 2.0, 3.0]),
+                     flexkin.BodyPose.planar(0.25, -1.0, 0.5)],
     }
     if hasattr(flexkin._flexkin, "render"):
         out.update({
@@ -149,8 +154,17 @@ def assert_same_fields(a, b, where):
 
 
 def test_every_class_has_samples():
-    assert sorted(SAMPLES) == [c for c in CLASSES
-                               if c not in RENDER_CLASSES or hasattr(flexkin._flexkin, "render")]
+    assert sorted(SAMPLES) == [c for c in CLASSES if c not in ENGINES and (
+        c not in RENDER_CLASSES or hasattr(flexkin._flexkin, "render"))]
+
+
+def test_engines_refuse_pickling_and_copying():
+    batch = flexkin.StrandBatch([flexkin.line(links=3)])
+    for attempt in (pickle.dumps, copy.copy, copy.deepcopy):
+        with pytest.raises(TypeError, match="cannot be pickled"):
+            attempt(batch)
+    text = repr(batch)
+    assert text.startswith("StrandBatch(") and text.endswith(")") and "\n" not in text
 
 
 @pytest.mark.parametrize("name", sorted(SAMPLES))
