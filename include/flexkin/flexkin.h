@@ -19,4 +19,5 @@
 #include "flexkin/robot_scenario.h"  // robot scenario files and trajectories
 #include "flexkin/run.h"             // Run: a chain through a list of targets, with metrics
 #include "flexkin/scenario.h"        // scenario files
+#include "flexkin/strands.h"         // many strands (hair, fur) stepped together
 #include "flexkin/vocabulary.h"      // the names of every enumerated choice
