@@ -30,6 +30,7 @@
 #include "flexkin/chain.h"
 #include "flexkin/link_step.h"
 #include "flexkin/propagate.h"
+#include "flexkin/result_io.h"
 #include "flexkin/run.h"
 #include "flexkin/scenario.h"
 
@@ -104,9 +105,8 @@ class ArraySink : public FrameSink {
 
 // Run as flexkin.run does it: the frames counted, arrays allocated, the frames copied in.
 RunResult RunToArrays(const Chain& chain, const Points& steps, const RunOptions& options) {
-  const int64_t m = steps.rows(), every = options.record_every;
-  const int64_t frames = 1 + m / every + (m % every != 0 ? 1 : 0);
-  ArraySink sink(frames, chain.num_links(), chain.dim());
+  ArraySink sink(CountRecordedFrames(steps.rows(), options.record_every), chain.num_links(),
+                 chain.dim());
   return Run(chain, steps, options, &sink);
 }
 
