@@ -13,7 +13,7 @@ declare -A header_layer=(
   [link_step]=sequential [propagate]=sequential
   [overall]=overall
   [run]=run
-  [arm]=arm [strands]=strands
+  [arm]=arm [strands]=strands [groom]=groom [strand_file]=groom
   [scenario]=io [result_io]=io [robot_scenario]=io [flexkin]=umbrella
   [render]=render [viewer]=viewer [gltf]=gltf [urdf]=urdf
 )
@@ -26,12 +26,13 @@ declare -A allowed=(
   [arm]="chain sequential"
   [strands]="chain sequential"
   [io]="chain sequential overall run arm"
-  [umbrella]="chain sequential overall run arm strands io"
-  [render]="chain sequential overall run arm io"
-  [viewer]="chain sequential overall run arm io"
+  [groom]="chain sequential overall run arm io strands"
+  [umbrella]="chain sequential overall run arm strands io groom"
+  [render]="chain sequential overall run arm io strands groom"
+  [viewer]="chain sequential overall run arm io strands groom"
   [gltf]="chain sequential overall run arm io render"
   [urdf]="chain sequential overall run arm io"
-  [apps]="chain sequential overall run arm io render viewer gltf urdf"
+  [apps]="chain sequential overall run arm io strands groom render viewer gltf urdf"
 )
 
 layer_of_path() {  # a file of the tree -> its layer
