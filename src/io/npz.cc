@@ -557,6 +557,7 @@ NpyArray ReadNpyHeader(ZipReader::Member* member, const std::string& name,
     Malformed(name, ".npy descr '" + a.descr + "' is not supported; expected '" + descr + "'");
   }
   if (fortran) Malformed(name, ".npy fortran_order True is not supported; expected False");
+  const uint64_t item = descr == "<f4" ? 4 : 8;
   a.count = 1;
   for (uint64_t d : a.shape) {
     if (d != 0 && a.count > std::numeric_limits<uint64_t>::max() / 8 / d) {
@@ -564,11 +565,23 @@ NpyArray ReadNpyHeader(ZipReader::Member* member, const std::string& name,
     }
     a.count *= d;
   }
-  if (a.count * 8 != member->left()) {
+  if (a.count * item != member->left()) {
     Malformed(name, "holds " + std::to_string(member->left()) + " data bytes; its shape needs " +
-                        std::to_string(a.count * 8));
+                        std::to_string(a.count * item));
   }
   return a;
+}
+
+void ExpectNpyShape(const NpyArray& a, const std::string& name, const std::vector<uint64_t>& shape,
+                    const std::string& file_kind) {
+  if (a.shape == shape) return;
+  auto text = [](const std::vector<uint64_t>& s) {
+    std::string t;
+    for (uint64_t d : s) t += (t.empty() ? "" : ", ") + std::to_string(d);
+    return "(" + t + (s.size() == 1 ? ",)" : ")");
+  };
+  throw InputError(
+      name, "has shape " + text(a.shape) + "; expected " + text(shape) + "; not " + file_kind);
 }
 
 }  // namespace flexkin

@@ -128,14 +128,7 @@ Eigen::VectorXd ReadVectorMember(ZipReader* zip, const std::string& name, int64_
 }
 
 void ExpectShape(const NpyArray& a, const std::string& name, const std::vector<uint64_t>& shape) {
-  if (a.shape == shape) return;
-  auto text = [](const std::vector<uint64_t>& s) {
-    std::string t;
-    for (uint64_t d : s) t += (t.empty() ? "" : ", ") + std::to_string(d);
-    return "(" + t + (s.size() == 1 ? ",)" : ")");
-  };
-  throw InputError(name, "has shape " + text(a.shape) + "; expected " + text(shape) +
-                             "; not a valid .npz result file");
+  ExpectNpyShape(a, name, shape, "a valid .npz result file");
 }
 
 }  // namespace
