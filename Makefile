@@ -1,10 +1,12 @@
 # flexkin: two commands on a fresh Debian machine (they install what is missing themselves).
 #   make demo   build, then run the paper's scenarios (figures' numbers printed, results in out/)
-#   make test   build and run every test, then again under AddressSanitizer + UBSan
+#   make test   build and run every test, then again under AddressSanitizer + UBSan, and the
+#               threaded ones under ThreadSanitizer
 # Also: make bench (Google Benchmark, see docs/BENCHMARKS.md), make install PREFIX=...
 
 BUILD      ?= build
 BUILD_SAN  ?= build-sanitize
+BUILD_TSAN ?= build-tsan
 JOBS       ?= $(shell nproc)
 PREFIX     ?= /usr/local
 PYTHON     ?= /usr/bin/python3
@@ -12,7 +14,7 @@ PYTHON     ?= /usr/bin/python3
 # The C++ sources that clang-format keeps in the style of .clang-format (make format applies it).
 FORMAT_FILES = $(shell git ls-files '*.cc' '*.h' 2>/dev/null)
 
-.PHONY: all deps build demo test test-release test-sanitize bench install clean format format-check
+.PHONY: all deps build demo test test-release test-sanitize test-thread bench install clean format format-check
 
 all: build
 
@@ -26,7 +28,7 @@ build: deps
 demo: build
 	@bash scripts/demo.sh $(BUILD)
 
-test: test-release test-sanitize
+test: test-release test-sanitize test-thread
 
 test-release: build
 	@ctest --test-dir $(BUILD) --output-on-failure -j$(JOBS)
@@ -37,6 +39,18 @@ test-sanitize: deps
 	@cmake --build $(BUILD_SAN) -j$(JOBS)
 	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --test-dir $(BUILD_SAN) --output-on-failure -j$(JOBS)
+
+# The tests that run threads (the strand engine's worker pool, groom runs), under ThreadSanitizer:
+# only their programs are built.
+TSAN_TESTS = strands_test
+test-thread: deps
+	@cmake -S . -B $(BUILD_TSAN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLEXKIN_SANITIZE_THREAD=ON \
+	  -DFLEXKIN_BUILD_APPS=OFF -DFLEXKIN_BUILD_BENCHMARKS=OFF -DFLEXKIN_BUILD_EXAMPLES=OFF \
+	  -DFLEXKIN_PYTHON=OFF > /dev/null
+	@cmake --build $(BUILD_TSAN) -j$(JOBS) --target $(TSAN_TESTS)
+	@TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 \
+	  ctest --test-dir $(BUILD_TSAN) --output-on-failure -j$(JOBS) \
+	  -R '^($(shell echo $(TSAN_TESTS) | sed 's/ /|/g'))\.'
 
 bench: build
 	@for b in propagation_benchmark overall_benchmark arm_benchmark arm_kdl_benchmark arm_limits_benchmark; do \
@@ -55,4 +69,4 @@ install: build
 	@cmake --install $(BUILD) --prefix $(PREFIX)
 
 clean:
-	@rm -rf $(BUILD) $(BUILD_SAN) out
+	@rm -rf $(BUILD) $(BUILD_SAN) $(BUILD_TSAN) out
