@@ -16,10 +16,16 @@
 
 namespace flexkin {
 
-// Strands grown on a scalp (all in body coordinates).
+// Limits that keep a small file from asking for unbounded memory or time.
+constexpr int kMaxGroomRoots = 10000000;         // roots (or explicit strands) of a groom
+constexpr int64_t kMaxGroomPoints = 200000000;   // points of all strands together (24 B each)
+constexpr int64_t kMaxGroomFrames = 10000000;    // frames of a motion
+constexpr int64_t kMaxGroomKeyframes = 1000000;  // keyframes of a motion
+
+// Strands grown on a scalp (all in body coordinates); docs/groom-format.md, "Growing strands".
 struct GrowSpec {
   ScalpShape scalp;                // shape "sphere" (radii all equal) or "ellipsoid"
-  int roots = 1000;                // number of strands, >= 1
+  int roots = 1000;                // number of strands, 1 .. kMaxGroomRoots
   // Roots only where the outward normal is within `max_angle_deg` of `region_axis` (a cap; 180:
   // the whole surface).
   Eigen::Vector3d region_axis = Eigen::Vector3d::UnitZ();
@@ -28,15 +34,20 @@ struct GrowSpec {
   double link_length = 0.005;      // > 0 (scenario units, e.g. metres)
   double length_variation = 0.0;   // in [0, 1): each strand's link length scaled by 1 + v (2u - 1)
   // Direction field: link j of a strand points along the surface normal turned toward `gravity`
-  // by droop * angle(normal, gravity) * (j + 1) / links (droop in [0, 1]; 0: straight out).
+  // by droop * angle(normal, gravity) * (j + 1) / links (droop in [0, 1]; 0: straight out; 1:
+  // the last link along gravity).
   double droop = 0.0;
   Eigen::Vector3d gravity = -Eigen::Vector3d::UnitZ();
   uint64_t seed = 1;               // roots are placed by a seeded generator: same seed, same groom
 };
 
-// The strands of `spec`, each (links + 1) x 3, root first, in body coordinates. Deterministic
-// on every platform for a given seed. Throws InputError naming the field ("roots", ...).
+// The strands of `spec`, each (links + 1) x 3, root first, in body coordinates. The same seed
+// gives the same roots on every platform (std::mt19937_64, + - * / and sqrt only). Throws
+// InputError naming the member ("roots", "scalp.radii[1]", ...) for an invalid spec, or "region"
+// when fewer than 1 in 10,000 of the first million or more candidate roots fell in the region.
 std::vector<Points> GrowStrands(const GrowSpec& spec);
+// Every problem of `spec` (empty if valid), named by member path; roots x (links + 1) must not
+// exceed kMaxGroomPoints.
 Problems ValidateGrowSpec(const GrowSpec& spec);
 
 // A keyframe of the body's motion.
@@ -54,9 +65,14 @@ struct BodyMotion {
   // (kLinear) or 3u^2 - 2u^3 (kSmooth: at rest at every keyframe).
   KeyframeInterpolation interpolation = KeyframeInterpolation::kSmooth;
 
-  // Frames from the first keyframe's time to the last's: floor(duration * fps + 1e-9) + 1.
+  // Frames from the first keyframe's time to the last's: floor(duration * fps + 1e-9) + 1 (0
+  // without keyframes).
   int64_t num_frames() const;
-  double TimeOf(int64_t frame) const;  // first keyframe's time + frame / fps
+  // The first keyframe's time + frame / fps, clamped to the keyframes' times.
+  double TimeOf(int64_t frame) const;
+  // The pose at TimeOf(frame): a keyframe's own pose at its time (and within 1e-12 of a segment
+  // from it), else the translation interpolated linearly and the rotation by slerp (the shorter
+  // arc) between the segment's keyframes. No keyframes: the identity.
   BodyPose PoseAt(int64_t frame) const;
 };
 
@@ -72,8 +88,10 @@ struct GroomScenario {
 };
 
 // Reads a groom scenario (a JSON object with "groom" or "strands", and "motion";
-// docs/groom-format.md); every problem is collected and thrown at once as InputError, each named
-// by its JSON pointer ("/groom/roots"). A file's problems are named "PATH: /pointer".
+// docs/groom-format.md) and grows its strands; every problem is collected, each named by its JSON
+// pointer ("/groom/roots"), and the first is thrown as InputError. As for chain and robot
+// scenario files, a file's problems are named by pointer alone (a front end prints
+// "PATH: /pointer: message"); a file that cannot be read is a std::system_error naming the path.
 GroomScenario ParseGroomText(const std::string& json_text);
 GroomScenario LoadGroomFile(const std::string& path);
 // Every problem (empty if valid), without throwing.

@@ -1,0 +1,635 @@
+// Groom scenario files in (docs/groom-format.md): a GroomParser on the value readers every file
+// reader shares (src/io/json_values.h), so numbers, messages and suggestions are those of chain
+// and robot scenario files, and every problem is listed before the first one is thrown.
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "flexkin/chain.h"
+#include "flexkin/error.h"
+#include "flexkin/groom.h"
+#include "flexkin/propagate.h"
+#include "flexkin/vocabulary.h"
+#include "groom/grow_internal.h"
+#include "io/json_file.h"
+#include "io/json_values.h"
+
+namespace flexkin {
+namespace {
+
+using json_internal::json;
+using json_internal::Range;
+using json_internal::ShowJson;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int64_t kMaxLinks = int64_t{1} << 20;
+constexpr int64_t kMaxSeed = int64_t{1} << 53;  // every integer up to here is exact in JSON
+
+const char* const kRootExpected =
+    "an object with \"groom\" (or \"strands\") and \"motion\" (docs/groom-format.md)";
+const char* const kRotationExpected =
+    "an object {\"axis\": [x, y, z], \"angle_deg\": a} or {\"quaternion\": [w, x, y, z]}";
+
+// A GrowSpec member path as the JSON pointer of the key that sets it.
+std::string GrowFieldToPointer(const std::string& field, const std::string& shape) {
+  const std::pair<const char*, const char*> keys[] = {
+      {"scalp.shape", "/groom/scalp/shape"},
+      {"scalp.center", "/groom/scalp/center"},
+      {"roots", "/groom/roots"},
+      {"links", "/groom/links"},
+      {"link_length", "/groom/link_length"},
+      {"length_variation", "/groom/length_variation"},
+      {"droop", "/groom/direction/droop"},
+      {"gravity", "/groom/direction/gravity"},
+      {"region_axis", "/groom/region/axis"},
+      {"max_angle_deg", "/groom/region/max_angle_deg"},
+      {"region", "/groom/region"}};
+  for (const auto& [member, pointer] : keys) {
+    if (field == member) return pointer;
+  }
+  if (field.rfind("scalp.radii", 0) == 0) {
+    if (shape == "sphere") return "/groom/scalp/radius";
+    return "/groom/scalp/radii" + MemberPathToPointer(field.substr(11));
+  }
+  return "/groom";
+}
+
+class GroomParser : public json_internal::JsonReader {
+ public:
+  // grow: grow the strands of a "groom" (else only place their roots, to check the region).
+  explicit GroomParser(bool grow) : grow_(grow) { dimension_of_ = "the scenario"; }
+
+  // The scenario with its strands grown (or given); valid if and only if no problem was added.
+  GroomScenario Parse(const json& root) {
+    GroomScenario s;
+    if (!ExpectObject(root, "", kRootExpected)) return s;
+    CheckKeys(root, "",
+              {"$schema", "name", "description", "groom", "strands", "motion", "method", "substeps",
+               "pinned", "threads", "record"});
+    for (const char* key : {"$schema", "name", "description"}) {
+      if (const json* v = Find(root, key)) {
+        if (const auto text = String(*v, std::string("/") + key)) {
+          if (key == std::string("name")) s.name = *text;
+          if (key == std::string("description")) s.description = *text;
+        }
+      }
+    }
+    std::optional<GrowSpec> spec;
+    std::optional<std::vector<Points>> strands;
+    int dim = 0;  // unknown
+    const json* groom = Find(root, "groom");
+    const json* given = Find(root, "strands");
+    if (groom != nullptr && given != nullptr) {
+      Add("/strands",
+          "is not valid with \"groom\"; give groom (strands grown on a scalp) or "
+          "strands (given point by point), not both");
+    } else if (groom != nullptr) {
+      dim = 3;
+      spec = ParseGroom(*groom, "/groom");
+    } else if (given != nullptr) {
+      strands = ParseStrands(*given, "/strands", &dim);
+    } else {
+      Add("/groom",
+          "missing; expected an object {\"scalp\": ..., \"roots\": n, \"links\": n, "
+          "\"link_length\": l, ...}, or \"strands\": [{\"points\": [...]}, ...]",
+          "", "an object, or \"strands\"");
+    }
+    std::optional<BodyMotion> motion;
+    if (const json* m = Required(root, "", "motion",
+                                 "an object {\"fps\": 30, \"keyframes\": [{\"time\": 0, ...}]}")) {
+      motion = ParseMotion(*m, "/motion", dim);
+    }
+    ParseOptions(root, &s);
+    if (!problems.empty()) return s;
+
+    s.dim = dim;
+    s.motion = std::move(*motion);
+    if (spec) {
+      s.scalp = spec->scalp;
+      try {
+        if (grow_) {
+          s.strands = GrowStrands(*spec);
+        } else {
+          groom_internal::PlaceRoots(*spec,
+                                     [](const Eigen::Vector3d&, const Eigen::Vector3d&, double) {});
+        }
+      } catch (const InputError& e) {
+        Problem p = e.problem();
+        p.field = GrowFieldToPointer(p.field, spec->scalp.shape);
+        problems.push_back(std::move(p));
+      }
+    } else {
+      s.strands = std::move(*strands);
+    }
+    return s;
+  }
+
+ private:
+  std::optional<int> Int(const json& v, const std::string& ptr, int64_t min, int64_t max) {
+    const auto n = Integer(v, ptr, min, max);
+    return n ? std::optional<int>(static_cast<int>(*n)) : std::nullopt;
+  }
+  auto NumberOf(Range range) {
+    return [this, range](const json& v, const std::string& p) { return Number(v, p, range); };
+  }
+  auto VectorOf(int dim) {
+    return [this, dim](const json& v, const std::string& p) { return Vector(v, p, dim); };
+  }
+  // A number in [0, 1) (below_one) or [0, 1].
+  std::optional<double> Fraction(const json& v, const std::string& ptr, bool below_one) {
+    const char* expected = below_one ? "a number >= 0 and < 1" : "a number from 0 to 1";
+    if (!v.is_number()) {
+      TypeProblem(v, ptr, expected);
+      return std::nullopt;
+    }
+    const double x = v.get<double>();
+    if (!(x >= 0.0 && (below_one ? x < 1.0 : x <= 1.0))) {
+      ValueProblem(v, ptr, expected);
+      return std::nullopt;
+    }
+    return x;
+  }
+
+  // "groom": the spec, checked but not grown.
+  std::optional<GrowSpec> ParseGroom(const json& groom, const std::string& ptr) {
+    if (!ExpectObject(groom, ptr,
+                      "an object {\"scalp\": ..., \"roots\": n, \"links\": n, \"link_length\": "
+                      "l, ...}")) {
+      return std::nullopt;
+    }
+    CheckKeys(groom, ptr,
+              {"scalp", "roots", "region", "links", "link_length", "length_variation", "direction",
+               "seed"});
+    const size_t before = problems.size();
+    GrowSpec spec;
+    if (const json* scalp = Required(groom, ptr, "scalp",
+                                     "an object {\"shape\": \"sphere\", \"center\": [x, y, z], "
+                                     "\"radius\": r} or {\"shape\": \"ellipsoid\", ..., "
+                                     "\"radii\": [a, b, c]}")) {
+      ParseScalp(*scalp, ptr + "/scalp", &spec.scalp);
+    }
+    Require(
+        groom, ptr, "roots", "an integer >= 1 (the number of strands)",
+        [this](const json& v, const std::string& p) { return Int(v, p, 1, kMaxGroomRoots); },
+        &spec.roots);
+    Require(
+        groom, ptr, "links", "an integer >= 1 (links per strand)",
+        [this](const json& v, const std::string& p) { return Int(v, p, 1, kMaxLinks); },
+        &spec.links);
+    Require(groom, ptr, "link_length", "a finite number > 0 (the length of a link)",
+            NumberOf(Range::kPositive), &spec.link_length);
+    Optional(
+        groom, ptr, "length_variation",
+        [this](const json& v, const std::string& p) { return Fraction(v, p, true); },
+        &spec.length_variation);
+    if (const json* region = Find(groom, "region")) {
+      const std::string rp = ptr + "/region";
+      if (ExpectObject(*region, rp, "an object {\"axis\": [x, y, z], \"max_angle_deg\": a}")) {
+        CheckKeys(*region, rp, {"axis", "max_angle_deg"});
+        Eigen::VectorXd axis = spec.region_axis;
+        Optional(*region, rp, "axis", VectorOf(3), &axis);
+        spec.region_axis = axis;
+        Optional(*region, rp, "max_angle_deg", NumberOf(Range::kPositive), &spec.max_angle_deg);
+      }
+    }
+    if (const json* direction = Find(groom, "direction")) {
+      const std::string dp = ptr + "/direction";
+      if (ExpectObject(*direction, dp, "an object {\"droop\": d, \"gravity\": [x, y, z]}")) {
+        CheckKeys(*direction, dp, {"droop", "gravity"});
+        Optional(
+            *direction, dp, "droop",
+            [this](const json& v, const std::string& p) { return Fraction(v, p, false); },
+            &spec.droop);
+        Eigen::VectorXd gravity = spec.gravity;
+        Optional(*direction, dp, "gravity", VectorOf(3), &gravity);
+        spec.gravity = gravity;
+      }
+    }
+    int64_t seed = 1;
+    Optional(
+        groom, ptr, "seed",
+        [this](const json& v, const std::string& p) { return Integer(v, p, 0, kMaxSeed); }, &seed);
+    spec.seed = static_cast<uint64_t>(seed);
+    if (problems.size() != before) return std::nullopt;
+    // What is left (zero vectors, the angle's range, the number of points) is the spec's own
+    // check.
+    for (Problem p : ValidateGrowSpec(spec)) {
+      p.field = GrowFieldToPointer(p.field, spec.scalp.shape);
+      problems.push_back(std::move(p));
+    }
+    if (problems.size() != before) return std::nullopt;
+    return spec;
+  }
+
+  void ParseScalp(const json& scalp, const std::string& ptr, ScalpShape* out) {
+    if (!ExpectObject(scalp, ptr,
+                      "an object {\"shape\": \"sphere\", \"radius\": r, ...} or {\"shape\": "
+                      "\"ellipsoid\", \"radii\": [a, b, c], ...}")) {
+      return;
+    }
+    std::optional<std::string> shape;
+    if (const json* v = Required(scalp, ptr, "shape", "\"sphere\" or \"ellipsoid\"")) {
+      shape = Choice(*v, ptr + "/shape", {"sphere", "ellipsoid"});
+    }
+    if (!shape) {
+      CheckKeys(scalp, ptr, {"shape", "center", "radius", "radii"});
+      return;
+    }
+    out->shape = *shape;
+    Eigen::VectorXd center = Eigen::Vector3d::Zero();
+    Optional(scalp, ptr, "center", VectorOf(3), &center);
+    out->center = center;
+    if (*shape == "sphere") {
+      CheckKeys(scalp, ptr, {"shape", "center", "radius"});
+      double radius = 0.0;
+      Require(scalp, ptr, "radius", "a finite number > 0 (the sphere's radius)",
+              NumberOf(Range::kPositive), &radius);
+      out->radii = Eigen::Vector3d::Constant(radius);
+      return;
+    }
+    CheckKeys(scalp, ptr, {"shape", "center", "radii"});
+    const json* radii =
+        Required(scalp, ptr, "radii", "an array of 3 numbers > 0 (the semi-axes along x, y and z)");
+    if (radii == nullptr) return;
+    const size_t before = problems.size();
+    Eigen::VectorXd r = Eigen::Vector3d::Zero();
+    Optional(scalp, ptr, "radii", VectorOf(3), &r);
+    if (problems.size() != before) return;
+    for (int k = 0; k < 3; ++k) {
+      if (!(r[k] > 0.0))
+        ValueProblem((*radii)[k], ptr + "/radii/" + std::to_string(k), "a finite number > 0");
+    }
+    out->radii = r;
+  }
+
+  // "strands": every strand a chain, all of one dimension (set into *dim).
+  std::optional<std::vector<Points>> ParseStrands(const json& list, const std::string& ptr,
+                                                  int* dim) {
+    const std::string expected = "an array of at least 1 strand {\"points\": [[x, y, z], ...]}";
+    if (!list.is_array()) {
+      TypeProblem(list, ptr, expected);
+      return std::nullopt;
+    }
+    if (list.empty()) {
+      Add(ptr, "has 0 strands; expected " + expected, "[]", expected);
+      return std::nullopt;
+    }
+    if (list.size() > size_t(kMaxGroomRoots)) {
+      Add(ptr, "has " + std::to_string(list.size()) + " strands; expected at most " +
+                   std::to_string(kMaxGroomRoots));
+      return std::nullopt;
+    }
+    const size_t before = problems.size();
+    std::vector<Points> strands;
+    strands.reserve(list.size());
+    int64_t total = 0;
+    for (size_t i = 0; i < list.size(); ++i) {
+      const std::string sp = ptr + "/" + std::to_string(i);
+      if (!ExpectObject(list[i], sp, "an object {\"points\": [[x, y, z], ...]}")) continue;
+      CheckKeys(list[i], sp, {"points"});
+      const json* v = Required(list[i], sp, "points", "an array of at least 2 points");
+      if (v == nullptr) continue;
+      const auto points = PointList(*v, sp + "/points", *dim, 2, kMaxLinks + 1);
+      if (!points) continue;
+      if (*dim == 0) *dim = static_cast<int>(points->cols());
+      try {
+        ValidateChain(MakeChain(*points), "strand");
+      } catch (const InputError& e) {
+        Problem p = e.problem();
+        std::string field = p.field;
+        if (field.rfind("strand.", 0) == 0) field = field.substr(7);
+        p.field = sp + MemberPathToPointer(field);
+        problems.push_back(std::move(p));
+        continue;
+      }
+      total += points->rows();
+      strands.push_back(std::move(*points));
+    }
+    if (total > kMaxGroomPoints) {
+      Add(ptr, "has " + std::to_string(total) + " points in all; expected at most " +
+                   std::to_string(kMaxGroomPoints));
+    }
+    if (problems.size() != before) return std::nullopt;
+    return strands;
+  }
+
+  // "motion"; dim 0: the scenario's dimension is not known (only what does not depend on it is
+  // checked).
+  std::optional<BodyMotion> ParseMotion(const json& motion, const std::string& ptr, int dim) {
+    if (!ExpectObject(motion, ptr, "an object {\"fps\": 30, \"keyframes\": [...]}")) {
+      return std::nullopt;
+    }
+    CheckKeys(motion, ptr, {"fps", "interpolation", "keyframes"});
+    const size_t before = problems.size();
+    BodyMotion m;
+    Optional(motion, ptr, "fps", NumberOf(Range::kPositive), &m.fps);
+    const bool fps_ok = problems.size() == before;
+    if (const json* v = Find(motion, "interpolation")) {
+      if (const auto name = Choice(*v, ptr + "/interpolation", {"smooth", "linear"})) {
+        m.interpolation =
+            *name == "linear" ? KeyframeInterpolation::kLinear : KeyframeInterpolation::kSmooth;
+      }
+    }
+    const json* list =
+        Required(motion, ptr, "keyframes", "an array of at least 1 keyframe {\"time\": t, ...}");
+    if (list == nullptr) return std::nullopt;
+    const std::string lp = ptr + "/keyframes";
+    const std::string expected = "an array of at least 1 keyframe {\"time\": t, ...}";
+    if (!list->is_array()) {
+      TypeProblem(*list, lp, expected);
+      return std::nullopt;
+    }
+    if (list->empty()) {
+      Add(lp, "has 0 keyframes; expected " + expected, "[]", expected);
+      return std::nullopt;
+    }
+    if (list->size() > size_t(kMaxGroomKeyframes)) {
+      Add(lp, "has " + std::to_string(list->size()) + " keyframes; expected at most " +
+                  std::to_string(kMaxGroomKeyframes));
+      return std::nullopt;
+    }
+    std::optional<double> previous;  // the last keyframe's time, if it could be read
+    for (size_t k = 0; k < list->size(); ++k) {
+      const std::string kp = lp + "/" + std::to_string(k);
+      std::optional<BodyKeyframe> keyframe = ParseKeyframe((*list)[k], kp, dim);
+      const json* time = (*list)[k].is_object() ? Find((*list)[k], "time") : nullptr;
+      std::optional<double> t;
+      if (time != nullptr && time->is_number() && std::isfinite(time->get<double>())) {
+        t = time->get<double>();
+      }
+      if (t && previous && !(*t > *previous)) {
+        Add(kp + "/time",
+            "value " + ShowJson(*time) + " is not above " + FormatNumber(*previous) +
+                ", the time of " + lp + "/" + std::to_string(k - 1) +
+                "/time; expected keyframe times that increase "
+                "strictly",
+            ShowJson(*time), "a time > " + FormatNumber(*previous));
+      }
+      previous = t;
+      if (keyframe) m.keyframes.push_back(std::move(*keyframe));
+    }
+    if (problems.size() != before) return std::nullopt;
+    if (fps_ok) {
+      const double duration = m.keyframes.back().time - m.keyframes.front().time;
+      const double frames = std::floor(duration * m.fps + 1e-9) + 1.0;
+      if (!(frames <= double(kMaxGroomFrames))) {
+        Add(ptr + "/fps",
+            "value " + FormatNumber(m.fps) + " over the keyframes' " + FormatNumber(duration) +
+                " s makes " + FormatNumber(frames) + " frames; expected at most " +
+                std::to_string(kMaxGroomFrames) + " frames",
+            FormatNumber(m.fps),
+            "at most " + std::to_string(kMaxGroomFrames) + " frames over the motion");
+        return std::nullopt;
+      }
+    }
+    return m;
+  }
+
+  std::optional<BodyKeyframe> ParseKeyframe(const json& v, const std::string& ptr, int dim) {
+    if (!ExpectObject(v, ptr,
+                      "an object {\"time\": t, \"translation\": [...], \"rotation\": {...}} (3D) "
+                      "or {\"time\": t, \"translation\": [x, y], \"angle_deg\": a} (2D)")) {
+      return std::nullopt;
+    }
+    CheckKeys(v, ptr, {"time", "translation", "rotation", "angle_deg"});
+    const size_t before = problems.size();
+    BodyKeyframe keyframe;
+    Require(v, ptr, "time", "a finite number (seconds)", NumberOf(Range::kAny), &keyframe.time);
+    Eigen::VectorXd translation = Eigen::Vector3d::Zero();
+    Optional(v, ptr, "translation", VectorOf(dim), &translation);
+    Eigen::Vector3d t = Eigen::Vector3d::Zero();
+    t.head(translation.size()) = translation;
+    if (dim == 2 && Find(v, "rotation")) {
+      Add(ptr + "/rotation",
+          "is only valid in 3D scenarios; a 2D keyframe turns about z by \"angle_deg\"");
+    }
+    if (dim == 3 && Find(v, "angle_deg")) {
+      Add(ptr + "/angle_deg",
+          "is only valid in 2D scenarios; a 3D keyframe turns by \"rotation\": " +
+              std::string(kRotationExpected));
+    }
+    std::optional<Eigen::Quaterniond> rotation;
+    if (dim != 2) {
+      if (const json* r = Find(v, "rotation")) rotation = ParseRotation(*r, ptr + "/rotation");
+    }
+    double angle_deg = 0.0;
+    if (dim != 3) Optional(v, ptr, "angle_deg", NumberOf(Range::kAny), &angle_deg);
+    if (problems.size() != before) return std::nullopt;
+    if (dim == 2) {
+      keyframe.pose = BodyPose::Planar(angle_deg * (kPi / 180.0), t[0], t[1]);
+    } else {
+      const Eigen::Quaterniond q = rotation.value_or(Eigen::Quaterniond::Identity());
+      keyframe.pose = BodyPose::FromQuaternion(q.w(), q.x(), q.y(), q.z(), t);
+    }
+    return keyframe;
+  }
+
+  std::optional<Eigen::Quaterniond> ParseRotation(const json& r, const std::string& ptr) {
+    if (!ExpectObject(r, ptr, kRotationExpected)) return std::nullopt;
+    CheckKeys(r, ptr, {"axis", "angle_deg", "quaternion"});
+    const size_t before = problems.size();
+    if (const json* q = Find(r, "quaternion")) {
+      for (const char* key : {"axis", "angle_deg"}) {
+        if (Find(r, key)) {
+          Add(ptr + "/" + key,
+              "is not valid with \"quaternion\"; give axis and angle_deg, or "
+              "quaternion, not both");
+        }
+      }
+      const std::string qp = ptr + "/quaternion";
+      const char* expected = "an array of 4 numbers [w, x, y, z], not all zero";
+      if (!q->is_array()) {
+        TypeProblem(*q, qp, expected);
+        return std::nullopt;
+      }
+      if (q->size() != 4) {
+        Add(qp,
+            "value " + ShowJson(*q) + " has " + std::to_string(q->size()) +
+                (q->size() == 1 ? " number" : " numbers") + "; expected " + expected,
+            ShowJson(*q), expected);
+        return std::nullopt;
+      }
+      Eigen::Vector4d c;
+      for (int k = 0; k < 4; ++k) {
+        if (const auto x = Number((*q)[k], qp + "/" + std::to_string(k), Range::kAny)) c[k] = *x;
+      }
+      if (problems.size() != before) return std::nullopt;
+      if (!(c.squaredNorm() > 0.0) || !std::isfinite(c.squaredNorm())) {
+        Add(qp, "value " + ShowJson(*q) + " is not valid; expected " + expected, ShowJson(*q),
+            expected);
+        return std::nullopt;
+      }
+      c.normalize();
+      return Eigen::Quaterniond(c[0], c[1], c[2], c[3]);
+    }
+    Eigen::VectorXd axis = Eigen::Vector3d::UnitZ();
+    double angle_deg = 0.0;
+    Require(r, ptr, "axis", "an array of 3 numbers, not all zero (the axis of the rotation)",
+            VectorOf(3), &axis);
+    Require(r, ptr, "angle_deg", "a finite number (degrees)", NumberOf(Range::kAny), &angle_deg);
+    if (problems.size() != before) return std::nullopt;
+    if (!(axis.squaredNorm() > 0.0) || !std::isfinite(axis.squaredNorm())) {
+      Add(ptr + "/axis", "is zero; expected a non-zero vector", ShowJson(r["axis"]),
+          "a non-zero vector");
+      return std::nullopt;
+    }
+    return Eigen::Quaterniond(
+        Eigen::AngleAxisd(angle_deg * (kPi / 180.0), Eigen::Vector3d(axis.normalized())));
+  }
+
+  // "method", "substeps", "pinned", "threads" and "record".
+  void ParseOptions(const json& root, GroomScenario* s) {
+    StrandOptions& o = s->options;
+    o.threads = 0;  // all cores, unless the file says otherwise
+    const size_t before = problems.size();
+    if (const json* v = Find(root, "method")) {
+      if (const auto name = String(*v, "/method")) {
+        const std::vector<std::string> strand_methods = {"tractrix", "ftl"};
+        const NamedValue<Method>* entry = FindName<Method>(*name);
+        if (entry != nullptr &&
+            (entry->value == Method::kTractrix || entry->value == Method::kFollowTheLeader)) {
+          o.method = entry->value;
+        } else if (entry != nullptr) {
+          ValueProblem(*v, "/method",
+                       QuotedList(strand_methods) + " (the methods of the strand engine)");
+        } else {
+          problems.push_back(
+              UnknownName("/method", Vocabulary<Method>::kKind, *name, strand_methods));
+        }
+      }
+    }
+    const auto integer = [this](int64_t min, int64_t max) {
+      return [this, min, max](const json& v, const std::string& p) { return Int(v, p, min, max); };
+    };
+    Optional(root, "", "substeps", integer(1, 1000000), &o.substeps);
+    Optional(root, "", "pinned", integer(1, kMaxLinks + 1), &o.pinned);
+    Optional(root, "", "threads", integer(0, 1024), &o.threads);
+    if (const json* record = Find(root, "record")) {
+      if (ExpectObject(*record, "/record",
+                       "an object {\"every\": e, \"precision\": \"float32\"}")) {
+        CheckKeys(*record, "/record", {"every", "precision"});
+        Optional(*record, "/record", "every", integer(1, kMaxGroomFrames), &s->record_every);
+        if (const json* p = Find(*record, "precision")) {
+          if (const auto name = Choice(*p, "/record/precision", {"float32", "float64"})) {
+            s->float32 = *name == "float32";
+          }
+        }
+      }
+    }
+    if (problems.size() != before) return;
+    for (Problem p : o.Validate()) {
+      p.field = MemberPathToPointer(p.field);
+      problems.push_back(std::move(p));
+    }
+  }
+
+  bool grow_;
+};
+
+GroomScenario ParseGroomJson(const json& root) {
+  GroomParser parser(/*grow=*/true);
+  GroomScenario scenario = parser.Parse(root);
+  ThrowIfAny(parser.problems);
+  return scenario;
+}
+
+}  // namespace
+
+GroomScenario ParseGroomText(const std::string& json_text) {
+  return ParseGroomJson(ParseJsonText(json_text));
+}
+
+GroomScenario LoadGroomFile(const std::string& path) { return ParseGroomJson(ReadJsonFile(path)); }
+
+Problems ValidateGroomText(const std::string& json_text) {
+  json root;
+  try {
+    root = ParseJsonText(json_text);
+  } catch (const InputError& e) {
+    return {e.problem()};
+  }
+  GroomParser parser(/*grow=*/false);
+  parser.Parse(root);
+  return std::move(parser.problems);
+}
+
+Problems ValidateGroomFile(const std::string& path) {
+  return ValidateGroomText(ReadTextFile(path));
+}
+
+bool IsGroomText(const std::string& json_text) {
+  try {
+    const json root = ParseJsonText(json_text);
+    return root.is_object() && (root.contains("groom") || root.contains("strands"));
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+bool IsGroomFile(const std::string& path) {
+  try {
+    return IsGroomText(ReadTextFile(path));
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+std::string GroomSummary(const GroomScenario& s) {
+  const size_t count = s.strands.size();
+  int min_links = 0, max_links = 0;
+  int64_t points = 0;
+  double total_length = 0.0;
+  for (size_t i = 0; i < count; ++i) {
+    const int n = static_cast<int>(s.strands[i].rows()) - 1;
+    min_links = i == 0 ? n : std::min(min_links, n);
+    max_links = i == 0 ? n : std::max(max_links, n);
+    points += s.strands[i].rows();
+    for (int j = 0; j < n; ++j) {
+      total_length += (s.strands[i].row(j + 1) - s.strands[i].row(j)).norm();
+    }
+  }
+  char mean[40], radius[80], seconds[40], fps[40];
+  std::snprintf(mean, sizeof mean, "%.3g", count > 0 ? total_length / double(count) : 0.0);
+  const std::string links = min_links == max_links
+                                ? std::to_string(min_links)
+                                : std::to_string(min_links) + " to " + std::to_string(max_links);
+  std::string out = std::to_string(s.dim) + "D, " + std::to_string(count) +
+                    (count == 1 ? " strand of " : " strands of ") + links +
+                    (max_links == 1 ? " link" : " links") + " (" + std::to_string(points) +
+                    " points, mean length " + mean;
+  if (s.scalp.shape == "sphere") {
+    std::snprintf(radius, sizeof radius, ", on a sphere of radius %.3g", s.scalp.radii[0]);
+    out += radius;
+  } else if (s.scalp.shape == "ellipsoid") {
+    std::snprintf(radius, sizeof radius, ", on an ellipsoid of radii %.3g, %.3g, %.3g",
+                  s.scalp.radii[0], s.scalp.radii[1], s.scalp.radii[2]);
+    out += radius;
+  }
+  const int64_t frames = s.motion.num_frames();
+  const double duration = s.motion.keyframes.empty()
+                              ? 0.0
+                              : s.motion.keyframes.back().time - s.motion.keyframes[0].time;
+  std::snprintf(seconds, sizeof seconds, "%.4g", duration);
+  std::snprintf(fps, sizeof fps, "%.4g", s.motion.fps);
+  const size_t keys = s.motion.keyframes.size();
+  out += std::string("), ") + std::to_string(frames) + (frames == 1 ? " frame" : " frames") +
+         " at " + fps + " fps (" + seconds + " s, " + std::to_string(keys) +
+         (keys == 1 ? " keyframe, " : " keyframes, ") +
+         (s.motion.interpolation == KeyframeInterpolation::kLinear ? "linear" : "smooth") +
+         "), method " + MethodName(s.options.method) + ", " + std::to_string(s.options.substeps) +
+         (s.options.substeps == 1 ? " sub-step" : " sub-steps");
+  if (s.options.pinned != 1) out += ", " + std::to_string(s.options.pinned) + " pinned points";
+  const int64_t recorded =
+      frames == 0 ? 0 : (frames - 1) / s.record_every + 1 + ((frames - 1) % s.record_every != 0);
+  out += ", recording " + std::to_string(recorded) + (recorded == 1 ? " frame" : " frames");
+  if (s.record_every != 1) out += " (every " + std::to_string(s.record_every) + ")";
+  out += s.float32 ? " as float32" : " as float64";
+  return out;
+}
+
+}  // namespace flexkin
