@@ -27,6 +27,7 @@
 #include "flexkin/error.h"
 #include "flexkin/robot_scenario.h"
 #include "flexkin/scenario.h"
+#include "flexkin/strands.h"
 #include "io/json_file.h"  // ReadJsonFile, ReadTextFile
 
 namespace flexkin {
@@ -876,6 +877,62 @@ TEST(GrowTest, DroopZeroGrowsAlongTheNormalAndDroopOneEndsAlongGravity) {
     const double half = std::acos(std::clamp(n.dot(g), -1.0, 1.0)) / 2;
     EXPECT_NEAR(std::acos(std::clamp(last.dot(n), -1.0, 1.0)), half, 1e-7);
     EXPECT_NEAR(std::acos(std::clamp(last.dot(g), -1.0, 1.0)), half, 1e-7);
+  }
+}
+
+// Gravity straight against a root's normal: the strand turns in the plane of the normal and the
+// coordinate axis least aligned with it, and with droop 1 still ends along gravity.
+TEST(GrowTest, GravityAgainstTheNormalTurnsTowardAFixedAxis) {
+  GrowSpec spec;
+  spec.scalp.shape = "sphere";
+  spec.scalp.radii = Eigen::Vector3d::Ones();
+  spec.roots = 3;
+  spec.links = 8;
+  spec.link_length = 0.1;
+  spec.droop = 1;
+  const Eigen::Vector3d n = GrowStrands(spec)[0].row(0).transpose().normalized();
+  spec.gravity = -n;  // the roots do not depend on gravity
+  const Points p = GrowStrands(spec)[0];
+  EXPECT_LT((Eigen::Vector3d(p.row(0).transpose()) - n).norm(), 1e-15);
+  int k = 0;  // the axis least aligned with n
+  for (int i = 1; i < 3; ++i) k = std::fabs(n[i]) < std::fabs(n[k]) ? i : k;
+  const Eigen::Vector3d side =
+      (Eigen::Vector3d::Unit(k) - n[k] * n).normalized();  // perpendicular to n
+  // Link 4 of 8 has turned by a quarter turn: along `side`; the last one along gravity.
+  const Eigen::Vector3d quarter = (p.row(4) - p.row(3)).transpose().normalized();
+  EXPECT_LT((quarter - side).norm(), 1e-9) << quarter.transpose() << " vs " << side.transpose();
+  const Eigen::Vector3d last = (p.row(8) - p.row(7)).transpose().normalized();
+  EXPECT_LT((last + n).norm(), 1e-9);
+  for (int j = 1; j <= 8; ++j) {
+    EXPECT_NEAR((p.row(j) - p.row(0)).dot(n.cross(side)), 0, 1e-14);  // in the plane
+  }
+}
+
+// The strands of the examples go into the strand engine as they are, in 2D and 3D, and keep their
+// link lengths over the keyframed motion.
+TEST(GroomExampleTest, ExamplesStepThroughTheStrandEngine) {
+  for (const char* name : {"groom_head.json", "groom_grass_2d.json"}) {
+    const GroomScenario s = LoadGroomFile(Example(name));
+    StrandOptions options = s.options;
+    options.threads = 1;
+    const size_t count = std::min<size_t>(s.strands.size(), 200);  // the head's first 200
+    const std::vector<Points> strands(s.strands.begin(), s.strands.begin() + count);
+    StrandBatch batch(strands, options);  // body coordinates: at the identity pose
+    EXPECT_EQ(batch.dim(), s.dim) << name;
+    const int64_t frames = s.motion.num_frames();
+    for (int64_t f = 0; f < frames; ++f) StepStrands(&batch, s.motion.PoseAt(f));
+    const BodyPose end = s.motion.PoseAt(frames - 1);
+    for (size_t i = 0; i < strands.size(); ++i) {
+      const Points now = batch.strand(static_cast<int>(i));
+      const Eigen::VectorXd root =
+          (end.rotation.topLeftCorner(s.dim, s.dim) * strands[i].row(0).transpose() +
+           end.translation.head(s.dim));
+      EXPECT_LT((now.row(0).transpose() - root).norm(), 1e-12) << name << " strand " << i;
+      for (Eigen::Index j = 1; j < now.rows(); ++j) {
+        const double rest = (strands[i].row(j) - strands[i].row(j - 1)).norm();
+        EXPECT_NEAR((now.row(j) - now.row(j - 1)).norm(), rest, 1e-9 * rest) << name << " " << i;
+      }
+    }
   }
 }
 
