@@ -14,6 +14,7 @@
 #include "flexkin/error.h"
 #include "flexkin/groom.h"
 #include "flexkin/propagate.h"
+#include "flexkin/result_io.h"
 #include "flexkin/vocabulary.h"
 #include "groom/grow_internal.h"
 #include "io/json_file.h"
@@ -624,8 +625,8 @@ std::string GroomSummary(const GroomScenario& s) {
          "), method " + MethodName(s.options.method) + ", " + std::to_string(s.options.substeps) +
          (s.options.substeps == 1 ? " sub-step" : " sub-steps");
   if (s.options.pinned != 1) out += ", " + std::to_string(s.options.pinned) + " pinned points";
-  const int64_t recorded =
-      frames == 0 ? 0 : (frames - 1) / s.record_every + 1 + ((frames - 1) % s.record_every != 0);
+  // Frames 0, e, 2e, ... and the last: as a chain run records its leader steps.
+  const int64_t recorded = frames == 0 ? 0 : CountRecordedFrames(frames - 1, s.record_every);
   out += ", recording " + std::to_string(recorded) + (recorded == 1 ? " frame" : " frames");
   if (s.record_every != 1) out += " (every " + std::to_string(s.record_every) + ")";
   out += s.float32 ? " as float32" : " as float64";
