@@ -1,0 +1,660 @@
+// flexkin strands viewer: plays many strands (hair, fur) from the data embedded in the page, with
+// plain WebGL2; nothing is fetched. The data's layout is written by src/viewer/strands_viewer.cc
+// (docs/viewer.md, "Many strands"): a JSON element with the facts and each frame's box and body
+// pose, and one base64 element per frame holding its 16-bit codes, delta-coded and zlib-compressed.
+// At load every frame is decoded once into one Uint16Array and uploaded into one GPU buffer; a
+// frame is then drawn by pointing the position attributes at its part of that buffer, so playing
+// uploads nothing. One draw call (gl.LINES, indexed) draws every strand; the shader turns the codes
+// into positions and blends two frames for smooth playback.
+(function () {
+  'use strict';
+
+  const $ = (id) => document.getElementById(id);
+  const api = {
+    ready: false, frame: 0, playing: false, error: null,
+    // draws: pictures drawn; newPictures: those showing another moment of the motion than the one
+    // before; fps: new pictures per second over the last second while playing.
+    stats: { ticks: 0, draws: 0, newPictures: 0, drawMs: 0, maxDrawMs: 0, fps: 0 },
+  };
+  window.flexkinStrandsViewer = api;
+
+  function fail(text) {
+    const box = $('message');
+    box.textContent = text;
+    box.hidden = false;
+    api.error = text;
+  }
+
+  let meta;
+  try {
+    meta = JSON.parse($('flexkin-strands').textContent);
+  } catch (e) {
+    fail('This page holds no strand data. Write it with flexkin (flexkin render of a strand ' +
+         'file, or WriteStrandsViewerHtml in C++).');
+    return;
+  }
+  const dim = meta.dim;
+  const numFrames = meta.frames.length;
+  const numPoints = meta.num_points;
+  const numStrands = meta.offsets.length - 1;
+  const values = numPoints * dim;  // codes per frame
+  // Codes per point in the GPU buffer: always 4 (x, y, z or 0, 0), since 4-component 16-bit
+  // attributes are what software Vulkan (SwiftShader under ANGLE) reads without converting the
+  // whole buffer on every draw.
+  const lanes = 4;
+  const frameCodes = numPoints * lanes;
+  const options = meta.options;
+  Object.assign(api, { dim, numFrames, numPoints, numStrands });
+
+  // ----- Decoding ---------------------------------------------------------------------------------
+  function base64Bytes(text) {
+    if (Uint8Array.fromBase64) return Uint8Array.fromBase64(text.trim());
+    const binary = atob(text.trim());
+    const bytes = new Uint8Array(binary.length);
+    for (let i = 0; i < binary.length; ++i) bytes[i] = binary.charCodeAt(i);
+    return bytes;
+  }
+  async function inflate(bytes) {
+    const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream('deflate'));
+    return new Uint8Array(await new Response(stream).arrayBuffer());
+  }
+  // Frame k's codes into all[k * frameCodes ...], point-major (x, y, z, 0 of point 0, then point 1).
+  // Stored component-major as two byte planes (low bytes of every value, then high bytes), each
+  // value the difference (mod 2^16) from the same value in the frame before, or, in the first
+  // frame, from the value before it in the same component.
+  function undelta(raw, all, k) {
+    if (raw.length !== 2 * values) throw new Error(`frame ${k}: ${raw.length} bytes, not ${2 * values}`);
+    const base = k * frameCodes;
+    for (let c = 0; c < dim; ++c) {
+      let previous = 0;
+      for (let i = 0, j = c * numPoints; i < numPoints; ++i, ++j) {
+        const delta = raw[j] | (raw[j + values] << 8);
+        const at = base + i * lanes + c;
+        const before = k === 0 ? previous : all[at - frameCodes];
+        const code = (before + delta) & 0xffff;
+        all[at] = code;
+        previous = code;
+      }
+    }
+  }
+  async function decodeAll() {
+    const elements = document.querySelectorAll('script.flexkin-frame');
+    if (elements.length !== numFrames) throw new Error(`${elements.length} frames, not ${numFrames}`);
+    const all = new Uint16Array(numFrames * frameCodes);
+    // Inflating runs off the main thread; the differences need the frames in order.
+    const pending = Array.from(elements, (e) => inflate(base64Bytes(e.textContent)));
+    for (let k = 0; k < numFrames; ++k) {
+      undelta(await pending[k], all, k);
+      pending[k] = null;
+      $('hint').textContent = `decoding frame ${k + 1} of ${numFrames}`;
+    }
+    return all;
+  }
+
+  // ----- Small matrix helpers (column-major 4x4, as WebGL wants) --------------------------------
+  function multiply(a, b) {
+    const m = new Float32Array(16);
+    for (let c = 0; c < 4; ++c) {
+      for (let r = 0; r < 4; ++r) {
+        let s = 0;
+        for (let k = 0; k < 4; ++k) s += a[k * 4 + r] * b[c * 4 + k];
+        m[c * 4 + r] = s;
+      }
+    }
+    return m;
+  }
+  function lookAt(eye, target, up) {
+    const f = normalize(sub(target, eye));
+    const s = normalize(cross(f, up));
+    const u = cross(s, f);
+    return new Float32Array([s[0], u[0], -f[0], 0, s[1], u[1], -f[1], 0, s[2], u[2], -f[2], 0,
+                             -dot(s, eye), -dot(u, eye), dot(f, eye), 1]);
+  }
+  function perspective(fovy, aspect, near, far) {
+    const t = 1 / Math.tan(fovy / 2);
+    return new Float32Array([t / aspect, 0, 0, 0, 0, t, 0, 0, 0, 0, (far + near) / (near - far), -1,
+                             0, 0, 2 * far * near / (near - far), 0]);
+  }
+  function ortho(halfWidth, halfHeight, near, far) {
+    return new Float32Array([1 / halfWidth, 0, 0, 0, 0, 1 / halfHeight, 0, 0,
+                             0, 0, -2 / (far - near), 0, 0, 0, -(far + near) / (far - near), 1]);
+  }
+  const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                           a[0] * b[1] - a[1] * b[0]];
+  function normalize(a) {
+    const n = Math.hypot(a[0], a[1], a[2]) || 1;
+    return [a[0] / n, a[1] / n, a[2] / n];
+  }
+
+  // ----- Bounds of the whole motion, for the view ------------------------------------------------
+  const boxLo = [Infinity, Infinity, Infinity];
+  const boxHi = [-Infinity, -Infinity, -Infinity];
+  for (const f of meta.frames) {
+    for (let c = 0; c < dim; ++c) {
+      boxLo[c] = Math.min(boxLo[c], f.lo[c]);
+      boxHi[c] = Math.max(boxHi[c], f.lo[c] + f.ext[c]);
+    }
+  }
+  if (dim === 2) { boxLo[2] = 0; boxHi[2] = 0; }
+  const center = [0, 1, 2].map((c) => (boxLo[c] + boxHi[c]) / 2);
+  const radius = Math.max(0.5 * Math.hypot(boxHi[0] - boxLo[0], boxHi[1] - boxLo[1],
+                                           boxHi[2] - boxLo[2]), 1e-9);
+
+  // ----- WebGL ------------------------------------------------------------------------------------
+  const canvas = $('view');
+  // No antialiasing: with software rendering it would cost several times the fill.
+  const gl = canvas.getContext('webgl2', { antialias: false, alpha: false, depth: true,
+                                           preserveDrawingBuffer: false,
+                                           powerPreference: 'high-performance' });
+  if (!gl) {
+    fail('This browser cannot draw WebGL2, which the strands viewer needs.');
+    return;
+  }
+  const background = [0xfb / 255, 0xfb / 255, 0xfd / 255];
+
+  function compile(vertexSource, fragmentSource) {
+    const program = gl.createProgram();
+    for (const [type, source] of [[gl.VERTEX_SHADER, vertexSource],
+                                  [gl.FRAGMENT_SHADER, fragmentSource]]) {
+      const shader = gl.createShader(type);
+      gl.shaderSource(shader, source);
+      gl.compileShader(shader);
+      if (!gl.getShaderParameter(shader, gl.COMPILE_STATUS)) {
+        throw new Error(gl.getShaderInfoLog(shader));
+      }
+      gl.attachShader(program, shader);
+    }
+    gl.linkProgram(program);
+    if (!gl.getProgramParameter(program, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(program));
+    const uniforms = {};
+    const count = gl.getProgramParameter(program, gl.ACTIVE_UNIFORMS);
+    for (let i = 0; i < count; ++i) {
+      const name = gl.getActiveUniform(program, i).name;
+      uniforms[name] = gl.getUniformLocation(program, name);
+    }
+    return { program, uniforms };
+  }
+
+  // Positions: the codes of frames a and b (normalized to [0, 1]) times each frame's box, blended.
+  // Colour: dark at the root to light at the tip, each strand a little lighter or darker, faded
+  // towards the background with depth so that the near strands stand out.
+  const strandProgram = compile(`#version 300 es
+    layout(location = 0) in vec4 codeA;
+    layout(location = 1) in vec4 codeB;
+    layout(location = 2) in vec2 along;  // (0 at the root .. 1 at the tip, strand's shade)
+    uniform vec3 loA, extA, loB, extB;
+    uniform float blend;
+    uniform mat4 viewMatrix, projection;
+    uniform vec2 fog;  // view depths where fading starts and where it is strongest
+    uniform vec3 background;
+    out vec3 color;
+    void main() {
+      vec3 p = mix(loA + codeA.xyz * extA, loB + codeB.xyz * extB, blend);
+      vec4 v = viewMatrix * vec4(p, 1.0);
+      gl_Position = projection * v;
+      vec3 root = vec3(0.23, 0.15, 0.09), tip = vec3(0.85, 0.66, 0.40);
+      vec3 c = mix(root, tip, along.x) * (0.75 + 0.5 * along.y);
+      float fade = clamp((-v.z - fog.x) / (fog.y - fog.x), 0.0, 1.0);
+      color = mix(c, background, 0.55 * fade);
+    }`, `#version 300 es
+    precision mediump float;
+    in vec3 color;
+    out vec4 outColor;
+    void main() { outColor = vec4(color, 1.0); }`);
+
+  // The scalp: a unit sphere scaled to the radii, placed by the body pose, lit from the viewer.
+  const scalpProgram = compile(`#version 300 es
+    layout(location = 0) in vec3 unit;
+    uniform vec3 scalpCenter, radii, translation;
+    uniform mat3 rotation;
+    uniform mat4 viewMatrix, projection;
+    out vec3 normal;
+    out vec3 toEye;
+    void main() {
+      vec4 v = viewMatrix * vec4(rotation * (scalpCenter + radii * unit) + translation, 1.0);
+      gl_Position = projection * v;
+      normal = mat3(viewMatrix) * rotation * normalize(unit / max(radii, vec3(1e-12)));
+      toEye = -v.xyz;
+    }`, `#version 300 es
+    precision mediump float;
+    in vec3 normal;
+    in vec3 toEye;
+    out vec4 outColor;
+    void main() {
+      vec3 n = normalize(normal);
+      vec3 l = normalize(normalize(toEye) + vec3(0.3, 0.5, 0.0));
+      float diffuse = max(dot(n, l), 0.0);
+      outColor = vec4(vec3(0.80, 0.70, 0.62) * (0.35 + 0.65 * diffuse), 1.0);
+    }`);
+
+  // Static per-vertex data and the index of every link, built once.
+  const strandVao = gl.createVertexArray();
+  const positionBuffer = gl.createBuffer();
+  let numIndices = 0;
+  function buildStrands(codes) {
+    gl.bindVertexArray(strandVao);
+    const along = new Uint8Array(2 * numPoints);
+    const indices = new Uint32Array(2 * (numPoints - numStrands));
+    let n = 0;
+    for (let s = 0; s < numStrands; ++s) {
+      const begin = meta.offsets[s], end = meta.offsets[s + 1];
+      // A fixed pseudo-random shade per strand (a hash of its index).
+      const shade = (Math.imul(s + 1, 2654435761) >>> 24) & 0xff;
+      for (let i = begin; i < end; ++i) {
+        along[2 * i] = Math.round(255 * (i - begin) / (end - begin - 1));
+        along[2 * i + 1] = shade;
+        if (i + 1 < end) { indices[n++] = i; indices[n++] = i + 1; }
+      }
+    }
+    numIndices = n;
+    const alongBuffer = gl.createBuffer();
+    gl.bindBuffer(gl.ARRAY_BUFFER, alongBuffer);
+    gl.bufferData(gl.ARRAY_BUFFER, along, gl.STATIC_DRAW);
+    gl.enableVertexAttribArray(2);
+    gl.vertexAttribPointer(2, 2, gl.UNSIGNED_BYTE, true, 0, 0);
+    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, gl.createBuffer());
+    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, indices, gl.STATIC_DRAW);
+    gl.bindBuffer(gl.ARRAY_BUFFER, positionBuffer);
+    gl.bufferData(gl.ARRAY_BUFFER, codes, gl.STATIC_DRAW);
+    gl.enableVertexAttribArray(0);
+    gl.enableVertexAttribArray(1);
+    gl.bindVertexArray(null);
+  }
+
+  const scalpVao = gl.createVertexArray();
+  let scalpIndices = 0;
+  const scalp = meta.scalp && (meta.scalp.shape === 'sphere' || meta.scalp.shape === 'ellipsoid') &&
+      dim === 3 ? meta.scalp : null;
+  function buildScalp() {
+    const rings = 32, sectors = 64;
+    const unit = [];
+    for (let r = 0; r <= rings; ++r) {
+      const theta = Math.PI * r / rings;
+      for (let s = 0; s <= sectors; ++s) {
+        const phi = 2 * Math.PI * s / sectors;
+        unit.push(Math.sin(theta) * Math.cos(phi), Math.sin(theta) * Math.sin(phi), Math.cos(theta));
+      }
+    }
+    const index = [];
+    for (let r = 0; r < rings; ++r) {
+      for (let s = 0; s < sectors; ++s) {
+        const a = r * (sectors + 1) + s, b = a + sectors + 1;
+        index.push(a, b, a + 1, a + 1, b, b + 1);
+      }
+    }
+    scalpIndices = index.length;
+    gl.bindVertexArray(scalpVao);
+    gl.bindBuffer(gl.ARRAY_BUFFER, gl.createBuffer());
+    gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(unit), gl.STATIC_DRAW);
+    gl.enableVertexAttribArray(0);
+    gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
+    gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, gl.createBuffer());
+    gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, new Uint16Array(index), gl.STATIC_DRAW);
+    gl.bindVertexArray(null);
+  }
+
+  // ----- State ------------------------------------------------------------------------------------
+  const speeds = [0.25, 0.5, 1, 2, 4, 8];
+  const state = {
+    position: 0,  // frames, fractional while blending
+    playing: false,
+    speed: 1,
+    blend: true,
+    showScalp: true,
+  };
+  const view = { azimuth: 0, elevation: 0, zoom: 1, panX: 0, panY: 0 };
+  function resetView() {
+    view.azimuth = options.azimuth * Math.PI / 180;
+    view.elevation = options.elevation * Math.PI / 180;
+    view.zoom = 1;
+    view.panX = 0;
+    view.panY = 0;
+    requestDraw();
+  }
+
+  let width = 1, height = 1;
+  function resize() {
+    const ratio = window.devicePixelRatio || 1;
+    width = Math.max(1, Math.round(canvas.clientWidth * ratio));
+    height = Math.max(1, Math.round(canvas.clientHeight * ratio));
+    if (canvas.width !== width || canvas.height !== height) {
+      canvas.width = width;
+      canvas.height = height;
+    }
+    requestDraw();
+  }
+
+  // View and projection matrices, and the depths for the fade.
+  function camera() {
+    const aspect = width / height;
+    if (dim === 2) {
+      const half = 1.1 * radius / view.zoom;
+      const hw = aspect >= 1 ? half * aspect : half, hh = aspect >= 1 ? half : half / aspect;
+      const eye = [center[0] - view.panX * hw, center[1] - view.panY * hh, 1];
+      return { view: lookAt(eye, [eye[0], eye[1], 0], [0, 1, 0]), projection: ortho(hw, hh, 0, 2),
+               fog: [1e9, 2e9] };
+    }
+    const fovy = 30 * Math.PI / 180;
+    const distance = 1.15 * radius / Math.sin(fovy / 2) / Math.min(1, aspect) / view.zoom;
+    const ce = Math.cos(view.elevation), se = Math.sin(view.elevation);
+    const dir = [ce * Math.cos(view.azimuth), ce * Math.sin(view.azimuth), se];
+    // Panning moves the target in the screen's plane, in units of the view's half height.
+    const right = normalize(cross([-dir[0], -dir[1], -dir[2]], [0, 0, 1]));
+    const up = cross(right, [-dir[0], -dir[1], -dir[2]]);
+    const panScale = distance * Math.tan(fovy / 2);
+    const target = [0, 1, 2].map((c) => center[c] - (view.panX * right[c] + view.panY * up[c]) * panScale);
+    const eye = [0, 1, 2].map((c) => target[c] + distance * dir[c]);
+    const near = Math.max(distance - 2 * radius, distance * 1e-3), far = distance + 2 * radius;
+    return { view: lookAt(eye, target, Math.abs(se) > 0.999 ? [0, 1, 0] : [0, 0, 1]),
+             projection: perspective(fovy, aspect, near, far),
+             fog: [distance - radius, distance + radius] };
+  }
+
+  // The two stored frames shown and how far between them.
+  function shown() {
+    const a = Math.min(numFrames - 1, Math.floor(state.position));
+    const t = state.blend ? state.position - a : 0;
+    const b = t > 0 && a + 1 < numFrames ? a + 1 : a;
+    return { a, b, t: b === a ? 0 : t };
+  }
+
+  let drawRequested = false, lastShown = '';
+  function requestDraw() { drawRequested = true; }
+
+  function draw() {
+    const start = performance.now();
+    const cam = camera();
+    const { a, b, t } = shown();
+    gl.viewport(0, 0, width, height);
+    gl.clearColor(background[0], background[1], background[2], 1);
+    gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
+    gl.enable(gl.DEPTH_TEST);
+    if (scalp && state.showScalp) {
+      const fa = meta.frames[a], fb = meta.frames[b];
+      const r = fa.rotation.map((x, i) => x + t * (fb.rotation[i] - x));
+      const p = fa.translation.map((x, i) => x + t * (fb.translation[i] - x));
+      const u = scalpProgram.uniforms;
+      gl.useProgram(scalpProgram.program);
+      // rotation is row-major in the data; a column-major mat3 wants the transpose.
+      gl.uniformMatrix3fv(u.rotation, true, r);
+      gl.uniform3fv(u.translation, p);
+      gl.uniform3fv(u.scalpCenter, scalp.center);
+      // Slightly smaller than the scalp, so that the roots on its surface stay visible.
+      gl.uniform3fv(u.radii, scalp.radii.map((x) => 0.985 * x));
+      gl.uniformMatrix4fv(u.viewMatrix, false, cam.view);
+      gl.uniformMatrix4fv(u.projection, false, cam.projection);
+      gl.bindVertexArray(scalpVao);
+      gl.drawElements(gl.TRIANGLES, scalpIndices, gl.UNSIGNED_SHORT, 0);
+    }
+    const u = strandProgram.uniforms;
+    gl.useProgram(strandProgram.program);
+    const box = (f, name) => {
+      const v = meta.frames[f][name];
+      return dim === 2 ? [v[0], v[1], 0] : v;
+    };
+    gl.uniform3fv(u.loA, box(a, 'lo'));
+    gl.uniform3fv(u.extA, box(a, 'ext'));
+    gl.uniform3fv(u.loB, box(b, 'lo'));
+    gl.uniform3fv(u.extB, box(b, 'ext'));
+    gl.uniform1f(u.blend, t);
+    gl.uniformMatrix4fv(u.viewMatrix, false, cam.view);
+    gl.uniformMatrix4fv(u.projection, false, cam.projection);
+    gl.uniform2fv(u.fog, cam.fog);
+    gl.uniform3fv(u.background, background);
+    gl.bindVertexArray(strandVao);
+    gl.bindBuffer(gl.ARRAY_BUFFER, positionBuffer);
+    gl.vertexAttribPointer(0, lanes, gl.UNSIGNED_SHORT, true, 2 * lanes, 2 * a * frameCodes);
+    gl.vertexAttribPointer(1, lanes, gl.UNSIGNED_SHORT, true, 2 * lanes, 2 * b * frameCodes);
+    gl.drawElements(gl.LINES, numIndices, gl.UNSIGNED_INT, 0);
+    gl.bindVertexArray(null);
+
+    const ms = performance.now() - start;
+    const s = api.stats;
+    s.draws += 1;
+    const key = `${a},${b},${t}`;
+    if (key !== lastShown) s.newPictures += 1;
+    lastShown = key;
+    s.drawMs += ms;
+    s.maxDrawMs = Math.max(s.maxDrawMs, ms);
+    drawRequested = false;
+  }
+
+  // ----- Playback -----------------------------------------------------------------------------------
+  const framesPerSecond = () => (numFrames - 1) / options.playback_seconds * state.speed;
+  let lastTick = null;
+  const recent = [];  // times of recent new pictures, for stats.fps
+  function tick(now) {
+    api.stats.ticks += 1;
+    if (state.playing && lastTick !== null && numFrames > 1) {
+      let p = state.position + (now - lastTick) / 1000 * framesPerSecond();
+      if (p >= numFrames - 1) {
+        if (options.loop) {
+          p = p % (numFrames - 1);
+        } else {
+          p = numFrames - 1;
+          setPlaying(false);
+        }
+      }
+      setPosition(p, false);
+    }
+    lastTick = now;
+    if (drawRequested) {
+      const before = api.stats.newPictures;
+      draw();
+      if (api.stats.newPictures !== before) recent.push(now);
+    }
+    while (recent.length && recent[0] < now - 1000) recent.shift();
+    if (state.playing) api.stats.fps = recent.length;
+    if (api.stats.ticks % 15 === 0) showPerf();
+    requestAnimationFrame(tick);
+  }
+
+  function setPosition(p, snap = true) {
+    p = Math.max(0, Math.min(numFrames - 1, p));
+    if (snap || !state.blend) p = Math.floor(p + (snap ? 0.5 : 0));
+    if (p === state.position) return;
+    const before = Math.floor(state.position);
+    state.position = p;
+    api.frame = Math.min(numFrames - 1, Math.floor(p));
+    requestDraw();
+    if (api.frame !== before || snap) showFrame();
+  }
+  const setFrame = (k) => setPosition(k, true);
+
+  function setPlaying(on) {
+    if (on && state.position >= numFrames - 1 && !options.loop) setFrame(0);
+    state.playing = on;
+    api.playing = on;
+    $('play').textContent = on ? 'Pause' : 'Play';
+    if (!on) {
+      api.stats.fps = 0;
+      recent.length = 0;
+    }
+  }
+  function setSpeed(x) {
+    state.speed = x;
+    $('speed').value = String(x);
+  }
+
+  // ----- Panel --------------------------------------------------------------------------------------
+  function fill(id, rows) {
+    const list = $(id);
+    list.replaceChildren();
+    for (const [name, value] of rows) {
+      const dt = document.createElement('dt');
+      dt.textContent = name;
+      const dd = document.createElement('dd');
+      dd.textContent = value;
+      list.append(dt, dd);
+    }
+  }
+  const number = (x, digits = 4) => (Number.isFinite(x) ? Number(x.toPrecision(digits)).toString() : String(x));
+  function showFacts() {
+    const links = numPoints - numStrands;
+    const report = meta.report || {};
+    const strands = numStrands === meta.file_strands ? String(numStrands)
+                                                       : `${numStrands} of ${meta.file_strands}`;
+    fill('facts', [
+      ['strands', strands],
+      ['links', numStrands ? `${links} (${number(links / numStrands, 3)} per strand)` : '0'],
+      ['frames', numFrames === meta.file_frames ? String(numFrames)
+                                                 : `${numFrames} of ${meta.file_frames}`],
+      ['dimensions', `${dim}D`],
+      ['method', meta.method],
+      ['file fps', number(meta.fps)],
+      ['substeps', String(meta.substeps)],
+      ['body', meta.scalp && meta.scalp.shape ? meta.scalp.shape : 'none'],
+      ['max length error', report.max_length_error !== undefined ? number(report.max_length_error, 3) : '?'],
+      ['engine', report.engine ? `${report.engine}, ${report.threads} thread${report.threads === 1 ? '' : 's'}` : '?'],
+      ['stepping time', report.seconds !== undefined ? `${number(report.seconds, 3)} s` : '?'],
+      ['page data', `${number(meta.data_bytes / 1e6, 3)} MB (${number(meta.data_bytes / numFrames / 1e3, 3)} kB per frame)`],
+      ['precision', `${number(meta.precision, 2)} (largest quantization error)`],
+    ]);
+  }
+  function showFrame() {
+    const f = meta.frames[api.frame];
+    $('timeline').value = String(api.frame);
+    $('counter').textContent = `frame ${api.frame + 1} / ${numFrames}` +
+        ` \u00b7 step ${f.frame} \u00b7 t = ${f.time.toFixed(3)} s`;
+    fill('now', [['step', String(f.frame)], ['time', `${f.time.toFixed(4)} s`],
+                 ['body position', f.translation.map((x) => number(x, 3)).join(', ')]]);
+  }
+  function showPerf() {
+    const s = api.stats;
+    fill('perf', [['frames per second', state.playing ? String(s.fps) : '(paused)'],
+                  ['line segments', String(numIndices / 2)],
+                  ['draw calls per picture', scalp && state.showScalp ? '2' : '1'],
+                  ['canvas', `${width} \u00d7 ${height}`]]);
+  }
+
+  // ----- Input ----------------------------------------------------------------------------------
+  function bind() {
+    $('play').addEventListener('click', () => setPlaying(!state.playing));
+    $('prev').addEventListener('click', () => { setPlaying(false); setFrame(api.frame - 1); });
+    $('next').addEventListener('click', () => { setPlaying(false); setFrame(api.frame + 1); });
+    const timeline = $('timeline');
+    timeline.max = String(numFrames - 1);
+    timeline.addEventListener('input', () => { setPlaying(false); setFrame(Number(timeline.value)); });
+    $('speed').addEventListener('change', () => setSpeed(Number($('speed').value)));
+    $('blend').addEventListener('change', () => {
+      state.blend = $('blend').checked;
+      if (!state.blend) setPosition(Math.floor(state.position), false);
+      requestDraw();
+    });
+    $('scalp-control').hidden = !scalp;
+    $('scalp').addEventListener('change', () => { state.showScalp = $('scalp').checked; requestDraw(); });
+    $('reset').addEventListener('click', resetView);
+    document.addEventListener('keydown', onKey);
+    document.addEventListener('keyup', (e) => {
+      if (e.key === ' ') e.preventDefault();
+    });
+    bindPointer();
+    new ResizeObserver(resize).observe(canvas);
+  }
+
+  function onKey(e) {
+    if (e.ctrlKey || e.metaKey || e.altKey) return;
+    const jump = e.shiftKey ? 10 : 1;
+    let handled = true;
+    switch (e.key) {
+      case ' ': setPlaying(!state.playing); break;
+      case 'ArrowRight': setPlaying(false); setFrame(api.frame + jump); break;
+      case 'ArrowLeft': setPlaying(false); setFrame(api.frame - jump); break;
+      case 'ArrowUp': setPlaying(false); setFrame(api.frame + 10 * jump); break;
+      case 'ArrowDown': setPlaying(false); setFrame(api.frame - 10 * jump); break;
+      case 'Home': setPlaying(false); setFrame(0); break;
+      case 'End': setPlaying(false); setFrame(numFrames - 1); break;
+      case '+': case '=': setSpeed(speeds[Math.min(speeds.length - 1, speeds.indexOf(state.speed) + 1)]); break;
+      case '-': setSpeed(speeds[Math.max(0, speeds.indexOf(state.speed) - 1)]); break;
+      case 'r': case 'R': resetView(); break;
+      case 'i': case 'I': $('blend').click(); break;
+      case 'b': case 'B': if (scalp) $('scalp').click(); break;
+      default: handled = false;
+    }
+    if (handled) e.preventDefault();
+  }
+
+  function bindPointer() {
+    let drag = null;
+    canvas.addEventListener('pointerdown', (e) => {
+      canvas.setPointerCapture(e.pointerId);
+      canvas.focus();
+      drag = { x: e.clientX, y: e.clientY, pan: dim === 2 || e.shiftKey || e.button !== 0 };
+      canvas.classList.add('dragging');
+    });
+    canvas.addEventListener('pointermove', (e) => {
+      if (!drag) return;
+      const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+      drag.x = e.clientX;
+      drag.y = e.clientY;
+      const h = canvas.clientHeight || 1;
+      if (drag.pan) {
+        view.panX += 2 * dx / h;
+        view.panY -= 2 * dy / h;
+      } else {
+        view.azimuth -= dx * 0.01;
+        view.elevation = Math.max(-Math.PI / 2, Math.min(Math.PI / 2, view.elevation + dy * 0.01));
+      }
+      requestDraw();
+    });
+    const end = () => { drag = null; canvas.classList.remove('dragging'); };
+    canvas.addEventListener('pointerup', end);
+    canvas.addEventListener('pointercancel', end);
+    canvas.addEventListener('contextmenu', (e) => e.preventDefault());
+    canvas.addEventListener('wheel', (e) => {
+      e.preventDefault();
+      view.zoom = Math.max(0.05, Math.min(200, view.zoom * Math.exp(-e.deltaY * 0.0015)));
+      requestDraw();
+    }, { passive: false });
+  }
+
+  // ----- For tests: the picture now, and a decoded point ------------------------------------------
+  let codes = null;
+  api.pixels = () => {
+    draw();
+    const d = new Uint8Array(width * height * 4);
+    gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, d);
+    let hash = 2166136261, drawn = 0;
+    const colors = new Set();
+    for (let i = 0; i < d.length; i += 4) {
+      const v = (d[i] << 16) | (d[i + 1] << 8) | d[i + 2];
+      hash = Math.imul(hash ^ v, 16777619) >>> 0;
+      if (v !== 0xfbfbfd) drawn += 1;
+      if (colors.size < 64) colors.add(v);
+    }
+    return { hash, drawnFraction: drawn / (d.length / 4), colors: colors.size };
+  };
+  // Point i (over the embedded strands) of stored frame k, as the page draws it.
+  api.point = (k, i) => {
+    const f = meta.frames[k];
+    const at = k * frameCodes + i * lanes;
+    return f.lo.map((lo, c) => lo + codes[at + c] / 65535 * f.ext[c]);
+  };
+  api.setFrame = (k) => { setPlaying(false); setFrame(k); };
+
+  // ----- Start ----------------------------------------------------------------------------------
+  $('title').textContent = meta.title;
+  document.title = meta.title;
+  $('subtitle').textContent = meta.description || '';
+  $('hint').textContent = 'decoding';
+  decodeAll().then((all) => {
+    codes = all;
+    buildStrands(all);
+    if (scalp) buildScalp();
+    setSpeed(1);
+    state.blend = $('blend').checked;
+    bind();
+    showFacts();
+    resetView();
+    resize();
+    api.frame = 0;
+    showFrame();
+    $('hint').textContent = dim === 3 ? 'drag: orbit \u00b7 shift-drag: pan \u00b7 wheel: zoom'
+                                      : 'drag: pan \u00b7 wheel: zoom';
+    api.ready = true;
+    setPlaying(options.autoplay);
+    requestAnimationFrame(tick);
+  }).catch((e) => fail(`The page's strand data cannot be decoded: ${e.message}`));
+})();
