@@ -80,7 +80,8 @@
   async function decodeAll() {
     const elements = document.querySelectorAll('script.flexkin-frame');
     if (elements.length !== numFrames) throw new Error(`${elements.length} frames, not ${numFrames}`);
-    const all = new Uint16Array(numFrames * frameCodes);
+    // One point more at the end: the last point's "next" (the tangent's) must be in the buffer.
+    const all = new Uint16Array(numFrames * frameCodes + lanes);
     // Inflating runs off the main thread; the differences need the frames in order.
     const pending = Array.from(elements, (e) => inflate(base64Bytes(e.textContent)));
     for (let k = 0; k < numFrames; ++k) {
@@ -184,18 +185,25 @@
     layout(location = 0) in vec4 codeA;
     layout(location = 1) in vec4 codeB;
     layout(location = 2) in vec2 along;  // (0 at the root .. 1 at the tip, strand's shade)
+    layout(location = 3) in vec4 nextA;  // the codes of the next point in frame a
+
     uniform vec3 loA, extA, loB, extB;
     uniform float blend;
     uniform mat4 viewMatrix, projection;
     uniform vec2 fog;  // view depths where fading starts and where it is strongest
     uniform vec3 background;
+    uniform vec3 light;  // unit vector towards the light
     out vec3 color;
     void main() {
       vec3 p = mix(loA + codeA.xyz * extA, loB + codeB.xyz * extB, blend);
       vec4 v = viewMatrix * vec4(p, 1.0);
       gl_Position = projection * v;
       vec3 root = vec3(0.23, 0.15, 0.09), tip = vec3(0.85, 0.66, 0.40);
-      vec3 c = mix(root, tip, along.x) * (0.75 + 0.5 * along.y);
+      // Hair-like lighting (Kajiya-Kay diffuse): brightest where the strand runs across the light.
+      // The tip's "next" point is the next strand's root: its shading only tints the last link.
+      vec3 tangent = normalize(loA + nextA.xyz * extA - (loA + codeA.xyz * extA) + vec3(1e-12));
+      float across = sqrt(max(0.0, 1.0 - pow(dot(tangent, light), 2.0)));
+      vec3 c = mix(root, tip, along.x) * (0.75 + 0.5 * along.y) * (0.35 + 0.8 * across);
       float fade = clamp((-v.z - fog.x) / (fog.y - fog.x), 0.0, 1.0);
       color = mix(c, background, 0.55 * fade);
     }`, `#version 300 es
@@ -260,6 +268,7 @@
     gl.bufferData(gl.ARRAY_BUFFER, codes, gl.STATIC_DRAW);
     gl.enableVertexAttribArray(0);
     gl.enableVertexAttribArray(1);
+    gl.enableVertexAttribArray(3);
     gl.bindVertexArray(null);
   }
 
@@ -334,7 +343,7 @@
       const hw = aspect >= 1 ? half * aspect : half, hh = aspect >= 1 ? half : half / aspect;
       const eye = [center[0] - view.panX * hw, center[1] - view.panY * hh, 1];
       return { view: lookAt(eye, [eye[0], eye[1], 0], [0, 1, 0]), projection: ortho(hw, hh, 0, 2),
-               fog: [1e9, 2e9] };
+               fog: [1e9, 2e9], eyeDir: [0, 0, 1] };
     }
     const fovy = 30 * Math.PI / 180;
     const distance = 1.15 * radius / Math.sin(fovy / 2) / Math.min(1, aspect) / view.zoom;
@@ -349,7 +358,7 @@
     const near = Math.max(distance - 2 * radius, distance * 1e-3), far = distance + 2 * radius;
     return { view: lookAt(eye, target, Math.abs(se) > 0.999 ? [0, 1, 0] : [0, 0, 1]),
              projection: perspective(fovy, aspect, near, far),
-             fog: [distance - radius, distance + radius] };
+             fog: [distance - radius, distance + radius], eyeDir: dir };
   }
 
   // The two stored frames shown and how far between them.
@@ -403,10 +412,14 @@
     gl.uniformMatrix4fv(u.projection, false, cam.projection);
     gl.uniform2fv(u.fog, cam.fog);
     gl.uniform3fv(u.background, background);
+    // From above, a little from the viewer's side: (in world coordinates; z is up).
+    const l = normalize(dim === 3 ? [cam.eyeDir[0] + 0.2, cam.eyeDir[1], cam.eyeDir[2] + 1.2] : [0, 0, 1]);
+    gl.uniform3fv(u.light, l);
     gl.bindVertexArray(strandVao);
     gl.bindBuffer(gl.ARRAY_BUFFER, positionBuffer);
     gl.vertexAttribPointer(0, lanes, gl.UNSIGNED_SHORT, true, 2 * lanes, 2 * a * frameCodes);
     gl.vertexAttribPointer(1, lanes, gl.UNSIGNED_SHORT, true, 2 * lanes, 2 * b * frameCodes);
+    gl.vertexAttribPointer(3, lanes, gl.UNSIGNED_SHORT, true, 2 * lanes, 2 * (a * frameCodes + lanes));
     gl.drawElements(gl.LINES, numIndices, gl.UNSIGNED_INT, 0);
     gl.bindVertexArray(null);
 
