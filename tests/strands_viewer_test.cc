@@ -349,6 +349,22 @@ TEST_F(StrandsViewerTest, PlaysTenThousandStrandsInHeadlessChromium) {
   std::printf("page of 10,000 x 32 links, 40 frames: %ju bytes (%.0f per frame)\n",
               static_cast<uintmax_t>(size), size / 40.0);
 
+  // Points of the files, for the browser check to compare with the page's decoding.
+  for (const char* name : {"small_2d", "hair_10000x32"}) {
+    StrandFileReader reader(Path(std::string(name) == "small_2d" ? "small_2d.npz" : "hair.npz"));
+    nlohmann::json points = nlohmann::json::array();
+    StrandFrame frame;
+    for (int k = 0; reader.Next(&frame); ++k) {
+      if (k % 7 != 0) continue;
+      for (Eigen::Index i = 0; i < frame.points.rows(); i += frame.points.rows() / 5 + 1) {
+        std::vector<double> xyz(frame.points.cols());
+        for (int c = 0; c < frame.points.cols(); ++c) xyz[c] = frame.points(i, c);
+        points.push_back({{"frame", k}, {"point", i}, {"xyz", xyz}});
+      }
+    }
+    std::ofstream(Path(std::string(name) + ".points.json")) << points.dump();
+  }
+
   std::string output;
   const int status = RunCommand("node '" + source + "/tests/viewer/strands_browser_check.mjs' '" +
                                     tools + "' '" + dir_ + "' '" + Path("small_2d.html") + "' '" +

@@ -624,7 +624,6 @@
   }
 
   // ----- For tests: the picture now, and a decoded point ------------------------------------------
-  let codes = null;
   api.pixels = () => {
     draw();
     const d = new Uint8Array(width * height * 4);
@@ -639,11 +638,14 @@
     }
     return { hash, drawnFraction: drawn / (d.length / 4), colors: colors.size };
   };
-  // Point i (over the embedded strands) of stored frame k, as the page draws it.
+  // Point i (over the embedded strands) of stored frame k, as the page draws it (read back from
+  // the GPU buffer: the page keeps no other copy of the decoded frames).
   api.point = (k, i) => {
     const f = meta.frames[k];
-    const at = k * frameCodes + i * lanes;
-    return f.lo.map((lo, c) => lo + codes[at + c] / 65535 * f.ext[c]);
+    const got = new Uint16Array(lanes);
+    gl.bindBuffer(gl.ARRAY_BUFFER, positionBuffer);
+    gl.getBufferSubData(gl.ARRAY_BUFFER, 2 * (k * frameCodes + i * lanes), got);
+    return f.lo.map((lo, c) => lo + got[c] / 65535 * f.ext[c]);
   };
   api.setFrame = (k) => { setPlaying(false); setFrame(k); };
 
@@ -653,7 +655,6 @@
   $('subtitle').textContent = meta.description || '';
   $('hint').textContent = 'decoding';
   decodeAll().then((all) => {
-    codes = all;
     buildStrands(all);
     if (scalp) buildScalp();
     setSpeed(1);

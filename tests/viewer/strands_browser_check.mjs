@@ -3,11 +3,13 @@
 // and checks that they work offline, draw, play, scrub and answer the keys, and how fast they
 // play. Run by tests/strands_viewer_test.cc:
 //   node tests/viewer/strands_browser_check.mjs TOOLS_NODE_DIR OUT_DIR PAGE.html...
+// Next to PAGE.html, PAGE.points.json may list points of the strand file ([{frame, point, xyz}],
+// frame and point as embedded): the page's decoded points must match them within its precision.
 // Writes screenshots to OUT_DIR, prints one line per check and the frame rate per page
 // ("fps ..."), and exits with 1 if any check failed. Environment: FLEXKIN_CHROMIUM overrides the
 // browser (default /usr/bin/chromium); FLEXKIN_MIN_STRANDS_FPS the frame-rate floor (default 30).
 import { createRequire } from 'node:module';
-import { existsSync } from 'node:fs';
+import { existsSync, readFileSync } from 'node:fs';
 import { basename, join, resolve } from 'node:path';
 import { pathToFileURL } from 'node:url';
 
@@ -75,6 +77,24 @@ async function checkPage(browser, file) {
               `${info.numPoints - info.numStrands} links, ${n} frames, canvas ${info.width} x ` +
               `${info.height}`);
   check(await viewer(page, 'playing'), `${name}: plays on opening (autoplay)`);
+
+  const expected = file.replace(/\.html$/, '.points.json');
+  if (existsSync(expected)) {
+    const points = JSON.parse(readFileSync(expected, 'utf8'));
+    const worst = await page.evaluate((points) => {
+      const v = window.flexkinStrandsViewer;
+      const precision = JSON.parse(document.getElementById('flexkin-strands').textContent).precision;
+      let error = 0;
+      for (const p of points) {
+        const got = v.point(p.frame, p.point);
+        for (let c = 0; c < p.xyz.length; ++c) error = Math.max(error, Math.abs(got[c] - p.xyz[c]));
+      }
+      return { error, precision };
+    }, points);
+    check(worst.error <= worst.precision * (1 + 1e-9) + 1e-12,
+          `${name}: ${points.length} decoded points within the precision ${worst.precision} ` +
+          `of the file's (largest error ${worst.error})`);
+  }
 
   // Pause with the space bar; the picture then stays still.
   await page.locator('#view').focus();
