@@ -1,7 +1,5 @@
 // WriteAnimation: the frames drawn with cairo, piped raw into ffmpeg, which writes an MP4 (H.264)
 // or a GIF to a temporary file that is renamed over the destination only on success.
-#include <fcntl.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -24,79 +22,7 @@ namespace flexkin {
 namespace {
 
 using render::ChainScene;
-
-enum class VideoFormat { kMp4, kGif };
-
-VideoFormat VideoFormatFromPath(const std::string& path) {
-  const size_t dot = path.rfind('.');
-  std::string ext = dot == std::string::npos ? "" : path.substr(dot);
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
-  if (ext == ".mp4") return VideoFormat::kMp4;
-  if (ext == ".gif") return VideoFormat::kGif;
-  throw InputError("path",
-                   "\"" + path + "\" has no known animation extension; expected .mp4 or .gif");
-}
-
-// The ffmpeg command line: raw frames in (cairo's RGB24 words: bytes B, G, R, unused on a
-// little-endian machine), the video out.
-std::vector<std::string> FfmpegArgs(VideoFormat format, int width, int height, int fps, int crf,
-                                    const std::string& output) {
-  const uint32_t probe = 1;
-  const bool little_endian = *reinterpret_cast<const unsigned char*>(&probe) == 1;
-  std::vector<std::string> args = {
-      "-hide_banner", "-loglevel",
-      "error",        "-nostdin",
-      "-f",           "rawvideo",
-      "-pix_fmt",     little_endian ? "bgr0" : "0rgb",
-      "-s",           std::to_string(width) + "x" + std::to_string(height),
-      "-framerate",   std::to_string(fps),
-      "-i",           "pipe:0",
-      "-an"};
-  if (format == VideoFormat::kMp4) {
-    args.insert(args.end(), {"-c:v", "libx264", "-preset", "medium", "-crf", std::to_string(crf),
-                             "-pix_fmt", "yuv420p", "-movflags", "+faststart", "-f", "mp4"});
-  } else {
-    // One palette for the whole animation, made from all its frames.
-    args.insert(args.end(),
-                {"-filter_complex",
-                 "split[a][b];[a]palettegen=stats_mode=full[p];[b][p]paletteuse=dither=sierra2_4a",
-                 "-loop", "0", "-f", "gif"});
-  }
-  args.insert(args.end(), {"-y", output});
-  return args;
-}
-
-// A temporary file next to `path` (".NAME.tmp-XXXXXX"), created empty.
-std::string TemporaryNextTo(const std::string& path) {
-  const size_t slash = path.rfind('/');
-  const std::string dir = slash == std::string::npos ? "" : path.substr(0, slash + 1);
-  const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
-  std::string temp = dir + "." + name + ".tmp-XXXXXX";
-  const int fd = ::mkstemp(temp.data());
-  if (fd < 0)
-    throw std::system_error(errno, std::generic_category(), "cannot write '" + path + "'");
-  ::close(fd);
-  return temp;
-}
-
-// Gives `temp` the mode `path` has, or 0666 less the umask for a new file, and renames it.
-void Publish(const std::string& temp, const std::string& path) {
-  struct stat st;
-  mode_t mode;
-  if (::stat(path.c_str(), &st) == 0) {
-    mode = st.st_mode & 07777;
-  } else {
-    const mode_t mask = ::umask(0);
-    ::umask(mask);
-    mode = 0666 & ~mask;
-  }
-  if (::chmod(temp.c_str(), mode) != 0 || ::rename(temp.c_str(), path.c_str()) != 0) {
-    const int e = errno;
-    ::unlink(temp.c_str());
-    throw std::system_error(e, std::generic_category(), "cannot write '" + path + "'");
-  }
-}
+using render::VideoFormat;
 
 // What stays the same in every picture: title, axes, the whole leader path faintly, the
 // initial configuration.
@@ -170,7 +96,7 @@ void DrawMoment(render::Canvas* canvas, const ChainScene& scene, const ResultFil
 void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
                     const std::string& path) {
   ThrowIfAny(options.Validate());
-  const VideoFormat format = VideoFormatFromPath(path);
+  const VideoFormat format = render::VideoFormatFromPath(path);
   render::CheckDrawable(file);
   const int width = options.width + options.width % 2;
   int height = options.height != 0
@@ -192,11 +118,11 @@ void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
   cairo_surface_flush(background.surface());
   render::Canvas picture(ImageFormat::kPng, width, height);
 
-  const std::string temp = TemporaryNextTo(path);
+  const std::string temp = render::TemporaryNextTo(path);
   std::string failure;
   try {
-    render::FfmpegPipe ffmpeg(options.ffmpeg,
-                              FfmpegArgs(format, width, height, options.fps, options.crf, temp));
+    render::FfmpegPipe ffmpeg(
+        options.ffmpeg, render::FfmpegArgs(format, width, height, options.fps, options.crf, temp));
     // Video frames per picture, so that short runs last min_seconds; the last one also holds
     // for end_pause.
     const int pictures = static_cast<int>(drawn.size());
@@ -230,7 +156,7 @@ void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
     throw std::runtime_error("ffmpeg (\"" + options.ffmpeg + "\") failed writing '" + path +
                              "': " + failure);
   }
-  Publish(temp, path);
+  render::Publish(temp, path);
 }
 
 }  // namespace flexkin

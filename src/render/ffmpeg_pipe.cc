@@ -4,13 +4,20 @@
 #include <signal.h>
 #include <spawn.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
+#include <system_error>
+
+#include "flexkin/error.h"
 
 extern char** environ;
 
@@ -120,6 +127,74 @@ std::string FfmpegPipe::Finish() {
                                       : "killed by signal " + std::to_string(WTERMSIG(status));
   text = Tail(text, 4);
   return text.empty() ? why : why + ": " + text;
+}
+
+VideoFormat VideoFormatFromPath(const std::string& path) {
+  const size_t dot = path.rfind('.');
+  std::string ext = dot == std::string::npos ? "" : path.substr(dot);
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".mp4") return VideoFormat::kMp4;
+  if (ext == ".gif") return VideoFormat::kGif;
+  throw InputError("path",
+                   "\"" + path + "\" has no known animation extension; expected .mp4 or .gif");
+}
+
+// Raw frames in: cairo's RGB24 words are bytes B, G, R, unused on a little-endian machine.
+std::vector<std::string> FfmpegArgs(VideoFormat format, int width, int height, int fps, int crf,
+                                    const std::string& output) {
+  const uint32_t probe = 1;
+  const bool little_endian = *reinterpret_cast<const unsigned char*>(&probe) == 1;
+  std::vector<std::string> args = {
+      "-hide_banner", "-loglevel",
+      "error",        "-nostdin",
+      "-f",           "rawvideo",
+      "-pix_fmt",     little_endian ? "bgr0" : "0rgb",
+      "-s",           std::to_string(width) + "x" + std::to_string(height),
+      "-framerate",   std::to_string(fps),
+      "-i",           "pipe:0",
+      "-an"};
+  if (format == VideoFormat::kMp4) {
+    args.insert(args.end(), {"-c:v", "libx264", "-preset", "medium", "-crf", std::to_string(crf),
+                             "-pix_fmt", "yuv420p", "-movflags", "+faststart", "-f", "mp4"});
+  } else {
+    // One palette for the whole animation, made from all its frames.
+    args.insert(args.end(),
+                {"-filter_complex",
+                 "split[a][b];[a]palettegen=stats_mode=full[p];[b][p]paletteuse=dither=sierra2_4a",
+                 "-loop", "0", "-f", "gif"});
+  }
+  args.insert(args.end(), {"-y", output});
+  return args;
+}
+
+std::string TemporaryNextTo(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  const std::string dir = slash == std::string::npos ? "" : path.substr(0, slash + 1);
+  const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  std::string temp = dir + "." + name + ".tmp-XXXXXX";
+  const int fd = ::mkstemp(temp.data());
+  if (fd < 0)
+    throw std::system_error(errno, std::generic_category(), "cannot write '" + path + "'");
+  ::close(fd);
+  return temp;
+}
+
+void Publish(const std::string& temp, const std::string& path) {
+  struct stat st;
+  mode_t mode;
+  if (::stat(path.c_str(), &st) == 0) {
+    mode = st.st_mode & 07777;
+  } else {
+    const mode_t mask = ::umask(0);
+    ::umask(mask);
+    mode = 0666 & ~mask;
+  }
+  if (::chmod(temp.c_str(), mode) != 0 || ::rename(temp.c_str(), path.c_str()) != 0) {
+    const int e = errno;
+    ::unlink(temp.c_str());
+    throw std::system_error(e, std::generic_category(), "cannot write '" + path + "'");
+  }
 }
 
 }  // namespace flexkin::render

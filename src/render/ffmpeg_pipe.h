@@ -1,5 +1,7 @@
 #pragma once
-// An ffmpeg process fed raw video frames on its standard input.
+// An ffmpeg process fed raw video frames on its standard input, and the pieces every animation
+// writer shares: the format by extension, ffmpeg's command line, the temporary file and its
+// renaming into place.
 
 #include <sys/types.h>
 
@@ -33,5 +35,19 @@ class FfmpegPipe {
   int input_ = -1;   // our end of ffmpeg's standard input
   int errors_ = -1;  // the temporary file holding ffmpeg's standard error
 };
+
+enum class VideoFormat { kMp4, kGif };
+
+// ".mp4" or ".gif" (case-insensitive); InputError (field "path") for any other extension.
+VideoFormat VideoFormatFromPath(const std::string& path);
+// The ffmpeg command line: raw frames of width x height in (cairo's RGB24 words), the video out
+// to `output` (MP4: H.264 at `crf`, yuv420p; GIF: one palette made from all frames, looping).
+std::vector<std::string> FfmpegArgs(VideoFormat format, int width, int height, int fps, int crf,
+                                    const std::string& output);
+// A temporary file next to `path` (".NAME.tmp-XXXXXX"), created empty. Throws std::system_error.
+std::string TemporaryNextTo(const std::string& path);
+// Gives `temp` the mode `path` has, or 0666 less the umask for a new file, and renames it over
+// `path`; on failure removes `temp` and throws std::system_error.
+void Publish(const std::string& temp, const std::string& path);
 
 }  // namespace flexkin::render
