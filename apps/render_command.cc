@@ -7,13 +7,16 @@
 #include <cerrno>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <stdexcept>
 #include <system_error>
 #include <vector>
 
 #include "flexkin/error.h"
 #include "flexkin/result_io.h"
+#include "flexkin/strand_file.h"
 #include "gltf/gltf.h"
+#include "render/strands_render.h"
 #include "viewer/viewer.h"
 
 namespace flexkin::cli {
@@ -120,6 +123,44 @@ std::vector<const FormatWriter*> ParseFormats(const std::string& list) {
   return writers;
 }
 
+// The formats a strand file can be drawn in, in the order they are written, with their
+// extensions.
+struct StrandFormat {
+  OutputFormat format;
+  const char* extension;
+  bool animation;
+};
+const StrandFormat kStrandFormats[] = {
+    {OutputFormat::kSvg, ".svg", false}, {OutputFormat::kPng, ".png", false},
+    {OutputFormat::kPdf, ".pdf", false}, {OutputFormat::kMp4, ".mp4", true},
+    {OutputFormat::kGif, ".gif", true},
+};
+
+// The chosen writers' formats that strand files support; InputError ("--formats") naming any
+// other and what is valid.
+std::vector<const StrandFormat*> StrandFormats(const std::vector<const FormatWriter*>& writers) {
+  std::string valid;
+  for (const StrandFormat& f : kStrandFormats)
+    valid += (valid.empty() ? "" : ", ") + std::string(NameOf(f.format));
+  std::vector<const StrandFormat*> formats;
+  for (const FormatWriter* writer : writers) {
+    const StrandFormat* found = nullptr;
+    for (const StrandFormat& f : kStrandFormats) {
+      if (f.format == writer->format) found = &f;
+    }
+    if (found == nullptr) {
+      const std::string name = NameOf(writer->format);
+      const std::string why = writer->format == OutputFormat::kHtml
+                                  ? "the strand viewer is not built into this flexkin yet"
+                                  : "it draws chain results only";
+      throw InputError("--formats", "format \"" + name + "\" is not available for strand files (" +
+                                        why + "); expected a comma-separated list of " + valid);
+    }
+    formats.push_back(found);
+  }
+  return formats;
+}
+
 // The first problem of render options, named by the command-line option that set the member
 // ("every_k" -> "--every", "max_frames" -> "--max-frames").
 void CheckOptions(const Problems& problems) {
@@ -159,7 +200,8 @@ RenderCommand::RenderCommand(CLI::App* app, const std::string& footer) {
   std::string formats_help = "Comma-separated outputs (default svg,png,plots):";
   for (const auto& entry : Vocabulary<OutputFormat>::kEntries)
     formats_help += std::string("\n  ") + entry.name + ": " + entry.summary;
-  command_->add_option("--formats", args_.formats, formats_help);
+  formats_help += "\n  (strand files: svg, png, pdf, mp4, gif; default svg,png)";
+  formats_ = command_->add_option("--formats", args_.formats, formats_help);
   command_->add_option("--every", args_.every,
                        "Figures: draw every K-th recorded frame (default: about 16 frames)");
   width_ = command_->add_option(
@@ -175,6 +217,8 @@ RenderCommand::RenderCommand(CLI::App* app, const std::string& footer) {
   max_frames_ = command_->add_option(
       "--max-frames", args_.max_frames,
       "Animations: at most N pictures; longer runs are subsampled (default 300)");
+  command_->add_option("--max-strands", args_.max_strands,
+                       "Strand files: draw at most N strands, spread evenly (default 0: all)");
   command_->add_option("--title", args_.title,
                        "Title of figures and animations (default: the scenario's name)");
   command_->add_flag("-q,--quiet", args_.quiet, "Do not list the files written");
@@ -182,6 +226,7 @@ RenderCommand::RenderCommand(CLI::App* app, const std::string& footer) {
 }
 
 int RenderCommand::Run() const {
+  if (IsStrandFile(args_.result)) return RunStrands();
   const std::vector<const FormatWriter*> formats = ParseFormats(args_.formats);
   RenderJob job;
   job.figure.every_k = args_.every;
@@ -217,6 +262,65 @@ int RenderCommand::Run() const {
   job.written = &written;
   try {
     for (const FormatWriter* format : formats) format->write(job);
+  } catch (const InputError& e) {
+    throw InputError(args_.result + (e.field().empty() ? "" : ": " + e.field()),
+                     std::string(e.what()).substr(e.field().empty() ? 0 : e.field().size() + 2));
+  } catch (const std::system_error&) {
+    throw;
+  } catch (const std::runtime_error& e) {  // ffmpeg missing or failing, cairo
+    std::cerr << "flexkin: error: " << e.what() << "\n";
+    return 1;
+  }
+  if (!args_.quiet) {
+    for (const std::string& path : written) std::cout << "wrote " << path << "\n";
+  }
+  return 0;
+}
+
+// A strand file: the figure (svg, png, pdf) and the animation (mp4, gif) of its strands; the
+// default formats are the figure's, svg and png.
+int RenderCommand::RunStrands() const {
+  const std::vector<const FormatWriter*> writers =
+      ParseFormats(*formats_ ? args_.formats : "svg,png");
+  const std::vector<const StrandFormat*> formats = StrandFormats(writers);
+  StrandsRenderOptions options;
+  options.title = args_.title;
+  options.every_k = args_.every;
+  options.max_strands = args_.max_strands;
+  if (*width_) options.width = args_.width;
+  if (*height_) options.height = args_.height;
+  if (*azimuth_) options.azimuth = args_.azimuth;
+  if (*elevation_) options.elevation = args_.elevation;
+  if (*fps_) options.fps = args_.fps;
+  if (*max_frames_) options.max_frames = args_.max_frames;
+  CheckOptions(options.Validate());
+
+  const std::string base = OutputBase(args_.result, args_.output_dir);
+  const std::string dir = base.substr(0, base.rfind('/'));
+  std::vector<std::string> written;
+  try {
+    // Each writer reads the whole file: a fresh reader each time.
+    StrandFileReader first(args_.result);
+    std::error_code error;
+    std::filesystem::create_directories(dir, error);
+    if (error) throw std::system_error(error, "cannot create the output directory '" + dir + "'");
+    bool fresh = true;
+    for (const StrandFormat* format : formats) {
+      std::unique_ptr<StrandFileReader> again;
+      StrandFileReader* reader = &first;
+      if (!fresh) {
+        again = std::make_unique<StrandFileReader>(args_.result);
+        reader = again.get();
+      }
+      fresh = false;
+      const std::string path = base + format->extension;
+      if (format->animation) {
+        RenderStrandsAnimation(reader, options, path);
+      } else {
+        RenderStrandsSnapshot(reader, options, path);
+      }
+      written.push_back(path);
+    }
   } catch (const InputError& e) {
     throw InputError(args_.result + (e.field().empty() ? "" : ": " + e.field()),
                      std::string(e.what()).substr(e.field().empty() ? 0 : e.field().size() + 2));

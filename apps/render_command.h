@@ -23,17 +23,20 @@ class RenderCommand {
 
   struct Args {
     std::string result, output_dir, formats = "svg,png,plots", title;
-    int every = 0, width = 0, height = 0, fps = 0, max_frames = 0;
+    int every = 0, width = 0, height = 0, fps = 0, max_frames = 0, max_strands = 0;
     double azimuth = 0.0, elevation = 0.0;
     bool quiet = false;
   };
 
  private:
+  // A strand file (docs/rendering.md, "Strand files"): its figure and animation.
+  int RunStrands() const;
+
   CLI::App* command_ = nullptr;
   Args args_;
   // Which of the shared options were given (the defaults differ per output).
   CLI::Option *width_ = nullptr, *height_ = nullptr, *azimuth_ = nullptr, *elevation_ = nullptr,
-              *fps_ = nullptr, *max_frames_ = nullptr;
+              *fps_ = nullptr, *max_frames_ = nullptr, *formats_ = nullptr;
 };
 
 }  // namespace flexkin::cli
