@@ -120,12 +120,13 @@ int ScalpPixels(const Image& image) {
   return count;
 }
 
-// Pixels clearly not white and not the scalp's grey: strands.
+// Pixels of the strands' colours: purple (blue above green) or warm (red well above blue),
+// which neither the white background nor the scalp's grey nor its outline has.
 int StrandPixels(const Image& image) {
   int count = 0;
   for (const uint32_t p : image.pixels) {
     const int r = p >> 16 & 255, g = p >> 8 & 255, b = p & 255;
-    if (std::abs(r - b) > 40 || std::abs(g - b) > 60 || std::max({r, g, b}) < 120) ++count;
+    if (b > g + 15 || r - b > 50) ++count;
   }
   return count;
 }
@@ -218,6 +219,53 @@ TEST_F(StrandsRenderTest, NoScalpWithoutOne) {
   const Image bare = ReadPng(dir_.Path("bare.png")), scalp = ReadPng(dir_.Path("f.png"));
   EXPECT_GT(ScalpPixels(scalp), 10 * ScalpPixels(bare));  // antialiased strands: a few
   EXPECT_GT(StrandPixels(bare), 2000);
+}
+
+// One strand of 6 links from the sphere's surface along `direction` (pointing at the viewer of
+// the default view, or away from it), with a second one to the side so the view has extent.
+void WriteOneStrandFile(const std::string& path, double sign) {
+  const double az = -60.0 * M_PI / 180, el = 20.0 * M_PI / 180;
+  const Eigen::Vector3d toward(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az),
+                               std::sin(el));
+  StrandFileHeader header;
+  header.num_frames = 2;
+  header.offsets = {0, 7, 14};
+  header.link_lengths = Eigen::VectorXd::Constant(12, 0.02);
+  header.scalp.shape = "sphere";
+  header.scalp.radii = Eigen::Vector3d::Constant(0.1);
+  const Eigen::Vector3d side = toward.cross(Eigen::Vector3d::UnitZ()).normalized();
+  // Tilted from the line of sight by 30 degrees: in front it is seen across the scalp.
+  const Eigen::Vector3d along =
+      (sign * toward * std::cos(M_PI / 6) + toward.cross(side).normalized() * std::sin(M_PI / 6));
+  Points points(14, 3);
+  for (int k = 0; k < 7; ++k) {
+    points.row(k) = ((0.1 + 0.02 * k) * along).transpose();
+    points.row(7 + k) = ((0.1 + 0.02 * k) * side).transpose();
+  }
+  StrandFileWriter writer(path, header);
+  for (int f = 0; f < 2; ++f) {
+    StrandFrame frame;
+    frame.frame = f;
+    frame.time = f / 30.0;
+    frame.points = points;
+    writer.Add(frame);
+  }
+  writer.Commit(StrandRunReport{});
+}
+
+TEST_F(StrandsRenderTest, TheScalpHidesTheStrandsBehindIt) {
+  WriteOneStrandFile(dir_.Path("front.npz"), 1.0);
+  WriteOneStrandFile(dir_.Path("back.npz"), -1.0);
+  StrandsRenderOptions options;
+  options.panels = 1;
+  options.line_width = 6.0;
+  Snapshot("front.png", options, dir_.Path("front.npz"));
+  Snapshot("back.png", options, dir_.Path("back.npz"));
+  // The side strand is seen in both; the one near the line of sight only in front, where it
+  // lies across the scalp.
+  const Image front = ReadPng(dir_.Path("front.png")), back = ReadPng(dir_.Path("back.png"));
+  EXPECT_GT(StrandPixels(front), StrandPixels(back) + 200);
+  EXPECT_LT(ScalpPixels(front), ScalpPixels(back) - 200);
 }
 
 // PNG only: cairo's SVG ids count the surfaces of the process (docs/rendering.md).
