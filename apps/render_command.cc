@@ -17,6 +17,7 @@
 #include "flexkin/strand_file.h"
 #include "gltf/gltf.h"
 #include "render/strands_render.h"
+#include "viewer/strands_viewer.h"
 #include "viewer/viewer.h"
 
 namespace flexkin::cli {
@@ -125,15 +126,19 @@ std::vector<const FormatWriter*> ParseFormats(const std::string& list) {
 
 // The formats a strand file can be drawn in, in the order they are written, with their
 // extensions.
+enum class StrandOutput { kFigure, kAnimation, kViewer };
 struct StrandFormat {
   OutputFormat format;
   const char* extension;
-  bool animation;
+  StrandOutput output;
 };
 const StrandFormat kStrandFormats[] = {
-    {OutputFormat::kSvg, ".svg", false}, {OutputFormat::kPng, ".png", false},
-    {OutputFormat::kPdf, ".pdf", false}, {OutputFormat::kMp4, ".mp4", true},
-    {OutputFormat::kGif, ".gif", true},
+    {OutputFormat::kSvg, ".svg", StrandOutput::kFigure},
+    {OutputFormat::kPng, ".png", StrandOutput::kFigure},
+    {OutputFormat::kPdf, ".pdf", StrandOutput::kFigure},
+    {OutputFormat::kMp4, ".mp4", StrandOutput::kAnimation},
+    {OutputFormat::kGif, ".gif", StrandOutput::kAnimation},
+    {OutputFormat::kHtml, ".html", StrandOutput::kViewer},
 };
 
 // The chosen writers' formats that strand files support; InputError ("--formats") naming any
@@ -149,12 +154,10 @@ std::vector<const StrandFormat*> StrandFormats(const std::vector<const FormatWri
       if (f.format == writer->format) found = &f;
     }
     if (found == nullptr) {
-      const std::string name = NameOf(writer->format);
-      const std::string why = writer->format == OutputFormat::kHtml
-                                  ? "the strand viewer is not built into this flexkin yet"
-                                  : "it draws chain results only";
-      throw InputError("--formats", "format \"" + name + "\" is not available for strand files (" +
-                                        why + "); expected a comma-separated list of " + valid);
+      throw InputError("--formats", "format \"" + std::string(NameOf(writer->format)) +
+                                        "\" is not available for strand files (it draws chain "
+                                        "results only); expected a comma-separated list of " +
+                                        valid);
     }
     formats.push_back(found);
   }
@@ -200,7 +203,7 @@ RenderCommand::RenderCommand(CLI::App* app, const std::string& footer) {
   std::string formats_help = "Comma-separated outputs (default svg,png,plots):";
   for (const auto& entry : Vocabulary<OutputFormat>::kEntries)
     formats_help += std::string("\n  ") + entry.name + ": " + entry.summary;
-  formats_help += "\n  (strand files: svg, png, pdf, mp4, gif; default svg,png)";
+  formats_help += "\n  (strand files: svg, png, pdf, mp4, gif, html; default svg,png)";
   formats_ = command_->add_option("--formats", args_.formats, formats_help);
   command_->add_option("--every", args_.every,
                        "Figures: draw every K-th recorded frame (default: about 16 frames)");
@@ -294,6 +297,13 @@ int RenderCommand::RunStrands() const {
   if (*fps_) options.fps = args_.fps;
   if (*max_frames_) options.max_frames = args_.max_frames;
   CheckOptions(options.Validate());
+  StrandsViewerOptions viewer;
+  viewer.title = args_.title;
+  viewer.max_strands = args_.max_strands;
+  if (*azimuth_) viewer.azimuth = args_.azimuth;
+  if (*elevation_) viewer.elevation = args_.elevation;
+  if (*max_frames_) viewer.max_frames = args_.max_frames;
+  CheckOptions(viewer.Validate());
 
   const std::string base = OutputBase(args_.result, args_.output_dir);
   const std::string dir = base.substr(0, base.rfind('/'));
@@ -314,10 +324,16 @@ int RenderCommand::RunStrands() const {
       }
       fresh = false;
       const std::string path = base + format->extension;
-      if (format->animation) {
-        RenderStrandsAnimation(reader, options, path);
-      } else {
-        RenderStrandsSnapshot(reader, options, path);
+      switch (format->output) {
+        case StrandOutput::kFigure:
+          RenderStrandsSnapshot(reader, options, path);
+          break;
+        case StrandOutput::kAnimation:
+          RenderStrandsAnimation(reader, options, path);
+          break;
+        case StrandOutput::kViewer:
+          WriteStrandsViewerHtml(reader, viewer, path);
+          break;
       }
       written.push_back(path);
     }

@@ -477,15 +477,25 @@ TEST_F(StrandsRenderCliTest, FigureAndAnimation) {
 }
 
 TEST_F(StrandsRenderCliTest, FormatsOfChainsAreRefusedByName) {
-  for (const char* format : {"plots", "glb", "gltf", "html"}) {
+  for (const char* format : {"plots", "glb", "gltf"}) {
     const auto r = Cli(std::string("render hair.npz -o out --formats png,") + format);
     EXPECT_EQ(r.exit_code, 1) << format;
     EXPECT_CONTAINS(r.err, "--formats");
     EXPECT_CONTAINS(r.err, std::string("\"") + format + "\"");
     EXPECT_CONTAINS(r.err, "strand files");
-    EXPECT_CONTAINS(r.err, "svg, png, pdf, mp4, gif");
+    EXPECT_CONTAINS(r.err, "svg, png, pdf, mp4, gif, html");
   }
   EXPECT_FALSE(Exists(dir_.Path("out")));
+}
+
+// html is the strand viewer (src/viewer/strands_viewer.h, docs/viewer.md).
+TEST_F(StrandsRenderCliTest, HtmlIsTheStrandViewer) {
+  const auto r = Cli("render hair.npz -o out --formats png,html --max-frames 5 --title Hair");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(Outputs("out"), (std::vector<std::string>{"hair.html", "hair.png"}));
+  const std::string page = ReadFile(dir_.Path("out/hair.html"));
+  EXPECT_CONTAINS(page, "<html");
+  EXPECT_CONTAINS(page, "Hair");
 }
 
 TEST_F(StrandsRenderCliTest, BadOptionsNameTheFlag) {
