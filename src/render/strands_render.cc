@@ -146,38 +146,66 @@ render::StrandsStyle StyleFor(const Drawing& d, const StrandsRenderOptions& opti
   return style;
 }
 
-// The frames of the figure's panels: the first, the last, and between them the moment of each
-// equal stretch when the body has been moving fastest (its speed times its mean speed over the
-// half-stretch before: late in a sustained turn, when the strands trail most).
+// The frames of the figure's panels: the first, the last, and between them one moment of each of
+// the most telling motions of the body. The run is cut into motions where the body rests or its
+// rotation (or, without one, its translation) changes direction; a motion's moment is its frame
+// of the largest speed times the distance moved since the motion began (late in a sustained
+// turn, when the strands trail most). Motions are taken by that score, a motion about an axis
+// already shown counting a quarter (so a nod gets in beside the turns), and drawn in time order.
 std::vector<int> PanelFrames(const std::vector<StrandFrame>& info, int panels) {
   const int n = static_cast<int>(info.size());
   if (panels == 1 || n == 1) return {n - 1};
   if (panels == 2 || n == 2) return {0, n - 1};
-  std::vector<double> speed(n, 0.0);
-  for (int f = 1; f < n; ++f) {
-    speed[f] = AngleBetween(info[f].pose.rotation, info[f - 1].pose.rotation) +
-               (info[f].pose.translation - info[f - 1].pose.translation).norm();
+  struct Motion {
+    int best = -1;
+    double score = 0.0;
+    Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+  };
+  std::vector<Motion> motions;
+  Eigen::Vector3d previous = Eigen::Vector3d::Zero();
+  double moved = 0.0;
+  for (int f = 1; f + 1 < n; ++f) {
+    const Eigen::AngleAxisd turn(info[f].pose.rotation * info[f - 1].pose.rotation.transpose());
+    Eigen::Vector3d velocity = turn.axis() * turn.angle() * 180.0 / M_PI;
+    if (velocity.norm() < 1e-9) velocity = info[f].pose.translation - info[f - 1].pose.translation;
+    const double speed = velocity.norm();
+    if (speed < 1e-9) {
+      previous.setZero();
+      continue;
+    }
+    const Eigen::Vector3d axis = velocity / speed;
+    if (previous.isZero() || axis.dot(previous) < 0.7) {
+      motions.emplace_back();
+      moved = 0.0;
+    }
+    previous = axis;
+    moved += speed;
+    if (speed * moved > motions.back().score) motions.back() = {f, speed * moved, axis};
   }
-  std::vector<int> frames = {0};
-  const int inner = panels - 2;
-  for (int p = 0; p < inner; ++p) {
-    const int lo = 1 + static_cast<int>(static_cast<long long>(p) * (n - 2) / inner);
-    const int hi = 1 + static_cast<int>(static_cast<long long>(p + 1) * (n - 2) / inner);
-    int best = (lo + hi) / 2;
-    double best_score = 1e-12;
-    const int reach = std::max(1, (hi - lo) / 2);
-    for (int f = lo; f < hi; ++f) {
-      double before = 0.0;
-      for (int g = std::max(1, f - reach); g <= f; ++g) before += speed[g];
-      const double score = speed[f] * before;
-      if (score > best_score) {
-        best_score = score;
-        best = f;
+  std::vector<int> frames = {0, n - 1};
+  std::vector<Eigen::Vector3d> shown;
+  std::vector<bool> taken(motions.size(), false);
+  for (int p = 0; p < panels - 2; ++p) {
+    int pick = -1;
+    double best = 0.0;
+    for (size_t m = 0; m < motions.size(); ++m) {
+      if (taken[m]) continue;
+      bool seen = false;
+      for (const Eigen::Vector3d& a : shown) seen |= std::abs(a.dot(motions[m].axis)) > 0.7;
+      const double score = motions[m].score * (seen ? 0.25 : 1.0);
+      if (score > best) {
+        best = score;
+        pick = static_cast<int>(m);
       }
     }
-    frames.push_back(std::clamp(best, 1, n - 2));
+    if (pick < 0) {  // fewer motions than panels: evenly spaced frames
+      frames.push_back(static_cast<int>(static_cast<long long>(p + 1) * (n - 1) / (panels - 1)));
+      continue;
+    }
+    taken[pick] = true;
+    shown.push_back(motions[pick].axis);
+    frames.push_back(motions[pick].best);
   }
-  frames.push_back(n - 1);
   std::sort(frames.begin(), frames.end());
   frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
   return frames;
