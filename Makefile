@@ -42,7 +42,7 @@ test-sanitize: deps
 
 # The tests that run threads (the strand engine's worker pool, groom runs), under ThreadSanitizer:
 # only their programs are built.
-TSAN_TESTS = strands_test
+TSAN_TESTS = strands_test groom_run_test
 test-thread: deps
 	@cmake -S . -B $(BUILD_TSAN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLEXKIN_SANITIZE_THREAD=ON \
 	  -DFLEXKIN_BUILD_APPS=OFF -DFLEXKIN_BUILD_BENCHMARKS=OFF -DFLEXKIN_BUILD_EXAMPLES=OFF \

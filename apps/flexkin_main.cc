@@ -3,7 +3,10 @@
 //   flexkin run SCENARIO.json -o RESULT.json|RESULT.npz [--csv FRAMES.csv] [--method METHOD]
 //       [--substeps N] [--tolerance T] [--max-substeps N] [--record-every N]
 //       [--max-output-size SIZE] [--report brief|full] [--quiet]
-//   flexkin validate SCENARIO.json   (chain or robot scenario, recognised by its keys)
+//   flexkin run GROOM.json -o HAIR.npz [--method tractrix|ftl] [--substeps N] [--threads N]
+//       [--record-every N] [--precision float32|float64] [--max-output-size SIZE] [--quiet]
+//       (a groom scenario, recognised by its keys: groom_command.h)
+//   flexkin validate SCENARIO.json   (chain, robot or groom scenario, recognised by its keys)
 //   flexkin render RESULT.json ...   (render_command.h)
 //   flexkin robot SCENARIO.json ...  (robot_command.h)
 //   flexkin vocabulary               (vocabulary_command.h: every enumerated name)
@@ -28,12 +31,14 @@
 #include <vector>
 
 #include "flexkin/error.h"
+#include "flexkin/groom.h"
 #include "flexkin/propagate.h"
 #include "flexkin/result_io.h"
 #include "flexkin/robot_scenario.h"
 #include "flexkin/run.h"
 #include "flexkin/scenario.h"
 #include "flexkin/urdf.h"
+#include "groom_command.h"
 #include "output_check.h"
 #include "output_limit.h"
 #include "render_command.h"
@@ -67,13 +72,15 @@ constexpr const char* kExitCodesHelp =
 void PrintError(const std::string& message) { std::cerr << "flexkin: error: " << message << "\n"; }
 
 struct RunArgs {
-  std::string scenario, output, csv, method, report = "brief", max_output_size;
-  int substeps = 0, record_every = 0, max_substeps = 0;
+  std::string scenario, output, csv, method, report = "brief", max_output_size, precision;
+  int substeps = 0, record_every = 0, max_substeps = 0, threads = 0;
   double tolerance = 0.0;
   bool quiet = false, no_link_angles = false;
   // Which overrides were given.
   CLI::Option *substeps_opt = nullptr, *record_every_opt = nullptr, *max_substeps_opt = nullptr,
-              *tolerance_opt = nullptr, *method_opt = nullptr;
+              *tolerance_opt = nullptr, *method_opt = nullptr, *threads_opt = nullptr,
+              *precision_opt = nullptr, *csv_opt = nullptr, *no_link_angles_opt = nullptr,
+              *report_opt = nullptr;
 };
 
 // Progress on stderr, rewritten in place; only used when stderr is a terminal.
@@ -194,7 +201,49 @@ void CheckOutputSize(const RunArgs& args, const flexkin::Scenario& s,
   throw flexkin::InputError(flexkin::Problem(flexkin::cli::kMaxOutputSizeOption, message));
 }
 
+// A groom scenario (docs/groom-format.md) goes to the strand engine; the options it shares with
+// chain runs keep their meaning, those it has no use for are refused by name.
+int RunGroom(const RunArgs& args) {
+  flexkin::cli::GroomRunArgs g;
+  g.scenario = args.scenario;
+  g.output = args.output;
+  g.max_output_size = args.max_output_size;
+  g.quiet = args.quiet;
+  if (*args.method_opt) g.method = args.method;
+  if (*args.precision_opt) g.precision = args.precision;
+  if (*args.substeps_opt) g.substeps = args.substeps;
+  if (*args.record_every_opt) g.record_every = args.record_every;
+  if (*args.threads_opt) g.threads = args.threads;
+  const std::pair<CLI::Option*, const char*> unsupported[] = {
+      {args.csv_opt, "--csv"},
+      {args.tolerance_opt, "--tolerance"},
+      {args.max_substeps_opt, "--max-substeps"},
+      {args.no_link_angles_opt, "--no-link-angles"},
+      {args.report_opt, "--report"}};
+  for (const auto& [option, name] : unsupported) {
+    if (*option) g.unsupported = name;
+  }
+  try {
+    return flexkin::cli::RunGroomCommand(g);
+  } catch (const flexkin::InputError& e) {
+    // Problems of the file are named by the file; those of options by the option.
+    const std::string field = e.field();
+    if (!field.empty() && field[0] == '/') {
+      PrintError(args.scenario + ": " + e.what());
+      return kExitInvalidInput;
+    }
+    throw;
+  }
+}
+
 int RunCommand(const RunArgs& args) {
+  if (flexkin::IsGroomFile(args.scenario)) return RunGroom(args);
+  if (*args.threads_opt || *args.precision_opt) {
+    throw flexkin::InputError(
+        flexkin::Problem(*args.threads_opt ? "--threads" : "--precision",
+                         "is an option of groom scenarios (docs/groom-format.md); " +
+                             args.scenario + " is a chain scenario"));
+  }
   flexkin::Scenario scenario;
   try {
     scenario = flexkin::LoadScenarioFile(args.scenario);
@@ -272,6 +321,7 @@ int ValidateRobotCommand(const std::string& path) {
 
 int ValidateCommand(const std::string& path) {
   if (flexkin::IsRobotScenarioFile(path)) return ValidateRobotCommand(path);
+  if (flexkin::IsGroomFile(path)) return flexkin::cli::ValidateGroomCommand(path);
   // Text that is not JSON is one problem, like any other.
   const flexkin::Problems problems = flexkin::ValidateScenarioFile(path);
   if (!problems.empty()) {
@@ -306,12 +356,14 @@ int Main(int argc, char** argv) {
 
   RunArgs args;
   CLI::App* run = app.add_subcommand("run", "Run a scenario file and write the result.");
-  run->add_option("scenario", args.scenario, "Scenario file (JSON, docs/scenario-format.md)")
+  run->add_option("scenario", args.scenario,
+                  "Scenario file (JSON): a chain (docs/scenario-format.md) or a groom "
+                  "(docs/groom-format.md)")
       ->required();
   run->add_option("-o,--output", args.output,
                   "Result file to write: .json (JSON) or .npz (NumPy archive), by its extension")
       ->required();
-  run->add_option("--csv", args.csv, "Also write the recorded frames as CSV");
+  args.csv_opt = run->add_option("--csv", args.csv, "Also write the recorded frames as CSV");
   args.method_opt = run->add_option("--method", args.method, MethodHelp());
   args.substeps_opt =
       run->add_option("--substeps", args.substeps, "Sub-steps per leader step (>= 1)");
@@ -322,17 +374,22 @@ int Main(int argc, char** argv) {
                                           "Upper bound of the automatic sub-steps");
   args.record_every_opt = run->add_option("--record-every", args.record_every,
                                           "Record every N-th leader step (and the last)");
-  run->add_flag("--no-link-angles", args.no_link_angles,
-                "Record frames without their link angles (an atan2 per link per frame saved)");
+  args.threads_opt = run->add_option(
+      "--threads", args.threads, "Groom scenarios: threads stepping the strands (0: all cores)");
+  args.precision_opt = run->add_option("--precision", args.precision,
+                                       "Groom scenarios: points stored as float32 or float64");
+  args.no_link_angles_opt =
+      run->add_flag("--no-link-angles", args.no_link_angles,
+                    "Record frames without their link angles (an atan2 per link per frame saved)");
   flexkin::cli::AddMaxOutputSizeOption(run, &args.max_output_size);
-  run->add_option("--report", args.report, "Report printed after the run")
-      ->check(CLI::IsMember({"brief", "full"}));
+  args.report_opt = run->add_option("--report", args.report, "Report printed after the run")
+                        ->check(CLI::IsMember({"brief", "full"}));
   run->add_flag("-q,--quiet", args.quiet, "Print no report and no progress");
   run->footer(kExitCodesHelp);
 
   std::string validate_path;
-  CLI::App* validate =
-      app.add_subcommand("validate", "Check a scenario file (chain or robot); list every problem.");
+  CLI::App* validate = app.add_subcommand(
+      "validate", "Check a scenario file (chain, robot or groom); list every problem.");
   validate->add_option("scenario", validate_path, "Scenario file (JSON)")->required();
   validate->footer(kExitCodesHelp);
 

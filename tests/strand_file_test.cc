@@ -25,21 +25,7 @@ namespace fs = std::filesystem;
 using test_util::ExpectInputError;
 using test_util::ReadFile;
 
-class StrandFileTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    std::string name = (fs::temp_directory_path() / "flexkin_strandfile_XXXXXX").string();
-    dir_ = ::mkdtemp(name.data());
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Path(const std::string& name) const { return dir_ + "/" + name; }
-  std::vector<std::string> Files() const {
-    std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir_)) names.push_back(e.path().filename());
-    return names;
-  }
-  std::string dir_;
-};
+using StrandFileTest = test_util::TempDirTest;
 
 // Three strands of 2, 4 and 1 links in 3D (or 2D).
 StrandFileHeader SmallHeader(int dim, bool float32, int64_t frames) {

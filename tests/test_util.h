@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -11,6 +13,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "flexkin/chain.h"
 #include "flexkin/error.h"
@@ -78,5 +81,28 @@ inline CliResult RunCli(const std::string& cli, const std::string& dir, const st
   std::filesystem::remove(err);
   return r;
 }
+
+// A test fixture with a fresh directory under the system's temporary one ("flexkin_test_..."),
+// removed with everything in it after the test.
+class TempDirTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string name = (std::filesystem::temp_directory_path() / "flexkin_test_XXXXXX").string();
+    ASSERT_NE(::mkdtemp(name.data()), nullptr) << name;
+    dir_ = name;
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string Path(const std::string& name) const { return dir_ + "/" + name; }
+  // The names of the files in the directory, sorted.
+  std::vector<std::string> Files() const {
+    std::vector<std::string> names;
+    for (const auto& e : std::filesystem::directory_iterator(dir_)) {
+      names.push_back(e.path().filename());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+  std::string dir_;
+};
 
 }  // namespace flexkin::test_util

@@ -24,21 +24,21 @@ constexpr int64_t kMaxGroomKeyframes = 1000000;  // keyframes of a motion
 
 // Strands grown on a scalp (all in body coordinates); docs/groom-format.md, "Growing strands".
 struct GrowSpec {
-  ScalpShape scalp;                // shape "sphere" (radii all equal) or "ellipsoid"
-  int roots = 1000;                // number of strands, 1 .. kMaxGroomRoots
+  ScalpShape scalp;  // shape "sphere" (radii all equal) or "ellipsoid"
+  int roots = 1000;  // number of strands, 1 .. kMaxGroomRoots
   // Roots only where the outward normal is within `max_angle_deg` of `region_axis` (a cap; 180:
   // the whole surface).
   Eigen::Vector3d region_axis = Eigen::Vector3d::UnitZ();
   double max_angle_deg = 180.0;
-  int links = 32;                  // links per strand, >= 1
-  double link_length = 0.005;      // > 0 (scenario units, e.g. metres)
-  double length_variation = 0.0;   // in [0, 1): each strand's link length scaled by 1 + v (2u - 1)
+  int links = 32;                 // links per strand, >= 1
+  double link_length = 0.005;     // > 0 (scenario units, e.g. metres)
+  double length_variation = 0.0;  // in [0, 1): each strand's link length scaled by 1 + v (2u - 1)
   // Direction field: link j of a strand points along the surface normal turned toward `gravity`
   // by droop * angle(normal, gravity) * (j + 1) / links (droop in [0, 1]; 0: straight out; 1:
   // the last link along gravity).
   double droop = 0.0;
   Eigen::Vector3d gravity = -Eigen::Vector3d::UnitZ();
-  uint64_t seed = 1;               // roots are placed by a seeded generator: same seed, same groom
+  uint64_t seed = 1;  // roots are placed by a seeded generator: same seed, same groom
 };
 
 // The strands of `spec`, each (links + 1) x 3, root first, in body coordinates. The same seed
@@ -82,9 +82,9 @@ struct GroomScenario {
   std::vector<Points> strands;  // body coordinates, grown or given
   ScalpShape scalp;             // for drawing ("" shape for explicit strands)
   BodyMotion motion;
-  StrandOptions options;        // method, substeps, pinned, threads
-  int record_every = 1;         // frames 0, e, 2e, ... and always the last
-  bool float32 = true;          // precision of points.npy
+  StrandOptions options;  // method, substeps, pinned, threads
+  int record_every = 1;   // frames 0, e, 2e, ... and always the last
+  bool float32 = true;    // precision of points.npy
 };
 
 // Reads a groom scenario (a JSON object with "groom" or "strands", and "motion";

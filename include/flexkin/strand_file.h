@@ -26,7 +26,7 @@ namespace flexkin {
 
 // The body the strands grow from, as far as drawing it goes.
 struct ScalpShape {
-  std::string shape;                         // "sphere", "ellipsoid" or "" (none: explicit strands)
+  std::string shape;  // "sphere", "ellipsoid" or "" (none: explicit strands)
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  // body coordinates
   Eigen::Vector3d radii = Eigen::Vector3d::Zero();   // semi-axes along body x, y, z
 };
@@ -34,12 +34,12 @@ struct ScalpShape {
 // Everything of a strand file but its frames.
 struct StrandFileHeader {
   std::string name, description;
-  int dim = 3;                    // 2 or 3
-  std::vector<int64_t> offsets;   // S+1 entries, offsets[0] = 0, strictly increasing by >= 2
-  Eigen::VectorXd link_lengths;   // P - S entries
-  int64_t num_frames = 0;         // F, known before the first frame is written
-  bool float32 = true;            // points stored as float32 ("<f4") or float64 ("<f8")
-  double fps = 30.0;              // frames per second of the motion
+  int dim = 3;                   // 2 or 3
+  std::vector<int64_t> offsets;  // S+1 entries, offsets[0] = 0, strictly increasing by >= 2
+  Eigen::VectorXd link_lengths;  // P - S entries
+  int64_t num_frames = 0;        // F, known before the first frame is written
+  bool float32 = true;           // points stored as float32 ("<f4") or float64 ("<f8")
+  double fps = 30.0;             // frames per second of the motion
   std::string method = "tractrix";
   int substeps = 1, pinned = 1, record_every = 1;
   ScalpShape scalp;

@@ -246,7 +246,17 @@ BodyPose BodyMotion::PoseAt(int64_t frame) const {
   if (u >= 1.0 - 1e-12) return b.pose;
   const double s = interpolation == KeyframeInterpolation::kLinear ? u : u * u * (3.0 - 2.0 * u);
 
-  const Eigen::Vector3d translation = (1.0 - s) * a.pose.translation + s * b.pose.translation;
+  // A part that does not change between the keyframes stays exactly as it is (a body that rests
+  // moves nothing; a pure turn does not shift, a pure shift does not turn).
+  const Eigen::Vector3d translation =
+      a.pose.translation == b.pose.translation
+          ? a.pose.translation
+          : Eigen::Vector3d((1.0 - s) * a.pose.translation + s * b.pose.translation);
+  if (a.pose.rotation == b.pose.rotation) {
+    BodyPose pose = a.pose;
+    pose.translation = translation;
+    return pose;
+  }
   const Eigen::Quaterniond qa = QuaternionOf(a.pose.rotation);
   Eigen::Quaterniond qb = QuaternionOf(b.pose.rotation);
   double d = qa.coeffs().dot(qb.coeffs());
