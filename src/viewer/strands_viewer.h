@@ -8,7 +8,8 @@
 namespace flexkin {
 
 // The viewer for many strands (hair, fur): one self-contained HTML page per strand file
-// (docs/viewer.md, "Many strands"). The page draws every strand with WebGL2 in one draw call; its
+// (docs/viewer.md, "Many strands"). The page draws every strand with WebGL2 in one draw call, or,
+// where WebGL runs in software and the links are many, with its own line drawing in JavaScript; its
 // script and style sheet are compiled into the library and the frames are embedded compactly:
 // each coordinate as a 16-bit code within the frame's bounding box, delta-coded over frames,
 // zlib-compressed and base64-encoded. It opens offline and fetches nothing. Library target

@@ -2,16 +2,23 @@
 // plain WebGL2; nothing is fetched. The data's layout is written by src/viewer/strands_viewer.cc
 // (docs/viewer.md, "Many strands"): a JSON element with the facts and each frame's box and body
 // pose, and one base64 element per frame holding its 16-bit codes, delta-coded and zlib-compressed.
-// At load every frame is decoded once into one Uint16Array and uploaded into one GPU buffer; a
-// frame is then drawn by pointing the position attributes at its part of that buffer, so playing
-// uploads nothing. One draw call (gl.LINES, indexed) draws every strand; the shader turns the codes
+// At load every frame is decoded once into one Uint16Array, which both renderers read; the WebGL
+// renderer uploads it into one GPU buffer the first time it draws, and draws a frame by pointing
+// the position attributes at its part of that buffer, so playing uploads nothing. One draw call (gl.LINES, indexed) draws every strand; the shader turns the codes
 // into positions and blends two frames for smooth playback.
+// Software WebGL (SwiftShader, llvmpipe) spends about a microsecond setting up each line, whatever
+// its length, so 320,000 links take about 300 ms a picture there. On such renderers, for many
+// links, the page draws the picture itself instead ("software" renderer): every link of every
+// strand as a one-pixel line into its own colour and depth buffers, the scalp ray-cast into the
+// same buffers, the picture then shown with putImageData on a 2D canvas laid over the WebGL one
+// (going through SwiftShader again would cost a texture upload and a read-back per picture).
+// The G key switches renderers.
 (function () {
   'use strict';
 
   const $ = (id) => document.getElementById(id);
   const api = {
-    ready: false, frame: 0, playing: false, error: null,
+    ready: false, renderer: null, frame: 0, playing: false, error: null,
     // draws: pictures drawn; newPictures: those showing another moment of the motion than the one
     // before; fps: new pictures per second over the last second while playing.
     stats: { ticks: 0, draws: 0, newPictures: 0, drawMs: 0, maxDrawMs: 0, fps: 0 },
@@ -241,10 +248,22 @@
   const strandVao = gl.createVertexArray();
   const positionBuffer = gl.createBuffer();
   let numIndices = 0;
-  function buildStrands(codes) {
+  let codes = null;  // every frame's codes (numFrames * frameCodes + lanes), kept for both renderers
+  let uploaded = false;  // whether the GPU holds them (only once the WebGL renderer has drawn)
+  function uploadPositions() {
+    if (uploaded) return;
+    gl.bindBuffer(gl.ARRAY_BUFFER, positionBuffer);
+    gl.bufferData(gl.ARRAY_BUFFER, codes, gl.STATIC_DRAW);
+    uploaded = true;
+  }
+  // For the software renderer: each point's colour before lighting and depth (root to tip, the
+  // strand's shade), as the shader computes it.
+  let baseColor = null;
+  function buildStrands() {
     gl.bindVertexArray(strandVao);
     const along = new Uint8Array(2 * numPoints);
     const indices = new Uint32Array(2 * (numPoints - numStrands));
+    baseColor = new Float32Array(3 * numPoints);
     let n = 0;
     for (let s = 0; s < numStrands; ++s) {
       const begin = meta.offsets[s], end = meta.offsets[s + 1];
@@ -253,6 +272,10 @@
       for (let i = begin; i < end; ++i) {
         along[2 * i] = Math.round(255 * (i - begin) / (end - begin - 1));
         along[2 * i + 1] = shade;
+        const x = along[2 * i] / 255, k = 0.75 + 0.5 * shade / 255;
+        baseColor[3 * i] = (0.23 + (0.85 - 0.23) * x) * k;
+        baseColor[3 * i + 1] = (0.15 + (0.66 - 0.15) * x) * k;
+        baseColor[3 * i + 2] = (0.09 + (0.40 - 0.09) * x) * k;
         if (i + 1 < end) { indices[n++] = i; indices[n++] = i + 1; }
       }
     }
@@ -264,8 +287,6 @@
     gl.vertexAttribPointer(2, 2, gl.UNSIGNED_BYTE, true, 0, 0);
     gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, gl.createBuffer());
     gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, indices, gl.STATIC_DRAW);
-    gl.bindBuffer(gl.ARRAY_BUFFER, positionBuffer);
-    gl.bufferData(gl.ARRAY_BUFFER, codes, gl.STATIC_DRAW);
     gl.enableVertexAttribArray(0);
     gl.enableVertexAttribArray(1);
     gl.enableVertexAttribArray(3);
@@ -312,6 +333,7 @@
     speed: 1,
     blend: true,
     showScalp: true,
+    renderer: 'webgl',  // or 'software'
   };
   const view = { azimuth: 0, elevation: 0, zoom: 1, panX: 0, panY: 0 };
   function resetView() {
@@ -343,7 +365,7 @@
       const hw = aspect >= 1 ? half * aspect : half, hh = aspect >= 1 ? half : half / aspect;
       const eye = [center[0] - view.panX * hw, center[1] - view.panY * hh, 1];
       return { view: lookAt(eye, [eye[0], eye[1], 0], [0, 1, 0]), projection: ortho(hw, hh, 0, 2),
-               fog: [1e9, 2e9], eyeDir: [0, 0, 1] };
+               fog: [1e9, 2e9], eyeDir: [0, 0, 1], near: 0, eye };
     }
     const fovy = 30 * Math.PI / 180;
     const distance = 1.15 * radius / Math.sin(fovy / 2) / Math.min(1, aspect) / view.zoom;
@@ -358,7 +380,8 @@
     const near = Math.max(distance - 2 * radius, distance * 1e-3), far = distance + 2 * radius;
     return { view: lookAt(eye, target, Math.abs(se) > 0.999 ? [0, 1, 0] : [0, 0, 1]),
              projection: perspective(fovy, aspect, near, far),
-             fog: [distance - radius, distance + radius], eyeDir: dir };
+             fog: [distance - radius, distance + radius], eyeDir: dir, near, eye,
+             tanHalf: Math.tan(fovy / 2), aspect };
   }
 
   // The two stored frames shown and how far between them.
@@ -376,6 +399,31 @@
     const start = performance.now();
     const cam = camera();
     const { a, b, t } = shown();
+    if (state.renderer === 'software') drawSoftware(cam, a, b, t);
+    else drawWebGL(cam, a, b, t);
+
+    const ms = performance.now() - start;
+    const s = api.stats;
+    s.draws += 1;
+    const key = `${a},${b},${t}`;
+    if (key !== lastShown) s.newPictures += 1;
+    lastShown = key;
+    s.drawMs += ms;
+    s.maxDrawMs = Math.max(s.maxDrawMs, ms);
+    drawRequested = false;
+  }
+
+  // A frame's box, three components also in 2D.
+  const box = (f, name) => {
+    const v = meta.frames[f][name];
+    return dim === 2 ? [v[0], v[1], 0] : v;
+  };
+  // From above, a little from the viewer's side (in world coordinates; z is up).
+  const lightDirection = (cam) => normalize(dim === 3 ? [cam.eyeDir[0] + 0.2, cam.eyeDir[1],
+                                                         cam.eyeDir[2] + 1.2] : [0, 0, 1]);
+
+  function drawWebGL(cam, a, b, t) {
+    uploadPositions();
     gl.viewport(0, 0, width, height);
     gl.clearColor(background[0], background[1], background[2], 1);
     gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
@@ -399,10 +447,6 @@
     }
     const u = strandProgram.uniforms;
     gl.useProgram(strandProgram.program);
-    const box = (f, name) => {
-      const v = meta.frames[f][name];
-      return dim === 2 ? [v[0], v[1], 0] : v;
-    };
     gl.uniform3fv(u.loA, box(a, 'lo'));
     gl.uniform3fv(u.extA, box(a, 'ext'));
     gl.uniform3fv(u.loB, box(b, 'lo'));
@@ -412,9 +456,7 @@
     gl.uniformMatrix4fv(u.projection, false, cam.projection);
     gl.uniform2fv(u.fog, cam.fog);
     gl.uniform3fv(u.background, background);
-    // From above, a little from the viewer's side: (in world coordinates; z is up).
-    const l = normalize(dim === 3 ? [cam.eyeDir[0] + 0.2, cam.eyeDir[1], cam.eyeDir[2] + 1.2] : [0, 0, 1]);
-    gl.uniform3fv(u.light, l);
+    gl.uniform3fv(u.light, lightDirection(cam));
     gl.bindVertexArray(strandVao);
     gl.bindBuffer(gl.ARRAY_BUFFER, positionBuffer);
     gl.vertexAttribPointer(0, lanes, gl.UNSIGNED_SHORT, true, 2 * lanes, 2 * a * frameCodes);
@@ -422,16 +464,230 @@
     gl.vertexAttribPointer(3, lanes, gl.UNSIGNED_SHORT, true, 2 * lanes, 2 * (a * frameCodes + lanes));
     gl.drawElements(gl.LINES, numIndices, gl.UNSIGNED_INT, 0);
     gl.bindVertexArray(null);
+  }
+  // ----- The software renderer --------------------------------------------------------------------
+  // The picture (row 0 at the top), shown with putImageData on a 2D canvas over the WebGL one:
+  // colours as RGBA bytes, depths as the view distance along the viewing direction. Links are one-pixel lines stepped along their longer
+  // axis, one colour per link (that of its first point, lit and faded as the shader does), depth
+  // interpolated along the line and tested as GL's LESS does.
+  let pixels32 = null, image = null, depths = null, softContext = null;
+  const toByte = (x) => (x <= 0 ? 0 : x >= 1 ? 255 : (x * 255 + 0.5) | 0);
+  const pack = (r, g, b) => ((255 << 24) | (toByte(b) << 16) | (toByte(g) << 8) | toByte(r)) >>> 0;
+  const backgroundPacked = pack(background[0], background[1], background[2]);
+  let offsets32 = null;
 
-    const ms = performance.now() - start;
-    const s = api.stats;
-    s.draws += 1;
-    const key = `${a},${b},${t}`;
-    if (key !== lastShown) s.newPictures += 1;
-    lastShown = key;
-    s.drawMs += ms;
-    s.maxDrawMs = Math.max(s.maxDrawMs, ms);
-    drawRequested = false;
+  let rowWidth = 1, clipX = 0, clipY = 0;  // the picture's width, and the largest x and y drawn
+  // A line from (x0, y0) to (x1, y1) in pixels, depths z0 to z1, colour col; clipped to the
+  // picture (Liang-Barsky).
+  function line(x0, y0, z0, x1, y1, z1, col) {
+    if (x0 >= 0 && x0 < clipX && y0 >= 0 && y0 < clipY && x1 >= 0 && x1 < clipX && y1 >= 0 &&
+        y1 < clipY) {
+      span(x0, y0, z0, x1 - x0, y1 - y0, z1 - z0, col);
+    } else {
+      clipped(x0, y0, z0, x1, y1, z1, col);
+    }
+  }
+  // Pixels from (x0, y0) on, n steps along (dx, dy), all inside the picture.
+  function span(x0, y0, z0, dx, dy, dz, col) {
+    const ax = dx < 0 ? -dx : dx, ay = dy < 0 ? -dy : dy;
+    const n = ax > ay ? ax : ay;
+    const steps = n < 1 ? 1 : (n + 0.5) | 0;
+    const inv = 1 / steps;
+    const ix = dx * inv, iy = dy * inv, iz = dz * inv;
+    let x = x0, y = y0, z = z0;
+    for (let k = 0; k < steps; ++k) {
+      const at = (y | 0) * rowWidth + (x | 0);
+      if (z < depths[at]) { depths[at] = z; pixels32[at] = col; }
+      x += ix; y += iy; z += iz;
+    }
+  }
+  function clipped(x0, y0, z0, x1, y1, z1, col) {
+    let dx = x1 - x0, dy = y1 - y0, dz = z1 - z0;
+    {
+      let t0 = 0, t1 = 1;
+      const p = [-dx, dx, -dy, dy], q = [x0, clipX - x0, y0, clipY - y0];
+      for (let k = 0; k < 4; ++k) {
+        if (p[k] === 0) {
+          if (q[k] < 0) return;
+        } else {
+          const r = q[k] / p[k];
+          if (p[k] < 0) { if (r > t1) return; if (r > t0) t0 = r; } else { if (r < t0) return; if (r < t1) t1 = r; }
+        }
+      }
+      const nx0 = x0 + t0 * dx, ny0 = y0 + t0 * dy, nz0 = z0 + t0 * dz;
+      x1 = x0 + t1 * dx; y1 = y0 + t1 * dy; z1 = z0 + t1 * dz;
+      x0 = Math.min(Math.max(nx0, 0), clipX); y0 = Math.min(Math.max(ny0, 0), clipY); z0 = nz0;
+      x1 = Math.min(Math.max(x1, 0), clipX); y1 = Math.min(Math.max(y1, 0), clipY);
+      span(x0, y0, z0, x1 - x0, y1 - y0, z1 - z0, col);
+    }
+  }
+
+  function drawSoftware(cam, a, b, t) {
+    const W = width, H = height;
+    if (!image || image.width !== W || image.height !== H) {
+      const soft = $('soft-view');
+      soft.width = W;
+      soft.height = H;
+      softContext = soft.getContext('2d', { alpha: false });
+      image = softContext.createImageData(W, H);
+      pixels32 = new Uint32Array(image.data.buffer);
+      depths = new Float32Array(W * H);
+    }
+    if (!offsets32) offsets32 = Int32Array.from(meta.offsets);
+    pixels32.fill(backgroundPacked);
+    depths.fill(Infinity);
+    if (scalp && state.showScalp) castScalp(cam, a, b, t);
+
+    const M = multiply(cam.projection, cam.view);
+    const m0 = M[0], m4 = M[4], m8 = M[8], m12 = M[12];
+    const m1 = M[1], m5 = M[5], m9 = M[9], m13 = M[13];
+    const m3 = M[3], m7 = M[7], m11 = M[11], m15 = M[15];
+    // World position = origin + codes of frame a * scaleA + codes of frame b * scaleB.
+    const u = 1 - t, la = box(a, 'lo'), ea = box(a, 'ext'), lb = box(b, 'lo'), eb = box(b, 'ext');
+    const ox = u * la[0] + t * lb[0], oy = u * la[1] + t * lb[1], oz = u * la[2] + t * lb[2];
+    const sax = u * ea[0] / 65535, say = u * ea[1] / 65535, saz = u * ea[2] / 65535;
+    const sbx = t * eb[0] / 65535, sby = t * eb[1] / 65535, sbz = t * eb[2] / 65535;
+    const fa = a * frameCodes, fb = b * frameCodes;
+    const l = lightDirection(cam), lx = l[0], ly = l[1], lz = l[2];
+    const fog0 = cam.fog[0], fogScale = 1 / (cam.fog[1] - cam.fog[0]);
+    const bgR = background[0], bgG = background[1], bgB = background[2];
+    const halfW = W / 2, halfH = H / 2, nearW = Math.max(cam.near, 1e-12);
+    const c = codes, base = baseColor, offs = offsets32;
+    rowWidth = W;
+    clipX = W - 1e-3;
+    clipY = H - 1e-3;
+
+    for (let s = 0; s < numStrands; ++s) {
+      const begin = offs[s], end = offs[s + 1];
+      // The previous point: world position, clip w, pixel position.
+      let pX = 0, pY = 0, pZ = 0, pcx = 0, pcy = 0, pw = 0, psx = 0, psy = 0;
+      for (let i = begin; i < end; ++i) {
+        const ia = fa + i * lanes, ib = fb + i * lanes;
+        const X = ox + c[ia] * sax + c[ib] * sbx;
+        const Y = oy + c[ia + 1] * say + c[ib + 1] * sby;
+        const Z = oz + c[ia + 2] * saz + c[ib + 2] * sbz;
+        const cx = m0 * X + m4 * Y + m8 * Z + m12;
+        const cy = m1 * X + m5 * Y + m9 * Z + m13;
+        const cw = m3 * X + m7 * Y + m11 * Z + m15;
+        let sx = 0, sy = 0;
+        if (cw > nearW) {
+          const inv = 1 / cw;
+          sx = (cx * inv + 1) * halfW;
+          sy = (1 - cy * inv) * halfH;
+        }
+        if (i > begin && (cw > nearW || pw > nearW)) {
+          // The link from the previous point, coloured as the shader colours its first point.
+          const tx = X - pX, ty = Y - pY, tz = Z - pZ;
+          const tt = tx * tx + ty * ty + tz * tz, tl = tx * lx + ty * ly + tz * lz;
+          const cos2 = tt > 0 ? tl * tl / tt : 0;
+          const across = cos2 < 1 ? Math.sqrt(1 - cos2) : 0;
+          const light = 0.35 + 0.8 * across;
+          let fade = (pw - fog0) * fogScale;
+          fade = 0.55 * (fade < 0 ? 0 : fade > 1 ? 1 : fade);
+          const j = 3 * (i - 1);
+          const r = base[j] * light, g = base[j + 1] * light, bl = base[j + 2] * light;
+          const col = pack(r + (bgR - r) * fade, g + (bgG - g) * fade, bl + (bgB - bl) * fade);
+          if (cw > nearW && pw > nearW) {
+            line(psx, psy, pw, sx, sy, cw, col);
+          } else {
+            // One end behind the near plane: cut the link there (in clip coordinates).
+            const k = (pw - nearW) / (pw - cw);
+            const qx = pcx + k * (cx - pcx), qy = pcy + k * (cy - pcy);
+            const qsx = (qx / nearW + 1) * halfW, qsy = (1 - qy / nearW) * halfH;
+            if (pw > nearW) line(psx, psy, pw, qsx, qsy, nearW, col);
+            else line(qsx, qsy, nearW, sx, sy, cw, col);
+          }
+        }
+        pX = X; pY = Y; pZ = Z; pcx = cx; pcy = cy; pw = cw; psx = sx; psy = sy;
+      }
+    }
+    softContext.putImageData(image, 0, 0);
+  }
+
+  // The scalp into the software picture: each pixel's ray against the ellipsoid placed by the body
+  // pose, lit as the WebGL renderer's shader lights it.
+  function castScalp(cam, a, b, t) {
+    const W = width, H = height;
+    const fa = meta.frames[a], fb = meta.frames[b];
+    const R = fa.rotation.map((x, i) => x + t * (fb.rotation[i] - x));  // row-major
+    const T = fa.translation.map((x, i) => x + t * (fb.translation[i] - x));
+    const C = scalp.center, r = scalp.radii.map((x) => Math.max(0.985 * x, 1e-12));
+    const V = cam.view;
+    const sv = [V[0], V[4], V[8]], uv = [V[1], V[5], V[9]], fv = [-V[2], -V[6], -V[10]];
+    const toLocal = (w) => [0, 1, 2].map((k) => (R[k] * w[0] + R[3 + k] * w[1] + R[6 + k] * w[2]) / r[k]);
+    const e = cam.eye;
+    const o = [0, 1, 2].map((k) => (R[k] * (e[0] - T[0]) + R[3 + k] * (e[1] - T[1]) +
+                                    R[6 + k] * (e[2] - T[2]) - C[k]) / r[k]);
+    const ax = cam.aspect * cam.tanHalf, ay = cam.tanHalf;
+    const D0 = toLocal(fv), DX = toLocal(sv.map((x) => x * ax)), DY = toLocal(uv.map((x) => x * ay));
+    // Pixels the scalp can cover: its box's corners projected (all the picture if one is behind).
+    let x0 = 0, x1 = W, y0 = 0, y1 = H;
+    const M = multiply(cam.projection, cam.view);
+    let behind = false, minX = Infinity, maxX = -Infinity, minY = Infinity, maxY = -Infinity;
+    for (let k = 0; k < 8; ++k) {
+      const lc = [0, 1, 2].map((j) => C[j] + ((k >> j) & 1 ? r[j] : -r[j]));
+      const w = [0, 1, 2].map((j) => R[3 * j] * lc[0] + R[3 * j + 1] * lc[1] + R[3 * j + 2] * lc[2] + T[j]);
+      const cw = M[3] * w[0] + M[7] * w[1] + M[11] * w[2] + M[15];
+      if (cw <= cam.near) { behind = true; break; }
+      const sx = ((M[0] * w[0] + M[4] * w[1] + M[8] * w[2] + M[12]) / cw + 1) * W / 2;
+      const sy = (1 - (M[1] * w[0] + M[5] * w[1] + M[9] * w[2] + M[13]) / cw) * H / 2;
+      minX = Math.min(minX, sx); maxX = Math.max(maxX, sx);
+      minY = Math.min(minY, sy); maxY = Math.max(maxY, sy);
+    }
+    if (!behind) {
+      x0 = Math.max(0, Math.floor(minX)); x1 = Math.min(W, Math.ceil(maxX) + 1);
+      y0 = Math.max(0, Math.floor(minY)); y1 = Math.min(H, Math.ceil(maxY) + 1);
+    }
+    const oo = o[0] * o[0] + o[1] * o[1] + o[2] * o[2] - 1;
+    const near = cam.near;
+    // View-space light offset of the scalp shader.
+    for (let py = y0; py < y1; ++py) {
+      const yn = 1 - (py + 0.5) / H * 2;
+      for (let px = x0; px < x1; ++px) {
+        const xn = (px + 0.5) / W * 2 - 1;
+        const dx = D0[0] + xn * DX[0] + yn * DY[0];
+        const dy = D0[1] + xn * DX[1] + yn * DY[1];
+        const dz = D0[2] + xn * DX[2] + yn * DY[2];
+        const A = dx * dx + dy * dy + dz * dz, B = o[0] * dx + o[1] * dy + o[2] * dz;
+        const disc = B * B - A * oo;
+        if (disc < 0) continue;
+        const th = (-B - Math.sqrt(disc)) / A;
+        if (th <= near) continue;
+        const at = py * W + px;
+        if (!(th < depths[at])) continue;
+        depths[at] = th;
+        // Normal: the unit-sphere point divided by the radii, rotated to world, then to view.
+        const nx = (o[0] + th * dx) / r[0], ny = (o[1] + th * dy) / r[1], nz = (o[2] + th * dz) / r[2];
+        const wx = R[0] * nx + R[1] * ny + R[2] * nz;
+        const wy = R[3] * nx + R[4] * ny + R[5] * nz;
+        const wz = R[6] * nx + R[7] * ny + R[8] * nz;
+        const vx = sv[0] * wx + sv[1] * wy + sv[2] * wz;
+        const vy = uv[0] * wx + uv[1] * wy + uv[2] * wz;
+        const vz = -(fv[0] * wx + fv[1] * wy + fv[2] * wz);
+        const vn = Math.sqrt(vx * vx + vy * vy + vz * vz) || 1;
+        // Towards the eye in view space, normalized, plus (0.3, 0.5, 0), normalized.
+        const ex = -xn * ax, ey = -yn * ay, en = Math.sqrt(ex * ex + ey * ey + 1);
+        const hx = ex / en + 0.3, hy = ey / en + 0.5, hz = 1 / en;
+        const hn = Math.sqrt(hx * hx + hy * hy + hz * hz);
+        const diffuse = Math.max(0, (vx * hx + vy * hy + vz * hz) / (vn * hn));
+        const k = 0.35 + 0.65 * diffuse;
+        pixels32[at] = pack(0.80 * k, 0.70 * k, 0.62 * k);
+      }
+    }
+  }
+
+  // The renderer: software where WebGL itself runs in software and the links are many.
+  const debugInfo = gl.getExtension('WEBGL_debug_renderer_info');
+  const rendererName = String(gl.getParameter(debugInfo ? debugInfo.UNMASKED_RENDERER_WEBGL
+                                                        : gl.RENDERER) || '');
+  const softwareGl = /swiftshader|llvmpipe|softpipe|software/i.test(rendererName);
+  const softwareFrom = 20000;  // links
+  function setRenderer(name) {
+    state.renderer = name;
+    api.renderer = name;
+    $('soft-view').hidden = name !== 'software';
+    requestDraw();
+    showPerf();
   }
 
   // ----- Playback -----------------------------------------------------------------------------------
@@ -538,7 +794,10 @@
     const s = api.stats;
     fill('perf', [['frames per second', state.playing ? String(s.fps) : '(paused)'],
                   ['line segments', String(numIndices / 2)],
-                  ['draw calls per picture', scalp && state.showScalp ? '2' : '1'],
+                  ['renderer', state.renderer === 'software'
+                      ? 'software: every link drawn by the page (G: WebGL lines)'
+                      : 'WebGL lines, one draw call (G: software)'],
+                  ['WebGL', rendererName || '?'],
                   ['canvas', `${width} \u00d7 ${height}`]]);
   }
 
@@ -584,6 +843,7 @@
       case 'r': case 'R': resetView(); break;
       case 'i': case 'I': $('blend').click(); break;
       case 'b': case 'B': if (scalp) $('scalp').click(); break;
+      case 'g': case 'G': setRenderer(state.renderer === 'software' ? 'webgl' : 'software'); break;
       default: handled = false;
     }
     if (handled) e.preventDefault();
@@ -626,8 +886,13 @@
   // ----- For tests: the picture now, and a decoded point ------------------------------------------
   api.pixels = () => {
     draw();
-    const d = new Uint8Array(width * height * 4);
-    gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, d);
+    let d;
+    if (state.renderer === 'software') {
+      d = image.data;
+    } else {
+      d = new Uint8Array(width * height * 4);
+      gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, d);
+    }
     let hash = 2166136261, drawn = 0;
     const colors = new Set();
     for (let i = 0; i < d.length; i += 4) {
@@ -638,15 +903,13 @@
     }
     return { hash, drawnFraction: drawn / (d.length / 4), colors: colors.size };
   };
-  // Point i (over the embedded strands) of stored frame k, as the page draws it (read back from
-  // the GPU buffer: the page keeps no other copy of the decoded frames).
+  // Point i (over the embedded strands) of stored frame k, as both renderers read it.
   api.point = (k, i) => {
     const f = meta.frames[k];
-    const got = new Uint16Array(lanes);
-    gl.bindBuffer(gl.ARRAY_BUFFER, positionBuffer);
-    gl.getBufferSubData(gl.ARRAY_BUFFER, 2 * (k * frameCodes + i * lanes), got);
-    return f.lo.map((lo, c) => lo + got[c] / 65535 * f.ext[c]);
+    const at = k * frameCodes + i * lanes;
+    return f.lo.map((lo, c) => lo + codes[at + c] / 65535 * f.ext[c]);
   };
+  api.setRenderer = (name) => setRenderer(name);
   api.setFrame = (k) => { setPlaying(false); setFrame(k); };
 
   // ----- Start ----------------------------------------------------------------------------------
@@ -655,10 +918,13 @@
   $('subtitle').textContent = meta.description || '';
   $('hint').textContent = 'decoding';
   decodeAll().then((all) => {
-    buildStrands(all);
+    codes = all;
+    buildStrands();
     if (scalp) buildScalp();
     setSpeed(1);
     state.blend = $('blend').checked;
+    state.renderer = softwareGl && numPoints - numStrands >= softwareFrom ? 'software' : 'webgl';
+    setRenderer(state.renderer);
     bind();
     showFacts();
     resetView();

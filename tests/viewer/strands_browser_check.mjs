@@ -185,9 +185,28 @@ async function checkPage(browser, file) {
               `${seconds.toFixed(2)} s, ${(perf.ticks / seconds).toFixed(1)} animation ` +
               `callbacks/s, mean draw call ${(perf.drawMs / Math.max(1, perf.draws)).toFixed(2)} ` +
               `ms of the main thread, canvas ${info.width} x ${info.height})`);
+  const renderer = await viewer(page, 'renderer');
   if (info.numPoints - info.numStrands >= 320000) {
-    check(fps >= minFps, `${name}: frame rate ${fps.toFixed(1)} >= ${minFps} fps`);
+    check(fps >= minFps, `${name}: frame rate ${fps.toFixed(1)} >= ${minFps} fps (${renderer} renderer)`);
+    // Software WebGL here: the page draws the many links itself.
+    check(renderer === 'software', `${name}: the software renderer is chosen (${renderer})`);
   }
+
+  // G switches renderers; both draw the same strands, so about as many pixels.
+  await page.click('#play');
+  await page.keyboard.press('Home');
+  await page.locator('#view').focus();
+  const before = await picture(page);
+  await page.keyboard.press('g');
+  const other = await viewer(page, 'renderer');
+  const switched = await picture(page);
+  check(other !== renderer && switched.colors > 8 &&
+        Math.abs(switched.drawnFraction - before.drawnFraction) <= 0.25 * before.drawnFraction,
+        `${name}: G switches ${renderer} -> ${other}; drawn ${(100 * before.drawnFraction).toFixed(1)}% ` +
+        `-> ${(100 * switched.drawnFraction).toFixed(1)}% of the canvas`);
+  await page.screenshot({ path: join(outDir, `${name}-${other}.png`) });
+  await page.keyboard.press('g');
+  check((await viewer(page, 'renderer')) === renderer, `${name}: G switches back to ${renderer}`);
 
   check(requests.length === 0, `${name}: no network requests (${requests.join(', ')})`);
   check(errors.length === 0, `${name}: no console or page errors ${errors.join('; ')}`);
