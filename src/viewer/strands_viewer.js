@@ -471,8 +471,10 @@
   // axis, one colour per link (that of its first point, lit and faded as the shader does), depth
   // interpolated along the line and tested as GL's LESS does.
   let pixels32 = null, image = null, depths = null, softContext = null;
-  const toByte = (x) => (x <= 0 ? 0 : x >= 1 ? 255 : (x * 255 + 0.5) | 0);
-  const pack = (r, g, b) => ((255 << 24) | (toByte(b) << 16) | (toByte(g) << 8) | toByte(r)) >>> 0;
+  // Colours are never negative here. Packed as a signed 32-bit integer (a small integer to V8,
+  // where an unsigned one above 2^31 would be a heap number), stored as the same bits.
+  const toByte = (x) => { const v = (x * 255 + 0.5) | 0; return v > 255 ? 255 : v; };
+  const pack = (r, g, b) => (-16777216 | (toByte(b) << 16) | (toByte(g) << 8) | toByte(r));
   const backgroundPacked = pack(background[0], background[1], background[2]);
   let offsets32 = null;
 
