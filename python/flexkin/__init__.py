@@ -35,11 +35,13 @@ from ._flexkin import (
     Scenario,
     StrandBatch,
     StrandOptions,
+    StrandRunReport,
     arc,
     arm_step,
     estimate_output,
     follow_the_leader_step,
     forward_kinematics,
+    groom_summary,
     helix,
     joint_angles_from_points,
     joint_quaternions,
@@ -87,7 +89,7 @@ for _name in ("arm_from_urdf", "urdf_from_arm"):
 _CLASSES = ("AccuracyReport", "ArmModel", "ArmOptions", "ArmStepReport", "BodyPose", "Chain",
             "Metrics", "ObjectiveWeights", "OverallOptions", "OverallReport", "OverallRunReport",
             "Result", "RobotResult", "RobotScenario", "RunOptions", "Scenario", "StrandBatch",
-            "StrandOptions") + _RENDER_CLASSES
+            "StrandOptions", "StrandRunReport") + _RENDER_CLASSES
 for _name in _CLASSES:
     if isinstance(globals()[_name], type):
         globals()[_name].__module__ = __name__
@@ -148,7 +150,11 @@ def track_path(model, path, *, progress=None, **options):
     return _flexkin.track_path(model, path, progress=_progress(progress, "target"), **options)
 
 
-for _function in (run, run_scenario, run_robot, track_path):
+def run_groom(scenario, output, *, progress=None, **options):
+    return _flexkin.run_groom(scenario, output, progress=_progress(progress, "frame"), **options)
+
+
+for _function in (run, run_scenario, run_robot, track_path, run_groom):
     _function.__doc__ = getattr(_flexkin, _function.__name__).__doc__ + _PROGRESS_DOC
 del _function
 
@@ -158,12 +164,12 @@ __all__ = [
     "FigureOptions", "GltfOptions", "InputError", "Metrics", "ObjectiveWeights",
     "OverallOptions", "OverallReport", "OverallRunReport", "PlotOptions", "Result",
     "RobotResult", "RobotScenario", "RunOptions", "Scenario", "StrandBatch", "StrandOptions",
-    "ViewerOptions",
+    "StrandRunReport", "ViewerOptions",
     "arc", "arm_from_urdf", "arm_step", "estimate_output", "follow_the_leader_step",
-    "forward_kinematics", "gltf_joint_positions", "helix", "joint_angles_from_points", "joint_quaternions", "line",
+    "forward_kinematics", "gltf_joint_positions", "groom_summary", "helix", "joint_angles_from_points", "joint_quaternions", "line",
     "load_robot_scenario", "load_scenario", "move_leader", "overall_objective", "overall_step",
     "parabola", "read_result", "render", "resample_path", "run", "run_robot", "run_scenario",
-    "run_strands",
+    "run_groom", "run_strands",
     "split_pull", "track_path", "tractrix_step", "urdf_from_arm", "validate_scenario",
     "within_limits", "write_result",
 ]

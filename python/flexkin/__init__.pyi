@@ -87,6 +87,12 @@ class OverallRunReport:
     optimality: float
     first_failure: str
 
+class StrandRunReport:
+    max_length_error: float
+    seconds: float
+    engine: str
+    threads: int
+
 class OverallReport:
     status: str
     converged: bool
@@ -442,3 +448,10 @@ def run_strands(strands: Sequence[ArrayLike], poses: ArrayLike, *,
                 translations: Optional[ArrayLike] = None, record_every: int = 1,
                 method: str = "tractrix", substeps: int = 1, pinned: int = 1, threads: int = 1,
                 rest: PoseArg = None) -> Float64Array: ...  # (F', S, n+1, dim)
+
+def run_groom(scenario: Union[PathLike, dict], output: PathLike, *, method: Optional[str] = None,
+              substeps: Optional[int] = None, pinned: Optional[int] = None,
+              threads: Optional[int] = None, record_every: Optional[int] = None,
+              precision: Optional[str] = None,
+              progress: Optional[Callable[[int, int], object]] = None) -> StrandRunReport: ...
+def groom_summary(scenario: Union[PathLike, dict]) -> str: ...

@@ -131,6 +131,7 @@ void BindRobot(py::module_& m);
 void BindArms(py::module_& m);
 // The strand engine: StrandOptions, BodyPose, StrandBatch, run_strands (strands.cc).
 void BindStrands(py::module_& m);
+void BindGroom(py::module_& m);
 // TrackPath of a robot scenario's model along its path with the GIL released, as a
 // flexkin.RobotResult (robot.cc): `progress` a callable(done, total) or None; `output`, `csv`
 // None or the paths of the trajectory JSON and the joint CSV, written while the steps come and

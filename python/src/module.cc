@@ -13,6 +13,7 @@ PYBIND11_MODULE(_flexkin, m) {
   flexkin::python::BindRobot(m);
   flexkin::python::BindArms(m);
   flexkin::python::BindStrands(m);
+  flexkin::python::BindGroom(m);
 #ifdef FLEXKIN_PYTHON_URDF
   flexkin::python::BindUrdf(m);
 #endif

@@ -16,6 +16,7 @@
 
 #include "convert.h"
 #include "fields.h"
+#include "flexkin/groom.h"
 #include "flexkin/result_io.h"
 #include "flexkin/scenario.h"
 #include "progress.h"
@@ -315,6 +316,7 @@ py::list ValidateScenario(ScenarioFile scenario, OptionalPath directory) {
     if (IsRobotScenarioText(text)) {
       return ProblemList(ValidateRobotScenarioText(text, RobotReaderOptions(directory)));
     }
+    if (IsGroomText(text)) return ProblemList(ValidateGroomText(text));
     return ProblemList(ValidateScenarioText(text));
   }
   const std::string path = PathArg(scenario);
@@ -323,8 +325,8 @@ py::list ValidateScenario(ScenarioFile scenario, OptionalPath directory) {
   }
   const RobotScenarioOptions options = RobotReaderOptions(directory);
   return ProblemList(OnFile(path, [&] {
-    return IsRobotScenarioFile(path) ? ValidateRobotScenarioFile(path, options)
-                                     : ValidateScenarioFile(path);
+    if (IsRobotScenarioFile(path)) return ValidateRobotScenarioFile(path, options);
+    return IsGroomFile(path) ? ValidateGroomFile(path) : ValidateScenarioFile(path);
   }));
 }
 
@@ -446,7 +448,8 @@ The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
         "Writes `result` to `path` (.json or .npz by the extension), as Result.write.");
   m.def("validate_scenario", &ValidateScenario, py::arg("scenario"), py::kw_only(),
         py::arg("directory") = py::none(),
-        "The problems of a chain or robot scenario (a path to a scenario file or a dict of its "
+        "The problems of a chain, robot or groom scenario (a path to a scenario file or a dict of "
+        "its "
         "JSON form; a robot scenario is told apart as `flexkin validate` does) as `flexkin "
         "validate` finds them: a list of dicts (field, message, value, expected), empty if the "
         "scenario is valid. directory: where a robot scenario's relative \"urdf\" file is looked "

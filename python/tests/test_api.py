@@ -4,8 +4,10 @@ import concurrent.futures
 import copy
 import math
 import multiprocessing
+import os
 import pickle
 import re
+import tempfile
 
 import numpy as np
 import pytest
@@ -91,6 +93,11 @@ def samples():
     first = flexkin.arm_step(spherical, [3.0, 1.0, 0.5])
     second = flexkin.arm_step(spherical, [3.0, 1.1, 0.6], state=first)
     robot = flexkin.run_robot(EXAMPLES / "robot_spatial_limits.json")
+    with tempfile.TemporaryDirectory() as directory:
+        groom_report = flexkin.run_groom(
+            {"strands": [{"points": [[0, 0], [0, 1], [0, 2]]}],
+             "motion": {"keyframes": [{"time": 0}, {"time": 1, "translation": [1, 0]}]}},
+            os.path.join(directory, "h.npz"), threads=2)
     out = {
         "AccuracyReport": [controlled.accuracy],
         "ArmModel": [limited, spherical, axes],
@@ -113,6 +120,7 @@ def samples():
                                           overall={"rotation": 0.5})],
         "Scenario": [flexkin.load_scenario(EXAMPLES / "fig12_spatial_curve.json")],
         "StrandOptions": [flexkin.StrandOptions(method="ftl", substeps=3, pinned=2, threads=0)],
+        "StrandRunReport": [groom_report],
         "BodyPose": [flexkin.BodyPose.from_quaternion(0.9, 0.1, -0.3, 0.2, [1.0, 2.0, 3.0]),
                      flexkin.BodyPose.planar(0.25, -1.0, 0.5)],
     }

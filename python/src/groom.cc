@@ -1,0 +1,128 @@
+// Grooms from Python (flexkin/groom.h, docs/groom-format.md): flexkin.run_groom runs a groom
+// scenario (a path or a dict of its JSON form) into a strand file as `flexkin run` does, with
+// the GIL released; flexkin.groom_summary describes one. The strand file is read with
+// numpy.load (docs/strands.md).
+#include "flexkin/groom.h"
+
+#include <pybind11/stl.h>
+
+#include <functional>
+#include <string>
+#include <utility>
+
+#include "convert.h"
+#include "fields.h"
+#include "flexkin/strand_file.h"
+#include "flexkin/vocabulary.h"
+#include "progress.h"
+
+namespace flexkin::python {
+namespace {
+
+using GroomSource = ScenarioFile;  // "Union[PathLike, dict]"
+
+// The scenario a path or a dict stands for; problems of a file carry its path.
+GroomScenario GroomArg(GroomSource scenario) {
+  if (py::isinstance<py::dict>(scenario)) {
+    const std::string text = JsonOfDict(scenario, "scenario");
+    py::gil_scoped_release release;
+    return ParseGroomText(text);
+  }
+  const std::string path = PathArg(scenario);
+  if (path.empty()) {
+    ThrowInput("scenario",
+               "is a " + std::string(py::str(py::type::of(scenario).attr("__name__"))) +
+                   "; expected a path to a groom scenario file or a dict of its JSON form");
+  }
+  return OnFile(path, [&] { return LoadGroomFile(path); });
+}
+
+StrandRunReport RunGroomTo(GroomSource source, PathLike output, OptionalStr method,
+                           OptionalInt substeps, OptionalInt pinned, OptionalInt threads,
+                           OptionalInt record_every, OptionalStr precision,
+                           ProgressCallback progress) {
+  GroomScenario s = GroomArg(source);
+  if (!method.is_none()) {
+    const std::string name = py::cast<std::string>(method);
+    const Method m = ParseName<Method>(name, "method");
+    if (m != Method::kTractrix && m != Method::kFollowTheLeader) {
+      ThrowInput("method", "\"" + name + "\" is not a method of the strand engine", name,
+                 "\"tractrix\" or \"ftl\"");
+    }
+    s.options.method = m;
+  }
+  if (!substeps.is_none()) s.options.substeps = py::cast<int>(substeps);
+  if (!pinned.is_none()) s.options.pinned = py::cast<int>(pinned);
+  if (!threads.is_none()) s.options.threads = py::cast<int>(threads);
+  if (!record_every.is_none()) {
+    s.record_every = py::cast<int>(record_every);
+    if (s.record_every < 1) {
+      ThrowInput("record_every", "must be at least 1", std::to_string(s.record_every),
+                 "an integer >= 1");
+    }
+  }
+  if (!precision.is_none()) {
+    const std::string p = py::cast<std::string>(precision);
+    if (p != "float32" && p != "float64") {
+      ThrowInput("precision", "\"" + p + "\" is not a precision", p, "'float32' or 'float64'");
+    }
+    s.float32 = p == "float32";
+  }
+  ThrowIfAny(s.options.Validate());
+  const std::string path = RequiredPath(output, "output", false);
+  ProgressHook hook(progress);
+  std::function<bool(int64_t, int64_t)> tick = [&hook](int64_t done, int64_t total) {
+    hook.Tick(done, total);
+    return true;
+  };
+  try {
+    return OnFile(path, [&] {
+      StrandFileWriter writer(path, MakeStrandFileHeader(s));
+      const StrandRunReport report = RunGroom(s, &writer, tick);
+      writer.Commit(report);
+      return report;
+    });
+  } catch (const StopRun&) {
+    hook.Rethrow();
+  }
+}
+
+}  // namespace
+
+void BindGroom(py::module_& m) {
+  py::class_<StrandRunReport> report(m, "StrandRunReport", R"doc(
+What a groom run did (flexkin.run_groom; also in the strand file's groom.json "report").
+  max_length_error (largest relative link-length error of the recorded frames), seconds (wall
+  time of the stepping), engine ('avx512', 'avx2' or 'scalar'), threads.
+)doc");
+  Fields<StrandRunReport>(report, "StrandRunReport")
+      .Member("max_length_error", &StrandRunReport::max_length_error,
+              "Largest |link length - rest length| / rest length over the recorded frames.")
+      .Member("seconds", &StrandRunReport::seconds,
+              "Wall time of the stepping, writing excluded (seconds).")
+      .Member("engine", &StrandRunReport::engine,
+              "The strand engine that ran: 'avx512', 'avx2' or 'scalar'.")
+      .Member("threads", &StrandRunReport::threads, "Threads that stepped the strands.")
+      .Finish();
+
+  m.def("run_groom", &RunGroomTo, py::arg("scenario"), py::arg("output"), py::kw_only(),
+        py::arg("method") = py::none(), py::arg("substeps") = py::none(),
+        py::arg("pinned") = py::none(), py::arg("threads") = py::none(),
+        py::arg("record_every") = py::none(), py::arg("precision") = py::none(),
+        py::arg("progress") = py::none(),
+        "Runs a groom scenario (a path to a groom file or a dict of its JSON form, "
+        "docs/groom-format.md) and writes the strand file `output` (.npz; read it with "
+        "numpy.load: points (F, P, dim), offsets, frames, times, body_rotation, "
+        "body_translation, link_lengths, groom.json; docs/strands.md), as `flexkin run` does, "
+        "bit for bit. The keyword arguments override the scenario's method ('tractrix' or "
+        "'ftl'), substeps, pinned, threads, record_every and precision ('float32' or "
+        "'float64'). The file is written whole or not at all; Ctrl-C or an exception from "
+        "progress(done, total) stops the run and leaves no file. Returns a StrandRunReport.");
+  m.def(
+      "groom_summary", [](GroomSource scenario) { return GroomSummary(GroomArg(scenario)); },
+      py::arg("scenario"),
+      "One line describing a groom scenario (a path or a dict), as `flexkin validate` prints "
+      "it; raises InputError naming the JSON pointer of a problem.");
+}
+
+}  // namespace flexkin::python
