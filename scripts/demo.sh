@@ -34,6 +34,18 @@ echo "== tractrix against the Jacobian pseudo-inverse (Orocos KDL), Ravi et al. 
 for scenario in robot_ravi_lines robot_ravi_circle; do
   "$build/examples/robot_compare" "examples/$scenario.json" "out/${scenario}_compare"
 done
+echo "== hair on a head that turns and nods (docs/strands.md, docs/groom-format.md)"
+# 5,000 strands of 24 links grown on a sphere of radius 0.1 m, stepped by the strand engine
+# frame by frame into a strand file (NumPy .npz), then drawn: a figure of four moments, an MP4
+# and the many-strand viewer. The README's frame is the figure with 1,500 of the strands drawn.
+"$flexkin" run examples/groom_head.json -o out/groom_head.npz
+"$flexkin" render out/groom_head.npz -o out --formats svg,png,mp4,html --quiet
+mkdir -p out/groom_head_readme
+"$flexkin" render out/groom_head.npz -o out/groom_head_readme --formats png --max-strands 1500 \
+  --elevation 10 --quiet
+# What the hair did, read back with numpy alone (no flexkin): the motion dying out toward the
+# tips, and every link's length.
+/usr/bin/python3 examples/python/hair_numpy.py out/groom_head.npz
 echo "== figures, plots, animations, viewers and glTF (docs/rendering.md)"
 for result in out/fig*.json; do
   "$flexkin" render "$result" -o out --formats svg,png,pdf,plots,mp4,gif,html,glb --quiet
@@ -53,6 +65,7 @@ else
   echo "skipped: the Python module is not built ($build/python/flexkin; docs/python.md)"
 fi
 echo "results: out/*.json (format: docs/result-format.md)"
+echo "hair: out/groom_head.npz (docs/strands.md: numpy.load reads it), out/groom_head.{svg,png,mp4,html}"
 echo "pictures: out/*.{svg,png,pdf}, out/*_{path_length,link_angles,length_error}.{svg,png},"
 echo "  out/*.{mp4,gif}, out/*.html (open in a browser), out/*.glb (docs/rendering.md)"
 echo "Python examples' figures: out/python/*.png (docs/python-examples.md)"
