@@ -266,6 +266,13 @@ int RenderCommand::Run() const {
   try {
     for (const FormatWriter* format : formats) format->write(job);
   } catch (const InputError& e) {
+    // An option found wrong only against the file (the viewer page's size against
+    // "options.max_frames") is named by its command-line option; the rest by the file.
+    if (e.field().rfind("options.", 0) == 0) {
+      Problem p = e.problem();
+      p.field = p.field.substr(8);
+      CheckOptions({p});
+    }
     throw InputError(args_.result + (e.field().empty() ? "" : ": " + e.field()),
                      std::string(e.what()).substr(e.field().empty() ? 0 : e.field().size() + 2));
   } catch (const std::system_error&) {
@@ -338,6 +345,13 @@ int RenderCommand::RunStrands() const {
       written.push_back(path);
     }
   } catch (const InputError& e) {
+    // An option found wrong only against the file (the viewer page's size against
+    // "options.max_frames") is named by its command-line option; the rest by the file.
+    if (e.field().rfind("options.", 0) == 0) {
+      Problem p = e.problem();
+      p.field = p.field.substr(8);
+      CheckOptions({p});
+    }
     throw InputError(args_.result + (e.field().empty() ? "" : ": " + e.field()),
                      std::string(e.what()).substr(e.field().empty() ? 0 : e.field().size() + 2));
   } catch (const std::system_error&) {

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <ostream>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -296,6 +297,8 @@ struct BadCase {
   const char* pointer;  // expected field of the first problem
   const char* message;  // expected in its message
 };
+// The case's name in test listings (ctest's names of the parameterized tests).
+void PrintTo(const BadCase& c, std::ostream* os) { *os << c.what; }
 
 #define GROOM_OPEN \
   R"({"groom": {"scalp": {"shape": "sphere", "radius": 1}, "roots": 3, "links": 2,)"
