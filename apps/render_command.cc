@@ -175,6 +175,19 @@ void CheckOptions(const Problems& problems) {
   throw InputError(p);
 }
 
+// A problem found while writing the outputs: an option found wrong only against the file (the
+// viewer page's size against "options.max_frames") is named by its command-line option, the rest
+// by the file ("RESULT: frames[3].points[2][1]").
+[[noreturn]] void ThrowForFile(const InputError& e, const std::string& result) {
+  if (e.field().rfind("options.", 0) == 0) {
+    Problem p = e.problem();
+    p.field = p.field.substr(8);
+    CheckOptions({p});
+  }
+  throw InputError(result + (e.field().empty() ? "" : ": " + e.field()),
+                   std::string(e.what()).substr(e.field().empty() ? 0 : e.field().size() + 2));
+}
+
 // OUTDIR/<stem>: <stem> is the result file's name without ".json".
 std::string OutputBase(const std::string& result, const std::string& output_dir) {
   std::string stem = std::filesystem::path(result).filename().string();
@@ -266,15 +279,7 @@ int RenderCommand::Run() const {
   try {
     for (const FormatWriter* format : formats) format->write(job);
   } catch (const InputError& e) {
-    // An option found wrong only against the file (the viewer page's size against
-    // "options.max_frames") is named by its command-line option; the rest by the file.
-    if (e.field().rfind("options.", 0) == 0) {
-      Problem p = e.problem();
-      p.field = p.field.substr(8);
-      CheckOptions({p});
-    }
-    throw InputError(args_.result + (e.field().empty() ? "" : ": " + e.field()),
-                     std::string(e.what()).substr(e.field().empty() ? 0 : e.field().size() + 2));
+    ThrowForFile(e, args_.result);
   } catch (const std::system_error&) {
     throw;
   } catch (const std::runtime_error& e) {  // ffmpeg missing or failing, cairo
@@ -345,15 +350,7 @@ int RenderCommand::RunStrands() const {
       written.push_back(path);
     }
   } catch (const InputError& e) {
-    // An option found wrong only against the file (the viewer page's size against
-    // "options.max_frames") is named by its command-line option; the rest by the file.
-    if (e.field().rfind("options.", 0) == 0) {
-      Problem p = e.problem();
-      p.field = p.field.substr(8);
-      CheckOptions({p});
-    }
-    throw InputError(args_.result + (e.field().empty() ? "" : ": " + e.field()),
-                     std::string(e.what()).substr(e.field().empty() ? 0 : e.field().size() + 2));
+    ThrowForFile(e, args_.result);
   } catch (const std::system_error&) {
     throw;
   } catch (const std::runtime_error& e) {  // ffmpeg missing or failing, cairo

@@ -118,45 +118,26 @@ void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
   cairo_surface_flush(background.surface());
   render::Canvas picture(ImageFormat::kPng, width, height);
 
-  const std::string temp = render::TemporaryNextTo(path);
-  std::string failure;
-  try {
-    render::FfmpegPipe ffmpeg(
-        options.ffmpeg, render::FfmpegArgs(format, width, height, options.fps, options.crf, temp));
-    // Video frames per picture, so that short runs last min_seconds; the last one also holds
-    // for end_pause.
-    const int pictures = static_cast<int>(drawn.size());
-    const int repeat = std::max(
-        1, static_cast<int>(std::ceil(options.min_seconds * options.fps / pictures - 1e-9)));
-    const int pause = static_cast<int>(std::lround(options.end_pause * options.fps));
-    for (int d = 0; d < pictures && failure.empty(); ++d) {
-      cairo_t* cr = picture.cr();
-      cairo_set_source_surface(cr, background.surface(), 0, 0);
-      cairo_paint(cr);
-      DrawMoment(&picture, scene, file, drawn, d);
-      const unsigned char* pixels = picture.Pixels();
-      const int copies = repeat + (d == pictures - 1 ? pause : 0);
-      for (int c = 0; c < copies && failure.empty(); ++c) {
-        for (int y = 0; y < height && failure.empty(); ++y) {
-          if (!ffmpeg.Write(pixels + static_cast<size_t>(y) * picture.Stride(),
-                            4 * static_cast<size_t>(width))) {
-            failure = "stopped reading";
-          }
-        }
-      }
-    }
-    const std::string status = ffmpeg.Finish();
-    if (!status.empty()) failure = status;
-  } catch (...) {
-    ::unlink(temp.c_str());
-    throw;
-  }
-  if (!failure.empty()) {
-    ::unlink(temp.c_str());
-    throw std::runtime_error("ffmpeg (\"" + options.ffmpeg + "\") failed writing '" + path +
-                             "': " + failure);
-  }
-  render::Publish(temp, path);
+  // Video frames per picture, so that short runs last min_seconds; the last one also holds
+  // for end_pause.
+  const int pictures = static_cast<int>(drawn.size());
+  const int repeat =
+      std::max(1, static_cast<int>(std::ceil(options.min_seconds * options.fps / pictures - 1e-9)));
+  const int pause = static_cast<int>(std::lround(options.end_pause * options.fps));
+  int d = 0;
+  render::WriteVideo(options.ffmpeg, format, width, height, options.fps, options.crf, path,
+                     [&](render::VideoPicture* out) {
+                       if (d == pictures) return false;
+                       cairo_t* cr = picture.cr();
+                       cairo_set_source_surface(cr, background.surface(), 0, 0);
+                       cairo_paint(cr);
+                       DrawMoment(&picture, scene, file, drawn, d);
+                       out->pixels = picture.Pixels();
+                       out->stride = picture.Stride();
+                       out->copies = repeat + (d == pictures - 1 ? pause : 0);
+                       ++d;
+                       return true;
+                     });
 }
 
 }  // namespace flexkin

@@ -197,4 +197,35 @@ void Publish(const std::string& temp, const std::string& path) {
   }
 }
 
+void WriteVideo(const std::string& program, VideoFormat format, int width, int height, int fps,
+                int crf, const std::string& path, const std::function<bool(VideoPicture*)>& next) {
+  const std::string temp = TemporaryNextTo(path);
+  std::string failure;
+  try {
+    FfmpegPipe ffmpeg(program, FfmpegArgs(format, width, height, fps, crf, temp));
+    VideoPicture picture;
+    while (failure.empty() && next(&picture)) {
+      for (int c = 0; c < picture.copies && failure.empty(); ++c) {
+        for (int y = 0; y < height && failure.empty(); ++y) {
+          if (!ffmpeg.Write(picture.pixels + static_cast<size_t>(y) * picture.stride,
+                            4 * static_cast<size_t>(width))) {
+            failure = "stopped reading";
+          }
+        }
+      }
+    }
+    const std::string status = ffmpeg.Finish();
+    if (!status.empty()) failure = status;
+  } catch (...) {
+    ::unlink(temp.c_str());
+    throw;
+  }
+  if (!failure.empty()) {
+    ::unlink(temp.c_str());
+    throw std::runtime_error("ffmpeg (\"" + program + "\") failed writing '" + path +
+                             "': " + failure);
+  }
+  Publish(temp, path);
+}
+
 }  // namespace flexkin::render

@@ -6,6 +6,7 @@
 #include <sys/types.h>
 
 #include <cstddef>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -49,5 +50,21 @@ std::string TemporaryNextTo(const std::string& path);
 // Gives `temp` the mode `path` has, or 0666 less the umask for a new file, and renames it over
 // `path`; on failure removes `temp` and throws std::system_error.
 void Publish(const std::string& temp, const std::string& path);
+
+// One picture of a video: `height` rows of 4 x width bytes (cairo's RGB24 words), `stride` bytes
+// apart, shown for `copies` video frames.
+struct VideoPicture {
+  const unsigned char* pixels = nullptr;
+  int stride = 0;
+  int copies = 1;
+};
+
+// Writes the video `path` through ffmpeg (`program`), picture by picture: `next(&picture)` draws
+// the next one and returns false after the last. The video goes to a temporary file next to
+// `path` and is renamed into place only when ffmpeg has finished well; on any failure the
+// temporary file is removed, an exception from `next` propagates, and a failing ffmpeg throws
+// std::runtime_error naming the program, the path and ffmpeg's reason.
+void WriteVideo(const std::string& program, VideoFormat format, int width, int height, int fps,
+                int crf, const std::string& path, const std::function<bool(VideoPicture*)>& next);
 
 }  // namespace flexkin::render

@@ -367,48 +367,29 @@ void RenderStrandsAnimation(StrandFileReader* reader, const StrandsRenderOptions
   counter.valign = render::Align::kEnd;
   counter.color = render::kMuted;
 
-  const std::string temp = render::TemporaryNextTo(path);
-  std::string failure;
-  try {
-    render::FfmpegPipe ffmpeg(options.ffmpeg,
-                              render::FfmpegArgs(video, width, height, fps, options.crf, temp));
-    const int pause = static_cast<int>(std::lround(options.end_pause * fps));
-    int f = 0;
-    for (size_t k = 0; k < drawn.size() && failure.empty(); ++k) {
-      while (f < drawn[k]) {
-        if (!reader->Next(&frame))
-          throw InputError("frames", "the file ended before frame " + std::to_string(drawn[k]));
-        ++f;
-      }
-      if (f > 0) CheckFinite(d, f, frame.points);
-      cairo_t* cr = picture.cr();
-      cairo_set_source_surface(cr, background.surface(), 0, 0);
-      cairo_paint(cr);
-      DrawStrandsFrame(cr, view, *d.header, d.strands, frame.points, frame.pose, style, &work);
-      render::DrawText(cr, width - 10 * ui, height - 8 * ui, Seconds(frame.time), counter);
-      const unsigned char* pixels = picture.Pixels();
-      const int copies = 1 + (k + 1 == drawn.size() ? pause : 0);
-      for (int c = 0; c < copies && failure.empty(); ++c) {
-        for (int y = 0; y < height && failure.empty(); ++y) {
-          if (!ffmpeg.Write(pixels + static_cast<size_t>(y) * picture.Stride(),
-                            4 * static_cast<size_t>(width))) {
-            failure = "stopped reading";
-          }
+  const int pause = static_cast<int>(std::lround(options.end_pause * fps));
+  int f = 0;
+  size_t k = 0;
+  render::WriteVideo(
+      options.ffmpeg, video, width, height, fps, options.crf, path, [&](render::VideoPicture* out) {
+        if (k == drawn.size()) return false;
+        while (f < drawn[k]) {
+          if (!reader->Next(&frame))
+            throw InputError("frames", "the file ended before frame " + std::to_string(drawn[k]));
+          ++f;
         }
-      }
-    }
-    const std::string status = ffmpeg.Finish();
-    if (!status.empty()) failure = status;
-  } catch (...) {
-    ::unlink(temp.c_str());
-    throw;
-  }
-  if (!failure.empty()) {
-    ::unlink(temp.c_str());
-    throw std::runtime_error("ffmpeg (\"" + options.ffmpeg + "\") failed writing '" + path +
-                             "': " + failure);
-  }
-  render::Publish(temp, path);
+        if (f > 0) CheckFinite(d, f, frame.points);
+        cairo_t* cr = picture.cr();
+        cairo_set_source_surface(cr, background.surface(), 0, 0);
+        cairo_paint(cr);
+        DrawStrandsFrame(cr, view, *d.header, d.strands, frame.points, frame.pose, style, &work);
+        render::DrawText(cr, width - 10 * ui, height - 8 * ui, Seconds(frame.time), counter);
+        out->pixels = picture.Pixels();
+        out->stride = picture.Stride();
+        out->copies = 1 + (k + 1 == drawn.size() ? pause : 0);
+        ++k;
+        return true;
+      });
 }
 
 }  // namespace flexkin
