@@ -7,7 +7,7 @@ numpy alone, no flexkin, and prints what the hair did (docs/strands.md, "The str
 - every link's length in the file against its rest length (float32 files round the coordinates
   to 7 digits; the run's own error, in double, is groom.json's report.max_length_error).
 
-    python3 examples/python/hair_numpy.py [out/groom_head.npz]
+    /usr/bin/python3 examples/python/hair_numpy.py [out/groom_head.npz]
 """
 import json
 import sys
