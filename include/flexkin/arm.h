@@ -31,11 +31,13 @@ namespace flexkin {
 //   rotation taking the world x axis to the base direction, and each joint's rotation (see
 //   JointQuaternions) is the smallest one taking link j's direction to link j+1's: its axis is
 //   perpendicular to link j, so no joint twists. azimuth is 0 where angle is 0.
-//   Spatial (dim 3), revolute joints about given axes (ArmModel::joint_axes, e.g. from a URDF):
-//   angle[j] (rad, (-pi, pi]) is the right-handed rotation of link j+1 about joint j's axis;
-//   every link frame coincides with the world frame when all angles are 0, and link j+1's frame
-//   is link j's frame times the rotation about joint j's axis (given in link j's frame).
-//   azimuth is empty.
+//   Spatial (dim 3), joints about or along given axes (ArmModel::joint_axes, e.g. from a URDF):
+//   angle[j] is the right-handed rotation (rad) of link j+1 about joint j's axis, or for a
+//   prismatic joint (ArmModel::joint_types) its displacement along the axis (length unit). Every
+//   link frame coincides with the world frame when all angles are 0, and link j+1's frame is
+//   link j's frame times the rotation about joint j's axis (given in link j's frame); a
+//   prismatic joint translates link j+1 and everything after it along its axis instead. Angles
+//   are not wrapped: a multi-turn or continuous joint may read 7.5 (rad). azimuth is empty.
 struct JointAngles {
   Eigen::VectorXd angle;    // n
   Eigen::VectorXd azimuth;  // n for spherical joints, otherwise empty
@@ -45,6 +47,21 @@ struct JointAngles {
 enum class ArmJoint {
   kRevolute,   // "revolute": one angle per joint; planar arms, or spatial arms with joint_axes
   kSpherical,  // "spherical": spatial arms, bend angle and azimuth per joint
+};
+
+// The type of each joint of an arm with joint axes (ArmModel::joint_types).
+enum class JointType {
+  kRevolute,   // "revolute": turns about its axis; angle in rad
+  kPrismatic,  // "prismatic": slides along its axis; displacement in the length unit
+};
+
+template <>
+struct Vocabulary<JointType> {
+  static constexpr const char* kKind = "joint type";
+  static constexpr NamedValue<JointType> kEntries[] = {
+      {JointType::kRevolute, "revolute", "turns about its axis (rad)"},
+      {JointType::kPrismatic, "prismatic", "slides along its axis (length unit)"},
+  };
 };
 
 template <>
@@ -58,26 +75,42 @@ struct Vocabulary<ArmJoint> {
 };
 
 struct ArmModel {
-  int dim = 2;                     // 2 (revolute) or 3 (spherical, or revolute with axes)
-  Eigen::VectorXd link_lengths;    // n >= 1 positive lengths, base link first
+  int dim = 2;  // 2 (revolute) or 3 (spherical, or revolute/prismatic with axes)
+  // n >= 1 lengths, base link first: positive, except with joint_axes, where a link may have
+  // length 0 (joints at one point, a universal or spherical joint built from revolute joints, or
+  // a tip on its joint: see JointGroups) as long as the sum is positive.
+  Eigen::VectorXd link_lengths;
   Eigen::VectorXd base;            // dim; where the base is bolted
   Eigen::VectorXd base_direction;  // dim, non-zero; the direction of "link 0"
-  // Revolute limits (rad, planar or with joint_axes): joint j stays in [joint_min[j],
-  // joint_max[j]], with -pi <= min <= max <= pi. Empty: no limits.
+  // Joint limits, planar or with joint_axes: joint j stays in [joint_min[j], joint_max[j]].
+  // Planar: rad, with -pi <= min <= max <= pi (on the circle). With joint_axes: as written, in
+  // rad for revolute joints (multi-turn joints may reach beyond [-pi, pi]; -inf and +inf for a
+  // continuous, unlimited joint) and in the length unit for prismatic ones. Empty: no limits.
   Eigen::VectorXd joint_min, joint_max;
   // Spherical limits (rad): joint j's bend angle stays <= max_bend[j], in (0, pi]. Empty: none.
   Eigen::VectorXd max_bend;
-  // Spatial revolute joints (dim 3): n by 3, row j the unit axis of joint j in link j's frame
-  // (the base frame for j = 0), which is the world frame when all angles are 0. No axis may lie
-  // along the link its joint turns (a pure twist cannot be read back from link positions).
-  // Empty: spherical joints.
+  // Spatial joints about or along axes (dim 3): n by 3, row j the unit axis of joint j in link
+  // j's frame (the base frame for j = 0), which is the world frame when all angles are 0. An axis
+  // may lie along its link (a twist joint, the roll module of a snake). Empty: spherical joints.
   Eigen::MatrixXd joint_axes;
   // With joint_axes: n by 3, row k the unit direction of link k+1 in its own frame (its world
   // direction when all angles are 0). Empty: every link along base_direction.
   Eigen::MatrixXd link_directions;
+  // With joint_axes: n types (JointType). Empty: every joint revolute.
+  std::vector<JointType> joint_types;
+  // With joint_axes: n speed limits (rad/s, or length unit/s for prismatic joints; +inf: none),
+  // respected where ArmOptions::time_step is set. Empty: none.
+  Eigen::VectorXd max_velocity;
+  // With joint_axes: the tool frame (the tip link's frame, whose origin is the end effector) in
+  // the last link's frame, as a unit quaternion (w, x, y, z): what ArmOptions::pointing's axis is
+  // given in. Identity by default.
+  Eigen::Vector4d tip_rotation = Eigen::Vector4d(1.0, 0.0, 0.0, 0.0);
   JointAngles initial;  // the joint angles at the start; within the limits
 
   bool has_axes() const { return joint_axes.size() > 0; }
+  bool prismatic(int j) const {
+    return !joint_types.empty() && joint_types[j] == JointType::kPrismatic;
+  }
   ArmJoint joint() const {
     return dim == 2 || has_axes() ? ArmJoint::kRevolute : ArmJoint::kSpherical;
   }
@@ -106,6 +139,23 @@ JointAngles JointAnglesFromPoints(const ArmModel& model, const Points& points);
 Eigen::MatrixXd JointQuaternions(const ArmModel& model, const JointAngles& angles);
 // Whether every joint is within its limits, with `slack` (rad) of tolerance.
 bool WithinLimits(const ArmModel& model, const JointAngles& angles, double slack = 0.0);
+
+// Joints at one point: ForwardKinematics gives every joint its own point, so joints joined by a
+// link of length 0 (with joint_axes: two revolute joints at one point make a universal joint,
+// three a spherical one) repeat a point. JointGroups lists the joints of each distinct point of
+// the chain, base first (a prismatic joint ends its group: it moves the next joint away); the
+// last group may hold the tip (a tip on its joint). ChainPoints keeps one point per group plus
+// the end effector where it is a point of its own: the chain as drawn and written to files.
+std::vector<std::vector<int>> JointGroups(const ArmModel& model);
+Points ChainPoints(const ArmModel& model, const Points& points);
+
+// The tool frame at `angles` (arms with joint_axes): the end effector (3) and the tip link's
+// rotation in the world (3 by 3; ArmModel::tip_rotation in the last link's frame).
+struct ToolPose {
+  Eigen::Vector3d position;
+  Eigen::Matrix3d rotation;
+};
+ToolPose ToolPoseAt(const ArmModel& model, const JointAngles& angles);
 
 // How the base is brought back after the sweep from the end effector has moved it.
 enum class FixedBaseMethod {
@@ -153,6 +203,27 @@ struct ArmOptions {
   // Targets farther from the base than (1 - edge_margin) times the reach are treated as out of
   // reach: the arm is stretched straight toward them. Typical 1e-9.
   double edge_margin = 1e-9;
+  // Pointing (arms with joint_axes, method newton): an axis of the tool frame (unit, in the tip
+  // link's frame, see ArmModel::tip_rotation) is turned toward a direction or a point as the end
+  // effector tracks its target. The step then minimises |position miss|^2 + (weight x mean link
+  // length x angular miss)^2, with the same smallest weighted joint motion; where both can be met
+  // (a redundant arm inside its workspace) both are, and the step counts as reached when the
+  // position is within the tolerance and the angle within angle_tolerance (rad).
+  struct Pointing {
+    bool enabled = false;
+    Eigen::Vector3d axis = Eigen::Vector3d::UnitX();  // in the tool frame
+    // The direction to point along (world, non-zero), or, with look_at, the point to look at.
+    Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+    bool look_at = false;
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();
+    double weight = 1.0;             // > 0: mean link lengths per radian of angular miss
+    double angle_tolerance = 1e-9;  // rad, > 0
+  } pointing;
+  // Velocity limits (arms with joint_axes and ArmModel::max_velocity): the time between two path
+  // points (s). A step whose joint motion would exceed a limit in that time is split into as many
+  // equal legs along the end effector's straight move, each taking time_step, as keep every joint
+  // within its limit (ArmStepReport::velocity_legs). 0: limits ignored.
+  double time_step = 0.0;
   // Every problem (empty if valid), each naming its member ("max_iterations").
   Problems Validate() const;
 };
@@ -210,6 +281,14 @@ struct ArmStepReport {
   // sweep. iterations, sweeps and passes count all of them.
   int legs = 0;
   int restarts = 0;  // joint-space solves after the first (ArmOptions::restarts)
+  // With ArmOptions::pointing: the angle (rad) between the tool axis and where it should point.
+  double pointing_error = 0.0;
+  // With ArmOptions::time_step: the legs the step took to keep every joint within its velocity
+  // limit (1: the step as asked), so the step lasted velocity_legs x time_step; 0 without.
+  int velocity_legs = 0;
+  // With ArmOptions::time_step: the largest joint speed over its limit in any leg (<= 1 when
+  // the limits were kept).
+  double velocity_ratio = 0.0;
   std::string BriefReport() const;
 };
 
@@ -228,6 +307,8 @@ struct ArmTrajectory {
   long long num_steps = 0;  // steps tracked (one per path point), with or without a sink
   double max_ee_error = 0.0, max_base_error = 0.0;
   int unreached = 0;  // steps with reached = false
+  double max_pointing_error = 0.0;  // rad, with ArmOptions::pointing
+  long long velocity_legs = 0;      // with ArmOptions::time_step: legs of all steps
   int max_iterations = 0;
   long long total_sweeps = 0;
   long long total_passes = 0;  // passes over the links (see ArmStepReport::passes)

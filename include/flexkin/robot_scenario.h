@@ -33,6 +33,9 @@ namespace flexkin {
 struct UrdfChain {
   std::string base_link;  // the link the arm is bolted to; "" = the URDF's root link
   std::string tip_link;   // the end effector's link; "" = the one leaf below base_link
+  // The end effector: this point of the tip link's frame (length unit), e.g. a tool point beyond
+  // the last joint. Zero: the tip link's origin (which may sit on the last joint).
+  Eigen::Vector3d tip_offset = Eigen::Vector3d::Zero();
 };
 
 // Reads the arm of the URDF file at `path` (flexkin/urdf.h: ArmFromUrdfFile). Throws InputError
