@@ -102,13 +102,17 @@ json HeadJson(const RobotScenario& s) {
 }
 
 json SummaryJson(const ArmTrajectory& t, int64_t steps) {
-  return {{"steps", steps},
-          {"unreached", t.unreached},
-          {"max_ee_error", t.max_ee_error},
-          {"max_base_error", t.max_base_error},
-          {"max_iterations", t.max_iterations},
-          {"total_sweeps", t.total_sweeps},
-          {"seconds", t.seconds}};
+  json summary = {{"steps", steps},
+                  {"unreached", t.unreached},
+                  {"max_ee_error", t.max_ee_error},
+                  {"max_base_error", t.max_base_error},
+                  {"max_iterations", t.max_iterations},
+                  {"total_sweeps", t.total_sweeps},
+                  {"seconds", t.seconds}};
+  // Only where the run pointed or kept velocity limits (the steps say which).
+  if (t.max_pointing_error > 0.0) summary["max_pointing_error"] = t.max_pointing_error;
+  if (t.velocity_legs > 0) summary["velocity_legs"] = t.velocity_legs;
+  return summary;
 }
 
 [[noreturn]] void ThrowNothingWritten(Problem problem) {
