@@ -78,6 +78,7 @@ int RobotCommand::Run() const {
   std::vector<ArmStepSink*> sinks = {&json_writer};
   if (!csv_.empty()) sinks.push_back(&csv_writer.emplace(s, csv_));
   ArmStepFanOut sink(sinks);
+  if (!quiet_) std::cout << JointGroupsReport(s.model);
   const ArmTrajectory t = TrackPath(s.model, s.path, s.options, &sink);
   json_writer.Commit(t);
   if (csv_writer) csv_writer->Commit(t);

@@ -433,9 +433,10 @@ TEST(ArmRevolute, UnreachableTargetIsReportedWithoutNaN) {
 
 TEST(ArmRevolute, BadAxesAreRefusedWithTheField) {
   ArmModel model = RevoluteSnake(4);
-  model.joint_axes.row(2) = Eigen::RowVector3d(1.0, 0.0, 0.0);  // along the link: a twist
-  ASSERT_EQ(model.Validate().size(), 1u);
-  EXPECT_EQ(model.Validate().front().field, "joint_axes[2]");
+  // Along the link: a twist joint, valid; but its angle cannot be read back from the points.
+  model.joint_axes.row(2) = Eigen::RowVector3d(1.0, 0.0, 0.0);
+  EXPECT_TRUE(model.Validate().empty());
+  EXPECT_THROW(JointAnglesFromPoints(model, InitialState(model).points), InputError);
   model.joint_axes.row(2) = Eigen::RowVector3d(0.0, 2.0, 0.0);  // not unit
   ASSERT_EQ(model.Validate().size(), 1u);
   EXPECT_EQ(model.Validate().front().field, "joint_axes[2]");

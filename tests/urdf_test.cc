@@ -122,8 +122,20 @@ TEST(Urdf, HandWrittenPlanarArmIsReadCorrectly) {
   EXPECT_NEAR(sub.link_lengths[0], 0.2, 1e-15);
   EXPECT_NEAR(sub.link_lengths[1], 0.1, 1e-15);
   EXPECT_NEAR((sub.base - Eigen::Vector2d(1.3, 0.5)).norm(), 0.0, 1e-15);
-  // Ending at the hand, the wrist's link would have length 0.
-  EXPECT_NE(InputErrorOf(kPlanarUrdf, {"upper", "hand"}).find("zero-length"), std::string::npos);
+  // Ending at the hand, the tip sits on the wrist: a link of length 0, accepted (a spatial arm
+  // with axes then, whose wrist turns the tool frame only).
+  const ArmModel on_joint = ArmFromUrdf(kPlanarUrdf, {"upper", "hand"});
+  ASSERT_EQ(on_joint.num_links(), 2);
+  EXPECT_EQ(on_joint.dim, 3);
+  EXPECT_NEAR(on_joint.link_lengths[0], 0.2, 1e-15);
+  EXPECT_EQ(on_joint.link_lengths[1], 0.0);
+  EXPECT_EQ(JointGroups(on_joint), (std::vector<std::vector<int>>{{0}, {1}}));
+  JointAngles wrist;
+  wrist.angle = Eigen::Vector2d(0.0, 1.0);
+  EXPECT_EQ(ChainPoints(on_joint, ForwardKinematics(on_joint, wrist)).rows(), 2);
+  EXPECT_NEAR((ToolPoseAt(on_joint, wrist).position - Eigen::Vector3d(1.5, 0.5, 0.0)).norm(), 0.0,
+              1e-15);
+  EXPECT_NEAR(ToolPoseAt(on_joint, wrist).rotation(1, 0), std::sin(1.0), 1e-15);
 }
 
 std::string Replace(std::string s, const std::string& from, const std::string& to) {
@@ -134,15 +146,20 @@ std::string Replace(std::string s, const std::string& from, const std::string& t
 
 TEST(Urdf, BadUrdfsNameTheElement) {
   const std::string good = kPlanarUrdf;
-  EXPECT_NE(
-      InputErrorOf(
-          Replace(good, "\"continuous\">",
-                  "\"prismatic\"><limit lower=\"0\" upper=\"1\" effort=\"1\" velocity=\"1\"/>"))
-          .find("joint \"wrist\""),
-      std::string::npos);
-  EXPECT_NE(InputErrorOf(Replace(good, "<origin xyz=\"0.2 0 0\"/>", "<origin xyz=\"0 0 0\"/>"))
-                .find("zero-length"),
+  EXPECT_NE(InputErrorOf(Replace(good, "\"continuous\">", "\"floating\">"))
+                .find("joint \"wrist\": has type floating"),
             std::string::npos);
+  EXPECT_NE(InputErrorOf(Replace(good, "\"continuous\">", "\"planar\">"))
+                .find("joint \"wrist\": has type planar"),
+            std::string::npos);
+  // A closed loop: "fore" the child of a second joint.
+  const std::string loop = Replace(good, "</robot>",
+                                   "<joint name=\"again\" type=\"fixed\"><parent link=\"mount\"/>"
+                                   "<child link=\"fore\"/></joint></robot>");
+  EXPECT_NE(InputErrorOf(loop).find("link \"fore\": is the child of joints \"again\" and "
+                                    "\"elbow\": a closed loop"),
+            std::string::npos)
+      << InputErrorOf(loop);
   EXPECT_NE(InputErrorOf(good, {"", "elbowx"}).find("\"elbowx\" is not in the URDF"),
             std::string::npos);
   EXPECT_NE(InputErrorOf(good, {"nowhere", ""}).find("base_link"), std::string::npos);
@@ -157,11 +174,8 @@ TEST(Urdf, BadUrdfsNameTheElement) {
                                      "<origin xyz=\"0 0.1 0\"/></joint></robot>");
   EXPECT_NE(InputErrorOf(branch).find("link \"fore\""), std::string::npos);
   EXPECT_NO_THROW(ArmFromUrdf(branch, {"", "tool"}));
-  // A twist joint: the axis along the link it turns.
-  EXPECT_NE(InputErrorOf(Replace(good, "<origin xyz=\"0.2 0 0\"/><axis xyz=\"0 0 1\"/>",
-                                 "<origin xyz=\"0.2 0 0\"/><axis xyz=\"1 0 0\"/>"))
-                .find("joint \"wrist\""),
-            std::string::npos);
+  // Everything at one point: no length to scale the arm by.
+  EXPECT_NE(InputErrorOf(good, {"fore", "hand"}).find("at one point"), std::string::npos);
   EXPECT_THROW(ArmFromUrdfFile("/nonexistent/arm.urdf"), std::system_error);
   // Spherical arms have no URDF form.
   EXPECT_THROW(UrdfFromArm(StraightArm(3, 2, 1.0)), InputError);

@@ -98,13 +98,16 @@ struct ArmModel {
   Eigen::MatrixXd link_directions;
   // With joint_axes: n types (JointType). Empty: every joint revolute.
   std::vector<JointType> joint_types;
-  // With joint_axes: n speed limits (rad/s, or length unit/s for prismatic joints; +inf: none),
-  // respected where ArmOptions::time_step is set. Empty: none.
+  // Revolute and prismatic joints (planar, or with joint_axes): n speed limits (rad/s, or length
+  // unit/s for prismatic joints; +inf: none), respected where ArmOptions::time_step is set.
+  // Empty: none.
   Eigen::VectorXd max_velocity;
   // With joint_axes: the tool frame (the tip link's frame, whose origin is the end effector) in
   // the last link's frame, as a unit quaternion (w, x, y, z): what ArmOptions::pointing's axis is
   // given in. Identity by default.
   Eigen::Vector4d tip_rotation = Eigen::Vector4d(1.0, 0.0, 0.0, 0.0);
+  // Optional names of the n joints (a URDF's), for reports; empty: "joint 0", "joint 1", ...
+  std::vector<std::string> joint_names;
   JointAngles initial;  // the joint angles at the start; within the limits
 
   bool has_axes() const { return joint_axes.size() > 0; }
@@ -148,6 +151,9 @@ bool WithinLimits(const ArmModel& model, const JointAngles& angles, double slack
 // the end effector where it is a point of its own: the chain as drawn and written to files.
 std::vector<std::vector<int>> JointGroups(const ArmModel& model);
 Points ChainPoints(const ArmModel& model, const Points& points);
+// The groups of more than one joint in words, one per line ("joints \"m1_pitch\" and
+// \"m1_yaw\" act at one point (a universal joint)"); "" if every joint has its own point.
+std::string JointGroupsReport(const ArmModel& model);
 
 // The tool frame at `angles` (arms with joint_axes): the end effector (3) and the tip link's
 // rotation in the world (3 by 3; ArmModel::tip_rotation in the last link's frame).
@@ -216,16 +222,20 @@ struct ArmOptions {
     Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
     bool look_at = false;
     Eigen::Vector3d point = Eigen::Vector3d::Zero();
-    double weight = 1.0;             // > 0: mean link lengths per radian of angular miss
+    double weight = 1.0;            // > 0: mean link lengths per radian of angular miss
     double angle_tolerance = 1e-9;  // rad, > 0
   } pointing;
-  // Velocity limits (arms with joint_axes and ArmModel::max_velocity): the time between two path
+  // Velocity limits (arms with ArmModel::max_velocity): the time between two path
   // points (s). A step whose joint motion would exceed a limit in that time is split into as many
   // equal legs along the end effector's straight move, each taking time_step, as keep every joint
   // within its limit (ArmStepReport::velocity_legs). 0: limits ignored.
   double time_step = 0.0;
   // Every problem (empty if valid), each naming its member ("max_iterations").
   Problems Validate() const;
+  // The problems of these options on `model` besides Validate's: pointing needs joint axes, and
+  // method fixed_point takes only revolute joints across links of positive length within
+  // [-pi, pi] and no pointing.
+  Problems ValidateFor(const ArmModel& model) const;
 };
 
 // What the Newton fixed-base solver learned in a step, to start the next one from (continuation
@@ -306,7 +316,7 @@ struct ArmTrajectory {
   std::vector<ArmStepReport> steps;
   long long num_steps = 0;  // steps tracked (one per path point), with or without a sink
   double max_ee_error = 0.0, max_base_error = 0.0;
-  int unreached = 0;  // steps with reached = false
+  int unreached = 0;                // steps with reached = false
   double max_pointing_error = 0.0;  // rad, with ArmOptions::pointing
   long long velocity_legs = 0;      // with ArmOptions::time_step: legs of all steps
   int max_iterations = 0;

@@ -37,51 +37,136 @@ using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
 
 // lambda = (A + ridge)^-1 rhs. A tiny ridge keeps the solve finite where the free joints cannot
-// move the end effector along some direction (an arm stretched straight, most joints held); the
-// Levenberg-Marquardt damping is relative to A's trace as well.
-Vec3 SolveNormal(Mat3 a, const Vec3& rhs, double damping) {
+// move the end effector along some direction (an arm stretched straight, most joints held; with
+// pointing, the roll about the tool axis, which no residual asks for); the Levenberg-Marquardt
+// damping is relative to A's trace as well.
+template <int T>
+Eigen::Matrix<double, T, 1> SolveNormal(Eigen::Matrix<double, T, T> a,
+                                        const Eigen::Matrix<double, T, 1>& rhs, double damping) {
   a.diagonal().array() += (1e-14 + damping) * a.trace() + 1e-300;
   return a.ldlt().solve(rhs);
 }
 
-// Revolute joints about axes (planar arms embedded with every axis z). The state is the angles q.
+// The rotation vector of the smallest rotation taking unit `from` to unit `to`.
+Vec3 RotationVector(const Vec3& from, const Vec3& to) {
+  const Vec3 axis = from.cross(to);
+  const double s = axis.norm(), c = from.dot(to);
+  if (!(s > 0.0)) return c >= 0.0 ? Vec3::Zero() : Vec3(from.unitOrthogonal() * M_PI);
+  return axis * (std::atan2(s, c) / s);
+}
+
+// What a solve aims at: the end effector's position and, with pointing, the direction the tool
+// axis should take (a unit vector; for look_at, recomputed from the end effector as it moves).
+struct Goal {
+  Vec3 position;
+  const ArmOptions::Pointing* pointing = nullptr;  // null: position only
+  Vec3 direction = Vec3::UnitX();                  // unit; pointing along it (not look_at)
+  bool look_at = false;
+  Vec3 point = Vec3::Zero();  // with look_at
+  Vec3 Direction(const Vec3& end) const {
+    if (!look_at) return direction;
+    const Vec3 d = point - end;
+    return d.squaredNorm() > 0.0 ? Vec3(d.normalized()) : direction;
+  }
+};
+
+// Joints about or along given axes (planar arms embedded with every axis z). The state is the
+// joint values q. T = 3: the end effector's position; T = 6: its position and, scaled by
+// `angle_scale` (length per rad), the rotation that would turn the tool axis onto its goal.
+// Prismatic joints are solved in q / scale (scale the mean link length), so that every column of
+// the Jacobian is a length and the weights stay dimensionless (InverseJointWeights).
+template <int T>
 class RevoluteArm {
  public:
-  RevoluteArm(const ArmModel& model, const Eigen::VectorXd& start, const Eigen::VectorXd& winv)
+  using Task = Eigen::Matrix<double, T, 1>;
+
+  RevoluteArm(const ArmModel& model, const Eigen::VectorXd& start, const Eigen::VectorXd& winv,
+              double scale, const Vec3& tool_axis = Vec3::UnitX(), double angle_scale = 0.0)
       : model_(model),
         n_(model.num_links()),
         limits_(model.joint_min.size() == n_),
         winv_(winv),
+        scale_(scale),
+        angle_scale_(angle_scale),
         q_(n_),
         dq_(n_),
         trial_(n_),
-        jac_(3, n_),
+        jac_(T, n_),
         held_(n_) {
+    const Eigen::Vector4d& t = model.tip_rotation;
+    tool_axis_ = Eigen::Quaterniond(t[0], t[1], t[2], t[3]) * tool_axis;
     for (int k = 0; k < n_; ++k) q_[k] = std::clamp(start[k], lo(k), hi(k));
-    points_ = RevoluteForward(model_, q_, &axes_);
+    points_ = RevoluteForward(model_, q_, &axes_, &frame_);
   }
   Vec3 end() const { return points_.row(n_).transpose(); }
   const Points& points() const { return points_; }
+  const Eigen::VectorXd& angles() const { return q_; }
   bool limited() const {
     for (int k = 0; k < n_ && limits_; ++k) {
       if (q_[k] <= lo(k) || q_[k] >= hi(k)) return true;
     }
     return false;
   }
+  // The tool axis in the world.
+  Vec3 axis() const { return frame_ * tool_axis_; }
+  Task Miss(const Goal& goal) const { return MissAt(points_, frame_, goal); }
+  Task TrialMiss(const Goal& goal) const { return MissAt(trial_points_, trial_frame_, goal); }
+  // Whether the miss is within the tolerances (position; angle in rad).
+  bool Within(const Task& r, double tol, double angle_tol) const {
+    if constexpr (T == 3) {
+      (void)angle_tol;
+      return r.norm() <= tol;
+    } else {
+      return r.template head<3>().norm() <= tol &&
+             r.template tail<3>().norm() <= angle_tol * angle_scale_;
+    }
+  }
+  double AngleMiss(const Task& r) const {
+    if constexpr (T == 3) {
+      (void)r;
+      return 0.0;
+    } else {
+      return r.template tail<3>().norm() / angle_scale_;
+    }
+  }
 
   // The step for the miss r. The active set: a joint that the step would carry past a limit is
   // moved onto that limit and held there, and the rest of the step re-solved for what it leaves
   // of the miss (each round holds at least one more joint: at most n rounds).
-  bool Propose(const Vec3& r, double damping) {
+  bool Propose(const Task& r, double damping, const Goal& goal) {
     const Vec3 ee = end();
+    Vec3 a_w = Vec3::Zero();
+    double look = 0.0;  // looking at a point: 1 / its distance (the goal turns as the end moves)
+    if constexpr (T == 6) {
+      a_w = axis();
+      if (goal.look_at && (goal.point - ee).norm() > 0.0) look = 1.0 / (goal.point - ee).norm();
+    }
     for (int k = 0; k < n_; ++k) {
-      jac_.col(k) = Vec3(axes_.row(k).transpose()).cross(ee - Vec3(points_.row(k).transpose()));
+      const Vec3 axis = axes_.row(k).transpose();
+      if (model_.prismatic(k)) {
+        jac_.col(k).template head<3>() = axis * scale_;
+        if constexpr (T == 6) jac_.col(k).template tail<3>().setZero();
+      } else {
+        jac_.col(k).template head<3>() = axis.cross(ee - Vec3(points_.row(k).transpose()));
+        // The tool axis turns with w x a_w: only w across a_w counts.
+        if constexpr (T == 6) {
+          jac_.col(k).template tail<3>() = angle_scale_ * (axis - axis.dot(a_w) * a_w);
+        }
+      }
+      // Looking at a point, the goal direction t = (point - end) / |point - end| turns as the
+      // end effector moves: d(a x t) = a x dt, dt = -(I - t t') d(end) / |point - end|.
+      if constexpr (T == 6) {
+        if (look > 0.0) {
+          const Vec3 move = jac_.col(k).template head<3>();
+          jac_.col(k).template tail<3>() += angle_scale_ * look * a_w.cross(move);
+        }
+      }
     }
     std::fill(held_.begin(), held_.end(), 0);
     dq_.setZero();
     for (int round = 0; round <= n_; ++round) {
-      Mat3 a = Mat3::Zero();
-      Vec3 rhs = -r;
+      Eigen::Matrix<double, T, T> a = Eigen::Matrix<double, T, T>::Zero();
+      Task rhs = -r;
       for (int k = 0; k < n_; ++k) {
         if (held_[k]) {
           rhs -= jac_.col(k) * dq_[k];
@@ -89,14 +174,15 @@ class RevoluteArm {
           a.noalias() += winv_[k] * jac_.col(k) * jac_.col(k).transpose();
         }
       }
-      const Vec3 lambda = SolveNormal(a, rhs, damping);
+      const Task lambda = SolveNormal<T>(a, rhs, damping);
       bool more = false;
       for (int k = 0; k < n_; ++k) {
         if (held_[k]) continue;
         dq_[k] = winv_[k] * jac_.col(k).dot(lambda);
-        const double to = std::clamp(q_[k] + dq_[k], lo(k), hi(k));
-        if (to != q_[k] + dq_[k]) {
-          dq_[k] = to - q_[k];
+        const double unit = unit_of(k);
+        const double to = std::clamp(q_[k] + unit * dq_[k], lo(k), hi(k));
+        if (to != q_[k] + unit * dq_[k]) {
+          dq_[k] = (to - q_[k]) / unit;
           held_[k] = 1;
           more = true;
         }
@@ -106,29 +192,46 @@ class RevoluteArm {
     return dq_.allFinite();
   }
   // The arm at q + alpha dq (the clamp only guards against rounding: the limits are an interval).
-  Vec3 Try(double alpha) {
-    for (int k = 0; k < n_; ++k) trial_[k] = std::clamp(q_[k] + alpha * dq_[k], lo(k), hi(k));
-    trial_points_ = RevoluteForward(model_, trial_, &trial_axes_);
-    return trial_points_.row(n_).transpose();
+  void Try(double alpha) {
+    for (int k = 0; k < n_; ++k) {
+      trial_[k] = std::clamp(q_[k] + alpha * (unit_of(k) * dq_[k]), lo(k), hi(k));
+    }
+    trial_points_ = RevoluteForward(model_, trial_, &trial_axes_, &trial_frame_);
   }
   void Accept() {
     q_.swap(trial_);
     points_.swap(trial_points_);
     axes_.swap(trial_axes_);
+    frame_ = trial_frame_;
   }
 
  private:
   double lo(int k) const { return limits_ ? model_.joint_min[k] : -INFINITY; }
   double hi(int k) const { return limits_ ? model_.joint_max[k] : INFINITY; }
+  // The joint value per unit of the solved variable: 1 (rad), or the scale for a prismatic joint.
+  double unit_of(int k) const { return model_.prismatic(k) ? scale_ : 1.0; }
+  Task MissAt(const Points& points, const Eigen::Quaterniond& frame, const Goal& goal) const {
+    const Vec3 end = points.row(n_).transpose();
+    Task r;
+    r.template head<3>() = end - goal.position;
+    if constexpr (T == 6) {
+      const Vec3 a_w = frame * tool_axis_;
+      r.template tail<3>() = -angle_scale_ * RotationVector(a_w, goal.Direction(end));
+    }
+    return r;
+  }
 
   const ArmModel& model_;
   const int n_;
   const bool limits_;
   const Eigen::VectorXd& winv_;
+  const double scale_, angle_scale_;
+  Vec3 tool_axis_;  // in the last link's frame
   Eigen::VectorXd q_, dq_, trial_;
   Points points_, trial_points_;
   Eigen::MatrixXd axes_, trial_axes_;
-  Eigen::Matrix<double, 3, Eigen::Dynamic> jac_;
+  Eigen::Quaterniond frame_, trial_frame_;
+  Eigen::Matrix<double, T, Eigen::Dynamic> jac_;
   std::vector<char> held_;
 };
 
@@ -137,14 +240,6 @@ Eigen::Quaterniond Exp(const Vec3& w) {
   const double angle = w.norm();
   if (!(angle > 0.0)) return Eigen::Quaterniond::Identity();
   return Eigen::Quaterniond(Eigen::AngleAxisd(angle, w / angle));
-}
-
-// The rotation vector of the smallest rotation taking unit `from` to unit `to`.
-Vec3 RotationVector(const Vec3& from, const Vec3& to) {
-  const Vec3 axis = from.cross(to);
-  const double s = axis.norm(), c = from.dot(to);
-  if (!(s > 0.0)) return c >= 0.0 ? Vec3::Zero() : Vec3(from.unitOrthogonal() * M_PI);
-  return axis * (std::atan2(s, c) / s);
 }
 
 // Spherical joints. The state is the links' unit directions d_1..d_n (d_0 the base direction);
@@ -178,8 +273,15 @@ class SphericalArm {
     }
     trial_points_ = points_;
   }
+  using Task = Vec3;
   Vec3 end() const { return points_.row(n_).transpose(); }
   const Points& points() const { return points_; }
+  Task Miss(const Goal& goal) const { return end() - goal.position; }
+  Task TrialMiss(const Goal& goal) const {
+    return trial_points_.row(n_).transpose() - goal.position;
+  }
+  bool Within(const Task& r, double tol, double) const { return r.norm() <= tol; }
+  double AngleMiss(const Task&) const { return 0.0; }
   bool limited() const {
     for (int j = 0; j < n_ && limits_; ++j) {
       if (std::acos(std::clamp(dirs_[j].dot(dirs_[j + 1]), -1.0, 1.0)) >=
@@ -192,7 +294,7 @@ class SphericalArm {
 
   // The step for the miss r, with the same active set as RevoluteArm's: a joint that the step
   // would carry out of its cone is turned onto the cone's nearest direction and held.
-  bool Propose(const Vec3& r, double damping) {
+  bool Propose(const Vec3& r, double damping, const Goal&) {
     const Vec3 ee = end();
     for (int j = 0; j < n_; ++j) lever_[j] = ee - points_.row(j).transpose();
     std::fill(held_.begin(), held_.end(), 0);
@@ -207,7 +309,7 @@ class SphericalArm {
           a.noalias() += winv_[j] * (l.squaredNorm() * Mat3::Identity() - l * l.transpose());
         }
       }
-      const Vec3 lambda = SolveNormal(a, rhs, damping);
+      const Vec3 lambda = SolveNormal<3>(a, rhs, damping);
       bool more = false;
       for (int j = 0; j < n_; ++j) {
         if (held_[j]) continue;
@@ -229,7 +331,7 @@ class SphericalArm {
   }
   // The arm after alpha times the step, every joint put back into its cone (on a curved step a
   // free joint may leave it between alpha = 0 and 1).
-  Vec3 Try(double alpha) {
+  void Try(double alpha) {
     Eigen::Quaterniond turn = Eigen::Quaterniond::Identity();
     for (int j = 0; j < n_; ++j) {
       Eigen::Quaterniond step = Exp(alpha * omega_[j]);
@@ -245,7 +347,6 @@ class SphericalArm {
       trial_points_.row(j + 1) =
           trial_points_.row(j) + model_.link_lengths[j] * trial_dirs_[j + 1].transpose();
     }
-    return trial_points_.row(n_).transpose();
   }
   void Accept() {
     dirs_.swap(trial_dirs_);
@@ -264,24 +365,28 @@ class SphericalArm {
   std::vector<char> held_;
 };
 
-// Gauss-Newton with line search, damping and intermediate goals, on either arm.
+// Gauss-Newton with line search, damping and intermediate goals, on either arm. `angle_tol`:
+// the pointing tolerance (rad), with pointing.
 template <class Arm>
-JointSpaceSolve Drive(Arm* arm, double scale, const Vec3& target, double tol, int max_iterations) {
+JointSpaceSolve Drive(Arm* arm, double scale, const Goal& target, double tol, double angle_tol,
+                      int max_iterations) {
+  using Task = typename Arm::Task;
   JointSpaceSolve out;
   out.passes = 1;  // the arm's first forward kinematics
-  Vec3 r;
-  // Gauss-Newton toward `goal` until the miss is at most `goal_tol` (or no descent is left).
-  auto solve_to = [&](const Vec3& goal, double goal_tol, int max_it) {
-    r = arm->end() - goal;
+  Task r;
+  // Gauss-Newton toward `goal` until the miss is within `goal_tol` (or no descent is left).
+  auto solve_to = [&](const Goal& goal, double goal_tol, double goal_angle_tol, int max_it) {
+    r = arm->Miss(goal);
     double damping = 0.0;
-    for (int it = 0; it < max_it && r.norm() > goal_tol; ++it) {
+    for (int it = 0; it < max_it && !arm->Within(r, goal_tol, goal_angle_tol); ++it) {
       ++out.iterations;
-      if (!arm->Propose(r, damping)) break;
+      if (!arm->Propose(r, damping, goal)) break;
       // Backtracking on the miss (every trial is within the limits).
       bool improved = false;
       double taken = 0.0;  // the step length accepted
       for (double alpha = 1.0; alpha > 1e-9 && !improved; alpha *= 0.5) {
-        const Vec3 r_trial = arm->Try(alpha) - goal;
+        arm->Try(alpha);
+        const Task r_trial = arm->TrialMiss(goal);
         ++out.passes;
         if (r_trial.allFinite() && r_trial.norm() <= (1.0 - 1e-4 * alpha) * r.norm()) {
           arm->Accept();
@@ -308,17 +413,36 @@ JointSpaceSolve Drive(Arm* arm, double scale, const Vec3& target, double tol, in
   // targets: 135 unreached without legs, 80 with), while each short leg converges in a few
   // iterations, its motion again carried by the joints near the end effector, as the tractrix
   // step moves a chain whose end is dragged along a line. The legs need not be reached exactly
-  // (kLegTol); the target must.
-  constexpr double kLeg = 0.5, kLegTol = 1e-3;
+  // (kLegTol); the target must. With pointing, the tool axis is turned toward its goal along the
+  // great circle in the same legs, at most kLegAngle rad apart.
+  constexpr double kLeg = 0.5, kLegTol = 1e-3, kLegAngle = 0.5;
   constexpr int kLegIterations = 20;
   const Vec3 from = arm->end();
-  const int legs = static_cast<int>(std::ceil((target - from).norm() / (kLeg * scale)));
-  for (int leg = 1; leg < legs; ++leg) {
-    solve_to(from + (target - from) * (double(leg) / legs), kLegTol * scale, kLegIterations);
+  int legs = static_cast<int>(std::ceil((target.position - from).norm() / (kLeg * scale)));
+  Vec3 turn = Vec3::Zero();  // the tool axis' rotation to its goal, with pointing
+  Vec3 axis_from = Vec3::UnitX();
+  if constexpr (Arm::Task::RowsAtCompileTime == 6) {
+    axis_from = arm->axis();
+    turn = RotationVector(axis_from, target.Direction(target.position));
+    legs = std::max(legs, static_cast<int>(std::ceil(turn.norm() / kLegAngle)));
   }
-  solve_to(target, tol, max_iterations);
-  out.residual = r.norm();
-  out.converged = out.residual <= tol;
+  for (int leg = 1; leg < legs; ++leg) {
+    const double t = double(leg) / legs;
+    Goal goal = target;
+    goal.position = from + (target.position - from) * t;
+    if constexpr (Arm::Task::RowsAtCompileTime == 6) {
+      goal.look_at = false;
+      goal.direction =
+          Eigen::AngleAxisd(t * turn.norm(),
+                            turn.norm() > 0.0 ? Vec3(turn.normalized()) : Vec3::UnitX()) *
+          axis_from;
+    }
+    solve_to(goal, kLegTol * scale, kLegAngle, kLegIterations);
+  }
+  solve_to(target, tol, angle_tol, max_iterations);
+  out.residual = r.template head<3>().norm();
+  out.angle_residual = arm->AngleMiss(r);
+  out.converged = arm->Within(r, tol, angle_tol);
   out.limited = arm->limited();
   out.points = arm->points();
   return out;
@@ -350,43 +474,80 @@ Eigen::VectorXd InverseJointWeights(const ArmModel& model) {
     along += model.link_lengths[k];
     winv[k] = 1.0 / ((along / scale) * (along / scale));
   }
+  // Joints at the end effector itself (a tip on its joint: d = 0) turn the tool frame only; they
+  // are weighted as the nearest joint with a lever.
+  double nearest = 0.0;  // the shortest positive distance along the chain to the end effector
+  along = 0.0;
+  for (int k = n - 1; k >= 0 && !(nearest > 0.0); --k) nearest = along += model.link_lengths[k];
+  for (int k = 0; k < n; ++k) {
+    if (!std::isfinite(winv[k])) winv[k] = 1.0 / ((nearest / scale) * (nearest / scale));
+  }
+  // A prismatic joint is solved in q / scale with the column axis x scale: weight 1 lets it move
+  // the end effector as much per unit of the weighted norm as any revolute joint does.
+  for (int k = 0; k < n; ++k) {
+    if (model.prismatic(k)) winv[k] = 1.0;
+  }
   return winv;
 }
 
 namespace {
 
+// The goal of a step: the target and, with pointing, the tool axis' goal.
+Goal MakeGoal(const Eigen::VectorXd& target, const ArmOptions::Pointing& pointing) {
+  Goal goal;
+  goal.position = Vec3::Zero();
+  goal.position.head(target.size()) = target;
+  if (pointing.enabled) {
+    goal.pointing = &pointing;
+    goal.look_at = pointing.look_at;
+    goal.point = pointing.point;
+    goal.direction = pointing.direction.normalized();
+  }
+  return goal;
+}
+
 // One solve from `previous` with the weights `winv`.
 JointSpaceSolve Attempt(const ArmModel& model, const ArmState& previous,
                         const Eigen::VectorXd& target, double tol, int max_iterations,
-                        const Eigen::VectorXd& winv) {
+                        const Eigen::VectorXd& winv, const ArmOptions::Pointing& pointing) {
   const double scale = model.link_lengths.mean();
-  if (model.has_axes()) {
-    RevoluteArm arm(model, previous.angles.angle, winv);
-    return Drive(&arm, scale, target, tol, max_iterations);
-  }
-  if (model.dim == 2) {
+  const Goal goal = MakeGoal(target, pointing);
+  JointSpaceSolve out;
+  if (model.has_axes() && pointing.enabled) {
+    RevoluteArm<6> arm(model, previous.angles.angle, winv, scale, pointing.axis.normalized(),
+                       pointing.weight * scale);
+    out = Drive(&arm, scale, goal, tol, pointing.angle_tolerance, max_iterations);
+    out.angles = arm.angles();
+  } else if (model.has_axes()) {
+    RevoluteArm<3> arm(model, previous.angles.angle, winv, scale);
+    out = Drive(&arm, scale, goal, tol, 0.0, max_iterations);
+    out.angles = arm.angles();
+  } else if (model.dim == 2) {
     const ArmModel embedded = Embedded(model);
-    RevoluteArm arm(embedded, AnglesUnchecked(model, previous.points).angle, winv);
-    JointSpaceSolve out = Drive(&arm, scale, Vec3(target[0], target[1], 0.0), tol, max_iterations);
+    RevoluteArm<3> arm(embedded, AnglesUnchecked(model, previous.points).angle, winv, scale);
+    out = Drive(&arm, scale, goal, tol, 0.0, max_iterations);
     out.points = Points(out.points.leftCols(2));
-    return out;
+  } else {
+    SphericalArm arm(model, previous.points, winv);
+    out = Drive(&arm, scale, goal, tol, 0.0, max_iterations);
   }
-  SphericalArm arm(model, previous.points, winv);
-  return Drive(&arm, scale, target, tol, max_iterations);
+  out.merit = std::hypot(out.residual,
+                         pointing.enabled ? out.angle_residual * pointing.weight * scale : 0.0);
+  return out;
 }
 
 }  // namespace
 
 JointSpaceSolve SolveJointSpace(const ArmModel& model, const ArmState& previous,
                                 const Eigen::VectorXd& target, double tol, int max_iterations,
-                                int restarts) {
+                                int restarts, const ArmOptions::Pointing& pointing) {
   const Eigen::VectorXd winv = InverseJointWeights(model);
-  JointSpaceSolve best = Attempt(model, previous, target, tol, max_iterations, winv);
+  JointSpaceSolve best = Attempt(model, previous, target, tol, max_iterations, winv, pointing);
   auto consider = [&](JointSpaceSolve next) {
     next.iterations += best.iterations;
     next.passes += best.passes;
     next.restarts = best.restarts + 1;
-    if (next.converged || next.residual < best.residual) {
+    if (next.converged || next.merit < best.merit) {
       best = std::move(next);
     } else {
       best.iterations = next.iterations;
@@ -411,23 +572,30 @@ JointSpaceSolve SolveJointSpace(const ArmModel& model, const ArmState& previous,
   for (int k = 0; k < restarts && !best.converged; ++k) {
     if (k < 2) {
       const double power = k == 0 ? 0.5 : 0.0;
-      consider(Attempt(model, previous, target, tol, max_iterations, winv.array().pow(power)));
+      consider(
+          Attempt(model, previous, target, tol, max_iterations, winv.array().pow(power), pointing));
       continue;
     }
     const double amplitude = k == 2 ? 0.25 : k == 3 ? 0.5 : 1.0;
     ArmState start;
     start.angles = from;
     for (int j = 0; j < n; ++j) {
-      // The joint's range: the limits, or the whole circle (a bend within [0, pi]).
-      double lo = spherical ? 0.0 : -M_PI, hi = M_PI;
-      if (model.joint_min.size() == n) lo = model.joint_min[j], hi = model.joint_max[j];
-      if (model.max_bend.size() == n) hi = model.max_bend[j];
       double& q = start.angles.angle[j];
+      // The joint's range: the limits, or the whole circle (a bend within [0, pi]); without a
+      // finite limit, half a turn (a mean link length for a prismatic joint) either side.
+      const double half = model.prismatic(j) ? model.link_lengths.mean() : M_PI;
+      double lo = spherical ? 0.0 : -M_PI, hi = M_PI;
+      if (model.has_axes()) lo = q - half, hi = q + half;
+      if (model.joint_min.size() == n) {
+        lo = std::isfinite(model.joint_min[j]) ? model.joint_min[j] : q - half;
+        hi = std::isfinite(model.joint_max[j]) ? model.joint_max[j] : q + half;
+      }
+      if (model.max_bend.size() == n) hi = model.max_bend[j];
       q = std::clamp(q + amplitude * 0.5 * (hi - lo) * unit(rng), lo, hi);
       if (spherical) start.angles.azimuth[j] += amplitude * M_PI * unit(rng);
     }
     start.points = ForwardUnchecked(model, start.angles);
-    consider(Attempt(model, start, target, tol, max_iterations, winv));
+    consider(Attempt(model, start, target, tol, max_iterations, winv, pointing));
   }
   return best;
 }

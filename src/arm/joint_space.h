@@ -21,13 +21,16 @@ namespace flexkin::arm_internal {
 Eigen::VectorXd InverseJointWeights(const ArmModel& model);
 
 struct JointSpaceSolve {
-  Points points;           // the arm at the end (n+1 by dim, base first), within the limits
-  double residual = 0.0;   // |end effector - target| (length)
-  int iterations = 0;      // Gauss-Newton iterations
-  int passes = 0;          // forward-kinematics passes over the links (cost ~ passes * n)
-  bool converged = false;  // residual <= tol
-  bool limited = false;    // a joint ended at one of its limits
-  int restarts = 0;        // solves after the first (see SolveJointSpace)
+  Points points;                // the arm at the end (n+1 by dim, base first), within the limits
+  Eigen::VectorXd angles;       // with joint axes: the joint values of `points`
+  double residual = 0.0;        // |end effector - target| (length)
+  double angle_residual = 0.0;  // with pointing: the tool axis' angle from its goal (rad)
+  double merit = 0.0;           // the residual with the weighted angle (what restarts compare)
+  int iterations = 0;           // Gauss-Newton iterations
+  int passes = 0;               // forward-kinematics passes over the links (cost ~ passes * n)
+  bool converged = false;       // residual <= tol
+  bool limited = false;         // a joint ended at one of its limits
+  int restarts = 0;             // solves after the first (see SolveJointSpace)
 };
 
 // From the arm at `previous` (its angles for revolute joints about axes, otherwise its points;
@@ -47,8 +50,10 @@ struct JointSpaceSolve {
 // to `restarts` more solves (ArmOptions::restarts): with weights that spread the motion more
 // evenly, then from random poses around the last one. The first that converges is taken,
 // otherwise the nearest end found.
+// With pointing.enabled (arms with joint axes), the tool axis is turned to its goal as well
+// (ArmOptions::Pointing), and converged means both are within their tolerances.
 JointSpaceSolve SolveJointSpace(const ArmModel& model, const ArmState& previous,
                                 const Eigen::VectorXd& target, double tol, int max_iterations,
-                                int restarts);
+                                int restarts, const ArmOptions::Pointing& pointing);
 
 }  // namespace flexkin::arm_internal

@@ -1,7 +1,9 @@
 // Joint angles <-> link points of a fixed-base arm (include/flexkin/arm.h), the model's checks
 // and the joint-limit projections the solver uses.
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -15,6 +17,7 @@ namespace flexkin {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // x mapped to (-pi, pi] by a multiple of 2 pi.
 double Wrap(double x) {
@@ -82,7 +85,11 @@ double ClampCircular(double theta, double lo, double hi) {
 bool ClampToLimits(const ArmModel& model, JointAngles* angles) {
   bool changed = false;
   for (int j = 0; j < model.joint_min.size(); ++j) {
-    const double c = ClampCircular(angles->angle[j], model.joint_min[j], model.joint_max[j]);
+    // With joint axes the limits are an interval of the line (multi-turn, prismatic); otherwise
+    // of the circle.
+    const double c = model.has_axes()
+                         ? std::clamp(angles->angle[j], model.joint_min[j], model.joint_max[j])
+                         : ClampCircular(angles->angle[j], model.joint_min[j], model.joint_max[j]);
     changed |= c != angles->angle[j];
     angles->angle[j] = c;
   }
@@ -132,12 +139,19 @@ std::optional<Problem> ArmModel::FirstProblem() const {
   }
   const int n = num_links();
   if (n < 1) return Problem("link_lengths", "the arm has no links; expected at least 1");
+  // With joint axes a link may have length 0 (joints at one point, a tip on its joint).
+  const bool zero_ok = has_axes();
   for (int i = 0; i < n; ++i) {
-    if (!(link_lengths[i] > 0.0) || !std::isfinite(link_lengths[i])) {
+    if (!(link_lengths[i] > 0.0 || (zero_ok && link_lengths[i] == 0.0)) ||
+        !std::isfinite(link_lengths[i])) {
+      const char* expected = zero_ok ? "a finite number >= 0" : "a positive finite number";
       return Problem(Indexed("link_lengths", i),
-                     "value " + FormatNumber(link_lengths[i]) + " is not a positive finite number",
-                     FormatNumber(link_lengths[i]), "a positive finite number");
+                     "value " + FormatNumber(link_lengths[i]) + " is not " + expected,
+                     FormatNumber(link_lengths[i]), expected);
     }
+  }
+  if (!(link_lengths.sum() > 0.0)) {
+    return Problem("link_lengths", "every link has length 0; expected a positive total length");
   }
   std::optional<Problem> why = CheckVector(base, "base", dim);
   if (!why) why = CheckVector(base_direction, "base_direction", dim);
@@ -159,7 +173,21 @@ std::optional<Problem> ArmModel::FirstProblem() const {
     if (joint_min.size() != joint_max.size()) {
       return Problem("joint_max", "joint_min and joint_max differ in size");
     }
-    if (joint_min.size() != 0) {
+    if (joint_min.size() != 0 && has_axes()) {
+      // As written: multi-turn, continuous (infinite) or prismatic (length) limits.
+      if (joint_min.size() != n) {
+        return Problem("joint_min", "has " + std::to_string(joint_min.size()) +
+                                        " values; expected " + std::to_string(n));
+      }
+      for (int j = 0; j < n; ++j) {
+        if (!(joint_min[j] <= joint_max[j]) || joint_min[j] == kInf || joint_max[j] == -kInf) {
+          return Problem(Indexed("joint_min", j),
+                         "limits [" + FormatNumber(joint_min[j]) + ", " +
+                             FormatNumber(joint_max[j]) +
+                             "] are not valid; expected min <= max (-inf and inf: no limit)");
+        }
+      }
+    } else if (joint_min.size() != 0) {
       if ((why = CheckVector(joint_min, "joint_min", n))) return why;
       if ((why = CheckVector(joint_max, "joint_max", n))) return why;
       for (int j = 0; j < n; ++j) {
@@ -187,6 +215,27 @@ std::optional<Problem> ArmModel::FirstProblem() const {
       }
     }
   }
+  if (!joint_names.empty() && static_cast<int>(joint_names.size()) != n) {
+    return Problem("joint_names", "has " + std::to_string(joint_names.size()) +
+                                      " names; expected " + std::to_string(n) + " or none");
+  }
+  if (max_velocity.size() != 0) {
+    if (!revolute) {
+      return Problem("max_velocity", "spherical joints have no velocity limits; expected none");
+    }
+    if (max_velocity.size() != n) {
+      return Problem("max_velocity", "has " + std::to_string(max_velocity.size()) +
+                                         " values; expected " + std::to_string(n) + " or none");
+    }
+    for (int j = 0; j < n; ++j) {
+      if (!(max_velocity[j] > 0.0)) {
+        return Problem(Indexed("max_velocity", j),
+                       "value " + FormatNumber(max_velocity[j]) +
+                           " is not valid; expected a speed > 0 (inf: no limit)",
+                       FormatNumber(max_velocity[j]), "> 0");
+      }
+    }
+  }
   why = CheckVector(initial.angle, "initial.angle", n);
   if (!why && !revolute) why = CheckVector(initial.azimuth, "initial.azimuth", n);
   if (!why && revolute && initial.azimuth.size() != 0) {
@@ -195,7 +244,8 @@ std::optional<Problem> ArmModel::FirstProblem() const {
   if (why) return why;
   for (int j = 0; j < n; ++j) {
     const double a = initial.angle[j];
-    const bool ok = revolute ? a >= -kPi && a <= kPi : a >= 0.0 && a <= kPi;
+    // With joint axes the limits alone bound the angles (multi-turn joints, prismatic ones).
+    const bool ok = has_axes() || (revolute ? a >= -kPi && a <= kPi : a >= 0.0 && a <= kPi);
     if (!ok) {
       const char* expected = revolute ? "-pi <= angle <= pi" : "0 <= bend angle <= pi";
       return Problem(Indexed("initial.angle", j),
@@ -241,6 +291,12 @@ JointAngles JointAnglesFromPoints(const ArmModel& model, const Points& points) {
                                    std::to_string(n + 1) + " by " + std::to_string(model.dim));
   }
   if (!points.allFinite()) throw InputError("points", "a value is not a finite number");
+  if (model.has_axes() && !arm_internal::Sweepable(model)) {
+    throw InputError("model",
+                     "has twist, prismatic or coincident joints (or limits beyond "
+                     "[-pi, pi]), whose values the points do not determine; keep the "
+                     "joint angles (ArmState::angles) instead");
+  }
   return arm_internal::AnglesUnchecked(model, points);
 }
 
@@ -364,6 +420,8 @@ Eigen::MatrixXd JointQuaternions(const ArmModel& model, const JointAngles& angle
   for (int j = 0; j < n; ++j) {
     if (model.dim == 2) {
       q.row(j) << std::cos(0.5 * angles.angle[j]), 0.0, 0.0, std::sin(0.5 * angles.angle[j]);
+    } else if (model.prismatic(j)) {
+      q.row(j) << 1.0, 0.0, 0.0, 0.0;  // a slide turns nothing
     } else if (model.has_axes()) {
       const double s = std::sin(0.5 * angles.angle[j]);
       q.row(j) << std::cos(0.5 * angles.angle[j]), s * model.joint_axes.row(j);
@@ -386,6 +444,76 @@ bool WithinLimits(const ArmModel& model, const JointAngles& angles, double slack
     if (!(angles.angle[j] <= model.max_bend[j] + slack)) return false;
   }
   return true;
+}
+
+std::vector<std::vector<int>> JointGroups(const ArmModel& model) {
+  arm_internal::CheckModel(model);
+  std::vector<std::vector<int>> groups;
+  bool open = false;  // the last group takes the next joint (a link of length 0 between them)
+  for (int j = 0; j < model.num_links(); ++j) {
+    if (!open) groups.emplace_back();
+    groups.back().push_back(j);
+    open = model.link_lengths[j] == 0.0 && !model.prismatic(j);
+  }
+  return groups;
+}
+
+Points ChainPoints(const ArmModel& model, const Points& points) {
+  const std::vector<std::vector<int>> groups = JointGroups(model);
+  const int n = model.num_links();
+  if (points.rows() != n + 1 || points.cols() != model.dim) {
+    throw InputError("points", "shape " + std::to_string(points.rows()) + " by " +
+                                   std::to_string(points.cols()) + " is not valid; expected " +
+                                   std::to_string(n + 1) + " by " + std::to_string(model.dim));
+  }
+  // The tip is a point of its own unless the last group reaches it (a tip on its joint).
+  const bool tip_apart = !(model.link_lengths[n - 1] == 0.0 && !model.prismatic(n - 1));
+  Points chain(groups.size() + (tip_apart ? 1 : 0), model.dim);
+  for (size_t g = 0; g < groups.size(); ++g) chain.row(g) = points.row(groups[g].front());
+  if (tip_apart) chain.row(groups.size()) = points.row(n);
+  return chain;
+}
+
+std::string JointGroupsReport(const ArmModel& model) {
+  std::string out;
+  auto name = [&](int j) {
+    return static_cast<int>(model.joint_names.size()) == model.num_links()
+               ? "\"" + model.joint_names[j] + "\""
+               : std::to_string(j);
+  };
+  const int n = model.num_links();
+  for (const std::vector<int>& group : JointGroups(model)) {
+    const bool with_tip =
+        group.back() == n - 1 && model.link_lengths[n - 1] == 0.0 && !model.prismatic(n - 1);
+    if (group.size() < 2 && !with_tip) continue;
+    std::string line = group.size() == 1 ? "joint " : "joints ";
+    for (size_t i = 0; i < group.size(); ++i) {
+      line += (i == 0 ? "" : i + 1 == group.size() ? " and " : ", ") + name(group[i]);
+    }
+    line += group.size() == 1 ? " acts" : " act";
+    line += with_tip ? " at the end effector (they turn the tool frame only)" : " at one point";
+    if (group.size() == 2) line += " (a universal joint)";
+    if (group.size() == 3) line += " (a spherical joint)";
+    out += line + "\n";
+  }
+  return out;
+}
+
+ToolPose ToolPoseAt(const ArmModel& model, const JointAngles& angles) {
+  arm_internal::CheckModel(model);
+  CheckAngles(model, angles, "angles");
+  if (!model.has_axes()) {
+    throw InputError("model",
+                     "has no joint axes; the tool frame is defined for arms with "
+                     "joint_axes (URDF arms)");
+  }
+  Eigen::Quaterniond last;
+  const Points points = arm_internal::RevoluteForward(model, angles.angle, nullptr, &last);
+  const Eigen::Vector4d& t = model.tip_rotation;
+  ToolPose pose;
+  pose.position = points.row(model.num_links()).transpose();
+  pose.rotation = (last * Eigen::Quaterniond(t[0], t[1], t[2], t[3])).toRotationMatrix();
+  return pose;
 }
 
 ArmState InitialState(const ArmModel& model) {

@@ -44,16 +44,31 @@ std::optional<Problem> ValidateAxes(const ArmModel& model) {
     why = CheckUnitRows(model.link_directions, "link_directions", n);
   }
   if (why) return why;
-  for (int j = 0; j < n; ++j) {
-    const Eigen::Vector3d a = model.joint_axes.row(j).transpose();
-    if (a.cross(RestDirection(model, j)).norm() < 1e-6) {
-      return Problem(Row("joint_axes", j),
-                     "lies along link " + std::to_string(j + 1) +
-                         ", which the joint turns; a joint that only twists its link is not "
-                         "supported");
-    }
+  if (!model.joint_types.empty() && static_cast<int>(model.joint_types.size()) != n) {
+    return Problem("joint_types", "has " + std::to_string(model.joint_types.size()) +
+                                      " entries; expected " + std::to_string(n) + " or none");
+  }
+  const Eigen::Vector4d& q = model.tip_rotation;
+  if (!q.allFinite() || std::abs(q.norm() - 1.0) > 1e-9) {
+    return Problem("tip_rotation", "is not a finite unit quaternion (norm " +
+                                       FormatNumber(q.norm()) + "); expected (w, x, y, z), norm 1");
   }
   return std::nullopt;
+}
+
+bool Sweepable(const ArmModel& model) {
+  for (int j = 0; j < model.num_links(); ++j) {
+    if (model.prismatic(j) || !(model.link_lengths[j] > 0.0)) return false;
+    if (Eigen::Vector3d(model.joint_axes.row(j).transpose()).cross(RestDirection(model, j)).norm() <
+        1e-6) {
+      return false;
+    }
+    if (model.joint_min.size() != 0 &&
+        !(model.joint_min[j] >= -M_PI && model.joint_max[j] <= M_PI)) {
+      return false;
+    }
+  }
+  return true;
 }
 
 Eigen::Vector3d RestDirection(const ArmModel& model, int k) {
@@ -68,7 +83,8 @@ double AngleAbout(const Eigen::Vector3d& axis, const Eigen::Vector3d& from,
   return std::atan2(axis.dot(f.cross(t)), f.dot(t));
 }
 
-Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle, Eigen::MatrixXd* axes) {
+Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle, Eigen::MatrixXd* axes,
+                       Eigen::Quaterniond* last_frame) {
   const int n = model.num_links();
   Points points(n + 1, 3);
   points.row(0) = model.base.transpose();
@@ -78,10 +94,18 @@ Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle, Eige
     const Eigen::Vector3d a = model.joint_axes.row(j).transpose();
     // A rotation about a leaves a fixed: the world axis is the frame above's image of it.
     if (axes != nullptr) axes->row(j) = (frame * a).transpose();
+    if (model.prismatic(j)) {
+      // A slide along a: link j+1 and everything after it move by angle[j] along it.
+      points.row(j + 1) =
+          points.row(j) +
+          (frame * ((model.link_lengths[j] * RestDirection(model, j)) + angle[j] * a)).transpose();
+      continue;
+    }
     frame = (frame * Eigen::Quaterniond(Eigen::AngleAxisd(angle[j], a))).normalized();
     points.row(j + 1) =
         points.row(j) + model.link_lengths[j] * (frame * RestDirection(model, j)).transpose();
   }
+  if (last_frame != nullptr) *last_frame = frame;
   return points;
 }
 

@@ -26,10 +26,15 @@ Eigen::Vector3d RestDirection(const ArmModel& model, int k);
 double AngleAbout(const Eigen::Vector3d& axis, const Eigen::Vector3d& from,
                   const Eigen::Vector3d& to);
 
-// Forward kinematics at `angle` (n): the n+1 points, base first.
-// With `axes`, also each joint's axis in the world (n by 3), as the position Jacobian needs.
+// Whether the fixed-point sweep (RevoluteSweeper) can move the arm: every joint revolute with
+// limits within [-pi, pi], every link of positive length and across its joint's axis.
+bool Sweepable(const ArmModel& model);
+
+// Forward kinematics at `angle` (n): the n+1 points, base first (prismatic joints slide).
+// With `axes`, also each joint's axis in the world (n by 3), as the Jacobian needs; with
+// `last_frame`, the last link's rotation in the world.
 Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle,
-                       Eigen::MatrixXd* axes = nullptr);
+                       Eigen::MatrixXd* axes = nullptr, Eigen::Quaterniond* last_frame = nullptr);
 // The angles whose forward kinematics puts every link nearest to the points' link directions
 // (exactly, for points that FK produced).
 Eigen::VectorXd RevoluteInverse(const ArmModel& model, const Points& points);

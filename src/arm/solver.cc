@@ -336,10 +336,59 @@ Problems ArmOptions::Validate() const {
     problems.push_back(
         Problem::Invalid("edge_margin", FormatNumber(edge_margin), "0 <= edge_margin < 0.5"));
   }
+  if (!(time_step >= 0.0 && std::isfinite(time_step))) {
+    problems.push_back(Problem::Invalid("time_step", FormatNumber(time_step),
+                                        "a time >= 0 (s; 0: velocity limits ignored)"));
+  }
+  if (pointing.enabled) {
+    auto unit_vector = [&](const Eigen::Vector3d& v, const char* name) {
+      if (!v.allFinite() || !(v.norm() > 0.0)) {
+        problems.emplace_back(std::string("pointing.") + name,
+                              "is zero or not finite; expected a non-zero direction");
+      }
+    };
+    unit_vector(pointing.axis, "axis");
+    if (pointing.look_at) {
+      if (!pointing.point.allFinite()) {
+        problems.emplace_back("pointing.point", "is not finite; expected a point to look at");
+      }
+    } else {
+      unit_vector(pointing.direction, "direction");
+    }
+    if (!(pointing.weight > 0.0 && std::isfinite(pointing.weight))) {
+      problems.push_back(Problem::Invalid("pointing.weight", FormatNumber(pointing.weight),
+                                          "a finite number > 0 (mean link lengths per rad)"));
+    }
+    if (!(pointing.angle_tolerance > 0.0 && pointing.angle_tolerance < 1.0)) {
+      problems.push_back(Problem::Invalid("pointing.angle_tolerance",
+                                          FormatNumber(pointing.angle_tolerance),
+                                          "0 < angle_tolerance < 1 (rad)"));
+    }
+  }
+  return problems;
+}
+
+Problems ArmOptions::ValidateFor(const ArmModel& model) const {
+  Problems problems;
+  if (pointing.enabled && !model.has_axes()) {
+    problems.emplace_back("pointing",
+                          "needs an arm with joint axes (a URDF arm, or joint_axes); planar and "
+                          "spherical arms have no tool frame");
+  }
+  if (method == FixedBaseMethod::kFixedPoint && model.has_axes() &&
+      (pointing.enabled || !arm_internal::Sweepable(model))) {
+    problems.emplace_back("method",
+                          "value \"fixed_point\" is not valid for this arm: the fixed-point sweep "
+                          "takes revolute joints across links of positive length with limits "
+                          "within [-pi, pi] and no pointing; expected \"newton\"");
+  }
   return problems;
 }
 
 namespace {
+
+void AddCost(const ArmStepReport& from, ArmStepReport* to);
+void SetCost(const ArmStepReport& from, ArmStepReport* to);
 
 void CheckOptions(const ArmOptions& options) {
   Problems problems;
@@ -372,18 +421,84 @@ ArmStepReport Report(const ArmModel& model, const Eigen::VectorXd& target, doubl
 }
 
 // The joint-space solve from `state` (src/arm/joint_space.h); base_error is the end effector's
-// miss, sweeps 0.
+// miss, sweeps 0. Arms with joint axes keep the solver's joint values (their points are its
+// forward kinematics); the others read their angles from the points, as the sweep's steps do.
 ArmStepReport JointSpaceStep(const ArmModel& model, const ArmState& state,
                              const Eigen::VectorXd& target, double tol, const ArmOptions& options) {
   const arm_internal::JointSpaceSolve solved = arm_internal::SolveJointSpace(
-      model, state, target, tol, options.max_iterations, options.restarts);
-  ArmStepReport report = Report(
-      model, target, tol,
-      SolveResult{
-          solved.points, solved.residual, solved.iterations, solved.converged, solved.limited, {}},
-      0, solved.passes);
+      model, state, target, tol, options.max_iterations, options.restarts, options.pointing);
+  const SolveResult result{solved.points,    solved.residual, solved.iterations,
+                           solved.converged, solved.limited,  {}};
+  ArmStepReport report;
+  if (model.has_axes()) {
+    report.base_error = solved.residual;
+    report.iterations = solved.iterations;
+    report.converged = solved.converged;
+    report.limited = solved.limited;
+    report.passes = solved.passes;
+    report.state.angles.angle = solved.angles;
+    report.state.points = solved.points;
+    report.ee_error = (report.state.points.row(model.num_links()).transpose() - target).norm();
+    report.reached = report.converged && report.ee_error <= 2.0 * tol + 1e-13 * model.reach();
+    if (options.pointing.enabled) report.pointing_error = solved.angle_residual;
+  } else {
+    report = Report(model, target, tol, result, 0, solved.passes);
+  }
   report.joint_space = true;
   report.restarts = solved.restarts;
+  return report;
+}
+
+// The largest joint speed of the move from `from` to `to` in `time_step`, over its limit.
+double VelocityRatio(const ArmModel& model, const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                     double time_step) {
+  double ratio = 0.0;
+  for (int j = 0; j < model.max_velocity.size(); ++j) {
+    double move = to[j] - from[j];
+    // Planar angles are read on the circle: the move is the shorter way round.
+    if (!model.has_axes()) move = std::remainder(move, 2.0 * M_PI);
+    ratio = std::max(ratio, std::abs(move) / (model.max_velocity[j] * time_step));
+  }
+  return ratio;
+}
+
+// The joint-space step with velocity limits (ArmOptions::time_step): where the step would move a
+// joint faster than its limit, the end effector's straight move is tracked in equal legs of one
+// time_step each, as many as the fastest joint needs, and more where the legs' motion is not
+// even (up to kMaxVelocityRounds tries).
+template <class Step>
+ArmStepReport VelocityLimitedStep(const ArmModel& model, const ArmState& state,
+                                  const Eigen::VectorXd& target, const ArmOptions& options,
+                                  const Step& step) {
+  constexpr int kMaxVelocityRounds = 4, kMaxVelocityLegs = 100000;
+  ArmStepReport report = step(state, target);
+  report.velocity_legs = 1;
+  report.velocity_ratio =
+      VelocityRatio(model, state.angles.angle, report.state.angles.angle, options.time_step);
+  if (report.velocity_ratio <= 1.0) return report;
+  ArmStepReport cost = report;
+  const Eigen::VectorXd from = state.points.row(model.num_links()).transpose();
+  int legs = static_cast<int>(std::min<double>(kMaxVelocityLegs, std::ceil(report.velocity_ratio)));
+  for (int round = 0; round < kMaxVelocityRounds; ++round) {
+    ArmStepReport leg_report;
+    ArmState leg_state = state;
+    double ratio = 0.0;
+    for (int leg = 1; leg <= legs; ++leg) {
+      const Eigen::VectorXd goal =
+          leg == legs ? target : Eigen::VectorXd(from + (target - from) * (double(leg) / legs));
+      leg_report = step(leg_state, goal);
+      AddCost(leg_report, &cost);
+      ratio = std::max(ratio, VelocityRatio(model, leg_state.angles.angle,
+                                            leg_report.state.angles.angle, options.time_step));
+      leg_state = leg_report.state;
+    }
+    report = leg_report;
+    report.velocity_legs = legs;
+    report.velocity_ratio = ratio;
+    if (ratio <= 1.0 || legs >= kMaxVelocityLegs) break;
+    legs = static_cast<int>(std::min<double>(kMaxVelocityLegs, std::ceil(legs * ratio)));
+  }
+  SetCost(cost, &report);
   return report;
 }
 
@@ -434,12 +549,35 @@ ArmStepReport LegsStep(const ArmModel& model, const ArmState& state, const Eigen
   return report;
 }
 
-// ArmStep on a checked model, options, state and target.
-ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
-                          const Eigen::VectorXd& target, const ArmOptions& options) {
+// The options that only some arms take, refused by name for the others.
+void CheckOptionsForModel(const ArmModel& model, const ArmOptions& options) {
+  Problems problems;
+  AppendNested("options", options.ValidateFor(model), &problems);
+  ThrowIfAny(problems);
+}
+
+// ArmStep on a checked model, options, state and target, without velocity limits.
+ArmStepReport StepUnlimited(const ArmModel& model, const ArmState& state,
+                            const Eigen::VectorXd& target, const ArmOptions& options) {
   const int n = model.num_links();
   const double scale = model.link_lengths.mean();
   const double tol = options.tolerance * scale;
+  const bool newton = options.method == FixedBaseMethod::kNewton;
+  if (model.has_axes()) {
+    if (state.angles.angle.size() != n || !state.angles.angle.allFinite()) {
+      throw InputError("state.angles", "has " + std::to_string(state.angles.angle.size()) +
+                                           " finite values or fewer; expected " +
+                                           std::to_string(n));
+    }
+    // Method newton: the weighted minimum-norm joint motion from the last angles
+    // (src/arm/joint_space.cc says why not the sweep). Out of reach, it ends at the nearest
+    // configuration its joints give (a straight arm is not one in general).
+    if (newton) return JointSpaceStep(model, state, target, tol, options);
+    arm_internal::RevoluteSweeper sweeper(model, state, target, options.substeps);
+    const SolveResult solved = SolveFixedPointRevolute(&sweeper, options, tol);
+    return Report(model, target, tol, solved, sweeper.sweeps(),
+                  sweeper.sweeps());  // 1 sweep a pass
+  }
   const Vec to_target = target - model.base;
   if (to_target.norm() >= model.reach() * (1.0 - options.edge_margin)) {
     // Out of reach (or on its edge, where the Jacobian is singular): stretched toward the target.
@@ -455,21 +593,6 @@ ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
     ArmStepReport report = Report(model, target, tol, stretched, 0, 0);
     report.stretched = true;
     return report;
-  }
-  const bool newton = options.method == FixedBaseMethod::kNewton;
-  if (model.has_axes()) {
-    if (state.angles.angle.size() != n || !state.angles.angle.allFinite()) {
-      throw InputError("state.angles", "has " + std::to_string(state.angles.angle.size()) +
-                                           " finite values or fewer; expected " +
-                                           std::to_string(n));
-    }
-    // Method newton: the weighted minimum-norm joint motion from the last angles
-    // (src/arm/joint_space.cc says why not the sweep).
-    if (newton) return JointSpaceStep(model, state, target, tol, options);
-    arm_internal::RevoluteSweeper sweeper(model, state, target, options.substeps);
-    const SolveResult solved = SolveFixedPointRevolute(&sweeper, options, tol);
-    return Report(model, target, tol, solved, sweeper.sweeps(),
-                  sweeper.sweeps());  // 1 sweep a pass
   }
   // A far move (more than one leg, below) gets fewer Newton iterations in one sweep: where
   // Newton converges it does in a few (at most 10 measured on single jumps across the
@@ -496,6 +619,18 @@ ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
   return report;
 }
 
+// ArmStep on a checked model, options, state and target.
+ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
+                          const Eigen::VectorXd& target, const ArmOptions& options) {
+  if (options.time_step > 0.0 && model.max_velocity.size() == model.num_links()) {
+    return VelocityLimitedStep(model, state, target, options,
+                               [&](const ArmState& from, const Eigen::VectorXd& goal) {
+                                 return StepUnlimited(model, from, goal, options);
+                               });
+  }
+  return StepUnlimited(model, state, target, options);
+}
+
 }  // namespace
 
 ArmStepReport ArmStep(const ArmModel& model, const ArmState& state,
@@ -503,6 +638,7 @@ ArmStepReport ArmStep(const ArmModel& model, const ArmState& state,
                       const ArmOptions& options) {
   arm_internal::CheckModel(model);
   CheckOptions(options);
+  CheckOptionsForModel(model, options);
   const Eigen::VectorXd target = target_in;
   CheckState(model, state, target);
   return StepChecked(model, state, target, options);
@@ -515,7 +651,13 @@ std::string ArmStepReport::BriefReport() const {
                 reached ? "reached" : "NOT reached", ee_error, base_error, iterations, sweeps,
                 stretched ? ", stretched toward an out-of-reach target" : "",
                 limited ? ", joint limits active" : "");
-  return line;
+  std::string text = line;
+  if (pointing_error > 0.0) {
+    std::snprintf(line, sizeof(line), ", pointing error %.3g rad", pointing_error);
+    text += line;
+  }
+  if (velocity_legs > 1) text += ", " + std::to_string(velocity_legs) + " legs for velocity limits";
+  return text;
 }
 
 ArmTrajectory TrackPath(const ArmModel& model, const Points& path, const ArmOptions& options,
@@ -529,6 +671,7 @@ ArmTrajectory TrackPath(const ArmModel& model, const Points& path, const ArmOpti
   const auto begin = std::chrono::steady_clock::now();
   ArmTrajectory trajectory;
   CheckOptions(options);
+  CheckOptionsForModel(model, options);
   for (int i = 0; i < path.rows(); ++i) {  // every target before the first step
     for (int k = 0; k < path.cols(); ++k) {
       if (!std::isfinite(path(i, k))) {
@@ -546,6 +689,8 @@ ArmTrajectory TrackPath(const ArmModel& model, const Points& path, const ArmOpti
     trajectory.max_ee_error = std::max(trajectory.max_ee_error, step.ee_error);
     trajectory.max_base_error = std::max(trajectory.max_base_error, step.base_error);
     trajectory.unreached += step.reached ? 0 : 1;
+    trajectory.max_pointing_error = std::max(trajectory.max_pointing_error, step.pointing_error);
+    trajectory.velocity_legs += step.velocity_legs;
     trajectory.max_iterations = std::max(trajectory.max_iterations, step.iterations);
     trajectory.total_sweeps += step.sweeps;
     trajectory.total_passes += step.passes;
@@ -573,7 +718,15 @@ std::string ArmTrajectory::BriefReport() const {
                 "max %d iterations, %lld sweeps, %.3g s",
                 static_cast<size_t>(std::max<long long>(num_steps, steps.size())), unreached,
                 max_ee_error, max_base_error, max_iterations, total_sweeps, seconds);
-  return line;
+  std::string text = line;
+  if (max_pointing_error > 0.0) {
+    std::snprintf(line, sizeof(line), ", max pointing error %.3g rad", max_pointing_error);
+    text += line;
+  }
+  if (velocity_legs > num_steps) {
+    text += ", " + std::to_string(velocity_legs) + " legs to keep velocity limits";
+  }
+  return text;
 }
 
 }  // namespace flexkin

@@ -66,7 +66,8 @@ class RobotParser : public json_internal::JsonReader {
     RobotScenario s;
     if (!ExpectObject(root, "", "an object with \"arm\" (or \"urdf\") and \"path\"")) return s;
     CheckKeys(root, "",
-              {"format", "name", "arm", "urdf", "base_link", "tip_link", "path", "solver"});
+              {"format", "name", "arm", "urdf", "base_link", "tip_link", "tip_offset", "pointing",
+               "path", "solver"});
     if (const json* f = Find(root, "format")) {
       if (!f->is_string()) {
         TypeProblem(*f, "/format", "\"flexkin-robot\"");
@@ -82,7 +83,7 @@ class RobotParser : public json_internal::JsonReader {
     if (Find(root, "urdf")) {
       model = ParseUrdfArm(root);
     } else {
-      for (const char* key : {"base_link", "tip_link"}) {
+      for (const char* key : {"base_link", "tip_link", "tip_offset"}) {
         if (Find(root, key)) {
           Add(std::string("/") + key, "belongs to a URDF arm; expected \"urdf\" too");
         }
@@ -99,6 +100,14 @@ class RobotParser : public json_internal::JsonReader {
       path = ParsePath(*p, "/path", model ? &*model : nullptr, dim);
     }
     if (const json* solver = Find(root, "solver")) ParseSolver(*solver, "/solver", &s.options);
+    if (const json* pointing = Find(root, "pointing")) {
+      ParsePointing(*pointing, "/pointing", &s.options.pointing);
+    }
+    if (model) {
+      for (const Problem& p : s.options.ValidateFor(*model)) {
+        Add(p.field == "method" ? "/solver/method" : "/" + p.field, p.message);
+      }
+    }
     if (!problems.empty()) return s;
     s.model = std::move(*model);
     s.path = std::move(*path);
@@ -248,6 +257,11 @@ class RobotParser : public json_internal::JsonReader {
     Optional(
         root, "", "tip_link", [this](const json& v, const std::string& p) { return String(v, p); },
         &chain.tip_link);
+    std::optional<Eigen::VectorXd> offset;
+    Optional(
+        root, "", "tip_offset",
+        [this](const json& v, const std::string& p) { return Vector(v, p, 3); }, &offset);
+    if (offset) chain.tip_offset = *offset;
     if (problems.size() != before) return std::nullopt;
     if (!options_.urdf_loader) {
       Add("/urdf", "value " + ShowJson(urdf) +
@@ -262,7 +276,7 @@ class RobotParser : public json_internal::JsonReader {
       return options_.urdf_loader(path.string(), chain);
     } catch (const InputError& e) {
       Problem p = e.problem();
-      if (p.field == "base_link" || p.field == "tip_link") {
+      if (p.field == "base_link" || p.field == "tip_link" || p.field == "tip_offset") {
         p.field = "/" + p.field;
       } else {
         p.message = path.string() + ": " + p.Text();
@@ -367,7 +381,7 @@ class RobotParser : public json_internal::JsonReader {
     }
     CheckKeys(solver, ptr,
               {"method", "tolerance", "max_iterations", "max_fixed_point_iterations", "substeps",
-               "edge_margin", "restarts"});
+               "edge_margin", "restarts", "time_step"});
     const size_t before = problems.size();
     if (const json* v = Find(solver, "method")) {
       if (const auto name = String(*v, ptr + "/method")) {
@@ -392,11 +406,55 @@ class RobotParser : public json_internal::JsonReader {
     Optional(solver, ptr, "substeps", integer(1, 1000000), &o->substeps);
     Optional(solver, ptr, "edge_margin", number(Range::kAny), &o->edge_margin);
     Optional(solver, ptr, "restarts", integer(0, 1000), &o->restarts);
+    Optional(solver, ptr, "time_step", number(Range::kNonNegative), &o->time_step);
     if (problems.size() != before) return;
     // What is left (tolerance < 1, the edge margin's range) is the options' own check; their
     // members are the keys.
     for (Problem p : o->Validate()) {
       p.field = ptr + MemberPathToPointer(p.field);
+      problems.push_back(std::move(p));
+    }
+  }
+
+  // "pointing": {"axis": a, "direction": d} or {"axis": a, "look_at": p}, "weight", "tolerance".
+  void ParsePointing(const json& pointing, const std::string& ptr, ArmOptions::Pointing* o) {
+    if (!ExpectObject(pointing, ptr,
+                      "an object {\"axis\": [x, y, z], \"direction\": [x, y, z]} or with "
+                      "\"look_at\": [x, y, z]")) {
+      return;
+    }
+    CheckKeys(pointing, ptr, {"axis", "direction", "look_at", "weight", "tolerance"});
+    const size_t before = problems.size();
+    const auto vector = [this](const json& v, const std::string& p) { return Vector(v, p, 3); };
+    std::optional<Eigen::VectorXd> axis, direction, point;
+    Optional(pointing, ptr, "axis", vector, &axis);
+    Optional(pointing, ptr, "direction", vector, &direction);
+    Optional(pointing, ptr, "look_at", vector, &point);
+    if (direction && point) {
+      Add(ptr + "/look_at", "is not valid with \"direction\"; give one of them");
+    } else if (!direction && !point) {
+      Add(ptr, "has neither \"direction\" nor \"look_at\"; expected one of them");
+    }
+    Optional(
+        pointing, ptr, "weight",
+        [this](const json& v, const std::string& p) { return Number(v, p, Range::kPositive); },
+        &o->weight);
+    Optional(
+        pointing, ptr, "tolerance",
+        [this](const json& v, const std::string& p) { return Number(v, p, Range::kPositive); },
+        &o->angle_tolerance);
+    if (problems.size() != before) return;
+    o->enabled = true;
+    if (axis) o->axis = *axis;
+    if (direction) o->direction = *direction;
+    if (point) {
+      o->look_at = true;
+      o->point = *point;
+    }
+    ArmOptions options;
+    options.pointing = *o;
+    for (Problem p : options.Validate()) {  // zero vectors, a tolerance of 1 rad or more
+      p.field = ptr + MemberPathToPointer(p.field.substr(std::string("pointing.").size()));
       problems.push_back(std::move(p));
     }
   }
@@ -484,6 +542,18 @@ std::string RobotScenarioSummary(const RobotScenario& s) {
                     ", method " + FixedBaseMethodName(s.options.method) + ", tolerance " +
                     tolerance;
   if (s.options.substeps > 1) out += ", " + std::to_string(s.options.substeps) + " sub-steps";
+  if (m.has_axes()) {
+    int prismatic = 0;
+    for (int j = 0; j < m.num_links(); ++j) prismatic += m.prismatic(j) ? 1 : 0;
+    const size_t points = JointGroups(m).size();
+    if (prismatic > 0) out += ", " + std::to_string(prismatic) + " prismatic";
+    if (points < static_cast<size_t>(m.num_links())) {
+      out +=
+          ", " + std::to_string(m.num_links()) + " joints at " + std::to_string(points) + " points";
+    }
+  }
+  if (s.options.pointing.enabled) out += ", pointing";
+  if (s.options.time_step > 0.0 && m.max_velocity.size() > 0) out += ", velocity limits";
   return out;
 }
 

@@ -36,10 +36,10 @@ json StateJson(const ArmModel& model, const ArmState& state) {
     for (int j = 0; j < q.rows(); ++j)
       out["joint_quaternions"].push_back(Row(q.row(j).transpose()));
   }
+  // One point per distinct position: joints at one point (JointGroups) share theirs.
+  const Points points = model.has_axes() ? ChainPoints(model, state.points) : state.points;
   out["points"] = json::array();
-  for (int i = 0; i < state.points.rows(); ++i) {
-    out["points"].push_back(Row(state.points.row(i).transpose()));
-  }
+  for (int i = 0; i < points.rows(); ++i) out["points"].push_back(Row(points.row(i).transpose()));
   return out;
 }
 
@@ -58,6 +58,11 @@ json StepJson(const RobotScenario& s, int64_t index, const ArmStepReport& r) {
   step["legs"] = r.legs;
   step["joint_space"] = r.joint_space;
   step["restarts"] = r.restarts;
+  if (s.options.pointing.enabled) step["pointing_error"] = r.pointing_error;
+  if (s.options.time_step > 0.0 && s.model.max_velocity.size() > 0) {
+    step["velocity_legs"] = r.velocity_legs;
+    step["velocity_ratio"] = r.velocity_ratio;
+  }
   return step;
 }
 
@@ -72,6 +77,26 @@ json HeadJson(const RobotScenario& s) {
   doc["base"] = Row(s.model.base);
   doc["method"] = FixedBaseMethodName(s.options.method);
   doc["tolerance"] = s.options.tolerance;
+  if (s.model.has_axes()) {
+    doc["joint_types"] = json::array();
+    for (int j = 0; j < s.model.num_links(); ++j) {
+      doc["joint_types"].push_back(
+          NameOf(s.model.prismatic(j) ? JointType::kPrismatic : JointType::kRevolute));
+    }
+    // The joints of each point of "points" (base first), as JointGroups gives them.
+    doc["joint_groups"] = JointGroups(s.model);
+  }
+  if (s.options.pointing.enabled) {
+    const ArmOptions::Pointing& p = s.options.pointing;
+    json pointing = {{"axis", Row(p.axis)}, {"weight", p.weight}, {"tolerance", p.angle_tolerance}};
+    if (p.look_at) {
+      pointing["look_at"] = Row(p.point);
+    } else {
+      pointing["direction"] = Row(p.direction);
+    }
+    doc["pointing"] = pointing;
+  }
+  if (s.options.time_step > 0.0) doc["time_step"] = s.options.time_step;
   doc["initial"] = StateJson(s.model, InitialState(s.model));
   return doc;
 }

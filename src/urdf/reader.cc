@@ -3,8 +3,12 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
+#include <map>
+#include <mutex>
 #include <sstream>
 #include <system_error>
 #include <vector>
@@ -17,6 +21,7 @@ namespace flexkin {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 std::string Quote(const std::string& s) { return "\"" + s + "\""; }
 
@@ -57,18 +62,59 @@ std::vector<urdf::JointConstSharedPtr> ChainJoints(const urdf::ModelInterface& r
   return joints;
 }
 
+// Collects what urdfdom reports while parsing, to name the element in our message.
+class Collect : public console_bridge::OutputHandler {
+ public:
+  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_ERROR && first.empty()) first = text;
+  }
+  std::string first;
+};
+
+urdf::ModelInterfaceSharedPtr Parse(const std::string& text) {
+  // console_bridge's handler is global: one parse at a time.
+  static std::mutex mutex;
+  Collect collect;
+  urdf::ModelInterfaceSharedPtr robot;
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    console_bridge::useOutputHandler(&collect);
+    console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_ERROR);
+    try {
+      robot = urdf::parseURDF(text);
+    } catch (...) {
+      robot = nullptr;
+    }
+    console_bridge::restorePreviousOutputHandler();
+    console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
+  }
+  if (!robot || !robot->getRoot()) {
+    throw InputError("urdf",
+                     "is not a valid URDF document (urdfdom: " +
+                         (collect.first.empty() ? std::string("no root link") : collect.first) +
+                         "); check the XML, that every joint names existing parent and "
+                         "child links, that no link has two parents (a closed loop) and "
+                         "that revolute and prismatic joints have <limit>");
+  }
+  // urdfdom keeps the last of two joints that share a child link: a closed loop would read as a
+  // tree. Refused here, naming the link and both joints.
+  std::map<std::string, std::string> parent_joint;
+  for (const auto& [name, joint] : robot->joints_) {
+    const auto [at, fresh] = parent_joint.emplace(joint->child_link_name, name);
+    if (!fresh) {
+      throw InputError("link " + Quote(joint->child_link_name),
+                       "is the child of joints " + Quote(at->second) + " and " + Quote(name) +
+                           ": a closed loop; flexkin arms are serial chains (each link the "
+                           "child of one joint): remove one of them");
+    }
+  }
+  return robot;
+}
+
 }  // namespace
 
 ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
-  console_bridge::setLogLevel(
-      console_bridge::CONSOLE_BRIDGE_LOG_NONE);  // errors are ours to report
-  const urdf::ModelInterfaceSharedPtr robot = urdf::parseURDF(text);
-  if (!robot || !robot->getRoot()) {
-    throw InputError("urdf",
-                     "is not a valid URDF document (urdfdom could not parse it: check the XML, "
-                     "that every joint names existing parent and child links and that "
-                     "revolute joints have <limit>)");
-  }
+  const urdf::ModelInterfaceSharedPtr robot = Parse(text);
   auto find = [&](const std::string& name, const char* field) {
     const urdf::LinkConstSharedPtr link = robot->getLink(name);
     if (!link)
@@ -76,6 +122,9 @@ ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
                        "link " + Quote(name) + " is not in the URDF; expected one of its links");
     return link;
   };
+  if (!chain.tip_offset.allFinite()) {
+    throw InputError("tip_offset", "is not finite; expected a point of the tip link's frame");
+  }
   const urdf::LinkConstSharedPtr base =
       chain.base_link.empty() ? robot->getRoot() : find(chain.base_link, "base_link");
   const urdf::LinkConstSharedPtr tip =
@@ -85,19 +134,28 @@ ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
   for (urdf::LinkConstSharedPtr link = base; link->parent_joint; link = link->getParent()) {
     pose = Transform(link->parent_joint->parent_to_joint_origin_transform) * pose;
   }
-  // Walk down the chain at the zero pose: joint origins, world axes and limits.
+  // Walk down the chain at the zero pose: joint origins, world axes, types and limits.
   std::vector<Eigen::Vector3d> origins, axes;
   std::vector<std::string> names;
-  std::vector<double> lower, upper;
-  bool any_limits = false;
+  std::vector<JointType> types;
+  std::vector<double> lower, upper, speed;
+  bool any_limits = false, any_speed = false;
   for (const urdf::JointConstSharedPtr& joint : ChainJoints(*robot, base, tip)) {
     const std::string field = "joint " + Quote(joint->name);
     pose = pose * Transform(joint->parent_to_joint_origin_transform);
     if (joint->type == urdf::Joint::FIXED) continue;
-    if (joint->type != urdf::Joint::REVOLUTE && joint->type != urdf::Joint::CONTINUOUS) {
+    if (joint->type == urdf::Joint::FLOATING || joint->type == urdf::Joint::PLANAR) {
+      throw InputError(field, std::string("has type ") +
+                                  (joint->type == urdf::Joint::FLOATING ? "floating" : "planar") +
+                                  ", which a fixed-base serial arm cannot have (flexkin takes "
+                                  "revolute, continuous, prismatic and fixed joints); start the "
+                                  "arm below it (base_link = its child link) or make it fixed");
+    }
+    if (joint->type != urdf::Joint::REVOLUTE && joint->type != urdf::Joint::CONTINUOUS &&
+        joint->type != urdf::Joint::PRISMATIC) {
       throw InputError(field,
-                       "has a type other than revolute, continuous or fixed (prismatic, floating "
-                       "or planar); flexkin arms have revolute joints only");
+                       "has an unknown type; expected revolute, continuous, prismatic "
+                       "or fixed");
     }
     const Eigen::Vector3d axis(joint->axis.x, joint->axis.y, joint->axis.z);
     if (!(axis.norm() > 0.0) || !axis.allFinite())
@@ -105,62 +163,84 @@ ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
     origins.push_back(pose.translation());
     axes.push_back((pose.linear() * axis).normalized());
     names.push_back(joint->name);
-    double lo = -kPi, hi = kPi;
-    if (joint->type == urdf::Joint::REVOLUTE && joint->limits) {
-      if (!(joint->limits->lower <= joint->limits->upper)) {
-        throw InputError(field, "limit lower " + FormatNumber(joint->limits->lower) + " > upper " +
-                                    FormatNumber(joint->limits->upper) +
+    const bool prismatic = joint->type == urdf::Joint::PRISMATIC;
+    types.push_back(prismatic ? JointType::kPrismatic : JointType::kRevolute);
+    // Limits as written: continuous joints have none; revolute ones may span several turns.
+    double lo = -kInf, hi = kInf, v = kInf;
+    if (joint->type != urdf::Joint::CONTINUOUS && joint->limits) {
+      lo = joint->limits->lower;
+      hi = joint->limits->upper;
+      if (!(lo <= hi)) {
+        throw InputError(field, "limit lower " + FormatNumber(lo) + " > upper " + FormatNumber(hi) +
                                     "; expected lower <= upper");
       }
-      lo = std::max(-kPi, joint->limits->lower);
-      hi = std::min(kPi, joint->limits->upper);
-      if (!(lo <= hi))
-        throw InputError(field, "limits lie outside [-pi, pi] rad; expected an overlap with it");
       any_limits = true;
+    }
+    // A velocity limit of 0 (or none) is taken as no limit, as URDF writers use it.
+    if (joint->limits && joint->limits->velocity > 0.0 && std::isfinite(joint->limits->velocity)) {
+      v = joint->limits->velocity;
+      any_speed = true;
     }
     lower.push_back(lo);
     upper.push_back(hi);
+    speed.push_back(v);
   }
   const int n = static_cast<int>(origins.size());
-  if (n == 0)
-    throw InputError("urdf", "the chain from the base link to the tip link has no revolute joint");
-  origins.push_back(pose.translation());  // the tip
+  if (n == 0) {
+    throw InputError("urdf",
+                     "the chain from the base link to the tip link has no revolute, "
+                     "continuous or prismatic joint");
+  }
+  origins.push_back(pose * chain.tip_offset);  // the end effector
   ArmModel model;
   model.dim = 3;
   model.base = origins[0];
   model.link_lengths.resize(n);
   model.joint_axes.resize(n, 3);
   model.link_directions.resize(n, 3);
+  model.joint_types = types;
+  model.joint_names = names;
+  // The tool frame (the tip link's) in the last link's frame, which is the world's at zero.
+  const Eigen::Quaterniond tool(pose.linear());
+  model.tip_rotation << tool.w(), tool.x(), tool.y(), tool.z();
+  Eigen::Vector3d last_direction = Eigen::Vector3d::UnitX();
   for (int k = 0; k < n; ++k) {
     const Eigen::Vector3d v = origins[k + 1] - origins[k];
-    if (!(v.norm() > 1e-12 * std::max(1.0, origins[k].norm()))) {
-      throw InputError(k + 1 < n ? "joint " + Quote(names[k + 1]) : "tip_link",
-                       "its origin coincides with joint " + Quote(names[k]) +
-                           "'s: a zero-length link; flexkin needs links of positive length");
-    }
-    model.link_lengths[k] = v.norm();
-    model.link_directions.row(k) = v.normalized().transpose();
+    // Joints at one point (a universal or spherical joint, a tip on its joint): length 0.
+    const bool zero = !(v.norm() > 1e-12 * std::max(1.0, origins[k].norm()));
+    model.link_lengths[k] = zero ? 0.0 : v.norm();
+    if (!zero) last_direction = v.normalized();
+    model.link_directions.row(k) = (zero ? axes[k].unitOrthogonal() : last_direction).transpose();
     model.joint_axes.row(k) = axes[k].transpose();
-    if (axes[k].cross(v.normalized()).norm() < 1e-6) {
-      throw InputError("joint " + Quote(names[k]),
-                       "axis lies along the link it turns (a pure twist); "
-                       "flexkin arms need axes across their links");
-    }
   }
-  model.base_direction = model.link_directions.row(0).transpose();
+  if (!(model.link_lengths.sum() > 0.0)) {
+    throw InputError("tip_link",
+                     "every joint of the chain and the end effector are at one "
+                     "point; expected a chain of positive length (or a tip_offset)");
+  }
+  // The base direction: the first link of positive length.
+  for (int k = n - 1; k >= 0; --k) {
+    if (model.link_lengths[k] > 0.0)
+      model.base_direction = model.link_directions.row(k).transpose();
+  }
   model.initial.angle = Eigen::VectorXd::Zero(n);
   if (any_limits) {
     model.joint_min = Eigen::Map<Eigen::VectorXd>(lower.data(), n);
     model.joint_max = Eigen::Map<Eigen::VectorXd>(upper.data(), n);
-    for (int j = 0; j < n; ++j)
-      model.initial.angle[j] = arm_internal::ClampCircular(0.0, lower[j], upper[j]);
+    for (int j = 0; j < n; ++j) model.initial.angle[j] = std::clamp(0.0, lower[j], upper[j]);
   }
-  // A planar arm: every axis +z, every link along one direction of the z = 0 plane.
-  bool planar = std::abs(model.base[2]) == 0.0;
+  if (any_speed) model.max_velocity = Eigen::Map<Eigen::VectorXd>(speed.data(), n);
+  // A planar arm: every joint revolute about +z within [-pi, pi] (or continuous), every link of
+  // positive length along one direction of the z = 0 plane, and the tool frame the last link's.
+  bool planar = std::abs(model.base[2]) == 0.0 &&
+                (model.tip_rotation - Eigen::Vector4d(1, 0, 0, 0)).norm() <= 1e-12;
   for (int k = 0; k < n && planar; ++k) {
-    planar = (model.joint_axes.row(k) - Eigen::RowVector3d::UnitZ()).norm() <= 1e-12 &&
+    planar = types[k] == JointType::kRevolute && model.link_lengths[k] > 0.0 &&
+             (model.joint_axes.row(k) - Eigen::RowVector3d::UnitZ()).norm() <= 1e-12 &&
              (model.link_directions.row(k) - model.link_directions.row(0)).norm() <= 1e-12 &&
-             model.link_directions(k, 2) == 0.0;
+             model.link_directions(k, 2) == 0.0 &&
+             (!any_limits || (std::isinf(lower[k]) && std::isinf(upper[k])) ||
+              (lower[k] >= -kPi && upper[k] <= kPi));
   }
   if (planar) {
     model.dim = 2;
@@ -168,6 +248,12 @@ ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
     model.base_direction = model.base_direction.head<2>().eval();
     model.joint_axes.resize(0, 0);
     model.link_directions.resize(0, 0);
+    model.joint_types.clear();
+    // (joint_names are kept: they name the planar joints too)
+    if (any_limits) {  // continuous joints of a planar arm: the whole circle
+      model.joint_min = model.joint_min.cwiseMax(-kPi);
+      model.joint_max = model.joint_max.cwiseMin(kPi);
+    }
   }
   // The model built from the file: its problem is the file's, named "urdf" with the member.
   if (const Problems problems = model.Validate(); !problems.empty()) {
