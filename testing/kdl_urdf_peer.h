@@ -29,6 +29,10 @@
 //     frames as NR and w = KdlUrdfOptions::rotation_weight (length per rad: flexkin's
 //     pointing.weight x the mean link length, so that both weigh an angular miss alike).
 // Neither solver has joint limits: KDL may leave them (the report counts the steps that do).
+// KDL resolves rotations only to about 1e-6 rad: its frame difference (Rotation::GetRot) reads a
+// rotation whose matrix is within KDL::epsilon (1e-6) of symmetric as the identity, so neither
+// NR's stopping test nor LMA's error sees a smaller angle, and both report success with up to
+// ~1e-6 rad left to the target rotation (angle_error below; set angle_tolerance accordingly).
 
 #include <Eigen/Core>
 #include <kdl/chain.hpp>
@@ -80,8 +84,8 @@ struct KdlUrdfOptions {
   // (rotations in rad); LMA: KDL's eps (the weighted error's norm).
   double tolerance = 1e-11;
   // Position+pointing: the largest angle (rad) between the tip rotation reached and the target
-  // rotation for the step to count as reached.
-  double angle_tolerance = 1e-8;
+  // rotation for the step to count as reached (KDL's resolution is about 1e-6 rad, see above).
+  double angle_tolerance = 1e-6;
   // LMA with target rotations: the task-space weight of the three rotation components (length
   // per rad).
   double rotation_weight = 0.1;
