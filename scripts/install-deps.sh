@@ -8,6 +8,7 @@ packages=(cmake make g++ ccache pkg-config clang-format git libeigen3-dev nlohma
 packages+=(libcairo2-dev fonts-dejavu-core ffmpeg)  # flexkin render (src/render)
 packages+=(libtinygltf-dev)  # glTF export (src/gltf)
 packages+=(liborocos-kdl-dev)  # the pseudo-inverse peer of the arm comparison (testing/kdl_peer.h)
+packages+=(libkdl-parser-dev)  # KDL chains from URDF text, the URDF snakes' peer (testing/kdl_urdf_peer.h)
 packages+=(chromium)         # the viewer's browser test (headless)
 packages+=(liburdfdom-dev)   # URDF arms (src/urdf)
 packages+=(zlib1g-dev)       # CRC-32 of the .npz result files (src/io/npz.cc)
