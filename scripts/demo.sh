@@ -26,6 +26,10 @@ echo "== robot arm with a fixed base (docs/robots.md)"
 # targets not reached (reported, docs/robots.md); it does not stop the demo.
 "$flexkin" robot examples/robot_snake_urdf.json -o out/robot_snake_urdf.json \
   --csv out/robot_snake_urdf_joints.csv || [ $? -eq 3 ]
+# Any serial robot: an 8-module universal-joint snake read from its URDF (joints grouped in pairs
+# at one point), its head pointing down a slope and its joints kept within their velocity limits.
+"$flexkin" robot examples/robot_universal_snake.json -o out/robot_universal_snake.json \
+  --csv out/robot_universal_snake_joints.csv
 # A spatial arm whose bend limits saturate along the path: every target is reachable and reached,
 # most through the joint-space step (docs/robots.md, "Joint limits").
 "$flexkin" robot examples/robot_spatial_limits.json -o out/robot_spatial_limits.json \

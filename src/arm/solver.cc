@@ -11,6 +11,7 @@
 // the fixed-point iteration u <- u - F(u) (the predecessors' scheme) contracts only by the norm of
 // g's Jacobian per sweep, which approaches 1 for long arms and near the edge.
 #include <Eigen/Dense>
+#include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -466,12 +467,30 @@ double VelocityRatio(const ArmModel& model, const Eigen::VectorXd& from, const E
 // joint faster than its limit, the end effector's straight move is tracked in equal legs of one
 // time_step each, as many as the fastest joint needs, and more where the legs' motion is not
 // even (up to kMaxVelocityRounds tries).
+// The options of leg `leg` of `legs` from `state` toward `target`: with pointing, the tool axis'
+// goal turned from where the axis is to the step's goal along the great circle (the last leg
+// keeps the step's own goal), so that the turn is split with the move.
+ArmOptions LegOptions(const ArmModel& model, const ArmState& state, const Eigen::VectorXd& target,
+                      const ArmOptions& options, int leg, int legs) {
+  if (!options.pointing.enabled || leg == legs) return options;
+  const ArmOptions::Pointing& p = options.pointing;
+  const Eigen::Vector3d from = ToolPoseAt(model, state.angles).rotation * p.axis.normalized();
+  const Eigen::Vector3d to = p.look_at ? Eigen::Vector3d((p.point - target.head<3>()).normalized())
+                                       : Eigen::Vector3d(p.direction.normalized());
+  ArmOptions out = options;
+  out.pointing.look_at = false;
+  out.pointing.direction = Eigen::Quaterniond::Identity().slerp(
+                               double(leg) / legs, Eigen::Quaterniond::FromTwoVectors(from, to)) *
+                           from;
+  return out;
+}
+
 template <class Step>
 ArmStepReport VelocityLimitedStep(const ArmModel& model, const ArmState& state,
                                   const Eigen::VectorXd& target, const ArmOptions& options,
                                   const Step& step) {
-  constexpr int kMaxVelocityRounds = 4, kMaxVelocityLegs = 100000;
-  ArmStepReport report = step(state, target);
+  constexpr int kMaxVelocityRounds = 8, kMaxVelocityLegs = 100000;
+  ArmStepReport report = step(state, target, options);
   report.velocity_legs = 1;
   report.velocity_ratio =
       VelocityRatio(model, state.angles.angle, report.state.angles.angle, options.time_step);
@@ -486,7 +505,7 @@ ArmStepReport VelocityLimitedStep(const ArmModel& model, const ArmState& state,
     for (int leg = 1; leg <= legs; ++leg) {
       const Eigen::VectorXd goal =
           leg == legs ? target : Eigen::VectorXd(from + (target - from) * (double(leg) / legs));
-      leg_report = step(leg_state, goal);
+      leg_report = step(leg_state, goal, LegOptions(model, state, target, options, leg, legs));
       AddCost(leg_report, &cost);
       ratio = std::max(ratio, VelocityRatio(model, leg_state.angles.angle,
                                             leg_report.state.angles.angle, options.time_step));
@@ -496,7 +515,8 @@ ArmStepReport VelocityLimitedStep(const ArmModel& model, const ArmState& state,
     report.velocity_legs = legs;
     report.velocity_ratio = ratio;
     if (ratio <= 1.0 || legs >= kMaxVelocityLegs) break;
-    legs = static_cast<int>(std::min<double>(kMaxVelocityLegs, std::ceil(legs * ratio)));
+    // A margin of 10%: the legs come out uneven where the motion is not linear in the move.
+    legs = static_cast<int>(std::min<double>(kMaxVelocityLegs, std::ceil(legs * ratio * 1.1)));
   }
   SetCost(cost, &report);
   return report;
@@ -623,10 +643,11 @@ ArmStepReport StepUnlimited(const ArmModel& model, const ArmState& state,
 ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
                           const Eigen::VectorXd& target, const ArmOptions& options) {
   if (options.time_step > 0.0 && model.max_velocity.size() == model.num_links()) {
-    return VelocityLimitedStep(model, state, target, options,
-                               [&](const ArmState& from, const Eigen::VectorXd& goal) {
-                                 return StepUnlimited(model, from, goal, options);
-                               });
+    return VelocityLimitedStep(
+        model, state, target, options,
+        [&](const ArmState& from, const Eigen::VectorXd& goal, const ArmOptions& leg_options) {
+          return StepUnlimited(model, from, goal, leg_options);
+        });
   }
   return StepUnlimited(model, state, target, options);
 }
