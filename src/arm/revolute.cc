@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "arm/internal.h"
 #include "chain/substep.h"
@@ -89,6 +90,15 @@ Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle, Eige
   Points points(n + 1, 3);
   points.row(0) = model.base.transpose();
   if (axes != nullptr) axes->resize(n, 3);
+  // The half angles' sines and cosines, batched where the CPU allows (SinCosAll): the rotation
+  // about a by q is the quaternion (cos q/2, sin q/2 a), as Eigen's AngleAxis gives it.
+  thread_local std::vector<double> scratch;
+  scratch.resize(3 * static_cast<size_t>(n));
+  double* half = scratch.data();
+  double* sn = half + n;
+  double* cs = sn + n;
+  for (int j = 0; j < n; ++j) half[j] = 0.5 * angle[j];
+  SinCosAll(half, n, sn, cs);
   Eigen::Quaterniond frame = Eigen::Quaterniond::Identity();
   for (int j = 0; j < n; ++j) {
     const Eigen::Vector3d a = model.joint_axes.row(j).transpose();
@@ -101,7 +111,8 @@ Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle, Eige
           (frame * ((model.link_lengths[j] * RestDirection(model, j)) + angle[j] * a)).transpose();
       continue;
     }
-    frame = (frame * Eigen::Quaterniond(Eigen::AngleAxisd(angle[j], a))).normalized();
+    frame = (frame * Eigen::Quaterniond(cs[j], sn[j] * a.x(), sn[j] * a.y(), sn[j] * a.z()))
+                .normalized();
     points.row(j + 1) =
         points.row(j) + model.link_lengths[j] * (frame * RestDirection(model, j)).transpose();
   }
