@@ -163,11 +163,14 @@ class RobotResult:
     points: Float64Array  # (T, n+1, dim)
     ee_error: Float64Array
     base_error: Float64Array
+    pointing_error: Float64Array
+    velocity_ratio: Float64Array
     iterations: npt.NDArray[np.int64]
     sweeps: npt.NDArray[np.int64]
     passes: npt.NDArray[np.int64]
     legs: npt.NDArray[np.int64]
     restarts: npt.NDArray[np.int64]
+    velocity_legs: npt.NDArray[np.int64]
     converged: npt.NDArray[np.bool_]
     reached: npt.NDArray[np.bool_]
     stretched: npt.NDArray[np.bool_]
@@ -181,9 +184,11 @@ class RobotResult:
     unreached: int
     max_ee_error: float
     max_base_error: float
+    max_pointing_error: float
     max_iterations: int
     total_sweeps: int
     total_passes: int
+    total_velocity_legs: int
     seconds: float
     def brief_report(self) -> str: ...
 
@@ -320,7 +325,11 @@ class ArmModel:
                  max_bend: Optional[ArrayLike] = None, joint_axes: Optional[ArrayLike] = None,
                  link_directions: Optional[ArrayLike] = None,
                  initial_angles: Optional[ArrayLike] = None,
-                 initial_azimuths: Optional[ArrayLike] = None) -> None: ...
+                 initial_azimuths: Optional[ArrayLike] = None,
+                 joint_types: Optional[List[str]] = None,
+                 max_velocity: Optional[ArrayLike] = None,
+                 tip_rotation: Optional[ArrayLike] = None,
+                 joint_names: Optional[List[str]] = None) -> None: ...
     @staticmethod
     def straight(dim: int, links: int, link_length: float) -> "ArmModel": ...
     def validate(self) -> None: ...
@@ -333,6 +342,10 @@ class ArmModel:
     max_bend: Optional[Float64Array]
     joint_axes: Optional[Float64Array]  # (n, 3)
     link_directions: Optional[Float64Array]  # (n, 3)
+    joint_types: List[str]  # "revolute" / "prismatic" (arms with joint_axes), else []
+    max_velocity: Optional[Float64Array]  # (n,)
+    tip_rotation: Float64Array  # (4,) w, x, y, z
+    joint_names: List[str]
     initial_angles: Float64Array
     initial_azimuths: Optional[Float64Array]
     joint: str
@@ -348,9 +361,19 @@ class ArmOptions:
     restarts: int
     substeps: int
     edge_margin: float
+    time_step: float
+    pointing_axis: Float64Array  # (3,), tool frame
+    pointing_direction: Optional[Float64Array]  # (3,)
+    look_at: Optional[Float64Array]  # (3,)
+    pointing_weight: float
+    pointing_tolerance: float
     def __init__(self, *, method: str = "newton", tolerance: float = 1e-10,
                  max_iterations: int = 100, max_fixed_point_iterations: int = 100000,
-                 restarts: int = 8, substeps: int = 1, edge_margin: float = 1e-9) -> None: ...
+                 restarts: int = 8, substeps: int = 1, edge_margin: float = 1e-9,
+                 time_step: float = 0.0, pointing_axis: Optional[ArrayLike] = None,
+                 pointing_direction: Optional[ArrayLike] = None,
+                 look_at: Optional[ArrayLike] = None, pointing_weight: float = 1.0,
+                 pointing_tolerance: float = 1e-9) -> None: ...
     def validate(self) -> None: ...
 
 class ArmStepReport:
@@ -369,6 +392,9 @@ class ArmStepReport:
     joint_space: bool
     legs: int
     restarts: int
+    pointing_error: float
+    velocity_legs: int
+    velocity_ratio: float
     def brief_report(self) -> str: ...
 
 class RobotScenario:
@@ -394,7 +420,13 @@ def arm_step(model: ArmModel, target: ArrayLike, *, state: Optional[ArmStepRepor
 def track_path(model: ArmModel, path: ArrayLike, *, options: ArmOptionsArg = None,
                progress: Progress = None, output: Optional[PathLike] = None,
                csv: Optional[PathLike] = None) -> RobotResult: ...
-def arm_from_urdf(source: PathLike, *, base_link: str = "", tip_link: str = "") -> ArmModel: ...
+def joint_groups(model: ArmModel) -> List[List[int]]: ...
+def chain_points(model: ArmModel, points: ArrayLike) -> Float64Array: ...  # (g, dim)
+def joint_groups_report(model: ArmModel) -> str: ...
+def tool_pose(model: ArmModel, angles: ArrayLike
+              ) -> Tuple[Float64Array, Float64Array]: ...  # (3,), (3, 3)
+def arm_from_urdf(source: PathLike, *, base_link: str = "", tip_link: str = "",
+                  tip_offset: Optional[ArrayLike] = None) -> ArmModel: ...
 def urdf_from_arm(model: ArmModel, robot_name: str = "flexkin_arm") -> str: ...
 
 # The strand engine (docs/strands.md).

@@ -5,7 +5,11 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
+#include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "convert.h"
 #include "fields.h"
@@ -18,6 +22,12 @@ namespace {
 Eigen::VectorXd OptionalVector(py::handle object, const std::string& name, int size) {
   if (object.is_none()) return Eigen::VectorXd();
   return ReadArray(object, name, 1, 1, 0, size).cast<Eigen::VectorXd>();
+}
+// An optional (n,) argument whose values may be infinite (limits: -inf/inf for none) but not
+// NaN; the model's Validate checks the rest.
+Eigen::VectorXd OptionalLimits(py::handle object, const std::string& name, int size) {
+  if (object.is_none()) return Eigen::VectorXd();
+  return ReadArray(object, name, 1, 1, 0, size, true).cast<Eigen::VectorXd>();
 }
 Eigen::MatrixXd OptionalRows(py::handle object, const std::string& name, int rows) {
   if (object.is_none()) return Eigen::MatrixXd();
@@ -63,7 +73,86 @@ py::object AzimuthsOrNone(const Eigen::VectorXd& azimuth) {
   return azimuth.size() > 0 ? py::object(ToArray(azimuth)) : py::none();
 }
 
+// Joint types from names ("revolute", "prismatic"), field joint_types[j].
+std::vector<JointType> JointTypesArg(const std::vector<std::string>& names) {
+  std::vector<JointType> types;
+  for (size_t j = 0; j < names.size(); ++j) {
+    types.push_back(ParseName<JointType>(names[j], "joint_types[" + std::to_string(j) + "]"));
+  }
+  return types;
+}
+// The joint types by name: n names for an arm with joint axes (every joint revolute where the
+// model lists none), [] for other arms.
+std::vector<std::string> JointTypeNames(const ArmModel& a) {
+  std::vector<std::string> names;
+  if (!a.has_axes()) return names;
+  for (int j = 0; j < a.num_links(); ++j)
+    names.emplace_back(NameOf(a.prismatic(j) ? JointType::kPrismatic : JointType::kRevolute));
+  return names;
+}
+
+// The Python names of ArmOptions' pointing members (flat keywords).
+std::string PythonOptionField(const std::string& field) {
+  static const std::pair<const char*, const char*> kNames[] = {
+      {"pointing.axis", "pointing_axis"},
+      {"pointing.direction", "pointing_direction"},
+      {"pointing.point", "look_at"},
+      {"pointing.weight", "pointing_weight"},
+      {"pointing.angle_tolerance", "pointing_tolerance"}};
+  for (const auto& [cc, py] : kNames) {
+    if (field == cc) return py;
+  }
+  return field;
+}
+Problems PythonOptionProblems(Problems problems) {
+  for (Problem& p : problems) p.field = PythonOptionField(p.field);
+  return problems;
+}
+
+// A (3,) vector argument of the pointing options; `name` in errors.
+Eigen::Vector3d Vector3Arg(py::handle object, const std::string& name) {
+  return ReadVector(object, name, 3);
+}
+
+// Sets the pointing direction (None: pointing off unless it looks at a point). Refused while
+// look_at is set: the two exclude each other.
+void SetPointingDirection(ArmOptions& o, py::handle value) {
+  ArmOptions::Pointing& p = o.pointing;
+  if (value.is_none()) {
+    if (!p.look_at) p.enabled = false;
+    return;
+  }
+  if (p.enabled && p.look_at) {
+    ThrowInput("pointing_direction",
+               "is given together with look_at; expected one of pointing_direction (a direction "
+               "to point along) and look_at (a point to look at)");
+  }
+  p.direction = Vector3Arg(value, "pointing_direction");
+  p.enabled = true;
+  p.look_at = false;
+}
+void SetLookAt(ArmOptions& o, py::handle value) {
+  ArmOptions::Pointing& p = o.pointing;
+  if (value.is_none()) {
+    if (p.look_at) p.enabled = false;
+    p.look_at = false;
+    return;
+  }
+  if (p.enabled && !p.look_at) {
+    ThrowInput("look_at",
+               "is given together with pointing_direction; expected one of pointing_direction (a "
+               "direction to point along) and look_at (a point to look at)");
+  }
+  p.point = Vector3Arg(value, "look_at");
+  p.enabled = true;
+  p.look_at = true;
+}
+
 }  // namespace
+
+void ThrowIfAnyArmOptions(const ArmOptions& options) {
+  ThrowIfAny(PythonOptionProblems(options.Validate()));
+}
 
 const ArmModel& ModelArg(py::handle model) {
   if (!py::isinstance<ArmModel>(model)) {
@@ -81,49 +170,70 @@ A fixed-base arm (flexkin::ArmModel, docs/robots.md), robot order: link 1 at the
 
 ArmModel(link_lengths, *, dim=2, base=None, base_direction=None, joint_min=None,
          joint_max=None, max_bend=None, joint_axes=None, link_directions=None,
-         initial_angles=None, initial_azimuths=None)
-  link_lengths: (n,) positive; base: (dim,) where the base is bolted (default the origin);
+         initial_angles=None, initial_azimuths=None, joint_types=None, max_velocity=None,
+         tip_rotation=None, joint_names=None)
+  link_lengths: (n,) positive (with joint_axes a link may have length 0: joints at one point,
+    as long as the sum is positive); base: (dim,) where the base is bolted (default the origin);
   base_direction: (dim,) the direction of "link 0" (default +x);
-  joint_min, joint_max: (n,) revolute limits (rad) in [-pi, pi]; max_bend: (n,) spherical limits;
-  joint_axes, link_directions: (n, 3) spatial revolute joints (URDF arms);
-  initial_angles, initial_azimuths: (n,) the start (default 0).
-Planar arms (dim 2) and arms with joint_axes have revolute joints, other spatial arms spherical.
+  joint_min, joint_max: (n,) joint limits: planar arms in [-pi, pi] (rad); with joint_axes as
+    written (rad, or length unit for prismatic joints; -inf/+inf for continuous joints);
+  max_bend: (n,) spherical limits;
+  joint_axes, link_directions: (n, 3) spatial joints about/along axes (URDF arms);
+  initial_angles, initial_azimuths: (n,) the start (default 0);
+  joint_types: n of "revolute", "prismatic" (with joint_axes; default every joint revolute);
+  max_velocity: (n,) joint speed limits (rad/s or length unit/s; inf: none), used where
+    ArmOptions.time_step > 0 (planar arms and arms with joint_axes);
+  tip_rotation: (4,) unit quaternion w, x, y, z: the tool frame in the last link's frame
+    (with joint_axes; default the identity);
+  joint_names: n str, the joints' names in reports (default "joint 0", "joint 1", ...).
+Planar arms (dim 2) have revolute joints, arms with joint_axes revolute and prismatic ones,
+other spatial arms spherical.
 )doc");
   model
-      .def(py::init([](ArrayLike link_lengths, int dim, OptionalArray base, OptionalArray direction,
-                       OptionalArray joint_min, OptionalArray joint_max, OptionalArray max_bend,
-                       OptionalArray joint_axes, OptionalArray link_directions,
-                       OptionalArray angles, OptionalArray azimuths) {
-             ArmModel a;
-             a.dim = dim;
-             if (dim != 2 && dim != 3) {
-               throw InputError(Problem::Invalid("dim", std::to_string(dim), "2 or 3"));
-             }
-             a.link_lengths =
-                 ReadArray(link_lengths, "link_lengths", 1, 1, 0, -1).cast<Eigen::VectorXd>();
-             const int n = a.num_links();
-             a.base = base.is_none() ? Eigen::VectorXd::Zero(dim) : ReadVector(base, "base", dim);
-             a.base_direction = direction.is_none() ? Eigen::VectorXd::Unit(dim, 0)
-                                                    : ReadVector(direction, "base_direction", dim);
-             a.joint_min = OptionalVector(joint_min, "joint_min", n);
-             a.joint_max = OptionalVector(joint_max, "joint_max", n);
-             a.max_bend = OptionalVector(max_bend, "max_bend", n);
-             a.joint_axes = OptionalRows(joint_axes, "joint_axes", n);
-             a.link_directions = OptionalRows(link_directions, "link_directions", n);
-             const bool spherical = dim == 3 && a.joint_axes.size() == 0;
-             a.initial.angle = angles.is_none() ? Eigen::VectorXd::Zero(n)
-                                                : OptionalVector(angles, "initial_angles", n);
-             a.initial.azimuth = azimuths.is_none()
-                                     ? (spherical ? Eigen::VectorXd::Zero(n) : Eigen::VectorXd())
-                                     : OptionalVector(azimuths, "initial_azimuths", n);
-             ThrowIfAny(a.Validate());
-             return a;
-           }),
-           py::arg("link_lengths"), py::kw_only(), py::arg("dim") = 2, py::arg("base") = py::none(),
-           py::arg("base_direction") = py::none(), py::arg("joint_min") = py::none(),
-           py::arg("joint_max") = py::none(), py::arg("max_bend") = py::none(),
-           py::arg("joint_axes") = py::none(), py::arg("link_directions") = py::none(),
-           py::arg("initial_angles") = py::none(), py::arg("initial_azimuths") = py::none())
+      .def(
+          py::init([](ArrayLike link_lengths, int dim, OptionalArray base, OptionalArray direction,
+                      OptionalArray joint_min, OptionalArray joint_max, OptionalArray max_bend,
+                      OptionalArray joint_axes, OptionalArray link_directions, OptionalArray angles,
+                      OptionalArray azimuths, std::optional<std::vector<std::string>> joint_types,
+                      OptionalArray max_velocity, OptionalArray tip_rotation,
+                      std::optional<std::vector<std::string>> joint_names) {
+            ArmModel a;
+            a.dim = dim;
+            if (dim != 2 && dim != 3) {
+              throw InputError(Problem::Invalid("dim", std::to_string(dim), "2 or 3"));
+            }
+            a.link_lengths =
+                ReadArray(link_lengths, "link_lengths", 1, 1, 0, -1).cast<Eigen::VectorXd>();
+            const int n = a.num_links();
+            a.base = base.is_none() ? Eigen::VectorXd::Zero(dim) : ReadVector(base, "base", dim);
+            a.base_direction = direction.is_none() ? Eigen::VectorXd::Unit(dim, 0)
+                                                   : ReadVector(direction, "base_direction", dim);
+            a.joint_min = OptionalLimits(joint_min, "joint_min", n);
+            a.joint_max = OptionalLimits(joint_max, "joint_max", n);
+            a.max_bend = OptionalVector(max_bend, "max_bend", n);
+            a.joint_axes = OptionalRows(joint_axes, "joint_axes", n);
+            a.link_directions = OptionalRows(link_directions, "link_directions", n);
+            const bool spherical = dim == 3 && a.joint_axes.size() == 0;
+            a.initial.angle = angles.is_none() ? Eigen::VectorXd::Zero(n)
+                                               : OptionalVector(angles, "initial_angles", n);
+            a.initial.azimuth = azimuths.is_none()
+                                    ? (spherical ? Eigen::VectorXd::Zero(n) : Eigen::VectorXd())
+                                    : OptionalVector(azimuths, "initial_azimuths", n);
+            if (joint_types) a.joint_types = JointTypesArg(*joint_types);
+            a.max_velocity = OptionalLimits(max_velocity, "max_velocity", n);
+            if (!tip_rotation.is_none())
+              a.tip_rotation = ReadVector(tip_rotation, "tip_rotation", 4);
+            if (joint_names) a.joint_names = *joint_names;
+            ThrowIfAny(a.Validate());
+            return a;
+          }),
+          py::arg("link_lengths"), py::kw_only(), py::arg("dim") = 2, py::arg("base") = py::none(),
+          py::arg("base_direction") = py::none(), py::arg("joint_min") = py::none(),
+          py::arg("joint_max") = py::none(), py::arg("max_bend") = py::none(),
+          py::arg("joint_axes") = py::none(), py::arg("link_directions") = py::none(),
+          py::arg("initial_angles") = py::none(), py::arg("initial_azimuths") = py::none(),
+          py::arg("joint_types") = py::none(), py::arg("max_velocity") = py::none(),
+          py::arg("tip_rotation") = py::none(), py::arg("joint_names") = py::none())
       .def_static(
           "straight",
           [](int dim, int links, double link_length) {
@@ -167,9 +277,14 @@ Planar arms (dim 2) and arms with joint_axes have revolute joints, other spatial
       .Array("base_direction", &ArmModel::base_direction,
              "(dim,) float64: the direction of \"link 0\", which joint 0 turns link 1 from.")
       .Array("joint_min", &ArmModel::joint_min,
-             "(n,) float64: revolute lower limits (radians, >= -pi), or None (no limits).", true)
+             "(n,) float64: joint lower limits, or None (no limits): radians, >= -pi on planar "
+             "arms; with joint_axes as written (radians, or length unit for prismatic joints; "
+             "-inf for a continuous joint).",
+             true)
       .Array("joint_max", &ArmModel::joint_max,
-             "(n,) float64: revolute upper limits (radians, <= pi), or None.", true)
+             "(n,) float64: joint upper limits (radians, <= pi on planar arms; with joint_axes as "
+             "written, +inf for a continuous joint), or None.",
+             true)
       .Array("max_bend", &ArmModel::max_bend,
              "(n,) float64: spherical limits, the largest bend angle of each joint (radians, "
              "(0, pi]), or None.",
@@ -183,6 +298,25 @@ Planar arms (dim 2) and arms with joint_axes have revolute joints, other spatial
              "None (every link along base_direction).",
              true)
       .Property(
+          "joint_types", &JointTypeNames,
+          [](ArmModel& a, py::handle v) {
+            a.joint_types = JointTypesArg(py::cast<std::vector<std::string>>(v));
+          },
+          "list of str: each joint's type, 'revolute' or 'prismatic' (arms with joint_axes; "
+          "[] for planar and spherical arms).")
+      .Array("max_velocity", &ArmModel::max_velocity,
+             "(n,) float64: joint speed limits (radians/s, or length unit/s for prismatic "
+             "joints; inf: none), used where ArmOptions.time_step > 0; or None (no limits).",
+             true)
+      .Property(
+          "tip_rotation",
+          [](const ArmModel& a) { return ToArray(Eigen::VectorXd(a.tip_rotation)); },
+          [](ArmModel& a, py::handle v) { a.tip_rotation = ReadVector(v, "tip_rotation", 4); },
+          "(4,) float64: the tool frame in the last link's frame, a unit quaternion (w, x, y, "
+          "z) (arms with joint_axes; the pointing axis is given in it).")
+      .Member("joint_names", &ArmModel::joint_names,
+              "list of str: the joints' names (a URDF's), or [] (reports say \"joint 0\", ...).")
+      .Property(
           "initial_angles", [](const ArmModel& a) { return ToArray(a.initial.angle); },
           [](ArmModel& a, py::handle v) { a.initial.angle = EigenIn<Eigen::VectorXd>(v); },
           "(n,) float64: the joint angles at the start (radians).")
@@ -193,13 +327,27 @@ Planar arms (dim 2) and arms with joint_axes have revolute joints, other spatial
       .Finish(false, [](ArmModel& a) { ThrowIfAny(a.Validate()); });
 
   py::class_<ArmOptions> options(m, "ArmOptions", R"doc(
-Options of the fixed-base solver (flexkin::ArmOptions; a robot scenario's "solver").
+Options of the fixed-base solver (flexkin::ArmOptions; a robot scenario's "solver", and its
+"pointing").
 ArmOptions(method="newton", tolerance=1e-10, max_iterations=100,
-           max_fixed_point_iterations=100000, restarts=8, substeps=1, edge_margin=1e-9)
+           max_fixed_point_iterations=100000, restarts=8, substeps=1, edge_margin=1e-9,
+           time_step=0.0, pointing_axis=None, pointing_direction=None, look_at=None,
+           pointing_weight=1.0, pointing_tolerance=1e-9)
+  time_step: the time between two path points (s) for ArmModel.max_velocity; 0: limits ignored.
+Pointing (arms with joint_axes, method newton): a tool axis is turned along a direction or
+toward a point as the end effector tracks its target. Pointing is on where pointing_direction
+or look_at is given (not both: InputError).
+  pointing_axis: (3,) the axis in the tool frame (ArmModel.tip_rotation; default +x).
+  pointing_direction: (3,) the world direction to point along, non-zero; or
+  look_at: (3,) the point to look at.
+  pointing_weight: > 0, mean link lengths per radian of angular miss (default 1).
+  pointing_tolerance: the angle (rad) within which a step counts as pointed (default 1e-9).
 )doc");
   options.def(
       py::init([](const std::string& method, double tolerance, int max_iterations,
-                  int max_fixed_point_iterations, int restarts, int substeps, double edge_margin) {
+                  int max_fixed_point_iterations, int restarts, int substeps, double edge_margin,
+                  double time_step, OptionalArray pointing_axis, OptionalArray pointing_direction,
+                  OptionalArray look_at, double pointing_weight, double pointing_tolerance) {
         ArmOptions o;
         o.method = ParseFixedBaseMethod(method);
         o.tolerance = tolerance;
@@ -208,14 +356,31 @@ ArmOptions(method="newton", tolerance=1e-10, max_iterations=100,
         o.restarts = restarts;
         o.substeps = substeps;
         o.edge_margin = edge_margin;
-        ThrowIfAny(o.Validate());
+        o.time_step = time_step;
+        if (!pointing_direction.is_none() && !look_at.is_none()) {
+          ThrowInput("pointing_direction",
+                     "and look_at are both given; expected one of them (a direction to point "
+                     "along, or a point to look at)");
+        }
+        if (!pointing_axis.is_none()) o.pointing.axis = Vector3Arg(pointing_axis, "pointing_axis");
+        SetPointingDirection(o, pointing_direction);
+        SetLookAt(o, look_at);
+        o.pointing.weight = pointing_weight;
+        o.pointing.angle_tolerance = pointing_tolerance;
+        ThrowIfAnyArmOptions(o);
         return o;
       }),
       py::kw_only(), py::arg("method") = "newton", py::arg("tolerance") = 1e-10,
       py::arg("max_iterations") = 100, py::arg("max_fixed_point_iterations") = 100000,
-      py::arg("restarts") = 8, py::arg("substeps") = 1, py::arg("edge_margin") = 1e-9);
+      py::arg("restarts") = 8, py::arg("substeps") = 1, py::arg("edge_margin") = 1e-9,
+      py::arg("time_step") = 0.0, py::arg("pointing_axis") = py::none(),
+      py::arg("pointing_direction") = py::none(), py::arg("look_at") = py::none(),
+      py::arg("pointing_weight") = 1.0, py::arg("pointing_tolerance") = 1e-9);
+  options.def(
+      "validate", [](const ArmOptions& o) { ThrowIfAnyArmOptions(o); },
+      "Raises InputError for the first problem, naming the member ('max_iterations', "
+      "'pointing_direction'); returns None if there is none.");
   Fields<ArmOptions>(options, "ArmOptions")
-      .Validate("max_iterations")
       .Property(
           "method", [](const ArmOptions& o) { return std::string(FixedBaseMethodName(o.method)); },
           [](ArmOptions& o, py::handle name) {
@@ -241,12 +406,56 @@ ArmOptions(method="newton", tolerance=1e-10, max_iterations=100,
               "Targets beyond (1 - edge_margin) times the reach are out of reach: the arm is "
               "stretched toward them (dimensionless; default 1e-9).",
               true)
+      .Member("time_step", &ArmOptions::time_step,
+              "The time between two path points (float, seconds) for the model's max_velocity: "
+              "a step that would exceed a limit is split into legs (default 0: limits ignored).",
+              true)
+      .Property(
+          "pointing_axis",
+          [](const ArmOptions& o) { return ToArray(Eigen::VectorXd(o.pointing.axis)); },
+          [](ArmOptions& o, py::handle v) { o.pointing.axis = Vector3Arg(v, "pointing_axis"); },
+          "(3,) float64: the tool axis that pointing turns, in the tool frame "
+          "(ArmModel.tip_rotation; default +x).",
+          true)
+      .Property(
+          "pointing_direction",
+          [](const ArmOptions& o) {
+            return o.pointing.enabled && !o.pointing.look_at
+                       ? py::object(ToArray(Eigen::VectorXd(o.pointing.direction)))
+                       : py::object(py::none());
+          },
+          &SetPointingDirection,
+          "(3,) float64: the world direction the tool axis points along, or None (setting it "
+          "turns pointing on; refused while look_at is set).",
+          true)
+      .Property(
+          "look_at",
+          [](const ArmOptions& o) {
+            return o.pointing.enabled && o.pointing.look_at
+                       ? py::object(ToArray(Eigen::VectorXd(o.pointing.point)))
+                       : py::object(py::none());
+          },
+          &SetLookAt,
+          "(3,) float64: the point the tool axis looks at, or None (setting it turns pointing "
+          "on; refused while pointing_direction is set).",
+          true)
+      .Property(
+          "pointing_weight", [](const ArmOptions& o) { return o.pointing.weight; },
+          [](ArmOptions& o, py::handle v) { o.pointing.weight = py::cast<double>(v); },
+          "float > 0: mean link lengths per radian of angular miss (default 1).", true)
+      .Property(
+          "pointing_tolerance", [](const ArmOptions& o) { return o.pointing.angle_tolerance; },
+          [](ArmOptions& o, py::handle v) { o.pointing.angle_tolerance = py::cast<double>(v); },
+          "float: the angle (radians) within which a pointed step counts as reached (default "
+          "1e-9).",
+          true)
       .Finish();
 
   py::class_<ArmStepReport> step(m, "ArmStepReport", R"doc(
 One step of a fixed-base arm (flexkin.arm_step): points (n+1, dim) base first, angles (n,),
 azimuths (n,) or None, ee_error, base_error, iterations, sweeps, passes, converged, reached,
-stretched, limited, joint_space, legs, restarts. Pass it as `state` to the next arm_step to
+stretched, limited, joint_space, legs, restarts, pointing_error, velocity_legs, velocity_ratio.
+Pass it as `state` to the next arm_step to
 continue from it (with the solver's memory, which pickles with it).
 )doc");
   Fields<ArmStepReport>(step, "ArmStepReport")
@@ -286,6 +495,15 @@ continue from it (with the solver's memory, which pickles with it).
       .Member("legs", &ArmStepReport::legs,
               "Legs a far move was tracked in (0: one sweep; docs/robots.md).")
       .Member("restarts", &ArmStepReport::restarts, "Joint-space solves after the first.")
+      .Member("pointing_error", &ArmStepReport::pointing_error,
+              "float: with pointing, the angle (radians) between the tool axis and where it "
+              "should point; 0 without.")
+      .Member("velocity_legs", &ArmStepReport::velocity_legs,
+              "int: with time_step, the legs the step took to keep every joint within its "
+              "velocity limit (1: as asked); 0 without.")
+      .Member("velocity_ratio", &ArmStepReport::velocity_ratio,
+              "float: with time_step, the largest joint speed over its limit in any leg (<= 1: "
+              "limits kept); 0 without.")
       .Hidden("memory_translation", MemoryGet(&ArmSolverMemory::translation),
               MemorySet(&ArmSolverMemory::translation))
       .Hidden("memory_earlier_translations", MemoryGet(&ArmSolverMemory::earlier_translations),
@@ -347,12 +565,59 @@ continue from it (with the solver's memory, which pickles with it).
       "Whether every joint angle (n,) (radians) is within the model's limits, with `slack` "
       "radians of tolerance (default 0). True for a model without limits.");
   m.def(
+      "joint_groups", [](ModelObject model) { return JointGroups(ModelArg(model)); },
+      py::arg("model"),
+      "The joints of each distinct point of the chain, base first: a list of lists of int "
+      "(joint indices). Joints joined by links of length 0 share a point (two revolute joints: "
+      "a universal joint, three: a spherical one); a prismatic joint ends its group; the last "
+      "group may hold the tip (a tip on its joint).");
+  m.def(
+      "chain_points",
+      [](ModelObject model, ArrayLike points) {
+        const ArmModel& a = ModelArg(model);
+        const Points p = ReadPoints(points, "points", a.num_links() + 1, a.dim);
+        if (p.rows() != a.num_links() + 1) {
+          ThrowInput("points", "has " + std::to_string(p.rows()) + " rows; expected " +
+                                   std::to_string(a.num_links() + 1) + " (n+1)");
+        }
+        return ToArray(ChainPoints(a, p));
+      },
+      py::arg("model"), py::arg("points"),
+      "The chain as drawn and written to files: of the arm's (n+1, dim) points (base first, as "
+      "forward_kinematics gives them), one per joint group (joint_groups) plus the end effector "
+      "where it is a point of its own; a (g, dim) float64 array.");
+  m.def(
+      "joint_groups_report", [](ModelObject model) { return JointGroupsReport(ModelArg(model)); },
+      py::arg("model"),
+      "The joint groups of more than one joint in words, one per line (str; 'joints \"m1_pitch\" "
+      "and \"m1_yaw\" act at one point (a universal joint)'); '' if every joint has its own "
+      "point.");
+  m.def(
+      "tool_pose",
+      [](ModelObject model, ArrayLike angles) {
+        const ArmModel& a = ModelArg(model);
+        if (!a.has_axes()) {
+          ThrowInput("model",
+                     "has no joint axes; the tool frame is defined for arms with joint_axes "
+                     "(URDF arms)");
+        }
+        const ToolPose pose = ToolPoseAt(a, AnglesArg(a, angles, py::none()));
+        return py::make_tuple(ToArray(Eigen::VectorXd(pose.position)),
+                              ToArray(Points(pose.rotation)));
+      },
+      py::arg("model"), py::arg("angles"),
+      "The tool frame of an arm with joint_axes at the joint values angles (n,) (radians, or "
+      "length unit for prismatic joints): a tuple (position (3,) float64, the end effector; "
+      "rotation (3, 3) float64, the tip link's frame in the world, its columns the tool axes; "
+      "ArmModel.tip_rotation in the last link's frame).");
+  m.def(
       "arm_step",
       [](ModelObject model, ArrayLike target, StepState state, ArmOptionsLike options) {
         const ArmModel& a = ModelArg(model);
         ThrowIfAny(a.Validate());
         const Eigen::VectorXd t = ReadVector(target, "target", a.dim);
         const ArmOptions o = OptionsArg<ArmOptions>(options, "options");
+        ThrowIfAnyArmOptions(o);
         if (!state.is_none() && !py::isinstance<ArmStepReport>(state)) {
           const std::string type = py::str(py::type::of(state).attr("__name__"));
           ThrowInput("state",
@@ -378,6 +643,7 @@ continue from it (with the solver's memory, which pickles with it).
         ThrowIfAny(s.model.Validate());
         s.path = ReadPoints(path, "path", 1, s.model.dim);
         s.options = OptionsArg<ArmOptions>(options, "options");
+        ThrowIfAnyArmOptions(s.options);
         return TrackToResult(s, std::move(progress), output, csv);
       },
       py::arg("model"), py::arg("path"), py::kw_only(), py::arg("options") = py::none(),

@@ -46,7 +46,8 @@ void ThrowInput(const std::string& field, const std::string& message, const std:
 }
 
 py::array_t<double, py::array::c_style> ReadArray(py::handle object, const std::string& name,
-                                                  int ndim, int min_rows, int cols, int size) {
+                                                  int ndim, int min_rows, int cols, int size,
+                                                  bool allow_infinite) {
   const std::string expected = ExpectedShape(ndim, min_rows, cols, size);
   if (object.is_none()) ThrowInput(name, "is None; expected " + expected, "None", expected);
   py::array array;
@@ -98,11 +99,12 @@ py::array_t<double, py::array::c_style> ReadArray(py::handle object, const std::
   const double* data = result.data();
   const py::ssize_t count = result.size();
   for (py::ssize_t k = 0; k < count; ++k) {
-    if (!std::isfinite(data[k])) {
+    if (std::isnan(data[k]) || (!allow_infinite && !std::isfinite(data[k]))) {
       const std::string where = ndim == 2 ? name + "[" + std::to_string(k / result.shape(1)) +
                                                 "][" + std::to_string(k % result.shape(1)) + "]"
                                           : name + "[" + std::to_string(k) + "]";
-      throw InputError(Problem::Invalid(where, Num(data[k]), "a finite number"));
+      throw InputError(Problem::Invalid(
+          where, Num(data[k]), allow_infinite ? "a number (inf: none)" : "a finite number"));
     }
   }
   return result;

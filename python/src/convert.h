@@ -87,11 +87,11 @@ namespace flexkin::python {
 
 // The float64, C-contiguous form of `object`, checked: `ndim` dimensions (1 or 2); with ndim 2,
 // at least `min_rows` rows and 2 or 3 columns (`cols` if it is not 0); with ndim 1, `size`
-// values if it is > 0 (2 or 3 if it is 0, any number >= 1 if it is < 0). Every value finite. Throws
-// InputError naming `name`.
+// values if it is > 0 (2 or 3 if it is 0, any number >= 1 if it is < 0). Every value finite
+// (or, if `allow_infinite`, not NaN: limits, -inf/inf for none). Throws InputError naming `name`.
 py::array_t<double, py::array::c_style> ReadArray(py::handle object, const std::string& name,
                                                   int ndim, int min_rows = 1, int cols = 0,
-                                                  int size = 0);
+                                                  int size = 0, bool allow_infinite = false);
 
 // Checked (n, dim) points (see ReadArray) copied into flexkin's Points.
 Points ReadPoints(py::handle object, const std::string& name, int min_rows = 1, int cols = 0);
@@ -140,6 +140,9 @@ py::object TrackToResult(const RobotScenario& scenario, py::object progress, py:
                          py::handle csv);
 // The model argument: an ArmModel, else InputError naming "model" (arm.cc).
 const ArmModel& ModelArg(py::handle model);
+// Raises InputError for the first problem of ArmOptions::Validate, the pointing members named
+// as the Python keywords (pointing.direction -> pointing_direction, pointing.point -> look_at).
+void ThrowIfAnyArmOptions(const ArmOptions& options);
 // The robot scenario readers' options: URDF arms read where the URDF component is built,
 // relative "urdf" files looked up in `directory` (None: the default).
 RobotScenarioOptions RobotReaderOptions(py::handle directory);

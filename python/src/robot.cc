@@ -24,8 +24,10 @@ namespace flexkin::python {
 namespace {
 
 // The per-step arrays of a RobotResult, in the order of their docs.
-constexpr const char* kFloatSteps[] = {"ee_error", "base_error"};
-constexpr const char* kIntSteps[] = {"iterations", "sweeps", "passes", "legs", "restarts"};
+constexpr const char* kFloatSteps[] = {"ee_error", "base_error", "pointing_error",
+                                       "velocity_ratio"};
+constexpr const char* kIntSteps[] = {"iterations", "sweeps",   "passes",
+                                     "legs",       "restarts", "velocity_legs"};
 constexpr const char* kBoolSteps[] = {"converged", "reached", "stretched", "limited",
                                       "joint_space"};
 
@@ -74,8 +76,8 @@ class StepArrays : public ArmStepSink {
       std::memcpy(azimuth_data_ + t * links_, s.state.angles.azimuth.data(),
                   sizeof(double) * static_cast<size_t>(links_));
     }
-    const double f[] = {s.ee_error, s.base_error};
-    const int64_t i[] = {s.iterations, s.sweeps, s.passes, s.legs, s.restarts};
+    const double f[] = {s.ee_error, s.base_error, s.pointing_error, s.velocity_ratio};
+    const int64_t i[] = {s.iterations, s.sweeps, s.passes, s.legs, s.restarts, s.velocity_legs};
     const bool b[] = {s.converged, s.reached, s.stretched, s.limited, s.joint_space};
     for (size_t k = 0; k < float_data_.size(); ++k) float_data_[k][t] = f[k];
     for (size_t k = 0; k < int_data_.size(); ++k) int_data_[k][t] = i[k];
@@ -132,7 +134,8 @@ RobotResult Track(const RobotScenario& s, py::object progress, const std::string
                   const std::string& csv) {
   const ArmModel& model = s.model;
   ThrowIfAny(model.Validate());
-  ThrowIfAny(s.options.Validate());
+  ThrowIfAnyArmOptions(s.options);
+  ThrowIfAny(s.options.ValidateFor(model));
   const int64_t links = model.num_links(), dim = model.dim;
   const bool spherical = model.joint() == ArmJoint::kSpherical;
   RobotResult r;
@@ -208,11 +211,20 @@ constexpr ArrayDoc kArrays[] = {
     {"points", "(T, n+1, dim) float64: the link points after each step, base first."},
     {"ee_error", "(T,) float64: |end effector - target| after each step (length unit)."},
     {"base_error", "(T,) float64: each step's last base residual (length unit)."},
+    {"pointing_error",
+     "(T,) float64: with pointing, the angle between the tool axis and where it should point "
+     "after each step (radians); 0 without."},
+    {"velocity_ratio",
+     "(T,) float64: with time_step, each step's largest joint speed over its limit (<= 1: "
+     "limits kept); 0 without."},
     {"iterations", "(T,) int64: solver iterations of each step."},
     {"sweeps", "(T,) int64: sweeps from the end effector of each step."},
     {"passes", "(T,) int64: passes over the links of each step."},
     {"legs", "(T,) int64: legs a far move was tracked in (0: one sweep)."},
     {"restarts", "(T,) int64: joint-space solves after the first."},
+    {"velocity_legs",
+     "(T,) int64: with time_step, the legs each step took to keep the velocity limits (1: as "
+     "asked); 0 without."},
     {"converged", "(T,) bool: the base residual reached the tolerance."},
     {"reached", "(T,) bool: the target was reached."},
     {"stretched", "(T,) bool: out of reach, the arm stretched toward the target."},
@@ -255,10 +267,12 @@ T = the number of path targets; row t is the state after the step to path[t].
   points: (T, n+1, dim) link points, base first
   initial_angles (n,), initial_azimuths (n,) or None, initial_points (n+1, dim): before the path
   path: (T, dim) the end effector's targets; link_lengths (n,), base (dim,)
-  per step (T,): ee_error, base_error (float64); iterations, sweeps, passes, legs, restarts
-    (int64); converged, reached, stretched, limited, joint_space (bool)
-  summary: num_steps, unreached, max_ee_error, max_base_error, max_iterations, total_sweeps,
-    total_passes, seconds; scenario, method ("newton", "fixed_point"), joint, dim
+  per step (T,): ee_error, base_error, pointing_error, velocity_ratio (float64); iterations,
+    sweeps, passes, legs, restarts, velocity_legs (int64); converged, reached, stretched,
+    limited, joint_space (bool)
+  summary: num_steps, unreached, max_ee_error, max_base_error, max_pointing_error,
+    max_iterations, total_sweeps, total_passes, total_velocity_legs, seconds; scenario, method
+    ("newton", "fixed_point"), joint, dim
 )doc");
   Fields<RobotResult> fields(c, "RobotResult");
   for (const ArrayDoc& array : kArrays) {
@@ -281,12 +295,16 @@ T = the number of path targets; row t is the state after the step to path[t].
               "Largest ee_error (length unit).")
       .Nested("max_base_error", &RobotResult::summary, &ArmTrajectory::max_base_error,
               "Largest base_error (length unit).")
+      .Nested("max_pointing_error", &RobotResult::summary, &ArmTrajectory::max_pointing_error,
+              "Largest pointing_error (radians; 0 without pointing).")
       .Nested("max_iterations", &RobotResult::summary, &ArmTrajectory::max_iterations,
               "Most solver iterations of one step.")
       .Nested("total_sweeps", &RobotResult::summary, &ArmTrajectory::total_sweeps,
               "Sweeps of all steps.")
       .Nested("total_passes", &RobotResult::summary, &ArmTrajectory::total_passes,
               "Passes over the links of all steps.")
+      .Nested("total_velocity_legs", &RobotResult::summary, &ArmTrajectory::velocity_legs,
+              "Legs of all steps with time_step (0 without).")
       .Nested("seconds", &RobotResult::summary, &ArmTrajectory::seconds,
               "Wall time of the tracking (seconds).")
       .Hidden(
@@ -312,6 +330,7 @@ RobotScenario(model, path, *, options=None, name="")
                  ThrowIfAny(s.model.Validate());
                  s.path = ReadPoints(path, "path", 1, s.model.dim);
                  s.options = OptionsArg<ArmOptions>(options, "options");
+                 ThrowIfAnyArmOptions(s.options);
                  s.name = name;
                  return s;
                }),

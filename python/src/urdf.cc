@@ -20,8 +20,11 @@ bool IsUrdfText(py::handle source) {
 }
 
 ArmModel ArmFromUrdfArg(UrdfSource source, const std::string& base_link,
-                        const std::string& tip_link) {
-  const UrdfChain chain{base_link, tip_link};
+                        const std::string& tip_link, OptionalArray tip_offset) {
+  UrdfChain chain;
+  chain.base_link = base_link;
+  chain.tip_link = tip_link;
+  if (!tip_offset.is_none()) chain.tip_offset = ReadVector(tip_offset, "tip_offset", 3);
   if (IsUrdfText(source)) {
     const std::string text = py::cast<std::string>(source);
     py::gil_scoped_release release;
@@ -41,23 +44,31 @@ ArmModel ArmFromUrdfArg(UrdfSource source, const std::string& base_link,
 
 void BindUrdf(py::module_& m) {
   m.def("arm_from_urdf", &ArmFromUrdfArg, py::arg("source"), py::kw_only(),
-        py::arg("base_link") = "", py::arg("tip_link") = "", R"doc(
-Reads an arm from a URDF (Unified Robot Description Format; docs/robots.md): the serial chain
-from base_link to tip_link, every revolute or continuous joint one joint of the arm, fixed
-joints merged into the links. Returns an ArmModel (planar where every axis is +z and the links
-lie along one direction of the z = 0 plane; spatial revolute with joint_axes otherwise).
+        py::arg("base_link") = "", py::arg("tip_link") = "", py::arg("tip_offset") = py::none(),
+        R"doc(
+Reads an arm from a URDF (Unified Robot Description Format; docs/robots.md): any serial chain
+from base_link to tip_link. Returns an ArmModel (planar where every axis is +z and the links
+lie along one direction of the z = 0 plane; spatial with joint_axes otherwise).
 
-arm_from_urdf(source, *, base_link="", tip_link="")
+arm_from_urdf(source, *, base_link="", tip_link="", tip_offset=None)
   source: URDF text (a str whose first non-blank character is '<') or the path of a URDF file
     (any other str, or an os.PathLike such as pathlib.Path).
   base_link: the link the arm is bolted to; "" = the URDF's root link.
   tip_link: the end effector's link; "" = the one leaf below base_link.
-Limits: a revolute joint's [lower, upper] (radians) cut to [-pi, pi]; continuous joints get
-[-pi, pi] when any other joint has limits. The initial angles are 0 (or the limit nearest 0).
+  tip_offset: (3,) the end effector as a point of the tip link's frame (length unit), e.g. a
+    tool point beyond the last joint; None = the tip link's origin.
+Joints: every revolute, continuous or prismatic joint on the chain is one joint of the arm
+(joint_types, joint_names), fixed joints are merged into the links. Joints at one point (a
+universal or spherical joint built from revolute joints), twist joints (an axis along its link,
+a snake's roll module) and a tip on its joint are taken, with links of length 0 between joints
+that coincide (joint_groups, joint_groups_report). Limits are as written (radians, or length
+unit for prismatic joints; multi-turn beyond [-pi, pi]; a continuous joint -inf..+inf); a
+joint's velocity limit becomes max_velocity (used with ArmOptions.time_step). The initial
+values are 0 (or the limit nearest 0).
 Raises InputError naming the element (field 'joint "elbow"', 'link "tool"', 'base_link',
-'urdf'; after the file's path for a file) for prismatic, floating or planar joints, branches,
-zero-length links, twist joints and text that is not a URDF; OSError (FileNotFoundError) with
-the path for a file that cannot be read.
+'urdf', 'tip_offset'; after the file's path for a file) for floating or planar joints,
+closed loops, a branching URDF without tip_link, missing links and text that is not a URDF;
+OSError (FileNotFoundError) with the path for a file that cannot be read.
 )doc");
   m.def(
       "urdf_from_arm",
@@ -65,8 +76,9 @@ the path for a file that cannot be read.
         return UrdfFromArm(ModelArg(model), robot_name);
       },
       py::arg("model"), py::arg("robot_name") = "flexkin_arm", R"doc(
-The URDF text of an arm with revolute joints: links "base_link", "link_1".."link_n", "tip_link";
-joints "joint_0".. (revolute where the model has limits, else continuous) and the fixed
+The URDF text of an arm with revolute or prismatic joints (planar, or with joint_axes): links
+"base_link", "link_1".."link_n", "tip_link"; joints "joint_0".. (revolute where the model has
+limits, else continuous; prismatic joints need limits) and the fixed
 "tip_joint". arm_from_urdf of it gives the same arm back. Planar arms are written with z axes
 in the z = 0 plane. Raises InputError for spherical joints (URDF has none) or an invalid model.
 )doc");

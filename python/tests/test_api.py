@@ -90,6 +90,11 @@ def samples():
                                  initial_angles=[0.1] * 5, initial_azimuths=[0.3] * 5)
     axes = flexkin.ArmModel([0.5] * 4, dim=3, joint_axes=[[0, 1, 0], [0, 0, 1]] * 2,
                             link_directions=[[1, 0, 0]] * 4)
+    slide = flexkin.ArmModel([0.5, 0.0, 0.5], dim=3, joint_axes=[[0, 1, 0], [0, 0, 1], [1, 0, 0]],
+                             joint_types=["revolute", "revolute", "prismatic"],
+                             joint_min=[-1, -np.inf, -0.2], joint_max=[1, np.inf, 0.2],
+                             max_velocity=[1.0, np.inf, 0.5], tip_rotation=[0, 0, 1, 0],
+                             joint_names=["a", "b", "c"])
     first = flexkin.arm_step(spherical, [3.0, 1.0, 0.5])
     second = flexkin.arm_step(spherical, [3.0, 1.1, 0.6], state=first)
     robot = flexkin.run_robot(EXAMPLES / "robot_spatial_limits.json")
@@ -100,9 +105,13 @@ def samples():
             os.path.join(directory, "h.npz"), threads=2)
     out = {
         "AccuracyReport": [controlled.accuracy],
-        "ArmModel": [limited, spherical, axes],
+        "ArmModel": [limited, spherical, axes, slide],
         "ArmOptions": [flexkin.ArmOptions(method="fixed_point", tolerance=1e-9, restarts=2,
-                                          substeps=3, edge_margin=1e-6)],
+                                          substeps=3, edge_margin=1e-6),
+                       flexkin.ArmOptions(time_step=0.1, pointing_axis=[0, 0, 1],
+                                          look_at=[1.0, 2.0, 3.0], pointing_weight=2.0),
+                       flexkin.ArmOptions(pointing_direction=[0, 1, 0],
+                                          pointing_tolerance=1e-7)],
         "ArmStepReport": [first, second],
         "Chain": [flexkin.Chain(p, link_length=0.25), flexkin.Chain(flexkin.helix(links=4))],
         "Metrics": [controlled.metrics, overall.metrics],

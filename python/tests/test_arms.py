@@ -188,11 +188,15 @@ def test_urdf_errors(tmp_path):
     with pytest.raises(flexkin.InputError) as info:
         flexkin.arm_from_urdf(EXAMPLES / "robot_snake.urdf", tip_link="nowhere")
     assert "tip_link" in info.value.field and str(EXAMPLES / "robot_snake.urdf") in str(info.value)
+    planar = (EXAMPLES / "robot_snake.urdf").read_text().replace(
+        'name="joint_3" type="revolute"', 'name="joint_3" type="planar"')
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.arm_from_urdf(planar)
+    assert info.value.field == 'joint "joint_3"' and "planar" in str(info.value)
     prismatic = (EXAMPLES / "robot_snake.urdf").read_text().replace(
         'name="joint_3" type="revolute"', 'name="joint_3" type="prismatic"')
-    with pytest.raises(flexkin.InputError) as info:
-        flexkin.arm_from_urdf(prismatic)
-    assert info.value.field == 'joint "joint_3"'
+    slide = flexkin.arm_from_urdf(prismatic)                  # read since prismatic joints are
+    assert slide.joint_types[3] == "prismatic" and slide.joint_types.count("prismatic") == 1
     with pytest.raises(flexkin.InputError) as info:
         flexkin.urdf_from_arm(flexkin.ArmModel([1.0, 1.0], dim=3))
     assert info.value.field.startswith("model")

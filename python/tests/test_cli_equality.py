@@ -67,6 +67,9 @@ def test_run_robot_equals_cli(path, cli, tmp_path):
     for key in ("iterations", "sweeps", "legs", "restarts", "reached", "stretched", "limited",
                 "joint_space"):
         assert getattr(traj, key).tolist() == [s[key] for s in steps], key
+    for key in ("pointing_error", "velocity_ratio", "velocity_legs"):   # where the file has them
+        if key in steps[0]:
+            assert getattr(traj, key).tolist() == [s[key] for s in steps], key
     assert same_bits(traj.initial_angles,
                      np.array(cli_result["initial"]["joint_angles"], dtype=float))
     assert traj.unreached == cli_result["summary"]["unreached"]
