@@ -2,14 +2,19 @@
 // Robot arms from and to URDF (Unified Robot Description Format) files, read with Debian's
 // urdfdom (library flexkin_urdf, for the command line and the tests; docs/robots.md).
 //
-// A URDF is read as a serial chain from `base_link` to `tip_link`: every revolute or continuous
-// joint on it becomes one joint of the arm, fixed joints are merged into the links, and the arm's
-// points are the revolute joints' origins followed by the tip link's origin, all at the pose
-// where every joint angle is 0. So link k's length is the distance from joint k-1's origin to
-// joint k's (or the tip's), its direction at that pose is ArmModel::link_directions' row k-1,
-// and joint j's axis is the URDF axis turned into the world frame of that pose
-// (ArmModel::joint_axes, see include/flexkin/arm.h). An arm whose axes are all +z and whose
-// links all lie along one direction of the z = 0 plane is returned as a planar arm (dim 2).
+// A URDF is read as a serial chain from `base_link` to `tip_link` (docs/robots.md, "Any serial
+// robot"): every revolute, continuous or prismatic joint on it becomes one joint of the arm, in
+// order from the base, its value angle[j] the URDF joint's (rad or length); fixed joints are
+// merged into the links. The arm's points are the joints' origins followed by the end effector
+// (the tip link's origin, or UrdfChain::tip_offset in its frame), all at the pose where every
+// joint is 0, in the frame of the URDF's root link. Link k's length is the distance from joint
+// k-1's origin to joint k's (or the end effector): 0 where joints share a point (a universal or
+// spherical joint, a tip on its joint); its direction at that pose is ArmModel::link_directions'
+// row k-1, joint j's axis the URDF axis turned into the world frame of that pose
+// (ArmModel::joint_axes; it may lie along its link: a twist joint), joint_types says which slide,
+// and tip_rotation is the tip link's frame. An arm whose joints are all revolute about +z with
+// links of positive length along one direction of the z = 0 plane is returned as a planar arm
+// (dim 2).
 
 #include <string>
 
@@ -18,12 +23,14 @@
 
 namespace flexkin {
 
-// Reads the chain from URDF text / a URDF file. Limits: a revolute joint's [lower, upper] (rad)
-// is cut to [-pi, pi]; continuous joints get [-pi, pi] when any other joint has limits. The
-// initial angles are 0 (or the limit nearest 0). Throws InputError naming the element
-// ("joint \"elbow\"", "link \"tool\"", "urdf") for prismatic, floating or planar joints,
-// branches, zero-length links, twist joints (axis along the link they turn), missing links
-// and text that is not a URDF; a file that cannot be read throws std::system_error.
+// Reads the chain from URDF text / a URDF file. Limits as written: revolute joints' [lower,
+// upper] (rad, multi-turn joints beyond [-pi, pi] kept), prismatic ones' (length); continuous
+// joints are unlimited (-inf, inf); velocity limits (> 0) go to ArmModel::max_velocity. The
+// initial values are 0 (or the limit nearest 0). Throws InputError naming the element
+// ("joint \"elbow\"", "link \"tool\"", "tip_link", "urdf") for floating or planar joints,
+// closed loops (a link the child of two joints), branches without tip_link, a chain without a
+// movable joint or all at one point, missing links and text that is not a URDF (with urdfdom's
+// reason); a file that cannot be read throws std::system_error.
 ArmModel ArmFromUrdf(const std::string& urdf_text, const UrdfChain& chain = {});
 ArmModel ArmFromUrdfFile(const std::string& path, const UrdfChain& chain = {});
 

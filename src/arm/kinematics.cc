@@ -491,7 +491,12 @@ std::string JointGroupsReport(const ArmModel& model) {
       line += (i == 0 ? "" : i + 1 == group.size() ? " and " : ", ") + name(group[i]);
     }
     line += group.size() == 1 ? " acts" : " act";
-    line += with_tip ? " at the end effector (they turn the tool frame only)" : " at one point";
+    if (with_tip) {
+      line += group.size() == 1 ? " at the end effector (it turns the tool frame only)"
+                                : " at the end effector (they turn the tool frame only)";
+    } else {
+      line += " at one point";
+    }
     if (group.size() == 2) line += " (a universal joint)";
     if (group.size() == 3) line += " (a spherical joint)";
     out += line + "\n";
