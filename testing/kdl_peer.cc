@@ -12,24 +12,12 @@
 #include <memory>
 
 #include "flexkin/error.h"
+#include "kdl_counting_fk.h"
 
 namespace flexkin::peers {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// KDL's FK, counting its calls: ChainIkSolverPos_NR evaluates it once per iteration (plus once
-// for the final check), and reports no iteration count itself.
-class CountingFk : public KDL::ChainFkSolverPos_recursive {
- public:
-  explicit CountingFk(const KDL::Chain& chain) : KDL::ChainFkSolverPos_recursive(chain) {}
-  int JntToCart(const KDL::JntArray& q, KDL::Frame& p, int segment = -1) override {
-    ++calls;
-    return KDL::ChainFkSolverPos_recursive::JntToCart(q, p, segment);
-  }
-  using KDL::ChainFkSolverPos_recursive::JntToCart;
-  int calls = 0;
-};
 
 KDL::Vector ToKdl(const Eigen::VectorXd& v) {
   return KDL::Vector(v[0], v[1], v.size() > 2 ? v[2] : 0.0);

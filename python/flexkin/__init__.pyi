@@ -160,7 +160,7 @@ class RobotResult:
     initial_points: Float64Array
     angles: Float64Array  # (T, n)
     azimuths: Optional[Float64Array]  # (T, n), spherical joints
-    points: Float64Array  # (T, n+1, dim)
+    points: Float64Array  # (T, g, dim): one point per distinct position (joint_groups)
     ee_error: Float64Array
     base_error: Float64Array
     pointing_error: Float64Array

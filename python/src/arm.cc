@@ -162,7 +162,19 @@ const ArmModel& ModelArg(py::handle model) {
   return py::cast<const ArmModel&>(model);
 }
 
-namespace {}  // namespace
+namespace {
+
+// The (n+1, dim) points of the arm `a` (base first), as forward_kinematics gives them.
+Points ArmPointsArg(const ArmModel& a, ArrayLike points) {
+  const Points p = ReadPoints(points, "points", a.num_links() + 1, a.dim);
+  if (p.rows() != a.num_links() + 1) {
+    ThrowInput("points", "has " + std::to_string(p.rows()) + " rows; expected " +
+                             std::to_string(a.num_links() + 1) + " (n+1)");
+  }
+  return p;
+}
+
+}  // namespace
 
 void BindArms(py::module_& m) {
   py::class_<ArmModel> model(m, "ArmModel", R"doc(
@@ -532,11 +544,7 @@ continue from it (with the solver's memory, which pickles with it).
       "joint_angles_from_points",
       [](ModelObject model, ArrayLike points) {
         const ArmModel& a = ModelArg(model);
-        const Points p = ReadPoints(points, "points", a.num_links() + 1, a.dim);
-        if (p.rows() != a.num_links() + 1) {
-          ThrowInput("points", "has " + std::to_string(p.rows()) + " rows; expected " +
-                                   std::to_string(a.num_links() + 1) + " (n+1)");
-        }
+        const Points p = ArmPointsArg(a, points);
         const JointAngles angles = JointAnglesFromPoints(a, p);
         return py::make_tuple(ToArray(angles.angle), AzimuthsOrNone(angles.azimuth));
       },
@@ -575,11 +583,7 @@ continue from it (with the solver's memory, which pickles with it).
       "chain_points",
       [](ModelObject model, ArrayLike points) {
         const ArmModel& a = ModelArg(model);
-        const Points p = ReadPoints(points, "points", a.num_links() + 1, a.dim);
-        if (p.rows() != a.num_links() + 1) {
-          ThrowInput("points", "has " + std::to_string(p.rows()) + " rows; expected " +
-                                   std::to_string(a.num_links() + 1) + " (n+1)");
-        }
+        const Points p = ArmPointsArg(a, points);
         return ToArray(ChainPoints(a, p));
       },
       py::arg("model"), py::arg("points"),

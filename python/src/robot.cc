@@ -45,10 +45,19 @@ struct RobotResult {
 // ticks the progress hook, which checks for Ctrl-C about every 0.1 s and throws StopRun.
 class StepArrays : public ArmStepSink {
  public:
-  StepArrays(int64_t count, int64_t links, int64_t dim, bool azimuths, ProgressHook* hook)
-      : count_(count), links_(links), dim_(dim), hook_(hook) {
+  // `model`: the arm; its points are kept one per distinct position (ChainPoints), as the
+  // trajectory file has them.
+  StepArrays(int64_t count, const ArmModel& model, bool azimuths, ProgressHook* hook)
+      : model_(model),
+        count_(count),
+        links_(model.num_links()),
+        dim_(model.dim),
+        chain_(model.has_axes() ? ChainPoints(model, InitialState(model).points).rows()
+                                : links_ + 1),
+        hook_(hook) {
+    const int64_t links = links_, dim = dim_;
     angles_ = py::array_t<double>({count, links});
-    points_ = py::array_t<double>({count, links + 1, dim});
+    points_ = py::array_t<double>({count, chain_, dim});
     if (azimuths) azimuths_ = py::array_t<double>({count, links});
     for (size_t k = 0; k < std::size(kFloatSteps); ++k) floats_.emplace_back(count);
     for (size_t k = 0; k < std::size(kIntSteps); ++k) ints_.emplace_back(count);
@@ -70,8 +79,14 @@ class StepArrays : public ArmStepSink {
     const int64_t t = done_;
     std::memcpy(angle_data_ + t * links_, s.state.angles.angle.data(),
                 sizeof(double) * static_cast<size_t>(links_));
-    std::memcpy(point_data_ + t * (links_ + 1) * dim_, s.state.points.data(),
-                sizeof(double) * static_cast<size_t>((links_ + 1) * dim_));
+    if (chain_ == links_ + 1) {
+      std::memcpy(point_data_ + t * chain_ * dim_, s.state.points.data(),
+                  sizeof(double) * static_cast<size_t>(chain_ * dim_));
+    } else {
+      const Points chain = ChainPoints(model_, s.state.points);
+      std::memcpy(point_data_ + t * chain_ * dim_, chain.data(),
+                  sizeof(double) * static_cast<size_t>(chain_ * dim_));
+    }
     if (azimuth_data_ != nullptr) {
       std::memcpy(azimuth_data_ + t * links_, s.state.angles.azimuth.data(),
                   sizeof(double) * static_cast<size_t>(links_));
@@ -99,7 +114,8 @@ class StepArrays : public ArmStepSink {
   }
 
  private:
-  int64_t count_, links_, dim_, done_ = 0;
+  const ArmModel& model_;
+  int64_t count_, links_, dim_, chain_, done_ = 0;
   ProgressHook* hook_;
   py::array_t<double> angles_, points_, azimuths_;
   std::vector<py::array_t<double>> floats_;  // one array each (not copies of one handle)
@@ -136,7 +152,7 @@ RobotResult Track(const RobotScenario& s, py::object progress, const std::string
   ThrowIfAny(model.Validate());
   ThrowIfAnyArmOptions(s.options);
   ThrowIfAny(s.options.ValidateFor(model));
-  const int64_t links = model.num_links(), dim = model.dim;
+  const int64_t dim = model.dim;
   const bool spherical = model.joint() == ArmJoint::kSpherical;
   RobotResult r;
   r.scenario = s.name;
@@ -149,10 +165,11 @@ RobotResult Track(const RobotScenario& s, py::object progress, const std::string
   const ArmState initial = InitialState(model);
   r.data["initial_angles"] = ToArray(initial.angles.angle);
   r.data["initial_azimuths"] = spherical ? py::object(ToArray(initial.angles.azimuth)) : py::none();
-  r.data["initial_points"] = ToArray(Points(initial.points));
+  r.data["initial_points"] =
+      ToArray(model.has_axes() ? ChainPoints(model, initial.points) : Points(initial.points));
   const int64_t count = static_cast<int64_t>(s.path.rows());
   ProgressHook hook(std::move(progress));
-  StepArrays arrays(count, links, dim, spherical, &hook);
+  StepArrays arrays(count, model, spherical, &hook);
   try {
     py::gil_scoped_release release;
     std::optional<RobotTrajectoryWriter> json;
@@ -205,10 +222,14 @@ constexpr ArrayDoc kArrays[] = {
     {"path", "(T, dim) float64: the end effector's targets, one per step (length unit)."},
     {"initial_angles", "(n,) float64: the joint angles before the path (radians)."},
     {"initial_azimuths", "(n,) float64: spherical joints' azimuths before the path, or None."},
-    {"initial_points", "(n+1, dim) float64: the link points before the path, base first."},
+    {"initial_points",
+     "(g, dim) float64: the points before the path, base first, one per "
+     "distinct position (joint_groups; g = n+1 where each joint has its own)."},
     {"angles", "(T, n) float64: the joint angles after each step (radians)."},
     {"azimuths", "(T, n) float64: spherical joints' azimuths after each step (radians), or None."},
-    {"points", "(T, n+1, dim) float64: the link points after each step, base first."},
+    {"points",
+     "(T, g, dim) float64: the points after each step, base first, one per distinct "
+     "position (joint_groups; g = n+1 where each joint has its own)."},
     {"ee_error", "(T,) float64: |end effector - target| after each step (length unit)."},
     {"base_error", "(T,) float64: each step's last base residual (length unit)."},
     {"pointing_error",
@@ -264,8 +285,9 @@ The trajectory of a fixed-base arm (flexkin.run_robot, flexkin.track_path), as `
 writes it (docs/robot-format.md). Robot order: point 0 the base, point n the end effector.
 T = the number of path targets; row t is the state after the step to path[t].
   angles: (T, n) joint angles (radians); azimuths: (T, n) for spherical joints, else None
-  points: (T, n+1, dim) link points, base first
-  initial_angles (n,), initial_azimuths (n,) or None, initial_points (n+1, dim): before the path
+  points: (T, g, dim) points, base first, one per distinct position (g = n+1 unless joints
+    share a point: joint_groups)
+  initial_angles (n,), initial_azimuths (n,) or None, initial_points (g, dim): before the path
   path: (T, dim) the end effector's targets; link_lengths (n,), base (dim,)
   per step (T,): ee_error, base_error, pointing_error, velocity_ratio (float64); iterations,
     sweeps, passes, legs, restarts, velocity_legs (int64); converged, reached, stretched,

@@ -147,8 +147,13 @@ def test_snake_tracks_a_circle_inside_its_workspace(snake):
     assert np.allclose(traj.points[:, 0], 0.0, atol=1e-12)
     assert np.all(traj.pointing_error == 0.0) and traj.max_pointing_error == 0.0
     assert np.all(traj.velocity_legs == 0) and traj.total_velocity_legs == 0
+    # One point per joint group, as chain_points gives them; the chain's lengths are kept.
+    fk = flexkin.forward_kinematics(snake, traj.angles[-1])
+    assert np.max(np.abs(traj.points[-1] - flexkin.chain_points(snake, fk))) < 1e-12
     lengths = np.linalg.norm(np.diff(traj.points, axis=1), axis=2)
-    assert np.max(np.abs(lengths - snake.link_lengths)) < 1e-12
+    rest = np.linalg.norm(np.diff(traj.initial_points, axis=0), axis=1)
+    assert lengths.shape[1] == len(flexkin.joint_groups(snake))
+    assert np.max(np.abs(lengths - rest)) < 1e-12
     assert (np.abs(traj.angles[:, :-1]) <= 1.2 + 1e-12).all()
 
 
