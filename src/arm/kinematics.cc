@@ -446,14 +446,22 @@ bool WithinLimits(const ArmModel& model, const JointAngles& angles, double slack
   return true;
 }
 
+namespace {
+
+// Whether joint j shares its point with what follows it (the next joint, or the tip after the
+// last joint): a link of length 0 that no slide stretches.
+bool JoinsNext(const ArmModel& model, int j) {
+  return model.link_lengths[j] == 0.0 && !model.prismatic(j);
+}
+
+}  // namespace
+
 std::vector<std::vector<int>> JointGroups(const ArmModel& model) {
   arm_internal::CheckModel(model);
   std::vector<std::vector<int>> groups;
-  bool open = false;  // the last group takes the next joint (a link of length 0 between them)
   for (int j = 0; j < model.num_links(); ++j) {
-    if (!open) groups.emplace_back();
+    if (j == 0 || !JoinsNext(model, j - 1)) groups.emplace_back();
     groups.back().push_back(j);
-    open = model.link_lengths[j] == 0.0 && !model.prismatic(j);
   }
   return groups;
 }
@@ -467,7 +475,7 @@ Points ChainPoints(const ArmModel& model, const Points& points) {
                                    std::to_string(n + 1) + " by " + std::to_string(model.dim));
   }
   // The tip is a point of its own unless the last group reaches it (a tip on its joint).
-  const bool tip_apart = !(model.link_lengths[n - 1] == 0.0 && !model.prismatic(n - 1));
+  const bool tip_apart = !JoinsNext(model, n - 1);
   Points chain(groups.size() + (tip_apart ? 1 : 0), model.dim);
   for (size_t g = 0; g < groups.size(); ++g) chain.row(g) = points.row(groups[g].front());
   if (tip_apart) chain.row(groups.size()) = points.row(n);
@@ -483,8 +491,7 @@ std::string JointGroupsReport(const ArmModel& model) {
   };
   const int n = model.num_links();
   for (const std::vector<int>& group : JointGroups(model)) {
-    const bool with_tip =
-        group.back() == n - 1 && model.link_lengths[n - 1] == 0.0 && !model.prismatic(n - 1);
+    const bool with_tip = group.back() == n - 1 && JoinsNext(model, n - 1);
     if (group.size() < 2 && !with_tip) continue;
     std::string line = group.size() == 1 ? "joint " : "joints ";
     for (size_t i = 0; i < group.size(); ++i) {

@@ -397,12 +397,18 @@ void CheckOptions(const ArmOptions& options) {
   ThrowIfAny(problems);
 }
 
+// The end effector's miss of the report's points, and whether the step reached the target.
+void MeasureReach(const ArmModel& model, const Eigen::VectorXd& target, double tol,
+                  ArmStepReport* report) {
+  report->ee_error = (report->state.points.row(model.num_links()).transpose() - target).norm();
+  report->reached = report->converged && report->ee_error <= 2.0 * tol + 1e-13 * model.reach();
+}
+
 // The report of a solve: the points re-anchored (rebuilt from the joint angles at the fixed
 // base, which also puts any joint the sweep could not keep within its limits, the base link
 // between two limits, there), the error measured on them.
 ArmStepReport Report(const ArmModel& model, const Eigen::VectorXd& target, double tol,
                      const SolveResult& solved, int sweeps, int passes) {
-  const int n = model.num_links();
   ArmStepReport report;
   report.base_error = solved.residual;
   report.iterations = solved.iterations;
@@ -416,8 +422,7 @@ ArmStepReport Report(const ArmModel& model, const Eigen::VectorXd& target, doubl
     report.limited = true;
     report.state.points = arm_internal::ForwardUnchecked(model, report.state.angles);
   }
-  report.ee_error = (report.state.points.row(n).transpose() - target).norm();
-  report.reached = report.converged && report.ee_error <= 2.0 * tol + 1e-13 * model.reach();
+  MeasureReach(model, target, tol, &report);
   return report;
 }
 
@@ -439,8 +444,7 @@ ArmStepReport JointSpaceStep(const ArmModel& model, const ArmState& state,
     report.passes = solved.passes;
     report.state.angles.angle = solved.angles;
     report.state.points = solved.points;
-    report.ee_error = (report.state.points.row(model.num_links()).transpose() - target).norm();
-    report.reached = report.converged && report.ee_error <= 2.0 * tol + 1e-13 * model.reach();
+    MeasureReach(model, target, tol, &report);
     if (options.pointing.enabled) report.pointing_error = solved.angle_residual;
   } else {
     report = Report(model, target, tol, result, 0, solved.passes);
