@@ -40,9 +40,9 @@ test-sanitize: deps
 	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	  ctest --test-dir $(BUILD_SAN) --output-on-failure -j$(JOBS)
 
-# The tests that run threads (the strand engine's worker pool, groom runs), under ThreadSanitizer:
-# only their programs are built.
-TSAN_TESTS = strands_test groom_run_test
+# The tests that run threads (the strand engine's worker pool, groom runs, the library called
+# from several threads at once), under ThreadSanitizer: only their programs are built.
+TSAN_TESTS = strands_test groom_run_test thread_safety_test
 test-thread: deps
 	@cmake -S . -B $(BUILD_TSAN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLEXKIN_SANITIZE_THREAD=ON \
 	  -DFLEXKIN_BUILD_APPS=OFF -DFLEXKIN_BUILD_BENCHMARKS=OFF -DFLEXKIN_BUILD_EXAMPLES=OFF \

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -73,6 +74,78 @@ TEST(ArmKinematics, QuaternionsAreUnitAndTurnTheLinkDirection) {
     const Eigen::Vector3d a = (p.row(j) - p.row(j - 1)).transpose().normalized();
     const Eigen::Vector3d b = (p.row(j + 1) - p.row(j)).transpose().normalized();
     EXPECT_NEAR(std::acos(std::clamp(a.dot(b), -1.0, 1.0)), 0.4, 1e-7);
+  }
+}
+
+// Arms with joint axes: the forward kinematics (rotations carried as a matrix, with plane
+// rotations for coordinate axes) equals the rotations composed one by one with Eigen's
+// AngleAxis, for coordinate axes of either sign, general axes, links along coordinate axes and
+// not, links of length 0 and prismatic joints, at random angles.
+TEST(ArmKinematics, AxisArmsMatchRotationsComposedOneByOne) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const auto random_unit = [&] {
+    Eigen::Vector3d v(u(rng), u(rng), u(rng));
+    return Eigen::Vector3d(v.normalized());
+  };
+  const auto coordinate = [&](int k) {
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    v[k % 3] = k < 3 ? 1.0 : -1.0;
+    return v;
+  };
+  for (int trial = 0; trial < 20; ++trial) {
+    const int n = 40;
+    ArmModel model;
+    model.dim = 3;
+    model.base = Eigen::Vector3d(u(rng), u(rng), u(rng));
+    model.base_direction = Eigen::Vector3d::UnitX();
+    model.initial.angle = Eigen::VectorXd::Zero(n);
+    model.link_lengths.resize(n);
+    model.joint_axes.resize(n, 3);
+    model.link_directions.resize(n, 3);
+    model.joint_types.assign(n, JointType::kRevolute);
+    for (int j = 0; j < n; ++j) {
+      const int kind = static_cast<int>(rng() % 8);  // 0-5: +-x, +-y, +-z; 6, 7: general
+      model.joint_axes.row(j) = (kind < 6 ? coordinate(kind) : random_unit()).transpose();
+      const int rest = static_cast<int>(rng() % 8);
+      model.link_directions.row(j) = (rest < 6 ? coordinate(rest) : random_unit()).transpose();
+      model.link_lengths[j] = rng() % 5 == 0 ? 0.0 : 0.5 + 0.5 * (u(rng) + 1.0);
+      if (rng() % 6 == 0) model.joint_types[j] = JointType::kPrismatic;
+    }
+    model.tip_rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, random_unit())).coeffs();
+    // coeffs() is (x, y, z, w); the model wants (w, x, y, z).
+    model.tip_rotation = Eigen::Vector4d(model.tip_rotation[3], model.tip_rotation[0],
+                                         model.tip_rotation[1], model.tip_rotation[2]);
+    ASSERT_TRUE(model.Validate().empty())
+        << model.Validate().front().field << ": " << model.Validate().front().message;
+    JointAngles angles;
+    angles.angle.resize(n);
+    for (int j = 0; j < n; ++j) angles.angle[j] = 3.0 * u(rng);
+
+    Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
+    Points expected(n + 1, 3);
+    expected.row(0) = model.base.transpose();
+    for (int j = 0; j < n; ++j) {
+      const Eigen::Vector3d a = model.joint_axes.row(j).transpose();
+      const Eigen::Vector3d d =
+          model.link_lengths[j] * Eigen::Vector3d(model.link_directions.row(j).transpose());
+      Eigen::Vector3d step;
+      if (model.prismatic(j)) {
+        step = r * (d + angles.angle[j] * a);
+      } else {
+        r = r * Eigen::AngleAxisd(angles.angle[j], a).toRotationMatrix();
+        step = r * d;
+      }
+      expected.row(j + 1) = expected.row(j) + step.transpose();
+    }
+    const Points points = ForwardKinematics(model, angles);
+    EXPECT_LT((points - expected).cwiseAbs().maxCoeff(), 1e-12) << "trial " << trial;
+    const ToolPose tool = ToolPoseAt(model, angles);
+    const Eigen::Vector4d& t = model.tip_rotation;
+    const Eigen::Matrix3d tool_expected =
+        r * Eigen::Quaterniond(t[0], t[1], t[2], t[3]).toRotationMatrix();
+    EXPECT_LT((tool.rotation - tool_expected).cwiseAbs().maxCoeff(), 1e-13) << "trial " << trial;
+    EXPECT_LT((tool.position - expected.row(n).transpose()).norm(), 1e-12) << "trial " << trial;
   }
 }
 

@@ -7,6 +7,9 @@
 // joint j (0-based) sits at point j and turns link j+1 relative to link j, where "link 0" is the
 // base direction of the model. (Internally the sweep runs on flexkin's chain order, point 0 = the
 // leading end = the end effector.)
+//
+// Threads: TrackPath, ArmStep and the kinematics may run in several threads at once, on the same
+// const model or on different ones (include/flexkin/flexkin.h).
 
 #include <Eigen/Core>
 #include <optional>

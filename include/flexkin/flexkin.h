@@ -6,6 +6,14 @@
 //   #include <flexkin/flexkin.h>
 //   flexkin::Chain chain = flexkin::MakeEqualLinkChain(flexkin::MakeParabola({}), 0.25);
 //   flexkin::RunResult result = flexkin::Run(chain, leader_steps, flexkin::RunOptions{});
+//
+// Threads: every function of the library may be called from several threads at once on different
+// objects (chains, arms, options, results, files); it keeps no mutable global state (scratch space
+// is per thread; urdfdom's process-wide error handler is taken under a lock by ArmFromUrdf). An
+// object that one thread changes (a Chain being moved, an OverallWorkspace, a writer) must not be
+// used by another at the same time; const objects (a model, options, a path) may be shared.
+// Results do not depend on which threads run them, bit for bit (tests/thread_safety_test.cc runs
+// every example scenario in four threads at once, under ThreadSanitizer in make test).
 
 #include "flexkin/arm.h"             // fixed-base arms: models, forward kinematics, TrackPath
 #include "flexkin/chain.h"           // Chain, Points, MakeChain

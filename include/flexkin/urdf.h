@@ -15,6 +15,9 @@
 // and tip_rotation is the tip link's frame. An arm whose joints are all revolute about +z with
 // links of positive length along one direction of the z = 0 plane is returned as a planar arm
 // (dim 2).
+//
+// Threads: ArmFromUrdf may be called from several threads at once; urdfdom's process-wide error
+// handler, which it replaces during a parse to quote urdfdom's reason, is held under a lock.
 
 #include <string>
 

@@ -39,12 +39,39 @@ using Mat3 = Eigen::Matrix3d;
 // lambda = (A + ridge)^-1 rhs. A tiny ridge keeps the solve finite where the free joints cannot
 // move the end effector along some direction (an arm stretched straight, most joints held; with
 // pointing, the roll about the tool axis, which no residual asks for); the Levenberg-Marquardt
-// damping is relative to A's trace as well.
+// damping is relative to A's trace as well. Only a's lower triangle is read, and `a` is
+// overwritten. The ridged matrix is positive definite: its Cholesky factor (T by T, unrolled) is
+// what solves it; where rounding leaves a pivot that is not positive, LDLT' with pivoting does.
 template <int T>
-Eigen::Matrix<double, T, 1> SolveNormal(Eigen::Matrix<double, T, T> a,
+Eigen::Matrix<double, T, 1> SolveNormal(Eigen::Matrix<double, T, T>* a_io,
                                         const Eigen::Matrix<double, T, 1>& rhs, double damping) {
-  a.diagonal().array() += (1e-14 + damping) * a.trace() + 1e-300;
-  return a.ldlt().solve(rhs);
+  Eigen::Matrix<double, T, T>& a = *a_io;
+  const double ridge = (1e-14 + damping) * a.trace() + 1e-300;
+  a.diagonal().array() += ridge;
+  Eigen::Matrix<double, T, T> l;  // lower triangle: A = L L'
+  for (int j = 0; j < T; ++j) {
+    double d = a(j, j);
+    for (int k = 0; k < j; ++k) d -= l(j, k) * l(j, k);
+    if (!(d > 0.0)) return a.template selfadjointView<Eigen::Lower>().ldlt().solve(rhs);
+    l(j, j) = std::sqrt(d);
+    for (int i = j + 1; i < T; ++i) {
+      double e = a(i, j);
+      for (int k = 0; k < j; ++k) e -= l(i, k) * l(j, k);
+      l(i, j) = e / l(j, j);
+    }
+  }
+  Eigen::Matrix<double, T, 1> x;
+  for (int i = 0; i < T; ++i) {  // L y = rhs
+    double e = rhs[i];
+    for (int k = 0; k < i; ++k) e -= l(i, k) * x[k];
+    x[i] = e / l(i, i);
+  }
+  for (int i = T - 1; i >= 0; --i) {  // L' x = y
+    double e = x[i];
+    for (int k = i + 1; k < T; ++k) e -= l(k, i) * x[k];
+    x[i] = e / l(i, i);
+  }
+  return x;
 }
 
 // The rotation vector of the smallest rotation taking unit `from` to unit `to`.
@@ -80,24 +107,45 @@ class RevoluteArm {
  public:
   using Task = Eigen::Matrix<double, T, 1>;
 
-  RevoluteArm(const ArmModel& model, const Eigen::VectorXd& start, const Eigen::VectorXd& winv,
-              double scale, const Vec3& tool_axis = Vec3::UnitX(), double angle_scale = 0.0)
+  // `ws`: the storage, sized here; where it holds the pose of the start (the last solve's end),
+  // that pose is taken instead of computing the forward kinematics.
+  RevoluteArm(const ArmModel& model, const AxisKinematics& kinematics, const Eigen::VectorXd& start,
+              const Eigen::VectorXd& winv, double scale, JointSpacePlan::Workspace* ws,
+              const Vec3& tool_axis = Vec3::UnitX(), double angle_scale = 0.0)
       : model_(model),
+        kinematics_(kinematics),
         n_(model.num_links()),
         limits_(model.joint_min.size() == n_),
         winv_(winv),
         scale_(scale),
         angle_scale_(angle_scale),
-        q_(n_),
-        dq_(n_),
-        trial_(n_),
-        jac_(T, n_),
-        held_(n_) {
+        q_(ws->q),
+        dq_(ws->dq),
+        trial_(ws->trial),
+        points_(ws->points),
+        trial_points_(ws->trial_points),
+        axes_(ws->axes),
+        trial_axes_(ws->trial_axes),
+        frame_(ws->frame),
+        trial_frame_(ws->trial_frame),
+        jac_(Sized(ws, n_), T, n_),
+        wjac_(ws->weighted.data(), T, n_),
+        held_(ws->held) {
     const Eigen::Vector4d& t = model.tip_rotation;
     tool_axis_ = Eigen::Quaterniond(t[0], t[1], t[2], t[3]) * tool_axis;
-    for (int k = 0; k < n_; ++k) q_[k] = std::clamp(start[k], lo(k), hi(k));
-    points_ = RevoluteForward(model_, q_, &axes_, &frame_);
+    for (int k = 0; k < n_; ++k) trial_[k] = std::clamp(start[k], lo(k), hi(k));
+    if (ws->valid && q_.size() == n_ && q_ == trial_) {
+      initial_passes_ = 0;
+    } else {
+      q_.swap(trial_);
+      trial_.resize(n_);
+      kinematics_.Forward(q_, &points_, &axes_, &frame_);
+      ws->valid = true;
+    }
   }
+  // Passes over the links that the constructor made: 1, or 0 where it started from the last
+  // solve's end.
+  int initial_passes() const { return initial_passes_; }
   Vec3 end() const { return points_.row(n_).transpose(); }
   const Points& points() const { return points_; }
   const Eigen::VectorXd& angles() const { return q_; }
@@ -164,26 +212,29 @@ class RevoluteArm {
     }
     std::fill(held_.begin(), held_.end(), 0);
     dq_.setZero();
+    // W^-1 J' by rows (a held joint's column is zeroed): the normal matrix J W^-1 J' is then
+    // T(T+1)/2 dot products of rows, contiguous in memory.
+    for (int i = 0; i < T; ++i) wjac_.row(i) = jac_.row(i).cwiseProduct(winv_.transpose());
     for (int round = 0; round <= n_; ++round) {
-      Eigen::Matrix<double, T, T> a = Eigen::Matrix<double, T, T>::Zero();
-      Task rhs = -r;
-      for (int k = 0; k < n_; ++k) {
-        if (held_[k]) {
-          rhs -= jac_.col(k) * dq_[k];
-        } else {
-          a.noalias() += winv_[k] * jac_.col(k) * jac_.col(k).transpose();
-        }
+      Eigen::Matrix<double, T, T> a;
+      for (int i = 0; i < T; ++i) {
+        for (int j = 0; j <= i; ++j) a(i, j) = wjac_.row(i).dot(jac_.row(j));  // lower triangle
       }
-      const Task lambda = SolveNormal<T>(a, rhs, damping);
+      Task rhs = -r;
+      for (int k = 0; k < n_ && round > 0; ++k) {
+        if (held_[k]) rhs -= jac_.col(k) * dq_[k];
+      }
+      const Task lambda = SolveNormal<T>(&a, rhs, damping);
       bool more = false;
       for (int k = 0; k < n_; ++k) {
         if (held_[k]) continue;
-        dq_[k] = winv_[k] * jac_.col(k).dot(lambda);
+        dq_[k] = wjac_.col(k).dot(lambda);
         const double unit = unit_of(k);
         const double to = std::clamp(q_[k] + unit * dq_[k], lo(k), hi(k));
         if (to != q_[k] + unit * dq_[k]) {
           dq_[k] = (to - q_[k]) / unit;
           held_[k] = 1;
+          wjac_.col(k).setZero();
           more = true;
         }
       }
@@ -196,7 +247,7 @@ class RevoluteArm {
     for (int k = 0; k < n_; ++k) {
       trial_[k] = std::clamp(q_[k] + alpha * (unit_of(k) * dq_[k]), lo(k), hi(k));
     }
-    trial_points_ = RevoluteForward(model_, trial_, &trial_axes_, &trial_frame_);
+    kinematics_.Forward(trial_, &trial_points_, &trial_axes_, &trial_frame_);
   }
   void Accept() {
     q_.swap(trial_);
@@ -210,7 +261,7 @@ class RevoluteArm {
   double hi(int k) const { return limits_ ? model_.joint_max[k] : INFINITY; }
   // The joint value per unit of the solved variable: 1 (rad), or the scale for a prismatic joint.
   double unit_of(int k) const { return model_.prismatic(k) ? scale_ : 1.0; }
-  Task MissAt(const Points& points, const Eigen::Quaterniond& frame, const Goal& goal) const {
+  Task MissAt(const Points& points, const Mat3& frame, const Goal& goal) const {
     const Vec3 end = points.row(n_).transpose();
     Task r;
     r.template head<3>() = end - goal.position;
@@ -222,17 +273,32 @@ class RevoluteArm {
   }
 
   const ArmModel& model_;
+  const AxisKinematics& kinematics_;
   const int n_;
   const bool limits_;
   const Eigen::VectorXd& winv_;
   const double scale_, angle_scale_;
   Vec3 tool_axis_;  // in the last link's frame
-  Eigen::VectorXd q_, dq_, trial_;
-  Points points_, trial_points_;
-  Eigen::MatrixXd axes_, trial_axes_;
-  Eigen::Quaterniond frame_, trial_frame_;
-  Eigen::Matrix<double, T, Eigen::Dynamic> jac_;
-  std::vector<char> held_;
+  // The workspace's storage (JointSpacePlan::Workspace).
+  Eigen::VectorXd &q_, &dq_, &trial_;
+  Points &points_, &trial_points_;
+  Eigen::MatrixXd &axes_, &trial_axes_;
+  Mat3 &frame_, &trial_frame_;
+  // The Jacobian (T by n; row k of J' per joint) and W^-1 J', stored by rows.
+  using Rows = Eigen::Map<Eigen::Matrix<double, T, Eigen::Dynamic, Eigen::RowMajor>>;
+  Rows jac_, wjac_;
+  std::vector<char>& held_;
+  int initial_passes_ = 1;
+
+  // Sizes the workspace's vectors for n joints; the Jacobian's storage (T by n).
+  static double* Sized(JointSpacePlan::Workspace* ws, int n) {
+    ws->dq.resize(n);
+    ws->trial.resize(n);
+    ws->held.resize(n);
+    ws->jacobian.resize(T, n);
+    ws->weighted.resize(T, n);
+    return ws->jacobian.data();
+  }
 };
 
 // exp of a rotation vector.
@@ -276,6 +342,7 @@ class SphericalArm {
   using Task = Vec3;
   Vec3 end() const { return points_.row(n_).transpose(); }
   const Points& points() const { return points_; }
+  int initial_passes() const { return 1; }  // the constructor's pass over the links
   Task Miss(const Goal& goal) const { return end() - goal.position; }
   Task TrialMiss(const Goal& goal) const {
     return trial_points_.row(n_).transpose() - goal.position;
@@ -309,7 +376,7 @@ class SphericalArm {
           a.noalias() += winv_[j] * (l.squaredNorm() * Mat3::Identity() - l * l.transpose());
         }
       }
-      const Vec3 lambda = SolveNormal<3>(a, rhs, damping);
+      const Vec3 lambda = SolveNormal<3>(&a, rhs, damping);
       bool more = false;
       for (int j = 0; j < n_; ++j) {
         if (held_[j]) continue;
@@ -372,7 +439,7 @@ JointSpaceSolve Drive(Arm* arm, double scale, const Goal& target, double tol, do
                       int max_iterations) {
   using Task = typename Arm::Task;
   JointSpaceSolve out;
-  out.passes = 1;  // the arm's first forward kinematics
+  out.passes = arm->initial_passes();  // the arm's first forward kinematics
   Task r;
   // Gauss-Newton toward `goal` until the miss is within `goal_tol` (or no descent is left).
   auto solve_to = [&](const Goal& goal, double goal_tol, double goal_angle_tol, int max_it) {
@@ -507,24 +574,29 @@ Goal MakeGoal(const Eigen::VectorXd& target, const ArmOptions::Pointing& pointin
 }
 
 // One solve from `previous` with the weights `winv`.
-JointSpaceSolve Attempt(const ArmModel& model, const ArmState& previous,
+JointSpaceSolve Attempt(const JointSpacePlan& plan, const ArmState& previous,
                         const Eigen::VectorXd& target, double tol, int max_iterations,
                         const Eigen::VectorXd& winv, const ArmOptions::Pointing& pointing) {
+  const ArmModel& model = plan.model();
   const double scale = model.link_lengths.mean();
   const Goal goal = MakeGoal(target, pointing);
   JointSpaceSolve out;
   if (model.has_axes() && pointing.enabled) {
-    RevoluteArm<6> arm(model, previous.angles.angle, winv, scale, pointing.axis.normalized(),
-                       pointing.weight * scale);
+    RevoluteArm<6> arm(model, plan.kinematics(), previous.angles.angle, winv, scale,
+                       &plan.workspace(), pointing.axis.normalized(), pointing.weight * scale);
     out = Drive(&arm, scale, goal, tol, pointing.angle_tolerance, max_iterations);
     out.angles = arm.angles();
   } else if (model.has_axes()) {
-    RevoluteArm<3> arm(model, previous.angles.angle, winv, scale);
+    RevoluteArm<3> arm(model, plan.kinematics(), previous.angles.angle, winv, scale,
+                       &plan.workspace());
     out = Drive(&arm, scale, goal, tol, 0.0, max_iterations);
     out.angles = arm.angles();
   } else if (model.dim == 2) {
     const ArmModel embedded = Embedded(model);
-    RevoluteArm<3> arm(embedded, AnglesUnchecked(model, previous.points).angle, winv, scale);
+    const AxisKinematics kinematics(embedded);
+    JointSpacePlan::Workspace ws;
+    RevoluteArm<3> arm(embedded, kinematics, AnglesUnchecked(model, previous.points).angle, winv,
+                       scale, &ws);
     out = Drive(&arm, scale, goal, tol, 0.0, max_iterations);
     out.points = Points(out.points.leftCols(2));
   } else {
@@ -538,11 +610,18 @@ JointSpaceSolve Attempt(const ArmModel& model, const ArmState& previous,
 
 }  // namespace
 
-JointSpaceSolve SolveJointSpace(const ArmModel& model, const ArmState& previous,
+JointSpacePlan::JointSpacePlan(const ArmModel& model)
+    : model_(model), winv_(InverseJointWeights(model)) {
+  if (model.has_axes()) kinematics_.emplace(model);
+}
+
+JointSpaceSolve SolveJointSpace(const JointSpacePlan& plan, const ArmState& previous,
                                 const Eigen::VectorXd& target, double tol, int max_iterations,
                                 int restarts, const ArmOptions::Pointing& pointing) {
-  const Eigen::VectorXd winv = InverseJointWeights(model);
-  JointSpaceSolve best = Attempt(model, previous, target, tol, max_iterations, winv, pointing);
+  const ArmModel& model = plan.model();
+  const Eigen::VectorXd& winv = plan.inverse_weights();
+  JointSpaceSolve best = Attempt(plan, previous, target, tol, max_iterations, winv, pointing);
+  if (best.converged) return best;  // the usual case: nothing below is needed
   auto consider = [&](JointSpaceSolve next) {
     next.iterations += best.iterations;
     next.passes += best.passes;
@@ -573,7 +652,7 @@ JointSpaceSolve SolveJointSpace(const ArmModel& model, const ArmState& previous,
     if (k < 2) {
       const double power = k == 0 ? 0.5 : 0.0;
       consider(
-          Attempt(model, previous, target, tol, max_iterations, winv.array().pow(power), pointing));
+          Attempt(plan, previous, target, tol, max_iterations, winv.array().pow(power), pointing));
       continue;
     }
     const double amplitude = k == 2 ? 0.25 : k == 3 ? 0.5 : 1.0;
@@ -595,7 +674,7 @@ JointSpaceSolve SolveJointSpace(const ArmModel& model, const ArmState& previous,
       if (spherical) start.angles.azimuth[j] += amplitude * M_PI * unit(rng);
     }
     start.points = ForwardUnchecked(model, start.angles);
-    consider(Attempt(model, start, target, tol, max_iterations, winv, pointing));
+    consider(Attempt(plan, start, target, tol, max_iterations, winv, pointing));
   }
   return best;
 }

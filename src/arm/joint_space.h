@@ -10,7 +10,10 @@
 // is reachable.
 
 #include <Eigen/Core>
+#include <optional>
+#include <vector>
 
+#include "arm/revolute.h"
 #include "flexkin/arm.h"
 
 namespace flexkin::arm_internal {
@@ -19,6 +22,37 @@ namespace flexkin::arm_internal {
 // distance along the chain from joint k to the end effector. A joint's lever on the end effector
 // grows about as d_k, so its share of a step, w_k^-1 (J' lambda)_k, falls off about as 1 / d_k.
 Eigen::VectorXd InverseJointWeights(const ArmModel& model);
+
+// What the joint-space solve needs of a model, prepared once for many steps (TrackPath prepares
+// it for all of its steps, ArmStep for its one): the weights and, for arms with joint axes, the
+// forward kinematics. Holds a reference to the model, which must outlive it.
+class JointSpacePlan {
+ public:
+  explicit JointSpacePlan(const ArmModel& model);
+  const ArmModel& model() const { return model_; }
+  const Eigen::VectorXd& inverse_weights() const { return winv_; }
+  const AxisKinematics& kinematics() const { return *kinematics_; }  // arms with joint axes only
+
+  // The storage of the solves of arms with joint axes, kept from one to the next so that a step
+  // allocates nothing; q, points, axes and frame are where the last solve ended (valid), so the
+  // next step, starting there, need not compute its forward kinematics again. A plan is used by
+  // one thread.
+  struct Workspace {
+    Eigen::VectorXd q, dq, trial;
+    Points points, trial_points;
+    Eigen::MatrixXd axes, trial_axes, jacobian, weighted;
+    Eigen::Matrix3d frame, trial_frame;
+    std::vector<char> held;
+    bool valid = false;
+  };
+  Workspace& workspace() const { return workspace_; }
+
+ private:
+  const ArmModel& model_;
+  Eigen::VectorXd winv_;
+  std::optional<AxisKinematics> kinematics_;
+  mutable Workspace workspace_;
+};
 
 struct JointSpaceSolve {
   Points points;                // the arm at the end (n+1 by dim, base first), within the limits
@@ -52,7 +86,7 @@ struct JointSpaceSolve {
 // otherwise the nearest end found.
 // With pointing.enabled (arms with joint axes), the tool axis is turned to its goal as well
 // (ArmOptions::Pointing), and converged means both are within their tolerances.
-JointSpaceSolve SolveJointSpace(const ArmModel& model, const ArmState& previous,
+JointSpaceSolve SolveJointSpace(const JointSpacePlan& plan, const ArmState& previous,
                                 const Eigen::VectorXd& target, double tol, int max_iterations,
                                 int restarts, const ArmOptions::Pointing& pointing);
 

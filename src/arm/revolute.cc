@@ -84,39 +84,118 @@ double AngleAbout(const Eigen::Vector3d& axis, const Eigen::Vector3d& from,
   return std::atan2(axis.dot(f.cross(t)), f.dot(t));
 }
 
+namespace {
+
+// The coordinate axis that `v` is (0, 1, 2 for +-x, +-y, +-z: two components exactly 0), with its
+// sign in `sign`; 3 if none.
+int CoordinateIndex(const Eigen::Vector3d& v, double* sign) {
+  for (int k = 0; k < 3; ++k) {
+    if (v[(k + 1) % 3] == 0.0 && v[(k + 2) % 3] == 0.0 && v[k] != 0.0) {
+      *sign = v[k];
+      return k;
+    }
+  }
+  *sign = 1.0;
+  return 3;
+}
+
+}  // namespace
+
+AxisKinematics::AxisKinematics(const ArmModel& model) : base_(model.base.head<3>()) {
+  const int n = model.num_links();
+  joints_.resize(n);
+  for (int j = 0; j < n; ++j) {
+    Joint& joint = joints_[j];
+    joint.axis = model.joint_axes.row(j).transpose();
+    joint.rest = model.link_lengths[j] * RestDirection(model, j);
+    joint.prismatic = model.prismatic(j);
+    joint.axis_index = CoordinateIndex(joint.axis, &joint.axis_sign);
+    // A unit axis with two zero components is exactly +-1 along the third (ValidateAxes allows
+    // 1e-9 of slack in the norm: such an axis takes the general path).
+    if (joint.axis_index < 3 && std::abs(joint.axis_sign) != 1.0) {
+      joint.axis_index = 3;
+      joint.axis_sign = 1.0;
+    }
+    joint.rest_index = CoordinateIndex(joint.rest, &joint.rest_sign);
+    if (joint.rest.isZero(0.0)) joint.rest_index = -1;  // a joint at the next one's point
+  }
+}
+
+void AxisKinematics::Forward(const Eigen::VectorXd& angle, Points* points, Eigen::MatrixXd* axes,
+                             Eigen::Matrix3d* last) const {
+  using Vec3 = Eigen::Vector3d;
+  const int n = num_links();
+  points->resize(n + 1, 3);
+  if (axes != nullptr) axes->resize(n, 3);
+  // The angles' sines and cosines, batched where the CPU allows (SinCosAll).
+  thread_local std::vector<double> scratch;
+  scratch.resize(2 * static_cast<size_t>(n));
+  double* sn = scratch.data();
+  double* cs = sn + n;
+  SinCosAll(angle.data(), n, sn, cs);
+  // R's columns, each its own variable (kept in registers: the switches below pick them by name,
+  // as an array indexed by the joint would go through memory).
+  Vec3 x = Vec3::UnitX(), y = Vec3::UnitY(), z = Vec3::UnitZ();
+  // R v, for v a coordinate axis times `sign` (index 0 to 2) or general (3).
+  const auto turned = [&](int index, double sign, const Vec3& v) -> Vec3 {
+    switch (index) {
+      case 0:
+        return sign * x;
+      case 1:
+        return sign * y;
+      case 2:
+        return sign * z;
+      default:
+        return x * v.x() + y * v.y() + z * v.z();
+    }
+  };
+  // R Rot(+-e_k, q): the plane rotation of the two other columns (s carries the sign).
+  const auto plane = [](double c, double s, Vec3* u, Vec3* v) {
+    const Vec3 u0 = *u;
+    *u = c * u0 + s * *v;
+    *v = c * *v - s * u0;
+  };
+  Vec3 p = base_;
+  points->row(0) = p.transpose();
+  for (int j = 0; j < n; ++j) {
+    const Joint& joint = joints_[j];
+    const Vec3 w = turned(joint.axis_index, joint.axis_sign, joint.axis);
+    if (axes != nullptr) axes->row(j) = w.transpose();
+    if (joint.prismatic) {
+      // A slide along the axis: link j+1 and everything after it move by angle[j] along it.
+      p += turned(3, 1.0, joint.rest) + angle[j] * w;
+    } else {
+      const double c = cs[j], s = joint.axis_sign * sn[j];
+      switch (joint.axis_index) {
+        case 0:
+          plane(c, s, &y, &z);
+          break;
+        case 1:
+          plane(c, s, &z, &x);
+          break;
+        case 2:
+          plane(c, s, &x, &y);
+          break;
+        default: {
+          const Vec3 a = joint.axis * (1.0 - c);
+          x = c * x + s * w.cross(x) + a.x() * w;
+          y = c * y + s * w.cross(y) + a.y() * w;
+          z = c * z + s * w.cross(z) + a.z() * w;
+        }
+      }
+      if (joint.rest_index >= 0) p += turned(joint.rest_index, joint.rest_sign, joint.rest);
+    }
+    points->row(j + 1) = p.transpose();
+  }
+  if (last != nullptr) *last << x, y, z;
+}
+
 Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle, Eigen::MatrixXd* axes,
                        Eigen::Quaterniond* last_frame) {
-  const int n = model.num_links();
-  Points points(n + 1, 3);
-  points.row(0) = model.base.transpose();
-  if (axes != nullptr) axes->resize(n, 3);
-  // The half angles' sines and cosines, batched where the CPU allows (SinCosAll): the rotation
-  // about a by q is the quaternion (cos q/2, sin q/2 a), as Eigen's AngleAxis gives it.
-  thread_local std::vector<double> scratch;
-  scratch.resize(3 * static_cast<size_t>(n));
-  double* half = scratch.data();
-  double* sn = half + n;
-  double* cs = sn + n;
-  for (int j = 0; j < n; ++j) half[j] = 0.5 * angle[j];
-  SinCosAll(half, n, sn, cs);
-  Eigen::Quaterniond frame = Eigen::Quaterniond::Identity();
-  for (int j = 0; j < n; ++j) {
-    const Eigen::Vector3d a = model.joint_axes.row(j).transpose();
-    // A rotation about a leaves a fixed: the world axis is the frame above's image of it.
-    if (axes != nullptr) axes->row(j) = (frame * a).transpose();
-    if (model.prismatic(j)) {
-      // A slide along a: link j+1 and everything after it move by angle[j] along it.
-      points.row(j + 1) =
-          points.row(j) +
-          (frame * ((model.link_lengths[j] * RestDirection(model, j)) + angle[j] * a)).transpose();
-      continue;
-    }
-    frame = (frame * Eigen::Quaterniond(cs[j], sn[j] * a.x(), sn[j] * a.y(), sn[j] * a.z()))
-                .normalized();
-    points.row(j + 1) =
-        points.row(j) + model.link_lengths[j] * (frame * RestDirection(model, j)).transpose();
-  }
-  if (last_frame != nullptr) *last_frame = frame;
+  Points points;
+  Eigen::Matrix3d last;
+  AxisKinematics(model).Forward(angle, &points, axes, &last);
+  if (last_frame != nullptr) *last_frame = Eigen::Quaterniond(last).normalized();
   return points;
 }
 

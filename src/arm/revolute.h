@@ -30,9 +30,40 @@ double AngleAbout(const Eigen::Vector3d& axis, const Eigen::Vector3d& from,
 // limits within [-pi, pi], every link of positive length and across its joint's axis.
 bool Sweepable(const ArmModel& model);
 
+// The forward kinematics of an arm with joint axes, prepared once for its model. The links'
+// rotation R is carried from the base as a matrix: joint j's axis a_j (in the frame of the zero
+// pose) is R a_j in the world before the joint turns, and the joint turns R into R Rot(a_j, q_j)
+// = c R + s [R a_j]x R + (1 - c) (R a_j) a_j' (Rodrigues, column by column). About a coordinate
+// axis (+-x, +-y, +-z: every joint of the usual snakes, whose zero pose is straight) that is a
+// plane rotation of two columns (4 products a column), and a link along a coordinate axis is a
+// column of R: no normalisation, no quaternion product, no rotation of vectors.
+class AxisKinematics {
+ public:
+  explicit AxisKinematics(const ArmModel& model);
+  // The n+1 points at `angle` (n), base first (prismatic joints slide), into `points` (resized
+  // to n+1 by 3); with `axes`, each joint's axis in the world (n by 3), as the Jacobian needs;
+  // with `last`, the last link's rotation in the world. Allocates nothing once sized.
+  void Forward(const Eigen::VectorXd& angle, Points* points, Eigen::MatrixXd* axes = nullptr,
+               Eigen::Matrix3d* last = nullptr) const;
+  int num_links() const { return static_cast<int>(joints_.size()); }
+
+ private:
+  struct Joint {
+    int axis_index;    // 0, 1, 2: the axis is axis_sign times that coordinate axis; 3: general
+    double axis_sign;  // +-1
+    Eigen::Vector3d axis;
+    int rest_index;        // the same for the link's rest direction times its length; -1: none
+    double rest_sign;      // +-length
+    Eigen::Vector3d rest;  // the rest direction times the link's length
+    bool prismatic;
+  };
+  std::vector<Joint> joints_;
+  Eigen::Vector3d base_;
+};
+
 // Forward kinematics at `angle` (n): the n+1 points, base first (prismatic joints slide).
 // With `axes`, also each joint's axis in the world (n by 3), as the Jacobian needs; with
-// `last_frame`, the last link's rotation in the world.
+// `last_frame`, the last link's rotation in the world. (AxisKinematics, prepared for one call.)
 Points RevoluteForward(const ArmModel& model, const Eigen::VectorXd& angle,
                        Eigen::MatrixXd* axes = nullptr, Eigen::Quaterniond* last_frame = nullptr);
 // The angles whose forward kinematics puts every link nearest to the points' link directions

@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <utility>
 
 #include "arm/internal.h"
 #include "arm/joint_space.h"
@@ -429,12 +430,11 @@ ArmStepReport Report(const ArmModel& model, const Eigen::VectorXd& target, doubl
 // The joint-space solve from `state` (src/arm/joint_space.h); base_error is the end effector's
 // miss, sweeps 0. Arms with joint axes keep the solver's joint values (their points are its
 // forward kinematics); the others read their angles from the points, as the sweep's steps do.
-ArmStepReport JointSpaceStep(const ArmModel& model, const ArmState& state,
+ArmStepReport JointSpaceStep(const arm_internal::JointSpacePlan& plan, const ArmState& state,
                              const Eigen::VectorXd& target, double tol, const ArmOptions& options) {
-  const arm_internal::JointSpaceSolve solved = arm_internal::SolveJointSpace(
-      model, state, target, tol, options.max_iterations, options.restarts, options.pointing);
-  const SolveResult result{solved.points,    solved.residual, solved.iterations,
-                           solved.converged, solved.limited,  {}};
+  const ArmModel& model = plan.model();
+  arm_internal::JointSpaceSolve solved = arm_internal::SolveJointSpace(
+      plan, state, target, tol, options.max_iterations, options.restarts, options.pointing);
   ArmStepReport report;
   if (model.has_axes()) {
     report.base_error = solved.residual;
@@ -442,11 +442,13 @@ ArmStepReport JointSpaceStep(const ArmModel& model, const ArmState& state,
     report.converged = solved.converged;
     report.limited = solved.limited;
     report.passes = solved.passes;
-    report.state.angles.angle = solved.angles;
-    report.state.points = solved.points;
+    report.state.angles.angle = std::move(solved.angles);
+    report.state.points = std::move(solved.points);
     MeasureReach(model, target, tol, &report);
     if (options.pointing.enabled) report.pointing_error = solved.angle_residual;
   } else {
+    const SolveResult result{std::move(solved.points), solved.residual, solved.iterations,
+                             solved.converged,         solved.limited,  {}};
     report = Report(model, target, tol, result, 0, solved.passes);
   }
   report.joint_space = true;
@@ -580,9 +582,11 @@ void CheckOptionsForModel(const ArmModel& model, const ArmOptions& options) {
   ThrowIfAny(problems);
 }
 
-// ArmStep on a checked model, options, state and target, without velocity limits.
-ArmStepReport StepUnlimited(const ArmModel& model, const ArmState& state,
+// ArmStep on a checked model (prepared in `plan`), options, state and target, without velocity
+// limits.
+ArmStepReport StepUnlimited(const arm_internal::JointSpacePlan& plan, const ArmState& state,
                             const Eigen::VectorXd& target, const ArmOptions& options) {
+  const ArmModel& model = plan.model();
   const int n = model.num_links();
   const double scale = model.link_lengths.mean();
   const double tol = options.tolerance * scale;
@@ -596,7 +600,7 @@ ArmStepReport StepUnlimited(const ArmModel& model, const ArmState& state,
     // Method newton: the weighted minimum-norm joint motion from the last angles
     // (src/arm/joint_space.cc says why not the sweep). Out of reach, it ends at the nearest
     // configuration its joints give (a straight arm is not one in general).
-    if (newton) return JointSpaceStep(model, state, target, tol, options);
+    if (newton) return JointSpaceStep(plan, state, target, tol, options);
     arm_internal::RevoluteSweeper sweeper(model, state, target, options.substeps);
     const SolveResult solved = SolveFixedPointRevolute(&sweeper, options, tol);
     return Report(model, target, tol, solved, sweeper.sweeps(),
@@ -636,24 +640,25 @@ ArmStepReport StepUnlimited(const ArmModel& model, const ArmState& state,
   }
   // (2) Joint limits saturated near the end effector, where the target needs bending near the
   // base: the joint-space solve from the last state, kept if it gets nearer.
-  ArmStepReport fallback = JointSpaceStep(model, state, target, tol, options);
+  ArmStepReport fallback = JointSpaceStep(plan, state, target, tol, options);
   AddCost(report, &fallback);
   if (fallback.reached || fallback.ee_error < report.ee_error) return fallback;
   SetCost(fallback, &report);
   return report;
 }
 
-// ArmStep on a checked model, options, state and target.
-ArmStepReport StepChecked(const ArmModel& model, const ArmState& state,
+// ArmStep on a checked model (prepared in `plan`), options, state and target.
+ArmStepReport StepChecked(const arm_internal::JointSpacePlan& plan, const ArmState& state,
                           const Eigen::VectorXd& target, const ArmOptions& options) {
+  const ArmModel& model = plan.model();
   if (options.time_step > 0.0 && model.max_velocity.size() == model.num_links()) {
     return VelocityLimitedStep(
         model, state, target, options,
         [&](const ArmState& from, const Eigen::VectorXd& goal, const ArmOptions& leg_options) {
-          return StepUnlimited(model, from, goal, leg_options);
+          return StepUnlimited(plan, from, goal, leg_options);
         });
   }
-  return StepUnlimited(model, state, target, options);
+  return StepUnlimited(plan, state, target, options);
 }
 
 }  // namespace
@@ -666,7 +671,7 @@ ArmStepReport ArmStep(const ArmModel& model, const ArmState& state,
   CheckOptionsForModel(model, options);
   const Eigen::VectorXd target = target_in;
   CheckState(model, state, target);
-  return StepChecked(model, state, target, options);
+  return StepChecked(arm_internal::JointSpacePlan(model), state, target, options);
 }
 
 std::string ArmStepReport::BriefReport() const {
@@ -708,9 +713,10 @@ ArmTrajectory TrackPath(const ArmModel& model, const Points& path, const ArmOpti
   // The last step's state is the next step's start: two reports, swapped after each step.
   ArmStepReport last;
   last.state = InitialState(model);
+  const arm_internal::JointSpacePlan plan(model);  // for every step
   for (int i = 0; i < path.rows(); ++i) {
     const Eigen::VectorXd target = path.row(i).transpose();
-    ArmStepReport step = StepChecked(model, last.state, target, options);
+    ArmStepReport step = StepChecked(plan, last.state, target, options);
     trajectory.max_ee_error = std::max(trajectory.max_ee_error, step.ee_error);
     trajectory.max_base_error = std::max(trajectory.max_base_error, step.base_error);
     trajectory.unreached += step.reached ? 0 : 1;
