@@ -80,11 +80,11 @@ const Case kCases[] = {
     {"groom_sigint", {"run", "groom.json", "-o", "hair.npz", "-q"}, "hair.npz", SIGINT},
     {"groom_sigterm", {"run", "groom.json", "-o", "hair.npz", "-q"}, "hair.npz", SIGTERM},
     {"render_mp4_sigint",
-     {"render", "frames.npz", "--formats", "mp4", "--every", "1", "--width", "960", "-q"},
+     {"render", "frames.npz", "--formats", "mp4", "--every", "1", "--width", "320", "-q"},
      "frames.mp4",
      SIGINT},
     {"render_gif_sigterm",
-     {"render", "frames.npz", "--formats", "gif", "--every", "1", "--width", "960", "-q"},
+     {"render", "frames.npz", "--formats", "gif", "--every", "1", "--width", "320", "-q"},
      "frames.gif",
      SIGTERM},
 };
