@@ -39,6 +39,7 @@
 #include "flexkin/scenario.h"
 #include "flexkin/urdf.h"
 #include "groom_command.h"
+#include "interrupt.h"
 #include "output_check.h"
 #include "output_limit.h"
 #include "render_command.h"
@@ -54,6 +55,8 @@ enum ExitCode : int {
   kExitAccuracyNotMet = 3,  // run done and result written, but the tolerance was not met
   kExitIoError = 4,         // a file could not be read or written
   kExitNotConverged = 5,    // run done and result written, but an overall solve did not converge
+  // Stopped by a signal: 128 + its number, as shells report it (130 SIGINT, 143 SIGTERM).
+  kExitInterruptedBase = 128,
 };
 
 constexpr const char* kExitCodesHelp =
@@ -67,9 +70,18 @@ constexpr const char* kExitCodesHelp =
     "  4  I/O error: a file could not be read or written (an existing output file is\n"
     "     never left half-written)\n"
     "  5  method overall: the run completed and the result was written, but the solver\n"
-    "     did not converge at some step (the result and the message say where)";
+    "     did not converge at some step (the result and the message say where)\n"
+    "  130, 143  interrupted by SIGINT (Ctrl-C) or SIGTERM: stopped at once, the\n"
+    "     output being written was not written and earlier files are unchanged";
 
 void PrintError(const std::string& message) { std::cerr << "flexkin: error: " << message << "\n"; }
+
+// After a signal, whatever exception ended the command (the interruption itself, or a failure
+// it caused, such as an ffmpeg that the terminal's Ctrl-C stopped too): 128 + the signal.
+int ExitInterrupted() {
+  std::cerr << "flexkin: " << flexkin::cli::InterruptMessage() << "\n";
+  return kExitInterruptedBase + flexkin::cli::InterruptSignal();
+}
 
 struct RunArgs {
   std::string scenario, output, csv, method, report = "brief", max_output_size, precision;
@@ -256,7 +268,13 @@ int RunCommand(const RunArgs& args) {
   CheckOutputSize(args, scenario, format);
   flexkin::cli::CheckOutputDirectory(args.output);
   if (!args.csv.empty()) flexkin::cli::CheckOutputDirectory(args.csv);
-  if (!args.quiet && ::isatty(STDERR_FILENO)) scenario.options.progress = ShowProgress;
+  // The progress callback comes about every 0.1 s: where a signal stops the run (by throwing).
+  const bool show_progress = !args.quiet && ::isatty(STDERR_FILENO);
+  scenario.options.progress = [show_progress](int64_t done, int64_t total) {
+    flexkin::cli::ThrowIfInterrupted();
+    if (show_progress) ShowProgress(done, total);
+  };
+  flexkin::cli::Writing(args.output + (args.csv.empty() ? "" : " or " + args.csv));
 
   // The frames stream to the files as the run records them; the files are renamed into place
   // only after the run, and removed if it fails.
@@ -402,18 +420,26 @@ int Main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? kExitOk : kExitUsage;
   }
+  flexkin::cli::InstallInterruptHandlers();
   try {
     if (*run) return RunCommand(args);
     if (render.Parsed()) return render.Run();
     if (robot.Parsed()) return robot.Run();
     if (vocabulary.Parsed()) return vocabulary.Run();
     return ValidateCommand(validate_path);
+  } catch (const flexkin::cli::Interrupted&) {
+    return ExitInterrupted();
   } catch (const flexkin::InputError& e) {
+    if (flexkin::cli::InterruptSignal() != 0) return ExitInterrupted();
     PrintError(e.what());
     return kExitInvalidInput;
   } catch (const std::system_error& e) {  // files; std::ios_base::failure is one too
+    if (flexkin::cli::InterruptSignal() != 0) return ExitInterrupted();
     PrintError(e.what());
     return kExitIoError;
+  } catch (const std::exception&) {
+    if (flexkin::cli::InterruptSignal() != 0) return ExitInterrupted();
+    throw;
   }
 }
 

@@ -11,6 +11,7 @@
 #include "flexkin/groom.h"
 #include "flexkin/strand_file.h"
 #include "flexkin/vocabulary.h"
+#include "interrupt.h"
 #include "output_check.h"
 #include "output_limit.h"
 
@@ -110,8 +111,13 @@ int RunGroomCommand(const GroomRunArgs& args) {
   CheckOutputDirectory(out);
   StrandFileWriter writer(out, header);
   const bool progress = !args.quiet && ::isatty(STDERR_FILENO);
-  const StrandRunReport report = RunGroom(
-      scenario, &writer, progress ? ShowProgress : std::function<bool(int64_t, int64_t)>());
+  Writing(out);
+  // Called after every frame: where a signal stops the run (by throwing).
+  const StrandRunReport report =
+      RunGroom(scenario, &writer, [progress](int64_t done, int64_t total) {
+        ThrowIfInterrupted();
+        return !progress || ShowProgress(done, total);
+      });
   writer.Commit(report);
   if (!args.quiet) {
     const int64_t frames = scenario.motion.num_frames();

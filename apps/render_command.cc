@@ -16,6 +16,7 @@
 #include "flexkin/result_io.h"
 #include "flexkin/strand_file.h"
 #include "gltf/gltf.h"
+#include "interrupt.h"
 #include "render/strands_render.h"
 #include "viewer/strands_viewer.h"
 #include "viewer/viewer.h"
@@ -35,6 +36,7 @@ struct RenderJob {
 
 void Figure(const RenderJob& job, const char* extension) {
   const std::string path = job.base + extension;
+  Writing(path);
   WriteSnapshotFigure(*job.file, job.figure, path);
   job.written->push_back(path);
 }
@@ -48,6 +50,7 @@ void Plots(const RenderJob& job) {
     }
     for (const char* extension : {".svg", ".png"}) {
       const std::string path = job.base + "_" + name + extension;
+      Writing(path);
       WritePlot(*job.file, kind, job.plot, path);
       job.written->push_back(path);
     }
@@ -56,6 +59,7 @@ void Plots(const RenderJob& job) {
 
 void Animation(const RenderJob& job, const char* extension) {
   const std::string path = job.base + extension;
+  Writing(path);
   WriteAnimation(*job.file, job.animation, path);
   job.written->push_back(path);
 }
@@ -63,6 +67,7 @@ void Animation(const RenderJob& job, const char* extension) {
 // The interactive viewer: one self-contained HTML page (docs/viewer.md).
 void Viewer(const RenderJob& job) {
   const std::string path = job.base + ".html";
+  Writing(path);
   ViewerOptions options;
   options.title = job.figure.title;
   WriteViewerHtml(*job.file, options, path);
@@ -72,6 +77,7 @@ void Viewer(const RenderJob& job) {
 // glTF 2.0: the chain as a skinned skeleton with keyframed joints (docs/gltf-export.md).
 void Gltf(const RenderJob& job, const char* extension) {
   const std::string path = job.base + extension;
+  Writing(path);
   WriteGltf(*job.file, GltfOptions{}, path);
   job.written->push_back(path);
 }
@@ -254,6 +260,7 @@ int RenderCommand::Run() const {
   if (*elevation_) job.figure.elevation = job.animation.elevation = args_.elevation;
   if (*fps_) job.animation.fps = args_.fps;
   if (*max_frames_) job.animation.max_frames = args_.max_frames;
+  job.animation.progress = [](int64_t, int64_t) { ThrowIfInterrupted(); };
   CheckOptions(job.figure.Validate());
   CheckOptions(job.plot.Validate());
   CheckOptions(job.animation.Validate());
@@ -283,6 +290,7 @@ int RenderCommand::Run() const {
   } catch (const std::system_error&) {
     throw;
   } catch (const std::runtime_error& e) {  // ffmpeg missing or failing, cairo
+    ThrowIfInterrupted();                  // an ffmpeg stopped by the same Ctrl-C
     std::cerr << "flexkin: error: " << e.what() << "\n";
     return 1;
   }
@@ -308,6 +316,7 @@ int RenderCommand::RunStrands() const {
   if (*elevation_) options.elevation = args_.elevation;
   if (*fps_) options.fps = args_.fps;
   if (*max_frames_) options.max_frames = args_.max_frames;
+  options.progress = [](int64_t, int64_t) { ThrowIfInterrupted(); };
   CheckOptions(options.Validate());
   StrandsViewerOptions viewer;
   viewer.title = args_.title;
@@ -336,6 +345,7 @@ int RenderCommand::RunStrands() const {
       }
       fresh = false;
       const std::string path = base + format->extension;
+      Writing(path);
       switch (format->output) {
         case StrandOutput::kFigure:
           RenderStrandsSnapshot(reader, options, path);
@@ -354,6 +364,7 @@ int RenderCommand::RunStrands() const {
   } catch (const std::system_error&) {
     throw;
   } catch (const std::runtime_error& e) {  // ffmpeg missing or failing, cairo
+    ThrowIfInterrupted();                  // an ffmpeg stopped by the same Ctrl-C
     std::cerr << "flexkin: error: " << e.what() << "\n";
     return 1;
   }

@@ -15,6 +15,7 @@
 #include "flexkin/robot_scenario.h"
 #include "flexkin/urdf.h"
 #include "flexkin/vocabulary.h"
+#include "interrupt.h"
 #include "output_check.h"
 #include "output_limit.h"
 
@@ -29,6 +30,12 @@ std::string MethodHelp() {
   }
   return help;
 }
+
+// First of the step sinks: a signal stops the tracking at the next step (by throwing).
+class InterruptCheck : public ArmStepSink {
+ public:
+  void Add(const ArmStepReport&) override { ThrowIfInterrupted(); }
+};
 
 }  // namespace
 
@@ -75,7 +82,9 @@ int RobotCommand::Run() const {
   // targets; each file is renamed into place only when complete.
   RobotTrajectoryWriter json_writer(s, output_);
   std::optional<RobotJointsCsvWriter> csv_writer;
-  std::vector<ArmStepSink*> sinks = {&json_writer};
+  InterruptCheck interrupt_check;
+  std::vector<ArmStepSink*> sinks = {&interrupt_check, &json_writer};
+  Writing(output_ + (csv_.empty() ? "" : " or " + csv_));
   if (!csv_.empty()) sinks.push_back(&csv_writer.emplace(s, csv_));
   ArmStepFanOut sink(sinks);
   if (!quiet_) std::cout << JointGroupsReport(s.model);

@@ -128,6 +128,7 @@ void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
   render::WriteVideo(options.ffmpeg, format, width, height, options.fps, options.crf, path,
                      [&](render::VideoPicture* out) {
                        if (d == pictures) return false;
+                       if (options.progress) options.progress(d, pictures);
                        cairo_t* cr = picture.cr();
                        cairo_set_source_surface(cr, background.surface(), 0, 0);
                        cairo_paint(cr);

@@ -35,6 +35,17 @@ std::string Tail(std::string text, int lines) {
   return text.substr(start == 0 ? 0 : start + 1);
 }
 
+// The errno of a failed write of the video that ffmpeg's failure `why` reports (the reasons a
+// disk refuses a file, as strerror words them, or SIGXFSZ: the file size limit); 0 for any
+// other failure (a missing codec, bad input).
+int WriteErrorOf(const std::string& why) {
+  if (why.find("killed by signal " + std::to_string(SIGXFSZ)) != std::string::npos) return EFBIG;
+  for (const int e : {EFBIG, ENOSPC, EDQUOT, EIO, EROFS, EACCES, EPERM}) {
+    if (why.find(std::strerror(e)) != std::string::npos) return e;
+  }
+  return 0;
+}
+
 }  // namespace
 
 FfmpegPipe::FfmpegPipe(const std::string& program, const std::vector<std::string>& args) {
@@ -117,15 +128,19 @@ std::string FfmpegPipe::Finish() {
     }
   }
   pid_ = -1;
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return "";
   std::string text;
   char buf[4096];
   ::lseek(errors_, 0, SEEK_SET);
   for (ssize_t n; (n = ::read(errors_, buf, sizeof buf)) > 0;)
     text.append(buf, static_cast<size_t>(n));
-  std::string why = WIFEXITED(status) ? "exit status " + std::to_string(WEXITSTATUS(status))
-                                      : "killed by signal " + std::to_string(WTERMSIG(status));
   text = Tail(text, 4);
+  // Some ffmpeg versions exit with status 0 after failing to write the trailer, saying so (only
+  // errors are printed): a write error it reports is a failure whatever the status.
+  const bool exited_well = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  if (exited_well && WriteErrorOf(text) == 0) return "";
+  std::string why = !WIFEXITED(status) ? "killed by signal " + std::to_string(WTERMSIG(status))
+                    : exited_well      ? "a write error"
+                                       : "exit status " + std::to_string(WEXITSTATUS(status));
   return text.empty() ? why : why + ": " + text;
 }
 
@@ -141,6 +156,8 @@ VideoFormat VideoFormatFromPath(const std::string& path) {
 }
 
 // Raw frames in: cairo's RGB24 words are bytes B, G, R, unused on a little-endian machine.
+// -xerror: a failed write ends ffmpeg with a non-zero status (without it ffmpeg 5 exits with 0
+// after failing to write an MP4's trailer, leaving a truncated file).
 std::vector<std::string> FfmpegArgs(VideoFormat format, int width, int height, int fps, int crf,
                                     const std::string& output) {
   const uint32_t probe = 1;
@@ -153,7 +170,7 @@ std::vector<std::string> FfmpegArgs(VideoFormat format, int width, int height, i
       "-s",           std::to_string(width) + "x" + std::to_string(height),
       "-framerate",   std::to_string(fps),
       "-i",           "pipe:0",
-      "-an"};
+      "-an",          "-xerror"};
   if (format == VideoFormat::kMp4) {
     args.insert(args.end(), {"-c:v", "libx264", "-preset", "medium", "-crf", std::to_string(crf),
                              "-pix_fmt", "yuv420p", "-movflags", "+faststart", "-f", "mp4"});
@@ -222,6 +239,13 @@ void WriteVideo(const std::string& program, VideoFormat format, int width, int h
   }
   if (!failure.empty()) {
     ::unlink(temp.c_str());
+    // A video that could not be written is an I/O error like any file's, in one line: the
+    // reason is the system's, ffmpeg's own words are left out.
+    if (const int e = WriteErrorOf(failure); e != 0) {
+      throw std::system_error(e, std::generic_category(),
+                              "cannot write '" + path + "' (ffmpeg \"" + program +
+                                  "\": " + failure.substr(0, failure.find(':')) + ")");
+    }
     throw std::runtime_error("ffmpeg (\"" + program + "\") failed writing '" + path +
                              "': " + failure);
   }

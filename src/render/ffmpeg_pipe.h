@@ -27,8 +27,9 @@ class FfmpegPipe {
 
   // Writes `size` bytes to ffmpeg's input; false if ffmpeg stopped reading (it failed).
   bool Write(const void* data, size_t size);
-  // Closes ffmpeg's input and waits for it. "" if it exited with status 0, otherwise the reason:
-  // the exit status or signal and the last lines ffmpeg wrote to its standard error.
+  // Closes ffmpeg's input and waits for it. "" if it exited with status 0 and reported no write
+  // error, otherwise the reason: the exit status or signal and the last lines ffmpeg wrote to
+  // its standard error.
   std::string Finish();
 
  private:
@@ -63,7 +64,9 @@ struct VideoPicture {
 // the next one and returns false after the last. The video goes to a temporary file next to
 // `path` and is renamed into place only when ffmpeg has finished well; on any failure the
 // temporary file is removed, an exception from `next` propagates, and a failing ffmpeg throws
-// std::runtime_error naming the program, the path and ffmpeg's reason.
+// std::runtime_error naming the program, the path and ffmpeg's reason, or std::system_error
+// ("cannot write 'PATH'" and the reason) when ffmpeg failed writing the video (no space, the file
+// size limit).
 void WriteVideo(const std::string& program, VideoFormat format, int width, int height, int fps,
                 int crf, const std::string& path, const std::function<bool(VideoPicture*)>& next);
 

@@ -1,6 +1,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -158,6 +160,11 @@ struct AnimationOptions {
   // H.264 constant rate factor for MP4, 0 (lossless) to 51; lower is better and larger.
   // Typical: 20.
   int crf = 20;
+  // Called before each picture is drawn (done of total pictures); empty = none. It may throw
+  // to stop the writing (a signal's handler, say): the video's temporary file is removed, ffmpeg
+  // is killed and reaped, an existing file at the path is left untouched and the exception
+  // propagates.
+  std::function<void(int64_t done, int64_t total)> progress;
 
   // Every problem (empty if valid), each naming its member ("width").
   Problems Validate() const;

@@ -249,6 +249,7 @@ void RenderStrandsSnapshot(StrandFileReader* reader, const StrandsRenderOptions&
   std::vector<StrandFrame> kept(n);
   StrandFrame frame;
   for (int f = 0, next = 0; next < n && reader->Next(&frame); ++f) {
+    if (options.progress) options.progress(f, d.num_frames);
     if (f != panels[next]) continue;
     CheckFinite(d, f, frame.points);
     kept[next++] = frame;
@@ -373,6 +374,8 @@ void RenderStrandsAnimation(StrandFileReader* reader, const StrandsRenderOptions
   render::WriteVideo(
       options.ffmpeg, video, width, height, fps, options.crf, path, [&](render::VideoPicture* out) {
         if (k == drawn.size()) return false;
+        if (options.progress)
+          options.progress(static_cast<int64_t>(k), static_cast<int64_t>(drawn.size()));
         while (f < drawn[k]) {
           if (!reader->Next(&frame))
             throw InputError("frames", "the file ended before frame " + std::to_string(drawn[k]));

@@ -17,6 +17,8 @@
 // std::system_error for a file that cannot be written; std::runtime_error when ffmpeg is missing
 // or fails. Every writer is all-or-nothing: an existing destination is left untouched on error.
 
+#include <cstdint>
+#include <functional>
 #include <string>
 
 #include "flexkin/error.h"
@@ -63,6 +65,10 @@ struct StrandsRenderOptions {
   std::string ffmpeg = "ffmpeg";
   // H.264 constant rate factor for MP4, 0 (lossless) to 51. Typical: 20.
   int crf = 20;
+  // Called before each picture of an animation is drawn (done of total pictures) and, for a
+  // figure, after each frame read (done of total frames); empty = none. It may throw to stop the
+  // writing, as AnimationOptions::progress.
+  std::function<void(int64_t done, int64_t total)> progress;
 
   // Every problem (empty if valid), each naming its member ("max_strands").
   Problems Validate() const;
