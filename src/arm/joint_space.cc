@@ -48,28 +48,30 @@ Eigen::Matrix<double, T, 1> SolveNormal(Eigen::Matrix<double, T, T>* a_io,
   Eigen::Matrix<double, T, T>& a = *a_io;
   const double ridge = (1e-14 + damping) * a.trace() + 1e-300;
   a.diagonal().array() += ridge;
-  Eigen::Matrix<double, T, T> l;  // lower triangle: A = L L'
+  Eigen::Matrix<double, T, T> l;    // lower triangle: A = L L'
+  Eigen::Matrix<double, T, 1> inv;  // 1 / L's diagonal (one division a column)
   for (int j = 0; j < T; ++j) {
     double d = a(j, j);
     for (int k = 0; k < j; ++k) d -= l(j, k) * l(j, k);
     if (!(d > 0.0)) return a.template selfadjointView<Eigen::Lower>().ldlt().solve(rhs);
     l(j, j) = std::sqrt(d);
+    inv[j] = 1.0 / l(j, j);
     for (int i = j + 1; i < T; ++i) {
       double e = a(i, j);
       for (int k = 0; k < j; ++k) e -= l(i, k) * l(j, k);
-      l(i, j) = e / l(j, j);
+      l(i, j) = e * inv[j];
     }
   }
   Eigen::Matrix<double, T, 1> x;
   for (int i = 0; i < T; ++i) {  // L y = rhs
     double e = rhs[i];
     for (int k = 0; k < i; ++k) e -= l(i, k) * x[k];
-    x[i] = e / l(i, i);
+    x[i] = e * inv[i];
   }
   for (int i = T - 1; i >= 0; --i) {  // L' x = y
     double e = x[i];
     for (int k = i + 1; k < T; ++k) e -= l(k, i) * x[k];
-    x[i] = e / l(i, i);
+    x[i] = e * inv[i];
   }
   return x;
 }
@@ -122,6 +124,7 @@ class RevoluteArm {
         q_(ws->q),
         dq_(ws->dq),
         trial_(ws->trial),
+        free_step_(ws->free_step),
         points_(ws->points),
         trial_points_(ws->trial_points),
         axes_(ws->axes),
@@ -225,10 +228,11 @@ class RevoluteArm {
         if (held_[k]) rhs -= jac_.col(k) * dq_[k];
       }
       const Task lambda = SolveNormal<T>(&a, rhs, damping);
+      free_step_.noalias() = wjac_.transpose() * lambda;  // W^-1 J' lambda (0 for held joints)
       bool more = false;
       for (int k = 0; k < n_; ++k) {
         if (held_[k]) continue;
-        dq_[k] = wjac_.col(k).dot(lambda);
+        dq_[k] = free_step_[k];
         const double unit = unit_of(k);
         const double to = std::clamp(q_[k] + unit * dq_[k], lo(k), hi(k));
         if (to != q_[k] + unit * dq_[k]) {
@@ -280,7 +284,7 @@ class RevoluteArm {
   const double scale_, angle_scale_;
   Vec3 tool_axis_;  // in the last link's frame
   // The workspace's storage (JointSpacePlan::Workspace).
-  Eigen::VectorXd &q_, &dq_, &trial_;
+  Eigen::VectorXd &q_, &dq_, &trial_, &free_step_;
   Points &points_, &trial_points_;
   Eigen::MatrixXd &axes_, &trial_axes_;
   Mat3 &frame_, &trial_frame_;
@@ -294,6 +298,7 @@ class RevoluteArm {
   static double* Sized(JointSpacePlan::Workspace* ws, int n) {
     ws->dq.resize(n);
     ws->trial.resize(n);
+    ws->free_step.resize(n);
     ws->held.resize(n);
     ws->jacobian.resize(T, n);
     ws->weighted.resize(T, n);

@@ -38,7 +38,7 @@ class JointSpacePlan {
   // next step, starting there, need not compute its forward kinematics again. A plan is used by
   // one thread.
   struct Workspace {
-    Eigen::VectorXd q, dq, trial;
+    Eigen::VectorXd q, dq, trial, free_step;
     Points points, trial_points;
     Eigen::MatrixXd axes, trial_axes, jacobian, weighted;
     Eigen::Matrix3d frame, trial_frame;
