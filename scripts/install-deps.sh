@@ -7,6 +7,7 @@ packages=(cmake make g++ ccache pkg-config clang-format git libeigen3-dev nlohma
           libgmock-dev libbenchmark-dev libboost-dev libxsimd-dev liblapack-dev libnlopt-dev coinor-libipopt-dev)
 packages+=(libcairo2-dev fonts-dejavu-core ffmpeg)  # flexkin render (src/render)
 packages+=(libtinygltf-dev)  # glTF export (src/gltf)
+packages+=(clang-14 libclang-rt-14-dev)  # libFuzzer targets, ASan + UBSan (fuzz/, make fuzz, docs/fuzzing.md)
 packages+=(liborocos-kdl-dev)  # the pseudo-inverse peer of the arm comparison (testing/kdl_peer.h)
 packages+=(libkdl-parser-dev)  # KDL chains from URDF text, the URDF snakes' peer (testing/kdl_urdf_peer.h)
 packages+=(chromium)         # the viewer's browser test (headless)
