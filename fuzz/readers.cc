@@ -36,16 +36,18 @@ const char* kUrdf = R"(<robot name="three"><link name="base_link"/><link name="a
 // `bytes` written to a file in a directory of this process's own (made once, removed at exit),
 // so that a glTF file's relative buffer URIs find nothing else.
 std::string WriteTemporary(const std::string& bytes, const char* name) {
-  static const std::filesystem::path dir = [] {
+  // Never destroyed: the atexit handler runs after the destructors of statics made before it.
+  static const std::filesystem::path* const dir = [] {
     std::string pattern = (std::filesystem::temp_directory_path() / "flexkin-fuzz-XXXXXX").string();
     if (!mkdtemp(pattern.data())) throw std::system_error(errno, std::generic_category(), pattern);
+    auto* made = new std::filesystem::path(pattern);
     std::atexit([] {
       std::error_code ignored;
-      std::filesystem::remove_all(dir, ignored);
+      std::filesystem::remove_all(*dir, ignored);
     });
-    return std::filesystem::path(pattern);
+    return made;
   }();
-  const std::string path = (dir / name).string();
+  const std::string path = (*dir / name).string();
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   out.close();

@@ -41,11 +41,16 @@ for t in "${targets[@]}"; do
   log="$work/$t.log"
   echo "fuzz: $t for $seconds s (log $log)"
   start=$(date +%s)
-  ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1} UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1} \
-    "$bin" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -max_len="${max_len[$t]:-16384}" \
-    -print_final_stats=1 -artifact_prefix="$artifacts/" "${dict[@]}" "${dirs[@]}" \
+  # The targets' temporary files (npz, glTF) in a folder of the run: libFuzzer may end without
+  # running their clean-up.
+  tmp="$work/tmp/$t"
+  rm -rf "$tmp" && mkdir -p "$tmp"
+  TMPDIR="$tmp" ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1} \
+    UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1} "$bin" -max_total_time="$seconds" -timeout=10 \
+    -rss_limit_mb=2048 -max_len="${max_len[$t]:-16384}" -print_final_stats=1 -artifact_prefix="$artifacts/" "${dict[@]}" "${dirs[@]}" \
     > "$log" 2>&1
   rc=$?
+  rm -rf "$tmp"
   elapsed=$(($(date +%s) - start))
   execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | tail -1 | grep -o '[0-9]*$')
   cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | grep -o '[0-9]*$')
