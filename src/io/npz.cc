@@ -242,6 +242,18 @@ ZipReader::ZipReader(const std::string& path) : path_(path) {
     ::close(fd_);
     throw std::system_error(err, std::generic_category(), "cannot read '" + path + "'");
   }
+  // The destructor does not run when the constructor throws: a malformed archive closes the file
+  // here (each refused file used to keep a descriptor open).
+  struct CloseUnlessKept {
+    int* fd;
+    bool keep = false;
+    ~CloseUnlessKept() {
+      if (!keep) {
+        ::close(*fd);
+        *fd = -1;
+      }
+    }
+  } closer{&fd_};
   file_size_ = static_cast<uint64_t>(st.st_size);
   const std::string end_field = "zip: end of central directory";
   if (file_size_ < kEndSize) Malformed(end_field, "is missing (the file is too short)");
@@ -352,6 +364,7 @@ ZipReader::ZipReader(const std::string& path) : path_(path) {
     if (!members_.emplace(name, e).second) Malformed(member_field, "appears twice");
     pos += kCentralHeaderSize + name_len + extra_len + comment_len;
   }
+  closer.keep = true;
 }
 
 ZipReader::~ZipReader() {
