@@ -1,12 +1,16 @@
 # flexkin: two commands on a fresh Debian machine (they install what is missing themselves).
 #   make demo   build, then run the paper's scenarios (figures' numbers printed, results in out/)
-#   make test   build and run every test, then again under AddressSanitizer + UBSan, and the
-#               threaded ones under ThreadSanitizer
-# Also: make bench (Google Benchmark, see docs/BENCHMARKS.md), make install PREFIX=...
+#   make test   build and run every test, then again under AddressSanitizer + UBSan, the
+#               threaded ones under ThreadSanitizer, and the fuzz targets briefly (test-fuzz)
+# Also: make bench (Google Benchmark, see docs/BENCHMARKS.md), make fuzz (libFuzzer, see
+# docs/fuzzing.md), make install PREFIX=...
 
 BUILD      ?= build
 BUILD_SAN  ?= build-sanitize
 BUILD_TSAN ?= build-tsan
+BUILD_FUZZ ?= build-fuzz
+FUZZ_SECONDS ?= 300
+FUZZ_SHORT_SECONDS ?= 20
 JOBS       ?= $(shell nproc)
 PREFIX     ?= /usr/local
 PYTHON     ?= /usr/bin/python3
@@ -14,7 +18,8 @@ PYTHON     ?= /usr/bin/python3
 # The C++ sources that clang-format keeps in the style of .clang-format (make format applies it).
 FORMAT_FILES = $(shell git ls-files '*.cc' '*.h' 2>/dev/null)
 
-.PHONY: all deps build demo test test-release test-sanitize test-thread bench install clean format format-check
+.PHONY: all deps build demo test test-release test-sanitize test-thread test-fuzz fuzz fuzz-build bench install \
+	clean format format-check
 
 all: build
 
@@ -28,7 +33,7 @@ build: deps
 demo: build
 	@bash scripts/demo.sh $(BUILD)
 
-test: test-release test-sanitize test-thread
+test: test-release test-sanitize test-thread test-fuzz
 
 test-release: build
 	@ctest --test-dir $(BUILD) --output-on-failure -j$(JOBS)
@@ -52,6 +57,22 @@ test-thread: deps
 	  ctest --test-dir $(BUILD_TSAN) --output-on-failure -j$(JOBS) \
 	  -R '^($(shell echo $(TSAN_TESTS) | sed 's/ /|/g'))\.'
 
+# The libFuzzer targets of fuzz/ (docs/fuzzing.md), built by clang with ASan + UBSan: only the
+# libraries they link. `make fuzz` runs each for FUZZ_SECONDS on its seeds (new units kept in
+# $(BUILD_FUZZ)/fuzz-run/); `make test-fuzz` for FUZZ_SHORT_SECONDS from the seeds alone, and
+# fails if any target finds something.
+fuzz-build: deps
+	@CC=clang-14 CXX=clang++-14 cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLEXKIN_FUZZ=ON \
+	  -DFLEXKIN_BUILD_APPS=OFF -DFLEXKIN_BUILD_TESTS=OFF -DFLEXKIN_BUILD_BENCHMARKS=OFF \
+	  -DFLEXKIN_BUILD_EXAMPLES=OFF -DFLEXKIN_PYTHON=OFF > /dev/null
+	@cmake --build $(BUILD_FUZZ) -j$(JOBS)
+
+fuzz: fuzz-build
+	@bash scripts/fuzz.sh $(BUILD_FUZZ) $(FUZZ_SECONDS)
+
+test-fuzz: fuzz-build
+	@bash scripts/fuzz.sh --fresh $(BUILD_FUZZ) $(FUZZ_SHORT_SECONDS)
+
 bench: build
 	@for b in propagation_benchmark overall_benchmark arm_benchmark arm_kdl_benchmark arm_limits_benchmark strands_benchmark urdf_kdl_benchmark; do \
 	  $(BUILD)/bench/$$b --benchmark_repetitions=5 --benchmark_report_aggregates_only=true || exit 1; \
@@ -69,4 +90,4 @@ install: build
 	@cmake --install $(BUILD) --prefix $(PREFIX)
 
 clean:
-	@rm -rf $(BUILD) $(BUILD_SAN) $(BUILD_TSAN) out
+	@rm -rf $(BUILD) $(BUILD_SAN) $(BUILD_TSAN) $(BUILD_FUZZ) out

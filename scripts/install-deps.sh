@@ -7,10 +7,11 @@ packages=(cmake make g++ ccache pkg-config clang-format git libeigen3-dev nlohma
           libgmock-dev libbenchmark-dev libboost-dev libxsimd-dev liblapack-dev libnlopt-dev coinor-libipopt-dev)
 packages+=(libcairo2-dev fonts-dejavu-core ffmpeg)  # flexkin render (src/render)
 packages+=(libtinygltf-dev)  # glTF export (src/gltf)
+packages+=(clang-14 libclang-rt-14-dev)  # libFuzzer targets, ASan + UBSan (fuzz/, make fuzz, docs/fuzzing.md)
 packages+=(liborocos-kdl-dev)  # the pseudo-inverse peer of the arm comparison (testing/kdl_peer.h)
 packages+=(libkdl-parser-dev)  # KDL chains from URDF text, the URDF snakes' peer (testing/kdl_urdf_peer.h)
 packages+=(chromium)         # the viewer's browser test (headless)
-packages+=(liburdfdom-dev)   # URDF arms (src/urdf)
+packages+=(liburdfdom-dev libtinyxml-dev)  # URDF arms (src/urdf); TinyXML, the parser urdfdom uses
 packages+=(zlib1g-dev)       # CRC-32 of the .npz result files (src/io/npz.cc)
 packages+=(python3-numpy)    # the tests read .npz results with numpy.load (tests/result_npz_test)
 packages+=(python3-dev pybind11-dev python3-pytest)  # the Python module (python/, docs/python.md)

@@ -452,5 +452,20 @@ TEST(ResultFormatTest, FormatFromTheExtension) {
                               "no extension");
 }
 
+// A refused archive leaves no file descriptor open (the reader's constructor closes its file when
+// it throws; each refused file used to keep one, until "Too many open files": result_fuzzer).
+class ResultNpzFileTest : public test_util::TempDirTest {};
+
+TEST_F(ResultNpzFileTest, RefusedArchiveClosesItsFile) {
+  const std::string path = Path("bad.npz");
+  std::ofstream(path, std::ios::binary) << std::string("PK\x03\x04", 4) << std::string(100, 'x');
+  auto open_files = [] {
+    return std::distance(fs::directory_iterator("/proc/self/fd"), fs::directory_iterator());
+  };
+  const auto before = open_files();
+  for (int i = 0; i < 50; ++i) EXPECT_THROW(ReadResultFile(path), InputError);
+  EXPECT_EQ(open_files(), before);
+}
+
 }  // namespace
 }  // namespace flexkin

@@ -160,6 +160,14 @@ TEST(Urdf, BadUrdfsNameTheElement) {
                                     "\"elbow\": a closed loop"),
             std::string::npos)
       << InputErrorOf(loop);
+  // A cycle of joints cut off from the root (fore -> hand -> fore): refused before urdfdom builds
+  // it (whose links would hold each other, never freed), naming a link of it.
+  const std::string cycle = Replace(good, "<parent link=\"upper\"/><child link=\"fore\"/>",
+                                    "<parent link=\"hand\"/><child link=\"fore\"/>");
+  EXPECT_NE(InputErrorOf(cycle).find("link \"hand\": is its own ancestor: joint \"wrist\" and the "
+                                     "joints above it form a cycle"),
+            std::string::npos)
+      << InputErrorOf(cycle);
   EXPECT_NE(InputErrorOf(good, {"", "elbowx"}).find("\"elbowx\" is not in the URDF"),
             std::string::npos);
   EXPECT_NE(InputErrorOf(good, {"nowhere", ""}).find("base_link"), std::string::npos);

@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -157,6 +158,14 @@ std::vector<Track> ReadTracks(const tinygltf::Model& model) {
         !std::is_sorted(track.times.begin(), track.times.end())) {
       throw InputError(Index("animations[0].samplers", channel.sampler),
                        "needs as many outputs as inputs, and increasing input times");
+    }
+    // A NaN would pass the order check and send Sample past the last keyframe.
+    if (const auto bad = std::find_if(track.times.begin(), track.times.end(),
+                                      [](float t) { return !std::isfinite(t); });
+        bad != track.times.end()) {
+      throw InputError(Index("animations[0].samplers", channel.sampler) + ".input",
+                       "time " + std::to_string(bad - track.times.begin()) + " is " +
+                           std::to_string(*bad) + "; expected finite, increasing times (seconds)");
     }
     tracks.push_back(std::move(track));
   }

@@ -89,6 +89,24 @@ std::string LocalHeader(const std::string& name, uint32_t crc, uint64_t size) {
   throw InputError(field, message + "; not a valid .npz result file");
 }
 
+// A member's name from the file as the field of a message: bytes outside printable ASCII as \xNN
+// (a NUL would cut what() short, a control character garble a terminal), at most 64 bytes of it.
+std::string PrintableName(const std::string& name) {
+  constexpr size_t kShown = 64;
+  std::string out;
+  for (size_t i = 0; i < std::min(name.size(), kShown); ++i) {
+    const unsigned char c = static_cast<unsigned char>(name[i]);
+    if (c >= 0x20 && c < 0x7f && c != '\\') {
+      out += static_cast<char>(c);
+    } else {
+      static const char kHex[] = "0123456789abcdef";
+      out += {'\\', 'x', kHex[c >> 4], kHex[c & 15]};
+    }
+  }
+  if (name.size() > kShown) out += "...";
+  return out;
+}
+
 }  // namespace
 
 std::string NpyHeader(const std::string& descr, const std::vector<uint64_t>& shape, size_t length) {
@@ -224,6 +242,18 @@ ZipReader::ZipReader(const std::string& path) : path_(path) {
     ::close(fd_);
     throw std::system_error(err, std::generic_category(), "cannot read '" + path + "'");
   }
+  // The destructor does not run when the constructor throws: a malformed archive closes the file
+  // here (each refused file used to keep a descriptor open).
+  struct CloseUnlessKept {
+    int* fd;
+    bool keep = false;
+    ~CloseUnlessKept() {
+      if (!keep) {
+        ::close(*fd);
+        *fd = -1;
+      }
+    }
+  } closer{&fd_};
   file_size_ = static_cast<uint64_t>(st.st_size);
   const std::string end_field = "zip: end of central directory";
   if (file_size_ < kEndSize) Malformed(end_field, "is missing (the file is too short)");
@@ -299,7 +329,7 @@ ZipReader::ZipReader(const std::string& path) : path_(path) {
       Malformed(field, "is truncated");
     }
     const std::string name(reinterpret_cast<const char*>(p + kCentralHeaderSize), name_len);
-    const std::string member_field = name.empty() ? field : name;
+    const std::string member_field = name.empty() ? field : PrintableName(name);
     // The ZIP64 extra field holds the values whose fixed fields are 0xffffffff, in this order.
     const unsigned char* x = p + kCentralHeaderSize + name_len;
     size_t x_left = extra_len;
@@ -334,6 +364,7 @@ ZipReader::ZipReader(const std::string& path) : path_(path) {
     if (!members_.emplace(name, e).second) Malformed(member_field, "appears twice");
     pos += kCentralHeaderSize + name_len + extra_len + comment_len;
   }
+  closer.keep = true;
 }
 
 ZipReader::~ZipReader() {

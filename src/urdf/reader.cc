@@ -1,5 +1,6 @@
 // A serial arm from a URDF (include/flexkin/urdf.h), parsed by urdfdom.
 #include <console_bridge/console.h>
+#include <tinyxml.h>
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Geometry>
@@ -9,6 +10,7 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <set>
 #include <sstream>
 #include <system_error>
 #include <vector>
@@ -71,7 +73,57 @@ class Collect : public console_bridge::OutputHandler {
   std::string first;
 };
 
+// Refuses joints that form a cycle (each link of it the child of the one before, none of them under
+// the root), read with TinyXML as urdfdom reads them: urdfdom accepts such a cycle, or fails later
+// with its links holding each other (never freed), and no walk up from them ends. Also refuses a
+// link that is the child of two joints (a closed loop; urdfdom keeps the last of them and would
+// read it as a tree).
+void RefuseJointCycles(const std::string& text) {
+  TiXmlDocument doc;
+  doc.Parse(text.c_str());
+  const TiXmlElement* robot = doc.Error() ? nullptr : doc.FirstChildElement("robot");
+  if (!robot) return;  // urdfdom says what is wrong
+  struct Up {
+    std::string link, joint;  // the parent link and the joint to it
+  };
+  std::map<std::string, Up> up;  // child link -> its parent
+  for (const TiXmlElement* j = robot->FirstChildElement("joint"); j;
+       j = j->NextSiblingElement("joint")) {
+    const TiXmlElement* parent = j->FirstChildElement("parent");
+    const TiXmlElement* child = j->FirstChildElement("child");
+    const char* parent_link = parent ? parent->Attribute("link") : nullptr;
+    const char* child_link = child ? child->Attribute("link") : nullptr;
+    const char* name = j->Attribute("name");
+    if (!parent_link || !child_link || !name) continue;  // urdfdom refuses the joint
+    const auto [at, fresh] = up.emplace(child_link, Up{parent_link, name});
+    if (!fresh) {
+      const std::string joint = name;
+      const auto [first, second] = std::minmax(at->second.joint, joint);
+      throw InputError("link " + Quote(child_link),
+                       "is the child of joints " + Quote(first) + " and " + Quote(second) +
+                           ": a closed loop; flexkin arms are serial chains (each link the "
+                           "child of one joint): remove one of them");
+    }
+  }
+  std::set<std::string> reaches_root;  // links known to lie under a link without a parent
+  for (const auto& [link, unused] : up) {
+    std::vector<std::string> path;
+    for (auto at = up.find(link); at != up.end() && !reaches_root.count(at->first);
+         at = up.find(at->second.link)) {
+      path.push_back(at->first);
+      if (path.size() > up.size()) {
+        throw InputError("link " + Quote(at->first),
+                         "is its own ancestor: joint " + Quote(at->second.joint) +
+                             " and the joints above it form a cycle; expected a tree (each "
+                             "joint's parent link nearer the root)");
+      }
+    }
+    reaches_root.insert(path.begin(), path.end());
+  }
+}
+
 urdf::ModelInterfaceSharedPtr Parse(const std::string& text) {
+  RefuseJointCycles(text);
   // console_bridge's handler is global: one parse at a time.
   static std::mutex mutex;
   Collect collect;
@@ -95,18 +147,6 @@ urdf::ModelInterfaceSharedPtr Parse(const std::string& text) {
                          "); check the XML, that every joint names existing parent and "
                          "child links, that no link has two parents (a closed loop) and "
                          "that revolute and prismatic joints have <limit>");
-  }
-  // urdfdom keeps the last of two joints that share a child link: a closed loop would read as a
-  // tree. Refused here, naming the link and both joints.
-  std::map<std::string, std::string> parent_joint;
-  for (const auto& [name, joint] : robot->joints_) {
-    const auto [at, fresh] = parent_joint.emplace(joint->child_link_name, name);
-    if (!fresh) {
-      throw InputError("link " + Quote(joint->child_link_name),
-                       "is the child of joints " + Quote(at->second) + " and " + Quote(name) +
-                           ": a closed loop; flexkin arms are serial chains (each link the "
-                           "child of one joint): remove one of them");
-    }
   }
   return robot;
 }

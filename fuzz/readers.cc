@@ -1,0 +1,137 @@
+#include "readers.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <system_error>
+
+#include "flexkin/error.h"
+#include "flexkin/result_io.h"
+#include "flexkin/robot_scenario.h"
+#include "flexkin/scenario.h"
+#include "flexkin/strand_file.h"
+#include "flexkin/urdf.h"
+#include "gltf/gltf.h"
+
+namespace flexkin::fuzz {
+namespace {
+
+// A spatial arm of three joints (yaw, pitch, roll) and a fixed tool frame: the arm of every robot
+// scenario that names a URDF file.
+const char* kUrdf = R"(<robot name="three"><link name="base_link"/><link name="a"/><link name="b"/>
+<link name="c"/><link name="tip_link"/>
+<joint name="yaw" type="revolute"><parent link="base_link"/><child link="a"/><axis xyz="0 0 1"/>
+<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+<joint name="pitch" type="continuous"><parent link="a"/><child link="b"/><origin xyz="0 0 0.3"/>
+<axis xyz="0 1 0"/></joint>
+<joint name="roll" type="continuous"><parent link="b"/><child link="c"/><origin xyz="0.2 0 0"/>
+<axis xyz="1 0 0"/></joint>
+<joint name="tool" type="fixed"><parent link="c"/><child link="tip_link"/><origin xyz="0.1 0 0"/>
+</joint></robot>)";
+
+// `bytes` written to a file in a directory of this process's own (made once, removed at exit),
+// so that a glTF file's relative buffer URIs find nothing else.
+std::string WriteTemporary(const std::string& bytes, const char* name) {
+  // Never destroyed: the atexit handler runs after the destructors of statics made before it.
+  static const std::filesystem::path* const dir = [] {
+    std::string pattern = (std::filesystem::temp_directory_path() / "flexkin-fuzz-XXXXXX").string();
+    if (!mkdtemp(pattern.data())) throw std::system_error(errno, std::generic_category(), pattern);
+    auto* made = new std::filesystem::path(pattern);
+    std::atexit([] {
+      std::error_code ignored;
+      std::filesystem::remove_all(*dir, ignored);
+    });
+    return made;
+  }();
+  const std::string path = (*dir / name).string();
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  out.close();
+  if (!out) throw std::system_error(EIO, std::generic_category(), path);
+  return path;
+}
+
+// Validate and Parse of one kind of scenario must agree: no problems if and only if it parses.
+// Else std::logic_error, which no reader throws: a finding.
+template <typename Validate, typename Parse>
+void ValidateThenParse(const Validate& validate, const Parse& parse) {
+  const Problems problems = validate();
+  bool parsed = false;
+  try {
+    parse();
+    parsed = true;
+  } catch (const InputError&) {
+    if (problems.empty()) throw;  // escapes as a finding below
+  }
+  if (parsed != problems.empty()) {
+    throw std::logic_error("validate found " + std::to_string(problems.size()) + " problems (" +
+                           (problems.empty() ? "" : problems.front().message) + ") but parse " +
+                           (parsed ? "succeeded" : "failed"));
+  }
+}
+
+}  // namespace
+
+void ReadScenario(const std::string& bytes) {
+  ValidateThenParse([&] { return ValidateScenarioText(bytes); }, [&] { ParseScenarioText(bytes); });
+}
+
+void ReadRobotScenario(const std::string& bytes) {
+  RobotScenarioOptions options;
+  options.urdf_loader = [](const std::string&, const UrdfChain& chain) {
+    return ArmFromUrdf(kUrdf, chain);
+  };
+  IsRobotScenarioText(bytes);
+  ValidateThenParse([&] { return ValidateRobotScenarioText(bytes, options); },
+                    [&] { ParseRobotScenarioText(bytes, options); });
+}
+
+void ReadResult(const std::string& bytes) {
+  if (bytes.compare(0, 4, std::string("PK\x03\x04", 4)) != 0) {
+    ResultFromText(bytes);
+    return;
+  }
+  const std::string path = WriteTemporary(bytes, "result.npz");
+  if (!IsStrandFile(path)) {
+    ReadResultFile(path);
+    return;
+  }
+  StrandFileReader reader(path);
+  StrandFrame frame;
+  while (reader.Next(&frame)) {
+  }
+}
+
+void ReadUrdf(const std::string& bytes) { ArmFromUrdf(bytes); }
+
+void ReadGltf(const std::string& bytes) {
+  ReadGltfJointPositions(WriteTemporary(bytes, "in.gltf"));
+}
+
+const std::vector<Target>& Targets() {
+  static const std::vector<Target> targets = {{"scenario", ReadScenario},
+                                              {"robot", ReadRobotScenario},
+                                              {"result", ReadResult},
+                                              {"urdf", ReadUrdf},
+                                              {"gltf", ReadGltf}};
+  return targets;
+}
+
+int RunOne(void (*read)(const std::string& bytes), const uint8_t* data, size_t size) {
+  try {
+    read(std::string(reinterpret_cast<const char*>(data), size));
+  } catch (const InputError& e) {
+    if (std::string(e.what()).empty()) {
+      std::fprintf(stderr, "InputError with an empty message\n");
+      std::abort();
+    }
+  } catch (const std::system_error&) {
+  }
+  return 0;
+}
+
+}  // namespace flexkin::fuzz
