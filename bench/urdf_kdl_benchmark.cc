@@ -13,7 +13,8 @@
 // Counters (all times CPU time of this thread; the machine may be shared):
 //   s/step       this benchmark's time per step (timed loop)
 //   x_nr, x_lma  (Flexkin rows) KDL NR's / LMA's time per step over flexkin's: the medians of 5
-//                runs of each, measured once per scene in this process
+//                runs of each KDL solver and 25 of flexkin, each after a run not timed, measured
+//                once per scene in this process
 //   x_flexkin    (KDL rows) this solver's median time per step over flexkin's
 //   us/module    the median time per step over the number of modules (linearity: constant if
 //                the cost grows linearly with the snake's length)
@@ -44,7 +45,8 @@ namespace peers = flexkin::peers;
 namespace snakes = flexkin::snakes;
 
 constexpr int kSteps = 64;
-constexpr int kRuns = 5;  // runs per solver for the reference medians
+constexpr int kRuns = 5;          // runs per KDL solver for the reference medians
+constexpr int kFlexkinRuns = 25;  // flexkin's (each run a hundred times shorter)
 
 // This thread's CPU time (s).
 double CpuSeconds() {
@@ -82,10 +84,14 @@ peers::KdlUrdfTrajectory RunKdl(const Scene& s, KdlUrdfSolver solver) {
                                      s.target_rotations);
 }
 
+// After one run not timed (first calls: lazy symbol binding, first allocations, cold caches), the
+// median of `runs` timed runs: flexkin's runs (64 steps) last a few hundred microseconds, a hundred
+// times less than KDL's, so they take more runs for the same shelter from the machine's noise.
 template <typename Run>
-double MedianPerStep(const Run& run) {
+double MedianPerStep(const Run& run, int runs = kRuns) {
+  run();
   std::vector<double> times;
-  for (int r = 0; r < kRuns; ++r) {
+  for (int r = 0; r < runs; ++r) {
     const double start = CpuSeconds();
     run();
     times.push_back(CpuSeconds() - start);
@@ -132,10 +138,12 @@ std::unique_ptr<Scene> MakeScene(int modules, int design, bool pointing) {
       s->target_rotations.push_back(flexkin::ToolPoseAt(s->model, step.state.angles).rotation);
     }
   }
-  s->flexkin_per_step = MedianPerStep([&] {
-    const flexkin::ArmTrajectory t = RunFlexkin(*s);
-    benchmark::DoNotOptimize(t.steps.back().state.points.data());
-  });
+  s->flexkin_per_step = MedianPerStep(
+      [&] {
+        const flexkin::ArmTrajectory t = RunFlexkin(*s);
+        benchmark::DoNotOptimize(t.steps.back().state.points.data());
+      },
+      kFlexkinRuns);
   s->nr_per_step = MedianPerStep([&] {
     const peers::KdlUrdfTrajectory t = RunKdl(*s, KdlUrdfSolver::kNewtonPinv);
     benchmark::DoNotOptimize(t.steps.back().angles.data());
