@@ -76,13 +76,6 @@ Eigen::Matrix<double, T, 1> SolveNormal(Eigen::Matrix<double, T, T>* a_io,
   return x;
 }
 
-// Two unit vectors across unit `a` that make a right-handed frame with it: e1 x e2 = a (the same
-// for the same a: a miss and a Jacobian at one pose are expressed in the same pair).
-void Across(const Vec3& a, Vec3* e1, Vec3* e2) {
-  *e1 = a.unitOrthogonal();
-  *e2 = a.cross(*e1);
-}
-
 // The rotation vector of the smallest rotation taking unit `from` to unit `to`.
 Vec3 RotationVector(const Vec3& from, const Vec3& to) {
   const Vec3 axis = from.cross(to);
@@ -107,9 +100,8 @@ struct Goal {
 };
 
 // Joints about or along given axes (planar arms embedded with every axis z). The state is the
-// joint values q. T = 3: the end effector's position; T = 5: its position and, scaled by
-// `angle_scale` (length per rad), the rotation that would turn the tool axis onto its goal, which
-// lies across the tool axis: its two components on a pair of unit vectors across it (Across).
+// joint values q. T = 3: the end effector's position; T = 6: its position and, scaled by
+// `angle_scale` (length per rad), the rotation that would turn the tool axis onto its goal.
 // Prismatic joints are solved in q / scale (scale the mean link length), so that every column of
 // the Jacobian is a length and the weights stay dimensionless (InverseJointWeights).
 template <int T>
@@ -177,7 +169,7 @@ class RevoluteArm {
       return r.norm() <= tol;
     } else {
       return r.template head<3>().norm() <= tol &&
-             r.template tail<2>().norm() <= angle_tol * angle_scale_;
+             r.template tail<3>().norm() <= angle_tol * angle_scale_;
     }
   }
   double AngleMiss(const Task& r) const {
@@ -185,7 +177,7 @@ class RevoluteArm {
       (void)r;
       return 0.0;
     } else {
-      return r.template tail<2>().norm() / angle_scale_;
+      return r.template tail<3>().norm() / angle_scale_;
     }
   }
 
@@ -194,33 +186,30 @@ class RevoluteArm {
   // of the miss (each round holds at least one more joint: at most n rounds).
   bool Propose(const Task& r, double damping, const Goal& goal) {
     const Vec3 ee = end();
-    Vec3 a_w = Vec3::Zero(), e1 = Vec3::Zero(), e2 = Vec3::Zero();
+    Vec3 a_w = Vec3::Zero();
     double look = 0.0;  // looking at a point: 1 / its distance (the goal turns as the end moves)
-    if constexpr (T == 5) {
+    if constexpr (T == 6) {
       a_w = axis();
-      Across(a_w, &e1, &e2);
       if (goal.look_at && (goal.point - ee).norm() > 0.0) look = 1.0 / (goal.point - ee).norm();
     }
     for (int k = 0; k < n_; ++k) {
       const Vec3 axis = axes_.row(k).transpose();
       if (model_.prismatic(k)) {
         jac_.col(k).template head<3>() = axis * scale_;
-        if constexpr (T == 5) jac_.col(k).template tail<2>().setZero();
+        if constexpr (T == 6) jac_.col(k).template tail<3>().setZero();
       } else {
         jac_.col(k).template head<3>() = axis.cross(ee - Vec3(points_.row(k).transpose()));
-        // The tool axis turns with w x a_w: only w across a_w counts, its components on e1, e2.
-        if constexpr (T == 5) {
-          jac_(3, k) = angle_scale_ * axis.dot(e1);
-          jac_(4, k) = angle_scale_ * axis.dot(e2);
+        // The tool axis turns with w x a_w: only w across a_w counts.
+        if constexpr (T == 6) {
+          jac_.col(k).template tail<3>() = angle_scale_ * (axis - axis.dot(a_w) * a_w);
         }
       }
       // Looking at a point, the goal direction t = (point - end) / |point - end| turns as the
       // end effector moves: d(a x t) = a x dt, dt = -(I - t t') d(end) / |point - end|.
-      if constexpr (T == 5) {
+      if constexpr (T == 6) {
         if (look > 0.0) {
-          const Vec3 turn = angle_scale_ * look * a_w.cross(Vec3(jac_.col(k).template head<3>()));
-          jac_(3, k) += turn.dot(e1);
-          jac_(4, k) += turn.dot(e2);
+          const Vec3 move = jac_.col(k).template head<3>();
+          jac_.col(k).template tail<3>() += angle_scale_ * look * a_w.cross(move);
         }
       }
     }
@@ -280,14 +269,9 @@ class RevoluteArm {
     const Vec3 end = points.row(n_).transpose();
     Task r;
     r.template head<3>() = end - goal.position;
-    if constexpr (T == 5) {
+    if constexpr (T == 6) {
       const Vec3 a_w = frame * tool_axis_;
-      // The rotation vector lies across a_w: its components on e1, e2 (Across) are all of it.
-      const Vec3 turn = -angle_scale_ * RotationVector(a_w, goal.Direction(end));
-      Vec3 e1, e2;
-      Across(a_w, &e1, &e2);
-      r[3] = turn.dot(e1);
-      r[4] = turn.dot(e2);
+      r.template tail<3>() = -angle_scale_ * RotationVector(a_w, goal.Direction(end));
     }
     return r;
   }
@@ -509,7 +493,7 @@ JointSpaceSolve Drive(Arm* arm, double scale, const Goal& target, double tol, do
   int legs = static_cast<int>(std::ceil((target.position - from).norm() / (kLeg * scale)));
   Vec3 turn = Vec3::Zero();  // the tool axis' rotation to its goal, with pointing
   Vec3 axis_from = Vec3::UnitX();
-  if constexpr (Arm::Task::RowsAtCompileTime == 5) {
+  if constexpr (Arm::Task::RowsAtCompileTime == 6) {
     axis_from = arm->axis();
     turn = RotationVector(axis_from, target.Direction(target.position));
     legs = std::max(legs, static_cast<int>(std::ceil(turn.norm() / kLegAngle)));
@@ -518,7 +502,7 @@ JointSpaceSolve Drive(Arm* arm, double scale, const Goal& target, double tol, do
     const double t = double(leg) / legs;
     Goal goal = target;
     goal.position = from + (target.position - from) * t;
-    if constexpr (Arm::Task::RowsAtCompileTime == 5) {
+    if constexpr (Arm::Task::RowsAtCompileTime == 6) {
       goal.look_at = false;
       goal.direction =
           Eigen::AngleAxisd(t * turn.norm(),
@@ -603,7 +587,7 @@ JointSpaceSolve Attempt(const JointSpacePlan& plan, const ArmState& previous,
   const Goal goal = MakeGoal(target, pointing);
   JointSpaceSolve out;
   if (model.has_axes() && pointing.enabled) {
-    RevoluteArm<5> arm(model, plan.kinematics(), previous.angles.angle, winv, scale,
+    RevoluteArm<6> arm(model, plan.kinematics(), previous.angles.angle, winv, scale,
                        &plan.workspace(), pointing.axis.normalized(), pointing.weight * scale);
     out = Drive(&arm, scale, goal, tol, pointing.angle_tolerance, max_iterations);
     out.angles = arm.angles();
