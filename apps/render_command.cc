@@ -1,5 +1,6 @@
-// flexkin render: one result file in, the chosen formats out, each file written whole or not at
-// all. The formats are a table: an entry names a format and the function that writes its files.
+// flexkin render: one result file (or robot trajectory, or strand file) in, the chosen formats
+// out, each file written whole or not at all. The formats are a table: an entry names a format and
+// the function that writes its files.
 #include "render_command.h"
 
 #include <sys/stat.h>
@@ -14,6 +15,7 @@
 
 #include "flexkin/error.h"
 #include "flexkin/result_io.h"
+#include "flexkin/robot_scenario.h"
 #include "flexkin/strand_file.h"
 #include "gltf/gltf.h"
 #include "interrupt.h"
@@ -24,9 +26,11 @@
 namespace flexkin::cli {
 namespace {
 
-// Everything a format's writer needs.
+// Everything a format's writer needs: a chain result, or a robot trajectory (drawn in the
+// formats of kTrajectoryFormats only).
 struct RenderJob {
   const ResultFile* file = nullptr;
+  const RobotTrajectoryFile* trajectory = nullptr;  // instead of `file`
   std::string base;  // OUTDIR/<stem>: each writer appends its suffix and extension
   FigureOptions figure;
   PlotOptions plot;
@@ -37,7 +41,11 @@ struct RenderJob {
 void Figure(const RenderJob& job, const char* extension) {
   const std::string path = job.base + extension;
   Writing(path);
-  WriteSnapshotFigure(*job.file, job.figure, path);
+  if (job.trajectory != nullptr) {
+    WriteSnapshotFigure(*job.trajectory, job.figure, path);
+  } else {
+    WriteSnapshotFigure(*job.file, job.figure, path);
+  }
   job.written->push_back(path);
 }
 
@@ -60,7 +68,11 @@ void Plots(const RenderJob& job) {
 void Animation(const RenderJob& job, const char* extension) {
   const std::string path = job.base + extension;
   Writing(path);
-  WriteAnimation(*job.file, job.animation, path);
+  if (job.trajectory != nullptr) {
+    WriteAnimation(*job.trajectory, job.animation, path);
+  } else {
+    WriteAnimation(*job.file, job.animation, path);
+  }
   job.written->push_back(path);
 }
 
@@ -70,7 +82,11 @@ void Viewer(const RenderJob& job) {
   Writing(path);
   ViewerOptions options;
   options.title = job.figure.title;
-  WriteViewerHtml(*job.file, options, path);
+  if (job.trajectory != nullptr) {
+    WriteViewerHtml(*job.trajectory, options, path);
+  } else {
+    WriteViewerHtml(*job.file, options, path);
+  }
   job.written->push_back(path);
 }
 
@@ -214,15 +230,21 @@ std::string OutputBase(const std::string& result, const std::string& output_dir)
 }  // namespace
 
 RenderCommand::RenderCommand(CLI::App* app, const std::string& footer) {
-  command_ = app->add_subcommand("render", "Draw a result file: figures, plots, animations.");
-  command_->add_option("result", args_.result, "Result file (.json or .npz, docs/result-format.md)")
+  command_ = app->add_subcommand(
+      "render", "Draw a result file or robot trajectory: figures, plots, animations.");
+  command_
+      ->add_option("result", args_.result,
+                   "Result file (.json or .npz, docs/result-format.md), robot trajectory "
+                   "(flexkin robot -o, docs/robot-format.md) or strand file (.npz)")
       ->required();
   command_->add_option("-o,--output-dir", args_.output_dir,
                        "Directory for the outputs, created if missing (default: the result's)");
   std::string formats_help = "Comma-separated outputs (default svg,png,plots):";
   for (const auto& entry : Vocabulary<OutputFormat>::kEntries)
     formats_help += std::string("\n  ") + entry.name + ": " + entry.summary;
-  formats_help += "\n  (strand files: svg, png, pdf, mp4, gif, html; default svg,png)";
+  formats_help +=
+      "\n  (robot trajectories and strand files: svg, png, pdf, mp4, gif, html; "
+      "default svg,png)";
   formats_ = command_->add_option("--formats", args_.formats, formats_help);
   command_->add_option("--every", args_.every,
                        "Figures: draw every K-th recorded frame (default: about 16 frames)");
@@ -249,7 +271,14 @@ RenderCommand::RenderCommand(CLI::App* app, const std::string& footer) {
 
 int RenderCommand::Run() const {
   if (IsStrandFile(args_.result)) return RunStrands();
-  const std::vector<const FormatWriter*> formats = ParseFormats(args_.formats);
+  // A robot trajectory is drawn as a chain whose end effector leads and whose base is fixed
+  // (RobotTrajectoryAsResult): the figure, animation and viewer, by default the figure.
+  const bool trajectory = IsRobotTrajectoryFile(args_.result);
+  const std::vector<const FormatWriter*> formats =
+      ParseFormats(trajectory && !*formats_ ? "svg,png" : args_.formats);
+  if (trajectory) {
+    for (const FormatWriter* format : formats) CheckTrajectoryFormat(format->format, "--formats");
+  }
   RenderJob job;
   job.figure.every_k = args_.every;
   job.figure.title = job.animation.title = args_.title;
@@ -266,16 +295,22 @@ int RenderCommand::Run() const {
   CheckOptions(job.animation.Validate());
 
   ResultFile file;
+  RobotTrajectoryFile robot;
   try {
-    file = ReadResultFile(args_.result);  // JSON or .npz, by content
+    if (trajectory) {
+      robot = ReadRobotTrajectoryFile(args_.result);
+    } else {
+      file = ReadResultFile(args_.result);  // JSON or .npz, by content
+    }
   } catch (const InputError& e) {
     throw InputError(args_.result + (e.field().empty() ? "" : ": " + e.field()),
                      std::string(e.what()).substr(e.field().empty() ? 0 : e.field().size() + 2));
   }
-  if (file.result.frames.empty())
+  if (!trajectory && file.result.frames.empty())
     throw InputError(args_.result + ": /frames", "no frames; nothing to draw");
 
   job.file = &file;
+  if (trajectory) job.trajectory = &robot;
   job.base = OutputBase(args_.result, args_.output_dir);
   const std::string dir = job.base.substr(0, job.base.rfind('/'));
   std::error_code error;

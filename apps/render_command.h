@@ -1,6 +1,7 @@
 #pragma once
 // `flexkin render RESULT.json [-o OUTDIR] [--formats ...]`: figures, plots and animations of a
-// result file (docs/rendering.md). Kept apart from flexkin_main.cc, which only registers it.
+// result file, and the figure, animation and viewer of a robot trajectory or a strand file
+// (docs/rendering.md). Kept apart from flexkin_main.cc, which only registers it.
 
 #include <CLI/CLI.hpp>
 #include <string>
@@ -16,9 +17,10 @@ class RenderCommand {
 
   // Whether the command line chose this subcommand.
   bool Parsed() const { return command_->parsed(); }
-  // Reads the result and writes the chosen formats. Returns the exit status for failures it
-  // reports itself (ffmpeg missing or failing: 1); throws InputError (bad option or result:
-  // exit 1) and std::system_error (a file: exit 4) for flexkin_main to report.
+  // Reads the result (or robot trajectory, told apart by content) and writes the chosen formats.
+  // Returns the exit status for failures it reports itself (ffmpeg missing or failing: 1); throws
+  // InputError (bad option or result: exit 1) and std::system_error (a file: exit 4) for
+  // flexkin_main to report.
   int Run() const;
 
   struct Args {

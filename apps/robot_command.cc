@@ -31,6 +31,14 @@ std::string MethodHelp() {
   return help;
 }
 
+// The vocabulary's summary of `method` (the --method help's words).
+const char* MethodSummary(FixedBaseMethod method) {
+  for (const auto& entry : Vocabulary<FixedBaseMethod>::kEntries) {
+    if (entry.value == method) return entry.summary;
+  }
+  return "";
+}
+
 // First of the step sinks: a signal stops the tracking at the next step (by throwing).
 class InterruptCheck : public ArmStepSink {
  public:
@@ -62,6 +70,7 @@ int RobotCommand::Run() const {
     throw InputError(p);
   }
   if (!method_.empty()) s.options.method = ParseFixedBaseMethod(method_, "--method");
+  const bool fixed_point = s.options.method == FixedBaseMethod::kFixedPoint;
   const uint64_t limit =
       max_output_size_.empty() ? kDefaultMaxOutputSize : ParseByteSize(max_output_size_);
   const RobotOutputEstimate estimate = EstimateRobotOutput(s);
@@ -88,13 +97,23 @@ int RobotCommand::Run() const {
   if (!csv_.empty()) sinks.push_back(&csv_writer.emplace(s, csv_));
   ArmStepFanOut sink(sinks);
   if (!quiet_) std::cout << JointGroupsReport(s.model);
+  if (fixed_point) {  // what the user chose, in the library's words, before the wait
+    std::cerr << "flexkin: note: method fixed_point is "
+              << MethodSummary(FixedBaseMethod::kFixedPoint)
+              << "; method newton (the default) is the one to use\n";
+  }
   const ArmTrajectory t = TrackPath(s.model, s.path, s.options, &sink);
   json_writer.Commit(t);
   if (csv_writer) csv_writer->Commit(t);
   if (!quiet_) std::cout << t.BriefReport() << "\n";
   if (t.unreached > 0) {
     std::cerr << "flexkin: warning: " << t.unreached << " of " << t.num_steps
-              << " targets were not reached (see \"reached\" in " << output_ << ")\n";
+              << " targets were not reached (largest end-effector error " << t.max_ee_error
+              << "; see \"reached\" in " << output_ << ")"
+              << (fixed_point ? "; method fixed_point does not converge on every arm: try "
+                                "--method newton"
+                              : "")
+              << "\n";
     return 3;
   }
   return 0;

@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <tuple>
 
@@ -243,6 +244,99 @@ TEST(CurveEqualLinkChainTest, LengthsAreExactlyTheRequestedLength) {
   // Points whose chords are not the given length are refused.
   ExpectInputError([&] { MakeEqualLinkChain(MakeArc(def), 0.1 * (1 + 1e-6)); }, "points",
                    "expected link_length");
+}
+
+// The largest documented size of every curved shape (kMaxGeneratedLinks, 10 million links of
+// 0.08): accepted, and every chord within the rounding of its end points' coordinates of
+// link_length (32 eps (|a| + |b|), MakeEqualLinkChain's allowance for it, without its 1e-9
+// relative part). Before, the arc and the helix turned by i * dt rounded to ulp(8e5) = 1.2e-10
+// rad, and their chords strayed by 1.6e-9 relative; MakeEqualLinkChain refused all three ("link
+// 8017535 has length 0.0800000001295933"). About a second per shape on one core.
+void ExpectLargestSizeAccepted(const Points& p, double link_length) {
+  ASSERT_EQ(p.rows(), kMaxGeneratedLinks + 1);
+  EXPECT_NO_THROW(MakeEqualLinkChain(p, link_length));
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
+  double worst = 0.0;  // |chord - L| over the allowance
+  Eigen::Index at = 0;
+  for (Eigen::Index i = 1; i < p.rows(); ++i) {
+    const double error = std::fabs((p.row(i) - p.row(i - 1)).norm() - link_length);
+    const double allowance = 32.0 * kEps * (p.row(i).norm() + p.row(i - 1).norm());
+    if (error / allowance > worst) {
+      worst = error / allowance;
+      at = i;
+    }
+  }
+  EXPECT_LE(worst, 1.0) << "link " << at << " of " << p.rows() - 1;
+}
+
+TEST(CurveLargestSizeTest, ArcOfTenMillionLinks) {
+  ArcDef def;
+  def.radius = 1.0;
+  def.links = kMaxGeneratedLinks;
+  def.link_length = 0.08;
+  ExpectLargestSizeAccepted(MakeArc(def), def.link_length);
+}
+
+TEST(CurveLargestSizeTest, HelixOfTenMillionLinks) {
+  HelixDef def;
+  def.radius = 1.0;
+  def.pitch = 0.5;
+  def.clockwise = true;
+  def.links = kMaxGeneratedLinks;
+  def.link_length = 0.08;
+  ExpectLargestSizeAccepted(MakeHelix(def), def.link_length);
+}
+
+TEST(CurveLargestSizeTest, ParabolaOfTenMillionLinks) {
+  ParabolaDef def;  // a = 1: y reaches 8e5, its rounding alone 1.2e-10
+  def.links = kMaxGeneratedLinks;
+  def.link_length = 0.08;
+  ExpectLargestSizeAccepted(MakeParabola(def), def.link_length);
+}
+
+TEST(CurveLargestSizeTest, DiagonalLineOfTenMillionLinks) {
+  LineDef def;
+  def.direction = Eigen::Vector2d(1.0, 3.0);
+  def.links = kMaxGeneratedLinks;
+  def.link_length = 0.08;
+  ExpectLargestSizeAccepted(MakeLine(def), def.link_length);
+}
+
+// Up to 16 rad of turning an arc's points are the plain formula's, bit for bit, so the scenes
+// pinned by tests/golden_test.cc (fig10: 80 links turning 4 rad) keep their points.
+TEST(CurveArcTest, ShortArcsAreThePlainFormulaBitForBit) {
+  ArcDef def;
+  def.radius = 1.0;
+  def.center = Eigen::Vector2d(0.0, 1.0);
+  def.start_angle = -kPi / 2;
+  def.links = 80;
+  def.link_length = 0.05;
+  const Points p = MakeArc(def);
+  const double dt = 2.0 * std::asin(def.link_length / (2.0 * def.radius));
+  for (int i = 0; i <= def.links; ++i) {
+    const double t = def.start_angle + 1.0 * (i * dt);
+    EXPECT_EQ(p(i, 0), def.center.x() + def.radius * std::cos(t)) << "point " << i;
+    EXPECT_EQ(p(i, 1), def.center.y() + def.radius * std::sin(t)) << "point " << i;
+  }
+}
+
+// Past 16 rad the angle is reduced modulo 2 pi: the points still lie on the circle, at the angle
+// i dt (to 1e-15 rad where the plain formula is still that good, so the switch leaves no seam).
+TEST(CurveArcTest, LongArcsStayOnTheCircleAtTheirAngle) {
+  ArcDef def;
+  def.radius = 2.0;
+  def.links = 2000;
+  def.link_length = 0.05;
+  def.clockwise = true;
+  const Points p = MakeArc(def);
+  ExpectChords(p, def.link_length, 1e-13);  // coordinates of 2: rounding is 1e-14 of a link
+  const double dt = 2.0 * std::asin(def.link_length / (2.0 * def.radius));
+  for (int i = 0; i <= def.links; i += 7) {
+    EXPECT_NEAR(p.row(i).norm(), def.radius, 1e-15 * def.radius) << "point " << i;
+    const double t = -(i * dt);
+    EXPECT_NEAR(p(i, 0), def.radius * std::cos(t), 2e-14) << "point " << i;
+    EXPECT_NEAR(p(i, 1), def.radius * std::sin(t), 2e-14) << "point " << i;
+  }
 }
 
 }  // namespace

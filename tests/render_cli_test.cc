@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "flexkin/result_io.h"
+#include "flexkin/robot_scenario.h"
 #include "render_test_util.h"
 
 namespace flexkin {
@@ -180,6 +181,101 @@ TEST_F(RenderCliTest, MissingResultOrUnwritableOutputExitsFour) {
   r = Cli("render run.json -o plain");
   EXPECT_EQ(r.exit_code, 4);
   EXPECT_EQ(ReadFile(Path("plain")), "a file, not a directory");
+}
+
+// Robot trajectories (`flexkin robot -o`, docs/robot-format.md) drawn as chains: the end effector
+// leads, the base is fixed (docs/rendering.md, "Robot trajectories"). Before, `flexkin render`
+// refused them with "/format: ... expected \"flexkin-result\"".
+class RenderTrajectoryTest : public RenderCliTest {
+ protected:
+  void SetUp() override {
+    RenderCliTest::SetUp();
+    const std::string examples = std::string(FLEXKIN_SOURCE_DIR) + "/examples/";
+    CliResult r = Cli("robot '" + examples + "robot_planar_8link.json' -o planar.json -q");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = Cli("robot '" + examples + "robot_universal_snake.json' -o snake.json -q");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+};
+
+// A closed triangle of three vertices filled in the ink colour: the fixed base's support.
+int Supports(const std::string& svg) {
+  int count = 0;
+  for (const render_test::SvgPath& p : render_test::SvgPaths(svg)) {
+    // cairo ends a closed path with a move back to its start: 4 vertices.
+    count += p.closed && !p.curved && p.vertices.size() == 4 && p.vertices[0] == p.vertices[3] &&
+             p.style.find("fill:rgb(13%,13%,13%)") != std::string::npos;
+  }
+  return count;
+}
+
+TEST_F(RenderTrajectoryTest, DrawsTheFigureByDefaultWithTheFixedBase) {
+  const CliResult r = Cli("render planar.json -o out");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(Outputs("out"), (std::vector<std::string>{"planar.png", "planar.svg"}));
+  EXPECT_EQ(ReadFile(Path("out/planar.png")).substr(1, 3), "PNG");
+  const std::string svg = ReadFile(Path("out/planar.svg"));
+  EXPECT_EQ(Supports(svg), 2);  // the base, and its swatch in the legend
+}
+
+TEST_F(RenderTrajectoryTest, DrawsASpatialArmWithSharedJointsInEveryTrajectoryFormat) {
+  const CliResult r = Cli("render snake.json -o out --formats svg,png,pdf,mp4,gif,html -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(Outputs("out"), (std::vector<std::string>{"snake.gif", "snake.html", "snake.mp4",
+                                                      "snake.pdf", "snake.png", "snake.svg"}));
+  EXPECT_EQ(Supports(ReadFile(Path("out/snake.svg"))), 2);
+  const std::string html = ReadFile(Path("out/snake.html"));
+  EXPECT_CONTAINS(html, "\"robot\":{\"links\":16,\"targets\":60,\"unreached\":0,");
+}
+
+TEST_F(RenderTrajectoryTest, ChainOnlyFormatsAreRefusedNamingTheAvailableOnes) {
+  for (const char* format : {"plots", "gltf", "glb"}) {
+    const CliResult r = Cli(std::string("render planar.json -o out --formats svg,") + format);
+    EXPECT_EQ(r.exit_code, 1) << format;
+    EXPECT_CONTAINS(r.err, std::string("flexkin: error: --formats: format \"") + format +
+                               "\" is not available for robot trajectories");
+    EXPECT_CONTAINS(r.err, "expected formats among svg, png, pdf, mp4, gif, html");
+  }
+  EXPECT_TRUE(Outputs("out").empty());
+}
+
+TEST_F(RenderTrajectoryTest, ABrokenTrajectoryIsRefusedNamingTheField) {
+  std::string text = ReadFile(Path("planar.json"));
+  const size_t at = text.find("\"target\":[");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 10, "\"target\":[\"x\",");
+  WriteFile(Path("bad.json"), text);
+  const CliResult r = Cli("render bad.json -o out");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "flexkin: error: bad.json: /steps/0/target");
+  EXPECT_TRUE(Outputs("out").empty());
+}
+
+// The chain the pictures draw: one frame per state, each state's points in reverse (the end
+// effector first, the base last), steps 0 to T, lengths from the points.
+TEST_F(RenderTrajectoryTest, TheChainIsTheStatesReversed) {
+  const RobotTrajectoryFile t = ReadRobotTrajectoryFile(Path("snake.json"));
+  ASSERT_EQ(t.states.size(), 61u);
+  ASSERT_EQ(t.targets.rows(), 60);
+  EXPECT_EQ(t.method, "newton");
+  EXPECT_EQ(t.unreached, 0);
+  const ResultFile file = RobotTrajectoryAsResult(t);
+  ASSERT_EQ(file.result.frames.size(), t.states.size());
+  EXPECT_EQ(file.dim, 3);
+  EXPECT_EQ(file.result.num_steps, 60);
+  const Eigen::Index g = t.states[0].rows();
+  ASSERT_EQ(file.result.lengths.size(), g - 1);
+  for (size_t s = 0; s < t.states.size(); ++s) {
+    EXPECT_EQ(file.result.frames[s].step, static_cast<int64_t>(s));
+    for (Eigen::Index i = 0; i < g; ++i) {
+      EXPECT_EQ(file.result.frames[s].points.row(i), t.states[s].row(g - 1 - i));
+    }
+    EXPECT_EQ(t.states[s].row(0).transpose(), t.base) << "the base is fixed";
+  }
+  EXPECT_TRUE(ValidateResult(file.result, file.dim).empty());
+  EXPECT_TRUE(IsRobotTrajectoryFile(Path("snake.json")));
+  EXPECT_FALSE(IsRobotTrajectoryFile(Path("run.json")));
+  EXPECT_FALSE(IsRobotTrajectoryFile(Path("missing.json")));
 }
 
 }  // namespace

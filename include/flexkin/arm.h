@@ -183,7 +183,9 @@ struct Vocabulary<FixedBaseMethod> {
       {FixedBaseMethod::kNewton, "newton",
        "Newton's method on the base translation before one sweep (the default)"},
       {FixedBaseMethod::kFixedPoint, "fixed_point",
-       "translate back to the base and sweep again until the base stays (linear convergence)"},
+       "the predecessors' baseline, for comparison: translate back to the base and sweep again "
+       "until the base stays; slow (linear convergence at best) and where it does not converge "
+       "(arms with joint axes, as URDF arms; joint limits) the step stops unreached"},
   };
 };
 inline const char* FixedBaseMethodName(FixedBaseMethod method) { return NameOf(method); }

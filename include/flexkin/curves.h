@@ -9,7 +9,9 @@
 namespace flexkin {
 
 // Generated initial curves. Each one is sampled so that every link has the same chord length
-// `link_length` (to rounding, about 1e-16 times the coordinates' magnitude over the link length),
+// `link_length` (to rounding, a few times 1e-16 times the coordinates' magnitude over the link
+// length, up to kMaxGeneratedLinks: arcs and helices reduce their angle modulo 2 pi exactly, so
+// their chords do not degrade as the angle grows),
 // with point 0 the leading end. The field names are those of the scenario file's "curve" object
 // (docs/scenario-format.md), so errors name the same field in C++ and in JSON. Lengths are in the
 // caller's unit, angles in radians.
@@ -78,8 +80,10 @@ Points MakeHelix(const HelixDef& def);
 
 // Like MakeChain, but every link length is exactly `link_length` instead of the distance between
 // the points, which differs from it by rounding. For points from the generators above.
-// Throws InputError (field "points") if any chord differs from `link_length` by more than 1e-9
-// relative, or as MakeChain does.
+// Throws InputError (field "points") if any chord differs from `link_length` by more than
+// 1e-9 relative plus 32 eps (|a| + |b|), a and b its end points (the rounding of their
+// coordinates, which far from the origin outgrows a fixed fraction of the link), or as MakeChain
+// does.
 Chain MakeEqualLinkChain(const Points& points, double link_length);
 
 }  // namespace flexkin

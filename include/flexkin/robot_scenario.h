@@ -22,10 +22,12 @@
 #include <iosfwd>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "flexkin/arm.h"
 #include "flexkin/chain.h"
 #include "flexkin/error.h"
+#include "flexkin/result_io.h"
 
 namespace flexkin {
 
@@ -121,9 +123,11 @@ void WriteRobotTrajectoryJson(const RobotScenario& scenario, const ArmTrajectory
 void WriteRobotTrajectoryJson(const RobotScenario& scenario, const ArmTrajectory& trajectory,
                               const std::string& path);
 
-// Writes the joint angles as CSV: a header "step,joint_0,...,joint_{n-1}" (spatial arms with
-// spherical joints: then "azimuth_0,..."), row 0 the initial angles, then one row per step, 17
-// significant digits. The path version writes atomically, as above.
+// Writes the joint angles as CSV: a header "step" and a column per joint, named by
+// model.joint_names where it has them (a URDF's; quoted as CSV quotes where a name holds a comma,
+// a quote or a line break), else "joint_0,...,joint_{n-1}" (spatial arms with spherical joints:
+// then "azimuth_0,..."), row 0 the initial angles, then one row per step, 17 significant digits.
+// The path version writes atomically, as above.
 void WriteRobotJointsCsv(const RobotScenario& scenario, const ArmTrajectory& trajectory,
                          std::ostream& out);
 void WriteRobotJointsCsv(const RobotScenario& scenario, const ArmTrajectory& trajectory,
@@ -188,5 +192,46 @@ class RobotJointsCsvWriter : public ArmStepSink {
   std::unique_ptr<Impl> impl_;
   int64_t steps_ = 0;
 };
+
+// A trajectory file (WriteRobotTrajectoryJson, RobotTrajectoryWriter) read back: what drawing
+// it takes (docs/rendering.md, "Robot trajectories"). Robot order: point 0 of each state is the
+// base.
+struct RobotTrajectoryFile {
+  std::string scenario_name;     // "scenario"; "" if none
+  int dim = 2;                   // 2 or 3
+  std::string method;            // the fixed-base method's name ("newton", "fixed_point")
+  Eigen::VectorXd link_lengths;  // the n link lengths, base link first
+  Eigen::VectorXd base;          // dim: where the base is bolted
+  // "initial" and then one state per step: each g by dim, base first, one point per distinct
+  // position (g = n + 1 unless joints share a point, "joint_groups").
+  std::vector<Points> states;
+  Points targets;             // T by dim: the end effector's target of each step
+  std::vector<bool> reached;  // T: each step's "reached"
+  int64_t unreached = 0;      // "summary": steps not reached, largest end-effector error,
+  double max_ee_error = 0.0;  // wall time of the tracking (s)
+  double seconds = 0.0;
+};
+
+// Whether the file at `path` is a robot trajectory: JSON whose top-level "format" is
+// "flexkin-robot-trajectory". Reads only up to that key (the writers put it first); false for
+// anything else (another format, not JSON, a file that cannot be read).
+bool IsRobotTrajectoryFile(const std::string& path);
+// Reads a trajectory file. Checks "format", "version", the shapes (every state g by dim, the
+// same g throughout; one target of dim numbers per step) and that every number is finite.
+// Throws std::system_error if it cannot be read, InputError (field: the JSON pointer,
+// "/steps/3/points/2/1") if it is not a valid trajectory.
+RobotTrajectoryFile ReadRobotTrajectoryFile(const std::string& path);
+// The same from the text of a trajectory file (InputError as ParseRobotScenarioText for text
+// that is not JSON).
+RobotTrajectoryFile RobotTrajectoryFromText(const std::string& json_text);
+
+// The trajectory as a chain result, the form the pictures and the viewer draw: one frame per
+// state (step 0 the initial state, then step t after target t), its points in reverse, the end
+// effector first as a chain's leading end and the base last; the link lengths the largest
+// distance of each pair of neighbouring points over the states (prismatic joints change it; 1 for
+// a pair that never parts); the metrics' path lengths and L2 per step from the states (no length
+// error: the arm keeps its own). Throws InputError for a trajectory without states or of
+// mismatched shapes.
+ResultFile RobotTrajectoryAsResult(const RobotTrajectoryFile& trajectory);
 
 }  // namespace flexkin

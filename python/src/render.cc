@@ -1,6 +1,7 @@
-// flexkin.render: the pictures, viewer page and glTF files of a Result, as `flexkin render`
-// writes them (apps/render_command.cc): one writer per format of the vocabulary of
-// src/render/render.h, each file written whole or not at all, with the GIL released. Every member
+// flexkin.render: the pictures, viewer page and glTF files of a Result (and the figure, animation
+// and viewer page of a RobotResult), as `flexkin render` writes them (apps/render_command.cc): one
+// writer per format of the vocabulary of src/render/render.h, each file written whole or not at
+// all, with the GIL released. Every member
 // of the components' options is reachable through FigureOptions, PlotOptions, AnimationOptions,
 // ViewerOptions and GltfOptions (or dicts of their fields).
 #include "render/render.h"
@@ -9,6 +10,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -20,11 +22,27 @@
 #include "viewer/viewer.h"
 
 namespace flexkin::python {
+
+// A flexkin.RobotResult as the trajectory the pictures and the viewer take; nullopt for another
+// object (robot.cc). Declared here, its one user, rather than in convert.h.
+std::optional<RobotTrajectoryFile> RobotTrajectoryOfObject(py::handle object);
+
 namespace {
+
+// render()'s own argument types, named in help() as convert.h's are.
+struct DrawableTag {
+  static constexpr char kText[] = "Union[Result, RobotResult]";
+};
+using Drawable = Typed<DrawableTag>;
+struct OptionalFormatsTag {
+  static constexpr char kText[] = "Union[str, Sequence[str], None]";
+};
+using OptionalFormats = Typed<OptionalFormatsTag>;
 
 struct RenderJob {
   const ResultFile* file = nullptr;
-  std::string base;  // out_dir/<stem>
+  const RobotTrajectoryFile* trajectory = nullptr;  // instead of `file`: kTrajectoryFormats
+  std::string base;                                 // out_dir/<stem>
   FigureOptions figure;
   PlotOptions plot;
   AnimationOptions animation;
@@ -41,7 +59,11 @@ void WriteFormat(OutputFormat format, RenderJob* job) {
     case OutputFormat::kPng:
     case OutputFormat::kPdf: {
       const std::string path = base + "." + NameOf(format);
-      WriteSnapshotFigure(*job->file, job->figure, path);
+      if (job->trajectory != nullptr) {
+        WriteSnapshotFigure(*job->trajectory, job->figure, path);
+      } else {
+        WriteSnapshotFigure(*job->file, job->figure, path);
+      }
       add(path);
       return;
     }
@@ -60,13 +82,21 @@ void WriteFormat(OutputFormat format, RenderJob* job) {
     case OutputFormat::kMp4:
     case OutputFormat::kGif: {
       const std::string path = base + "." + NameOf(format);
-      WriteAnimation(*job->file, job->animation, path);
+      if (job->trajectory != nullptr) {
+        WriteAnimation(*job->trajectory, job->animation, path);
+      } else {
+        WriteAnimation(*job->file, job->animation, path);
+      }
       add(path);
       return;
     }
     case OutputFormat::kHtml: {
       const std::string path = base + ".html";
-      WriteViewerHtml(*job->file, job->viewer, path);
+      if (job->trajectory != nullptr) {
+        WriteViewerHtml(*job->trajectory, job->viewer, path);
+      } else {
+        WriteViewerHtml(*job->file, job->viewer, path);
+      }
       add(path);
       return;
     }
@@ -135,13 +165,20 @@ T CheckedOptions(py::handle object, const std::string& name) {
   return options;
 }
 
-std::vector<std::string> Render(ResultObject result, PathLike out_dir, FormatList formats,
+std::vector<std::string> Render(Drawable result, PathLike out_dir, OptionalFormats formats,
                                 const std::string& stem, OptionalInt every, OptionalInt width,
                                 OptionalInt height, OptionalFloat azimuth, OptionalFloat elevation,
                                 OptionalInt fps, OptionalInt max_frames, OptionalStr title,
                                 OptionalStr ffmpeg, FigureLike figure, PlotLike plot,
                                 AnimationLike animation, ViewerLike viewer, GltfLike gltf) {
-  const std::vector<OutputFormat> chosen = FormatsArg(formats);
+  // A RobotResult is drawn as `flexkin render` draws a trajectory file: its figure by default.
+  const std::optional<RobotTrajectoryFile> trajectory = RobotTrajectoryOfObject(result);
+  const std::vector<OutputFormat> chosen = FormatsArg(!formats.is_none() ? py::handle(formats)
+                                                      : trajectory       ? py::str("svg,png")
+                                                                   : py::str("svg,png,plots"));
+  if (trajectory) {
+    for (OutputFormat format : chosen) CheckTrajectoryFormat(format, "formats");
+  }
   const std::string dir = RequiredPath(out_dir, "out_dir");
   if (stem.empty() || stem.find('/') != std::string::npos) {
     ThrowInput("stem", "must be a file name without '/'", Quoted(stem));
@@ -173,17 +210,24 @@ std::vector<std::string> Render(ResultObject result, PathLike out_dir, FormatLis
   CheckOptions(job.figure.Validate());
   CheckOptions(job.plot.Validate());
   CheckOptions(job.animation.Validate());
-  const ResultFile file = ResultFileOfObject(result);
-  if (file.result.frames.empty()) ThrowInput("result.frames", "no frames; nothing to draw");
+  ResultFile file;
+  if (!trajectory) {
+    file = ResultFileOfObject(result);
+    if (file.result.frames.empty()) ThrowInput("result.frames", "no frames; nothing to draw");
+  }
+  // The drawing's last point: n for a chain, the base (g - 1, point 0 the end effector) for a
+  // trajectory.
+  const Eigen::Index last =
+      trajectory ? trajectory->states.front().rows() - 1 : file.result.lengths.size();
   for (size_t i = 0; i < job.viewer.trail_points.size(); ++i) {
-    if (job.viewer.trail_points[i] > file.result.lengths.size()) {
+    if (job.viewer.trail_points[i] > last) {
       ThrowInput("viewer.trail_points[" + std::to_string(i) + "]",
-                 "is not a point of the result; expected a point index <= n = " +
-                     std::to_string(file.result.lengths.size()),
+                 "is not a point of the result; expected a point index <= " + std::to_string(last),
                  std::to_string(job.viewer.trail_points[i]));
     }
   }
   job.file = &file;
+  if (trajectory) job.trajectory = &*trajectory;
   job.base = dir + "/" + stem;
   {
     py::gil_scoped_release release;
@@ -371,23 +415,26 @@ that is not valid glTF, has no skin, or uses what the reader does not support.
   for (const auto& entry : Vocabulary<OutputFormat>::kEntries) {
     formats_doc += std::string("\n  ") + entry.name + ": " + entry.summary;
   }
-  m.def("render", &Render, py::arg("result"), py::arg("out_dir"),
-        py::arg("formats") = std::vector<std::string>{"svg", "png", "plots"}, py::kw_only(),
-        py::arg("stem") = "result", py::arg("every") = py::none(), py::arg("width") = py::none(),
-        py::arg("height") = py::none(), py::arg("azimuth") = py::none(),
-        py::arg("elevation") = py::none(), py::arg("fps") = py::none(),
-        py::arg("max_frames") = py::none(), py::arg("title") = py::none(),
-        py::arg("ffmpeg") = py::none(), py::arg("figure") = py::none(),
-        py::arg("plot") = py::none(), py::arg("animation") = py::none(),
-        py::arg("viewer") = py::none(), py::arg("gltf") = py::none(),
+  m.def("render", &Render, py::arg("result"), py::arg("out_dir"), py::arg("formats") = py::none(),
+        py::kw_only(), py::arg("stem") = "result", py::arg("every") = py::none(),
+        py::arg("width") = py::none(), py::arg("height") = py::none(),
+        py::arg("azimuth") = py::none(), py::arg("elevation") = py::none(),
+        py::arg("fps") = py::none(), py::arg("max_frames") = py::none(),
+        py::arg("title") = py::none(), py::arg("ffmpeg") = py::none(),
+        py::arg("figure") = py::none(), py::arg("plot") = py::none(),
+        py::arg("animation") = py::none(), py::arg("viewer") = py::none(),
+        py::arg("gltf") = py::none(),
         (R"doc(
-Draws a Result as `flexkin render` does (docs/rendering.md) and returns the paths written.
+Draws a Result (or a RobotResult) as `flexkin render` draws a result file (or a robot
+trajectory, docs/rendering.md) and returns the paths written.
 
-render(result, out_dir, formats=("svg", "png", "plots"), *, stem="result", every=None,
+render(result, out_dir, formats=None, *, stem="result", every=None,
        width=None, height=None, azimuth=None, elevation=None, fps=None, max_frames=None,
        title=None, ffmpeg=None, figure=None, plot=None, animation=None, viewer=None, gltf=None)
   formats: a list of names or a comma-separated string, written to out_dir/<stem>.<ext>
-    (out_dir created if missing), each file whole or not at all.
+    (out_dir created if missing), each file whole or not at all. None: svg, png, plots for a
+    Result; svg, png for a RobotResult, which is drawn in svg, png, pdf, mp4, gif and html only
+    (its arm as a chain whose end effector leads, the fixed base marked).
   The command's options, None = its default: every (figures: every K-th frame, 0 automatic),
     width, height (pixels; height 0 = from the data), azimuth, elevation (3D view, degrees),
     fps, max_frames (animations), title, ffmpeg (the program for mp4 and gif).
@@ -396,7 +443,7 @@ render(result, out_dir, formats=("svg", "png", "plots"), *, stem="result", every
     (GltfOptions: tube_radius, tube_sides, scale, up_axis, ...), each an options object or a
     dict of its fields; the keywords above are applied on top of them.
 The GIL is released while drawing. Raises InputError for an unknown format (listing the valid
-names) or an invalid option (field the keyword, or "gltf.tube_sides" for an options object),
+names), a format a RobotResult is not drawn in (naming the ones it is), or an invalid option (field the keyword, or "gltf.tube_sides" for an options object),
 OSError for a file that cannot be written, RuntimeError when ffmpeg is missing or fails.
 Formats:)doc" +
          formats_doc)

@@ -143,6 +143,24 @@ RobotScenario RobotScenarioArg(RobotScenarioSource scenario, OptionalPath direct
   return OnFile(path, [&] { return LoadRobotScenarioFile(path, options); });
 }
 
+// A RuntimeWarning where some target was not reached, as `flexkin robot` warns (and exits with 3):
+// never silently. With method fixed_point, the vocabulary's words on where it fails. Raises if
+// warnings are errors.
+void WarnIfUnreached(const RobotResult& r, FixedBaseMethod method) {
+  if (r.summary.unreached == 0) return;
+  std::string message = "flexkin: " + std::to_string(r.summary.unreached) + " of " +
+                        std::to_string(r.num_steps) +
+                        " targets were not reached (largest end-effector error " +
+                        Num(r.summary.max_ee_error) + "; see RobotResult.reached)";
+  if (method == FixedBaseMethod::kFixedPoint) {
+    for (const auto& entry : Vocabulary<FixedBaseMethod>::kEntries) {
+      if (entry.value == method) message += std::string("; method fixed_point is ") + entry.summary;
+    }
+    message += "; method newton (the default) is the one to use";
+  }
+  if (PyErr_WarnEx(PyExc_RuntimeWarning, message.c_str(), 1) != 0) throw py::error_already_set();
+}
+
 // TrackPath of the scenario into the arrays of a RobotResult, and into the trajectory JSON at
 // `output` and the joint CSV at `csv` where they are not "" (each renamed into place only when
 // complete: on Ctrl-C or an error the writers remove their temporary files).
@@ -192,6 +210,7 @@ RobotResult Track(const RobotScenario& s, py::object progress, const std::string
   arrays.MoveTo(&r);
   r.num_steps = count;
   r.brief = r.summary.BriefReport();
+  WarnIfUnreached(r, s.options.method);
   return r;
 }
 
@@ -262,6 +281,50 @@ py::dict EstimateRobot(const RobotScenario& s) {
 }
 
 }  // namespace
+
+std::optional<RobotTrajectoryFile> RobotTrajectoryOfObject(py::handle object) {
+  if (!py::isinstance<RobotResult>(object)) return std::nullopt;
+  const RobotResult& r = py::cast<const RobotResult&>(object);
+  const int dim = r.dim;
+  RobotTrajectoryFile t;
+  t.scenario_name = r.scenario;
+  t.dim = dim;
+  t.method = r.method;
+  t.link_lengths = ReadVector(r.data.at("link_lengths"), "result.link_lengths", -1);
+  t.base = ReadVector(r.data.at("base"), "result.base", dim);
+  t.states.push_back(ReadPoints(r.data.at("initial_points"), "result.initial_points", 2, dim));
+  const auto points =
+      py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(r.data.at("points"));
+  if (!points || points.ndim() != 3) {
+    PyErr_Clear();
+    ThrowInput("result.points", "is not valid; expected a (T, g, dim) array of numbers");
+  }
+  const int64_t steps = points.shape(0), rows = points.shape(1);
+  if (rows != t.states.front().rows() || points.shape(2) != dim) {
+    ThrowInput("result.points", "has shape (" + std::to_string(steps) + ", " +
+                                    std::to_string(rows) + ", " + std::to_string(points.shape(2)) +
+                                    "); expected (T, " + std::to_string(t.states.front().rows()) +
+                                    ", " + std::to_string(dim) + "), as initial_points");
+  }
+  for (int64_t s = 0; s < steps; ++s) {
+    Points state(rows, dim);
+    std::memcpy(state.data(), points.data() + s * rows * dim,
+                sizeof(double) * static_cast<size_t>(rows * dim));
+    t.states.push_back(std::move(state));
+  }
+  t.targets = ReadPoints(r.data.at("path"), "result.path", 1, dim);
+  const auto reached =
+      py::array_t<bool, py::array::c_style | py::array::forcecast>::ensure(r.data.at("reached"));
+  if (!reached || reached.ndim() != 1 || reached.shape(0) != steps || t.targets.rows() != steps) {
+    PyErr_Clear();
+    ThrowInput("result", "its path, points and reached disagree in the number of steps");
+  }
+  t.reached.assign(reached.data(), reached.data() + steps);
+  t.unreached = r.summary.unreached;
+  t.max_ee_error = r.summary.max_ee_error;
+  t.seconds = r.summary.seconds;
+  return t;
+}
 
 RobotScenarioOptions RobotReaderOptions(py::handle directory) {
 #ifdef FLEXKIN_PYTHON_URDF
@@ -402,9 +465,14 @@ run_robot(scenario, *, directory=None, method=None, progress=None, output=None, 
   directory: where a relative "urdf" file is looked up (default: the scenario file's
     directory, or the working directory for a dict).
   method: overrides the solver's method ("newton", "fixed_point"), as --method.
+    "fixed_point" is the predecessors' baseline, for comparison: slow, and where it does not
+    converge (arms with joint axes such as URDF arms, joint limits) its steps stop unreached.
   progress: callable(done, total) called about every 0.1 s with the targets done.
   output: a path: also write the trajectory JSON there, as `flexkin robot -o`, streamed.
-  csv: a path: also write the joint angles as CSV there, as --csv.
+  csv: a path: also write the joint angles as CSV there, as --csv (one column per joint,
+    named by the URDF's joint names where the model has them, else joint_0, joint_1, ...).
+Where some target is not reached (result.unreached > 0), a RuntimeWarning says how many, as
+`flexkin robot` warns and exits with 3.
 The GIL is released during the tracking; Ctrl-C raises KeyboardInterrupt within about 0.1 s.
 The files are written whole or not at all (Ctrl-C, an error: no file, an existing one left
 untouched).

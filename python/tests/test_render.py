@@ -158,3 +158,45 @@ def test_gltf_animation_reads_back_as_the_frames(tmp_path, up_axis):
     assert str(EXAMPLES / "fig12_spatial_curve.json") in info.value.field
     with pytest.raises(FileNotFoundError):
         flexkin.gltf_joint_positions(tmp_path / "missing.glb")
+
+
+# A RobotResult (flexkin.run_robot, docs/robot-format.md) is drawn as `flexkin render` draws a
+# trajectory file: the arm as a chain whose end effector leads, the base fixed; by default the
+# figure (svg, png); the chain-only formats (plots, gltf, glb) are refused naming the valid ones.
+# Before, render refused any object but a Result.
+@pytest.fixture(scope="module")
+def planar_robot():
+    from conftest import EXAMPLES
+    return flexkin.run_robot(EXAMPLES / "robot_planar_8link.json")
+
+
+def test_a_robot_result_is_drawn_as_the_command_draws_its_trajectory(cli, tmp_path):
+    import re
+    import subprocess
+    from conftest import EXAMPLES
+    robot = flexkin.run_robot(EXAMPLES / "robot_planar_8link.json", output=tmp_path / "t.json")
+    subprocess.run([cli, "render", str(tmp_path / "t.json"), "--formats", "svg,html", "--width",
+                    "300", "-o", str(tmp_path / "cli"), "-q"], check=True)
+    files = flexkin.render(robot, tmp_path / "py", "svg,html", stem="t", width=300)
+    # the same pictures, bit for bit (the trajectory file holds the same numbers)
+    assert [f.rsplit("/", 1)[1] for f in files] == ["t.svg", "t.html"]
+    for file in files:
+        name = file.rsplit("/", 1)[1]
+        ours, theirs = open(file, "rb").read(), (tmp_path / "cli" / name).read_bytes()
+        if name.endswith(".svg"):
+            ours, theirs = (re.sub(rb'id="surface\d+"', b"", x) for x in (ours, theirs))
+        assert ours == theirs, name
+    assert b'"robot":{"links":8,"targets":200,"unreached":0,' in open(files[1], "rb").read()
+
+
+def test_a_robot_result_by_default_and_its_refused_formats(planar_robot, tmp_path):
+    written = flexkin.render(planar_robot, tmp_path, width=200)
+    assert written == [str(tmp_path / "result.svg"), str(tmp_path / "result.png")]
+    assert (tmp_path / "result.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    for name in ("plots", "gltf", "glb"):
+        with pytest.raises(flexkin.InputError) as info:
+            flexkin.render(planar_robot, tmp_path / "no", ["svg", name])
+        assert info.value.field == "formats" and f'"{name}"' in str(info.value)
+        assert "not available for robot trajectories" in str(info.value)
+        assert info.value.expected == "svg, png, pdf, mp4, gif, html"
+    assert not (tmp_path / "no").exists()

@@ -279,3 +279,35 @@ def test_a_scenario_dict_passes_tip_offset_pointing_and_time_step(tmp_path):
     assert [s["pointing_error"] for s in steps] == traj.pointing_error.tolist()
     assert [s["velocity_legs"] for s in steps] == traj.velocity_legs.tolist()
     assert [s["velocity_ratio"] for s in steps] == traj.velocity_ratio.tolist()
+
+
+@needs_urdf
+def test_the_joint_csv_is_headed_by_the_urdfs_joint_names(snake, tmp_path):
+    path = circle(snake, 0.5, 4)
+    flexkin.track_path(snake, path, csv=tmp_path / "j.csv")
+    header = (tmp_path / "j.csv").read_text().splitlines()[0]
+    assert header == "step," + ",".join(snake.joint_names)
+    assert header.startswith("step,m0_pitch,m0_yaw,m1_pitch") and header.endswith(",roll")
+    # An arm without names keeps joint_0, joint_1, ...
+    plain = flexkin.ArmModel([0.1] * 3)
+    flexkin.track_path(plain, [[0.25, 0.05]], csv=tmp_path / "p.csv")
+    assert (tmp_path / "p.csv").read_text().splitlines()[0] == "step,joint_0,joint_1,joint_2"
+
+
+@needs_urdf
+def test_fixed_point_on_a_urdf_arm_fails_fast_and_warns(tmp_path):
+    from conftest import EXAMPLES
+    scenario = EXAMPLES / "robot_snake_urdf.json"
+    with pytest.warns(RuntimeWarning, match=r"of 50 targets were not reached") as caught:
+        traj = flexkin.run_robot(scenario, method="fixed_point")
+    text = str(caught[0].message)
+    assert "method fixed_point is the predecessors' baseline" in text
+    assert "method newton (the default) is the one to use" in text
+    assert traj.unreached > 0 and traj.unreached == (~traj.reached).sum()
+    assert f"{traj.unreached} not reached" in repr(traj)
+    # each stalled step stops after a few thousand sweeps, not 100000 (5.8 s before)
+    assert traj.max_iterations <= 10000 and traj.total_sweeps < 100000
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert flexkin.run_robot(scenario).unreached == 0  # newton: no warning

@@ -12,6 +12,7 @@
 // g's Jacobian per sweep, which approaches 1 for long arms and near the edge.
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -248,14 +249,43 @@ SolveResult SolveNewton(Sweeper* sweeper, const ArmModel& model, const Vec& move
   return best;
 }
 
+// Stops a fixed-point iteration that does not contract. Where the iteration converges it
+// converges linearly: the slowest steps measured (512 links near the edge of the workspace, up
+// to 1500 sweeps for some 30 halvings of the residual) halve it every 50 sweeps or so. Where it
+// does not (revolute joints about axes, whose cone projections need not contract: on
+// examples/robot_snake.urdf the residual wanders between 0.006 and 0.17 for all 100000 sweeps;
+// joint limits that hold the arm off the target), max_fixed_point_iterations sweeps a step
+// bought nothing but time (5.5 s for a path of 60 targets). So each window of kStallWindow
+// iterations, 20 times the slowest pace measured, must halve the smallest residual so far; the
+// first that does not ends the step, unconverged. A run that converges is not touched: its
+// residual keeps halving.
+class StallCheck {
+ public:
+  static constexpr int kStallWindow = 1000;
+  // Whether to stop after `iterations` iterations, the last with residual `residual`.
+  bool Stalled(int iterations, double residual) {
+    if (iterations == 1) mark_ = residual;
+    best_ = std::min(best_, residual);
+    if (iterations % kStallWindow != 0) return false;
+    const bool stalled = !(best_ <= 0.5 * mark_);
+    mark_ = best_;
+    return stalled;
+  }
+
+ private:
+  double best_ = INFINITY, mark_ = INFINITY;
+};
+
 SolveResult SolveFixedPoint(Sweeper* sweeper, const Points& start, const ArmOptions& options,
                             double tol) {
   SolveResult result;
   result.points = start;
   Vec f = sweeper->SweepInPlace(&result.points);
   result.iterations = 1;
+  StallCheck stall;
   while (f.allFinite() && f.norm() > tol &&
-         result.iterations < options.max_fixed_point_iterations) {
+         result.iterations < options.max_fixed_point_iterations &&
+         !stall.Stalled(result.iterations, f.norm())) {
     result.points.rowwise() -= f.transpose();  // the base back where it is bolted
     f = sweeper->SweepInPlace(&result.points);
     ++result.iterations;
@@ -274,8 +304,10 @@ SolveResult SolveFixedPointRevolute(arm_internal::RevoluteSweeper* sweeper,
   Vec u = Vec::Zero(3);
   Vec f = sweeper->Evaluate(u);
   result.iterations = 1;
+  StallCheck stall;
   while (f.allFinite() && f.norm() > tol &&
-         result.iterations < options.max_fixed_point_iterations) {
+         result.iterations < options.max_fixed_point_iterations &&
+         !stall.Stalled(result.iterations, f.norm())) {
     u += f;
     f = sweeper->Evaluate(u);
     ++result.iterations;

@@ -6,6 +6,7 @@
 
 #include "flexkin/error.h"
 #include "flexkin/result_io.h"
+#include "io/json_checked.h"
 #include "io/json_file.h"
 #include "io/result_json.h"
 
@@ -16,32 +17,10 @@ namespace {
 
 using json = nlohmann::json;
 
-std::string Show(const json& v) {
-  std::string text = v.dump(-1, ' ', false, json::error_handler_t::replace);
-  return text.size() > 60 ? text.substr(0, 56) + " ..." : text;
-}
-
-const json& Member(const json& object, const std::string& ptr, const char* key) {
-  if (!object.is_object()) throw InputError(ptr, "value " + Show(object) + " is not an object");
-  const auto it = object.find(key);
-  if (it == object.end()) throw InputError(ptr + "/" + key, "is missing");
-  return *it;
-}
-
-double ReadNumber(const json& v, const std::string& ptr) {
-  if (!v.is_number() || !std::isfinite(v.get<double>())) {
-    throw InputError(ptr, "value " + Show(v) + " is not valid; expected a finite number");
-  }
-  return v.get<double>();
-}
-
-int64_t ReadInteger(const json& v, const std::string& ptr, int64_t min) {
-  if (!v.is_number_integer() || v.get<int64_t>() < min) {
-    throw InputError(
-        ptr, "value " + Show(v) + " is not valid; expected an integer >= " + std::to_string(min));
-  }
-  return v.get<int64_t>();
-}
+using json_checked::Member;
+using json_checked::ReadInteger;
+using json_checked::ReadNumber;
+using json_checked::Show;
 
 bool ReadBool(const json& v, const std::string& ptr) {
   if (!v.is_boolean()) throw InputError(ptr, "value " + Show(v) + " is not true or false");

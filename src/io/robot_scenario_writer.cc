@@ -230,11 +230,26 @@ void WriteKeys(const json& doc, std::ostream& out, bool first) {
 
 bool SphericalAngles(const ArmModel& model) { return model.joint() == ArmJoint::kSpherical; }
 
-// The CSV header: "step,joint_0,...", then ",azimuth_0,..." for spherical joints.
+// A CSV field: as it is, or quoted (RFC 4180) where it holds a comma, a quote or a line break.
+std::string CsvField(const std::string& text) {
+  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (const char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+// The CSV header: "step", then each joint's name where the model has one (a URDF's), else
+// "joint_j"; then ",azimuth_0,..." for spherical joints.
 void CsvHeader(const ArmModel& model, std::ostream& out) {
   const int n = model.num_links();
   out << "step";
-  for (int j = 0; j < n; ++j) out << ",joint_" << j;
+  for (int j = 0; j < n; ++j) {
+    const bool named = static_cast<int>(model.joint_names.size()) == n &&
+                       !model.joint_names[static_cast<size_t>(j)].empty();
+    out << ","
+        << (named ? CsvField(model.joint_names[static_cast<size_t>(j)])
+                  : "joint_" + std::to_string(j));
+  }
   if (SphericalAngles(model)) {
     for (int j = 0; j < n; ++j) out << ",azimuth_" << j;
   }

@@ -27,11 +27,10 @@ using render::VideoFormat;
 // What stays the same in every picture: title, axes, the whole leader path faintly, the
 // initial configuration.
 void DrawBackground(render::Canvas* canvas, const ChainScene& scene, const ResultFile& file,
-                    const std::string& title) {
+                    const render::Look& look, const std::string& title) {
   cairo_t* cr = canvas->cr();
   const double ui = canvas->ui();
-  render::DrawTitle(cr, ui, canvas->width(), render::MainTitle(file, title),
-                    render::RunSummary(file));
+  render::DrawTitle(cr, ui, canvas->width(), render::MainTitle(file, title), look.summary);
   scene.DrawAxes(cr);
   const std::vector<double> leader = render::LeaderPath(file);
   const int num_frames = static_cast<int>(file.result.frames.size());
@@ -40,6 +39,10 @@ void DrawBackground(render::Canvas* canvas, const ChainScene& scene, const Resul
   const Points& first = file.result.frames.front().points;
   scene.DrawChains(cr, {first.data()}, {static_cast<int>(first.rows())},
                    {{render::Mix(render::kInitial, render::kWhite, 0.55), 1.6 * ui, true}});
+  if (look.fixed_tail) {  // the base stays where it is bolted: drawn once
+    const Eigen::Vector2d base = scene.Pixel(first.row(first.rows() - 1).data());
+    render::DrawFixedBase(cr, base.x(), base.y(), ui);
+  }
 }
 
 // The moving parts of drawn frame `d` (recorded frame drawn[d]): the leader's path so far,
@@ -91,10 +94,8 @@ void DrawMoment(render::Canvas* canvas, const ChainScene& scene, const ResultFil
       counter);
 }
 
-}  // namespace
-
-void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
-                    const std::string& path) {
+void DrawAnimation(const ResultFile& file, const render::Look& look,
+                   const AnimationOptions& options, const std::string& path) {
   ThrowIfAny(options.Validate());
   const VideoFormat format = render::VideoFormatFromPath(path);
   render::CheckDrawable(file);
@@ -114,7 +115,7 @@ void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
   const ChainScene scene(file, render::SceneArea(file.dim, width, height), ui, options.azimuth,
                          options.elevation);
   render::Canvas background(ImageFormat::kPng, width, height);
-  DrawBackground(&background, scene, file, options.title);
+  DrawBackground(&background, scene, file, look, options.title);
   cairo_surface_flush(background.surface());
   render::Canvas picture(ImageFormat::kPng, width, height);
 
@@ -139,6 +140,20 @@ void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
                        ++d;
                        return true;
                      });
+}
+
+}  // namespace
+
+void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
+                    const std::string& path) {
+  DrawAnimation(file, render::ChainLook(file), options, path);
+}
+
+void WriteAnimation(const RobotTrajectoryFile& trajectory, const AnimationOptions& options,
+                    const std::string& path) {
+  ThrowIfAny(options.Validate());
+  DrawAnimation(RobotTrajectoryAsResult(trajectory), render::TrajectoryLook(trajectory), options,
+                path);
 }
 
 }  // namespace flexkin

@@ -37,6 +37,19 @@ std::string RunSummary(const ResultFile& file) {
          std::to_string(r.num_steps) + (r.num_steps == 1 ? " leader step" : " leader steps");
 }
 
+Look ChainLook(const ResultFile& file) { return {RunSummary(file), "leading end", false}; }
+
+Look TrajectoryLook(const RobotTrajectoryFile& t) {
+  const long long n = t.link_lengths.size(), targets = t.targets.rows();
+  std::string summary = "robot \u00b7 " + t.method + " \u00b7 " + std::to_string(t.dim) +
+                        "D \u00b7 " + std::to_string(n) + (n == 1 ? " link" : " links") +
+                        " \u00b7 " + std::to_string(targets) +
+                        (targets == 1 ? " target" : " targets") + " \u00b7 ";
+  summary +=
+      t.unreached == 0 ? std::string("all reached") : std::to_string(t.unreached) + " not reached";
+  return {summary, "end effector", true};
+}
+
 }  // namespace render
 
 namespace {
@@ -128,6 +141,21 @@ Problems AnimationOptions::Validate() const {
                           "\"ffmpeg\"");
   }
   return problems;
+}
+
+void CheckTrajectoryFormat(OutputFormat format, const std::string& field) {
+  std::string valid;
+  for (OutputFormat f : kTrajectoryFormats) {
+    if (f == format) return;
+    valid += (valid.empty() ? "" : ", ") + std::string(NameOf(f));
+  }
+  const std::string name = NameOf(format);
+  throw InputError(Problem(field,
+                           "format \"" + name +
+                               "\" is not available for robot trajectories (it draws chain "
+                               "results only); expected formats among " +
+                               valid,
+                           "\"" + name + "\"", valid));
 }
 
 std::vector<int> SnapshotFrames(int num_frames, int every_k) {

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "flexkin/result_io.h"
+#include "flexkin/robot_scenario.h"
 
 namespace flexkin::render {
 
@@ -19,5 +20,17 @@ void CheckRange(const char* field, double value, double lo, double hi, bool inte
 std::string MainTitle(const ResultFile& file, const std::string& title);
 // "tractrix · 20 links · 2650 leader steps".
 std::string RunSummary(const ResultFile& file);
+
+// How a picture names and marks what it draws: a chain result's leading end and leader steps, or
+// a robot trajectory's end effector, targets and fixed base (RobotTrajectoryAsResult puts the end
+// effector first and the base last).
+struct Look {
+  std::string summary;               // the subtitle's line about the run (RunSummary)
+  std::string lead = "leading end";  // point 0, whose path is drawn: "<lead>'s path"
+  bool fixed_tail = false;           // the last point is a fixed base: drawn as a support
+};
+Look ChainLook(const ResultFile& file);
+// "robot · newton · 3D · 16 links · 60 targets · 24 not reached".
+Look TrajectoryLook(const RobotTrajectoryFile& trajectory);
 
 }  // namespace flexkin::render

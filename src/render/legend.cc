@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "render/canvas.h"
+#include "render/snapshot.h"
 
 namespace flexkin::render {
 namespace {
@@ -73,7 +74,9 @@ void Legend::Draw(cairo_t* cr) const {
   for (size_t i = 0; i < entries_.size(); ++i) {
     const LegendEntry& e = entries_[i];
     const double cy = y_ + (kPad + kRow * i + 6) * ui, x0 = x_ + kPad * ui, x1 = x0 + kSwatch * ui;
-    if (e.kind == LegendEntry::kGradient) {
+    if (e.kind == LegendEntry::kBase) {
+      DrawFixedBase(cr, x0 + 0.5 * kSwatch * ui, cy - 5 * ui, 0.8 * ui);
+    } else if (e.kind == LegendEntry::kGradient) {
       const int pieces = 12;
       for (int k = 0; k < pieces; ++k) {
         Line(cr, x0 + kSwatch * ui * k / pieces, cy, x0 + kSwatch * ui * (k + 1) / pieces, cy,

@@ -14,9 +14,10 @@ namespace flexkin::render {
 
 // One legend line: a swatch and a label.
 struct LegendEntry {
-  enum Kind { kLine, kGradient } kind = kLine;  // kGradient: the snapshots' fade
-  ChainStyle style;                             // kLine: the line's look
-  bool dot = false;                             // a disc at the swatch's right end
+  // kGradient: the snapshots' fade; kBase: the fixed base's support (DrawFixedBase)
+  enum Kind { kLine, kGradient, kBase } kind = kLine;
+  ChainStyle style;  // kLine: the line's look
+  bool dot = false;  // a disc at the swatch's right end
   std::string label;
 };
 

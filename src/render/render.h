@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "flexkin/result_io.h"
+#include "flexkin/robot_scenario.h"
 #include "flexkin/vocabulary.h"
 
 namespace flexkin {
@@ -53,6 +54,16 @@ struct Vocabulary<OutputFormat> {
   };
 };
 
+// The formats a robot trajectory (flexkin/robot_scenario.h, RobotTrajectoryFile) is drawn in: the
+// figure, the animation and the viewer. Not "plots" (they plot a chain result's claims: its
+// metrics, link angles and length errors) nor glTF (a chain's skeleton).
+inline constexpr OutputFormat kTrajectoryFormats[] = {
+    OutputFormat::kSvg, OutputFormat::kPng, OutputFormat::kPdf,
+    OutputFormat::kMp4, OutputFormat::kGif, OutputFormat::kHtml,
+};
+// Throws InputError (field `field`) naming `format` and the ones above unless it is one of them.
+void CheckTrajectoryFormat(OutputFormat format, const std::string& field);
+
 // The snapshot figure: the chain every k-th recorded frame, overlaid, in the style of the paper's
 // Figs. 6 to 12.
 struct FigureOptions {
@@ -86,6 +97,11 @@ std::vector<int> SnapshotFrames(int num_frames, int every_k);
 
 // Writes the snapshot figure of `file` to `path` (.svg, .png or .pdf).
 void WriteSnapshotFigure(const ResultFile& file, const FigureOptions& options,
+                         const std::string& path);
+// The same for a robot trajectory, drawn as RobotTrajectoryAsResult makes it a chain: the end
+// effector leads (its path is drawn), the fixed base is drawn as a support, and the subtitle says
+// "robot", the method, the targets and how many were not reached.
+void WriteSnapshotFigure(const RobotTrajectoryFile& trajectory, const FigureOptions& options,
                          const std::string& path);
 
 // Plots of one quantity of a result.
@@ -175,6 +191,9 @@ struct AnimationOptions {
 // with cairo and piped raw into an ffmpeg process; the output goes to a temporary file in the
 // destination's directory that is renamed over `path` only when ffmpeg succeeds.
 void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
+                    const std::string& path);
+// The same for a robot trajectory, drawn as its snapshot figure is.
+void WriteAnimation(const RobotTrajectoryFile& trajectory, const AnimationOptions& options,
                     const std::string& path);
 
 }  // namespace flexkin

@@ -42,6 +42,28 @@ std::vector<double> LeaderPath(const ResultFile& file) {
   return path;
 }
 
+void DrawFixedBase(cairo_t* cr, double x, double y, double ui) {
+  const double half = 7.0 * ui, h = 10.0 * ui, ground = y + h;
+  cairo_save(cr);
+  cairo_move_to(cr, x, y);
+  cairo_line_to(cr, x + half, ground);
+  cairo_line_to(cr, x - half, ground);
+  cairo_close_path(cr);
+  SetColor(cr, kInk);
+  cairo_fill(cr);
+  cairo_set_line_width(cr, 1.4 * ui);
+  cairo_set_line_cap(cr, CAIRO_LINE_CAP_BUTT);
+  cairo_move_to(cr, x - 1.4 * half, ground);
+  cairo_line_to(cr, x + 1.4 * half, ground);
+  for (int k = 0; k < 5; ++k) {  // the hatching under the ground line
+    const double hx = x - 1.4 * half + (k + 0.5) * 0.56 * half;
+    cairo_move_to(cr, hx + 0.25 * half, ground);
+    cairo_line_to(cr, hx - 0.25 * half, ground + 0.45 * h);
+  }
+  cairo_stroke(cr);
+  cairo_restore(cr);
+}
+
 void DrawPathArrow(cairo_t* cr, const ChainScene& scene, const std::vector<double>& path, int dim,
                    const Rgb& color, double size) {
   const int rows = static_cast<int>(path.size()) / dim;
@@ -64,11 +86,8 @@ void DrawPathArrow(cairo_t* cr, const ChainScene& scene, const std::vector<doubl
   cairo_fill(cr);
 }
 
-}  // namespace render
-
-void WriteSnapshotFigure(const ResultFile& file, const FigureOptions& options,
-                         const std::string& path) {
-  using namespace render;
+void DrawSnapshotFigure(const ResultFile& file, const Look& look, const FigureOptions& options,
+                        const std::string& path) {
   ThrowIfAny(options.Validate());
   const ImageFormat format = ImageFormatFromPath(path);
   CheckDrawable(file);
@@ -76,7 +95,7 @@ void WriteSnapshotFigure(const ResultFile& file, const FigureOptions& options,
   const std::vector<Frame>& frames = file.result.frames;
   const int num_frames = static_cast<int>(frames.size()), dim = file.dim;
   const int rows = static_cast<int>(frames[0].points.rows());
-  const SnapshotLayout layout = LayoutSnapshot(file, options);
+  const SnapshotLayout layout = LayoutSnapshot(file, options, look);
   const std::vector<int>& drawn = layout.drawn;
   const ChainScene& scene = layout.scene;
   const int every_k = drawn.size() > 1 ? drawn[1] - drawn[0] : 1;
@@ -90,7 +109,7 @@ void WriteSnapshotFigure(const ResultFile& file, const FigureOptions& options,
                       : std::to_string(drawn.size()) + " of " + std::to_string(num_frames) +
                            " recorded frames drawn (every " + std::to_string(every_k) + ")";
   DrawTitle(cr, ui, canvas.width(), MainTitle(file, options.title),
-            RunSummary(file) + " \u00b7 " + frames_note);
+            look.summary + " \u00b7 " + frames_note);
   scene.DrawAxes(cr);
 
   // The leading end's path under the chains, which mostly follow it.
@@ -130,9 +149,27 @@ void WriteSnapshotFigure(const ResultFile& file, const FigureOptions& options,
   }
   const Eigen::Vector2d head = scene.Pixel(last.row(0).data());
   Disc(cr, head.x(), head.y(), 4.4 * ui, kFinal);
+  if (look.fixed_tail) {
+    const Eigen::Vector2d base = scene.Pixel(last.row(rows - 1).data());
+    DrawFixedBase(cr, base.x(), base.y(), ui);
+  }
 
   if (layout.legend) layout.legend->Draw(cr);
   SaveCanvas(&canvas, path);
+}
+
+}  // namespace render
+
+void WriteSnapshotFigure(const ResultFile& file, const FigureOptions& options,
+                         const std::string& path) {
+  render::DrawSnapshotFigure(file, render::ChainLook(file), options, path);
+}
+
+void WriteSnapshotFigure(const RobotTrajectoryFile& trajectory, const FigureOptions& options,
+                         const std::string& path) {
+  ThrowIfAny(options.Validate());
+  render::DrawSnapshotFigure(RobotTrajectoryAsResult(trajectory),
+                             render::TrajectoryLook(trajectory), options, path);
 }
 
 }  // namespace flexkin

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "render/axes.h"
+#include "render/checks.h"
 #include "render/legend.h"
 #include "render/render.h"
 #include "render/scene.h"
@@ -21,6 +22,9 @@ void DrawTitle(cairo_t* cr, double ui, int width, const std::string& title,
                const std::string& subtitle);
 // The leading end (point 0) of every frame: frames by dim values, row-major.
 std::vector<double> LeaderPath(const ResultFile& file);
+// The fixed base at (x, y): a support (a dark triangle standing on a hatched ground line), about
+// 16 ui pixels wide, its apex on the point.
+void DrawFixedBase(cairo_t* cr, double x, double y, double ui);
 // An arrowhead at half the pixel length of `path` (rows of dim values), pointing along it.
 void DrawPathArrow(cairo_t* cr, const ChainScene& scene, const std::vector<double>& path, int dim,
                    const Rgb& color, double size);
@@ -37,6 +41,12 @@ struct SnapshotLayout {
 };
 // The legend goes into the corner of the plot that covers the fewest lines if one covers none;
 // otherwise beside the plot, on the right, and the scene gets narrower.
+// `look` names the legend's entries (ChainLook(file) by default).
 SnapshotLayout LayoutSnapshot(const ResultFile& file, const FigureOptions& options);
+SnapshotLayout LayoutSnapshot(const ResultFile& file, const FigureOptions& options,
+                              const Look& look);
+// The snapshot figure of `file` as `look` names and marks it (WriteSnapshotFigure).
+void DrawSnapshotFigure(const ResultFile& file, const Look& look, const FigureOptions& options,
+                        const std::string& path);
 
 }  // namespace flexkin::render

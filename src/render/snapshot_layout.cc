@@ -47,8 +47,9 @@ std::string Ordinal(int k) {
   return "every " + std::to_string(k) + suffix;
 }
 
-std::vector<LegendEntry> LegendEntries(const ResultFile& file, const FigureOptions& options,
-                                       const std::vector<int>& drawn, double ui) {
+std::vector<LegendEntry> LegendEntries(const ResultFile& file, const Look& look,
+                                       const FigureOptions& options, const std::vector<int>& drawn,
+                                       double ui) {
   const std::vector<Frame>& frames = file.result.frames;
   std::vector<LegendEntry> entries;
   if (frames.size() > 1) {
@@ -69,8 +70,9 @@ std::vector<LegendEntry> LegendEntries(const ResultFile& file, const FigureOptio
                      "final (step " + std::to_string(frames.back().step) + ")"});
   if (options.show_leader_path && frames.size() > 1) {
     entries.push_back(
-        {LegendEntry::kLine, {kLeaderPath, 1.5 * ui, false}, false, "leading end's path"});
+        {LegendEntry::kLine, {kLeaderPath, 1.5 * ui, false}, false, look.lead + "'s path"});
   }
+  if (look.fixed_tail) entries.push_back({LegendEntry::kBase, {}, false, "fixed base"});
   return entries;
 }
 
@@ -106,6 +108,11 @@ std::vector<Eigen::Vector2d> DrawnLines(const ResultFile& file, const ChainScene
 }  // namespace
 
 SnapshotLayout LayoutSnapshot(const ResultFile& file, const FigureOptions& options) {
+  return LayoutSnapshot(file, options, ChainLook(file));
+}
+
+SnapshotLayout LayoutSnapshot(const ResultFile& file, const FigureOptions& options,
+                              const Look& look) {
   FigureOptions resolved = options;
   if (resolved.height == 0)
     resolved.height = AutoHeight(file, options.width, options.azimuth, options.elevation, 0.0);
@@ -117,7 +124,7 @@ SnapshotLayout LayoutSnapshot(const ResultFile& file, const FigureOptions& optio
       resolved, drawn, ChainScene(file, area, ui, options.azimuth, options.elevation), {}};
   if (!options.show_legend) return layout;
 
-  Legend legend(ui, LegendEntries(file, options, drawn, ui));
+  Legend legend(ui, LegendEntries(file, look, options, drawn, ui));
   const Rect region = file.dim == 2 ? layout.scene.plot() : area;
   if (legend.PlaceInCorner(region, DrawnLines(file, layout.scene, drawn, ui)) > 0) {
     // Beside the plot: narrower scene, legend at the top right.
@@ -126,7 +133,7 @@ SnapshotLayout LayoutSnapshot(const ResultFile& file, const FigureOptions& optio
       layout.options.height =
           AutoHeight(file, options.width, options.azimuth, options.elevation, reserve);
       ui = UiScale(resolved.width, layout.options.height);
-      legend = Legend(ui, LegendEntries(file, options, drawn, ui));
+      legend = Legend(ui, LegendEntries(file, look, options, drawn, ui));
     }
     area = Narrowed(SceneArea(file.dim, resolved.width, layout.options.height), reserve * ui);
     layout.scene = ChainScene(file, area, ui, options.azimuth, options.elevation);

@@ -66,14 +66,10 @@ Problems ViewerOptions::Validate() const {
   return problems;
 }
 
-void WriteViewerHtml(const ResultFile& result, const ViewerOptions& options,
-                     const std::string& path) {
-  Problems problems;
-  AppendNested("options", options.Validate(), &problems);
-  ThrowIfAny(problems);
-  // All checks happen here, before the file is touched.
-  const std::string data = viewer_internal::ViewerDataJson(result, options);
+namespace {
 
+// The page with `data` (ViewerDataJson) inlined.
+void WritePage(const std::string& data, const std::string& path) {
   const std::string_view html = Asset(kViewerHtml, sizeof kViewerHtml);
   const std::string_view css = Asset(kViewerCss, sizeof kViewerCss);
   const std::string_view js = Asset(kViewerJs, sizeof kViewerJs);
@@ -94,6 +90,28 @@ void WriteViewerHtml(const ResultFile& result, const ViewerOptions& options,
     });
     out << rest;
   });
+}
+
+void CheckOptions(const ViewerOptions& options) {
+  Problems problems;
+  AppendNested("options", options.Validate(), &problems);
+  ThrowIfAny(problems);
+}
+
+}  // namespace
+
+void WriteViewerHtml(const ResultFile& result, const ViewerOptions& options,
+                     const std::string& path) {
+  CheckOptions(options);
+  // All checks happen here, before the file is touched.
+  WritePage(viewer_internal::ViewerDataJson(result, options), path);
+}
+
+void WriteViewerHtml(const RobotTrajectoryFile& trajectory, const ViewerOptions& options,
+                     const std::string& path) {
+  CheckOptions(options);
+  const ResultFile result = RobotTrajectoryAsResult(trajectory);
+  WritePage(viewer_internal::ViewerDataJson(result, options, &trajectory), path);
 }
 
 }  // namespace flexkin

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "flexkin/result_io.h"
+#include "flexkin/robot_scenario.h"
 
 namespace flexkin {
 
@@ -49,6 +50,14 @@ struct ViewerOptions {
 // ("frames"), a frame of the wrong shape or a non-finite number (e.g. "frames[3].points[2][1]",
 // "metrics.l2_total", "link_lengths[0]"). Throws std::system_error if the file cannot be written.
 void WriteViewerHtml(const ResultFile& result, const ViewerOptions& options,
+                     const std::string& path);
+// The viewer page of a robot trajectory, drawn as RobotTrajectoryAsResult makes it a chain: the
+// end effector is point 0 (the leading end: its path is the one shown) and the fixed base, point
+// g - 1, is marked as a support; the panel gives the method, the targets and how many were not
+// reached, the end effector and the base instead of the leading and trailing ends, and no
+// link-length error (the arm keeps its lengths; prismatic joints change the distances). Errors as
+// above.
+void WriteViewerHtml(const RobotTrajectoryFile& trajectory, const ViewerOptions& options,
                      const std::string& path);
 
 }  // namespace flexkin

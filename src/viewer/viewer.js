@@ -28,6 +28,8 @@
   data.positions = null;
   const steps = Float64Array.from(data.steps);
   const options = data.options;
+  // A robot trajectory (src/viewer/viewer.h): point 0 the end effector, the last the fixed base.
+  const robot = data.robot || null;
 
   // Bounding box of the whole motion, its centre and the radius of its bounding sphere.
   const lo = [Infinity, Infinity, Infinity];
@@ -317,8 +319,24 @@
     }
     g.fillStyle = colors.tail;
     g.beginPath();
-    g.arc(screenX[numPoints - 1], screenY[numPoints - 1], 3.5, 0, 2 * Math.PI);
-    g.fill();
+    if (robot) {
+      // The fixed base: a support, its apex on the point, standing on a ground line.
+      const bx = screenX[numPoints - 1], by = screenY[numPoints - 1];
+      g.moveTo(bx, by);
+      g.lineTo(bx + 7, by + 10);
+      g.lineTo(bx - 7, by + 10);
+      g.closePath();
+      g.fill();
+      g.strokeStyle = colors.tail;
+      g.lineWidth = 1.5;
+      g.beginPath();
+      g.moveTo(bx - 10, by + 10);
+      g.lineTo(bx + 10, by + 10);
+      g.stroke();
+    } else {
+      g.arc(screenX[numPoints - 1], screenY[numPoints - 1], 3.5, 0, 2 * Math.PI);
+      g.fill();
+    }
     g.fillStyle = colors.lead;
     g.beginPath();
     g.arc(screenX[0], screenY[0], 5, 0, 2 * Math.PI);
@@ -392,9 +410,52 @@
 
   const metrics = data.metrics;
   const nowFields = {};
+  // A robot trajectory's panel: its method, targets and what was reached; the end effector and
+  // the base for the leading and trailing ends.
+  function buildRobotPanel() {
+    $('subtitle').textContent = 'robot, ' + data.method + ', ' + dim + 'D, ' + robot.links +
+        ' links, ' + robot.targets + ' targets, ' +
+        (robot.unreached > 0 ? robot.unreached + ' not reached' : 'all reached');
+    const facts = $('facts');
+    if (data.scenario) addFact(facts, 'Scenario', data.scenario);
+    addFact(facts, 'Method', data.method);
+    addFact(facts, 'Dimension', dim + 'D');
+    addFact(facts, 'Links', String(robot.links));
+    addFact(facts, 'Targets', String(robot.targets));
+    const missed = addFact(facts, 'Not reached', String(robot.unreached));
+    if (robot.unreached > 0) missed.style.color = colors.lead;
+    addFact(facts, 'End-effector error (max)', fmt(robot.max_ee_error));
+    addFact(facts, 'Compute time', fmt(data.seconds) + ' s');
+    const now = $('now');
+    nowFields.step = addFact(now, 'Target', '');
+    nowFields.lead = addFact(now, 'End effector', '');
+    nowFields.tail = addFact(now, 'Base', '');
+    const leader = $('leader').parentNode;
+    leader.title = 'The end effector\'s path (L)';
+    leader.lastChild.textContent = ' End-effector path';
+    const ends = document.querySelectorAll('#profile + .axis span');
+    if (ends.length === 2) {
+      ends[0].textContent = 'end effector';
+      ends[1].textContent = 'base';
+    }
+    $('l2plot').previousElementSibling.textContent = 'L2 per target';
+  }
+
   function buildPanel() {
     document.title = data.title + ' \u2013 flexkin viewer';
     $('title').textContent = data.title;
+    if (robot) {
+      buildRobotPanel();
+    } else {
+      buildChainPanel();
+    }
+    $('perspective-control').hidden = dim !== 3;
+    $('hint').textContent = dim === 2
+        ? 'drag: pan \u00b7 wheel: zoom \u00b7 click a point: trail'
+        : 'drag: orbit \u00b7 shift+drag: pan \u00b7 wheel: zoom \u00b7 click a point: trail';
+  }
+
+  function buildChainPanel() {
     $('subtitle').textContent = data.method + ', ' + dim + 'D, ' + data.num_links + ' links, ' +
         data.num_steps + ' leader steps';
     const facts = $('facts');
@@ -420,10 +481,6 @@
     nowFields.error = addFact(now, 'Link-length error', '');
     nowFields.lead = addFact(now, 'Leading end', '');
     nowFields.tail = addFact(now, 'Trailing end', '');
-    $('perspective-control').hidden = dim !== 3;
-    $('hint').textContent = dim === 2
-        ? 'drag: pan \u00b7 wheel: zoom \u00b7 click a point: trail'
-        : 'drag: orbit \u00b7 shift+drag: pan \u00b7 wheel: zoom \u00b7 click a point: trail';
   }
 
   // A sparkline of `values` into `canvas`, kept as an image so the marker can be moved cheaply.
@@ -517,7 +574,7 @@
     $('counter').textContent = 'frame ' + (f + 1) + ' / ' + numFrames + ' \u00b7 step ' +
         steps[f] + ' / ' + data.num_steps;
     nowFields.step.textContent = String(steps[f]);
-    nowFields.error.textContent = fmt(data.frame_length_error[f]);
+    if (nowFields.error) nowFields.error.textContent = fmt(data.frame_length_error[f]);
     nowFields.lead.textContent = pointText(f, 0);
     nowFields.tail.textContent = pointText(f, numPoints - 1);
     drawSparks();

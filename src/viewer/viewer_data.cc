@@ -81,7 +81,8 @@ double FrameLengthError(const Points& p, const Eigen::VectorXd& lengths) {
 
 }  // namespace
 
-std::string ViewerDataJson(const ResultFile& file, const ViewerOptions& options) {
+std::string ViewerDataJson(const ResultFile& file, const ViewerOptions& options,
+                           const RobotTrajectoryFile* robot) {
   CheckResult(file, options);
   const RunResult& r = file.result;
   const size_t num_frames = r.frames.size();
@@ -96,7 +97,20 @@ std::string ViewerDataJson(const ResultFile& file, const ViewerOptions& options)
   AppendKey("scenario", &out);
   AppendString(file.scenario_name, &out);
   AppendKey("method", &out);
-  AppendString(MethodName(r.method), &out);
+  AppendString(robot != nullptr ? robot->method : std::string(MethodName(r.method)), &out);
+  if (robot != nullptr) {
+    AppendKey("robot", &out);
+    out.push_back('{');
+    AppendKey("links", &out);
+    out += std::to_string(robot->link_lengths.size());
+    AppendKey("targets", &out);
+    out += std::to_string(robot->targets.rows());
+    AppendKey("unreached", &out);
+    out += std::to_string(robot->unreached);
+    AppendKey("max_ee_error", &out);
+    AppendExact(robot->max_ee_error, &out);
+    out.push_back('}');
+  }
   AppendKey("dim", &out);
   out += std::to_string(file.dim);
   AppendKey("num_links", &out);

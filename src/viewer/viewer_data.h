@@ -12,6 +12,10 @@ namespace flexkin::viewer_internal {
 // text can sit inside a <script> element without closing it. Throws InputError as
 // WriteViewerHtml (src/viewer/viewer.h) for a result that cannot be shown; `options` must be
 // valid.
-std::string ViewerDataJson(const ResultFile& result, const ViewerOptions& options);
+// `robot`: the trajectory that `result` was made from (RobotTrajectoryAsResult), whose facts go
+// into a "robot" object (method, targets, unreached, max_ee_error) that the page shows instead of
+// the chain's (and "links", the arm's n); null for a chain result.
+std::string ViewerDataJson(const ResultFile& result, const ViewerOptions& options,
+                           const RobotTrajectoryFile* robot = nullptr);
 
 }  // namespace flexkin::viewer_internal
