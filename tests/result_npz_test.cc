@@ -26,6 +26,7 @@
 #include "flexkin/result_io.h"
 #include "flexkin/run.h"
 #include "flexkin/scenario.h"
+#include "flexkin/strand_file.h"
 #include "test_util.h"
 
 namespace flexkin {
@@ -465,6 +466,35 @@ TEST_F(ResultNpzFileTest, RefusedArchiveClosesItsFile) {
   const auto before = open_files();
   for (int i = 0; i < 50; ++i) EXPECT_THROW(ReadResultFile(path), InputError);
   EXPECT_EQ(open_files(), before);
+}
+
+// A strand file (the other .npz flexkin writes, docs/strands.md) is not reported as a result
+// whose result.json is missing: the message says what it is and what reads it.
+TEST_F(ResultNpzFileTest, StrandFileIsNamedWithItsReader) {
+  StrandFileHeader h;
+  h.dim = 3;
+  h.offsets = {0, 3};
+  h.link_lengths = Eigen::VectorXd::Constant(2, 0.5);
+  h.num_frames = 1;
+  StrandFrame frame;
+  frame.points = Points::Zero(3, 3);
+  frame.points.col(2) << 0.0, -0.5, -1.0;
+  const std::string path = Path("hair.npz");
+  StrandFileWriter writer(path, h);
+  writer.Add(frame);
+  writer.Commit(StrandRunReport());
+  ASSERT_TRUE(IsStrandFile(path));
+  try {
+    ReadResultFile(path);
+    ADD_FAILURE() << "a strand file was read as a result";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "");
+    const std::string what = e.what();
+    EXPECT_NE(what.find("is a strand file"), std::string::npos) << what;
+    EXPECT_NE(what.find("StrandFileReader"), std::string::npos) << what;
+    EXPECT_NE(what.find("numpy.load"), std::string::npos) << what;
+    EXPECT_EQ(what.find("result.json"), std::string::npos) << what;
+  }
 }
 
 }  // namespace

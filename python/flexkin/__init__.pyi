@@ -1,6 +1,6 @@
 # Type stubs of the flexkin module (docs/python.md). Arrays are numpy float64 unless noted.
 import os
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Literal, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -20,6 +20,10 @@ class InputError(ValueError):
     message: str
     value: str
     expected: str
+
+class KeywordError(InputError, TypeError): ...
+
+__version__: str
 
 class ObjectiveWeights:
     squared: float
@@ -192,15 +196,18 @@ class RobotResult:
     seconds: float
     def brief_report(self) -> str: ...
 
-def line(*, start: ArrayLike = ..., direction: ArrayLike = ..., links: int = 10,
-         link_length: float = 0.1) -> Float64Array: ...
+# The curve generators take a scenario file's "curve" fields (docs/scenario-format.md).
+# clockwise= and side=1/-1 are the deprecated forms of turn= and side="+x"/"-x".
+def line(*, start: Optional[ArrayLike] = None, direction: Optional[ArrayLike] = None,
+         links: int = 10, link_length: float = 0.1) -> Float64Array: ...
 def parabola(*, a: float = 1.0, links: int = 20, link_length: float = 0.25,
-             side: int = 1) -> Float64Array: ...
+             side: Literal["+x", "-x"] = "+x") -> Float64Array: ...
 def arc(*, radius: float = 1.0, center: ArrayLike = ..., start_angle: float = 0.0,
-        clockwise: bool = False, links: int = 10, link_length: float = 0.1) -> Float64Array: ...
+        turn: Literal["ccw", "cw"] = "ccw", links: int = 10, link_length: float = 0.1,
+        clockwise: Optional[bool] = None) -> Float64Array: ...
 def helix(*, radius: float = 1.0, pitch: float = 1.0, center: ArrayLike = ...,
-          start_angle: float = 0.0, clockwise: bool = False, links: int = 20,
-          link_length: float = 1.5) -> Float64Array: ...
+          start_angle: float = 0.0, turn: Literal["ccw", "cw"] = "ccw", links: int = 20,
+          link_length: float = 1.5, clockwise: Optional[bool] = None) -> Float64Array: ...
 def split_pull(start: ArrayLike, pull: ArrayLike, steps: int) -> Float64Array: ...
 def resample_path(start: ArrayLike, path: ArrayLike, max_step: float) -> Float64Array: ...
 def tractrix_step(head_old: ArrayLike, head_new: ArrayLike, tail: ArrayLike,
@@ -305,8 +312,8 @@ class GltfOptions:
     def validate(self) -> None: ...
 
 def gltf_joint_positions(path: PathLike) -> Tuple[Float64Array, Float64Array]: ...
-def render(result: Result, out_dir: PathLike,
-           formats: Union[str, Sequence[str]] = ("svg", "png", "plots"), *,
+def render(result: Union[Result, RobotResult], out_dir: PathLike,
+           formats: Union[str, Sequence[str], None] = None, *,
            stem: str = "result", every: Optional[int] = None, width: Optional[int] = None,
            height: Optional[int] = None, azimuth: Optional[float] = None,
            elevation: Optional[float] = None, fps: Optional[int] = None,

@@ -13,9 +13,100 @@
 #include "flexkin/link_step.h"
 #include "flexkin/overall.h"
 #include "flexkin/propagate.h"
+#include "flexkin/vocabulary.h"
+
+namespace flexkin::python {
+// The values of a scenario file's "curve" "turn" (arc, helix) and "side" (parabola),
+// docs/scenario-format.md, for the curve generators' keywords of the same names.
+enum class Turn { kCcw, kCw };
+enum class Side { kPlusX, kMinusX };
+}  // namespace flexkin::python
+
+namespace flexkin {
+// The names as scenario files spell them. The scenario parser (src/io/scenario_sections.cc)
+// spells them too; python/tests/test_front_end.py checks that both accept the same names.
+template <>
+struct Vocabulary<python::Turn> {
+  static constexpr const char* kKind = "turn";
+  static constexpr NamedValue<python::Turn> kEntries[] = {
+      {python::Turn::kCcw, "ccw", "counterclockwise: the angle grows along the chain"},
+      {python::Turn::kCw, "cw", "clockwise: the angle shrinks along the chain"},
+  };
+};
+template <>
+struct Vocabulary<python::Side> {
+  static constexpr const char* kKind = "side";
+  static constexpr NamedValue<python::Side> kEntries[] = {
+      {python::Side::kPlusX, "+x", "from the vertex toward +x"},
+      {python::Side::kMinusX, "-x", "from the vertex toward -x"},
+  };
+};
+}  // namespace flexkin
 
 namespace flexkin::python {
 namespace {
+
+// A DeprecationWarning attributed to the caller of the module's function (stack level 2: the
+// function is called through its wrapper in flexkin/__init__.py).
+void Deprecated(const char* message) {
+  if (PyErr_WarnEx(PyExc_DeprecationWarning, message, 2) != 0) throw py::error_already_set();
+}
+
+// The enumerator named by a str argument `name` ("turn", "side"); InputError naming the keyword,
+// the value and the valid names otherwise.
+template <typename Enum>
+Enum NameArg(py::handle value, const std::string& name) {
+  if (!py::isinstance<py::str>(value)) {
+    throw InputError(Problem::Invalid(name, std::string(py::repr(value)), QuotedNames<Enum>()));
+  }
+  return ParseName<Enum>(py::cast<std::string>(value), name);
+}
+
+// turn="ccw" or "cw"; the deprecated clockwise=True/False, where given, agreeing with it.
+bool TurnArg(py::handle turn, py::handle clockwise) {
+  const bool cw = NameArg<Turn>(turn, "turn") == Turn::kCw;
+  if (clockwise.is_none()) return cw;
+  if (!py::isinstance<py::bool_>(clockwise)) {
+    throw InputError(
+        Problem::Invalid("clockwise", std::string(py::repr(clockwise)), "True or False"));
+  }
+  Deprecated(
+      "flexkin: clockwise= is deprecated; use turn=\"cw\" or turn=\"ccw\", as in scenario "
+      "files");
+  if (cw && !clockwise.cast<bool>()) {
+    ThrowInput("clockwise", "False contradicts turn=\"cw\"; give turn alone", "False",
+               "turn alone");
+  }
+  return cw || clockwise.cast<bool>();
+}
+
+// side="+x" or "-x" as +1 or -1; the deprecated 1 and -1 too.
+int SideArg(py::handle side) {
+  if (py::isinstance<py::int_>(side) && !py::isinstance<py::bool_>(side) &&
+      (side.equal(py::int_(1)) || side.equal(py::int_(-1)))) {
+    Deprecated(
+        "flexkin: side=1 and side=-1 are deprecated; use side=\"+x\" or side=\"-x\", as "
+        "in scenario files");
+    return side.cast<int>();
+  }
+  return NameArg<Side>(side, "side") == Side::kPlusX ? 1 : -1;
+}
+
+// A line as a scenario file defines it: a start sets the dimension (and the default direction
+// [1, 0] or [1, 0, 0]); without one the direction does (2 or 3 values), from the origin; without
+// either the line is 2D.
+LineDef LineArgs(py::handle start, py::handle direction, int links, double link_length) {
+  LineDef d;
+  const bool has_start = !start.is_none();
+  if (has_start) d.start = ReadVector(start, "start");
+  const int dim = has_start ? static_cast<int>(d.start.size()) : 0;
+  d.direction = direction.is_none() ? Eigen::VectorXd::Unit(has_start ? dim : 2, 0)
+                                    : ReadVector(direction, "direction", dim);
+  if (!has_start) d.start = Eigen::VectorXd::Zero(d.direction.size());
+  d.links = links;
+  d.link_length = link_length;
+  return d;
+}
 
 // The single link step, 2D or 3D by the size of the points.
 template <typename Step2, typename Step3>
@@ -139,71 +230,73 @@ Chain(points, *, link_length=None, lengths=None)
 
   m.def(
       "line",
-      [](ArrayLike start, ArrayLike direction, int links, double link_length) {
-        LineDef d;
-        d.start = ReadVector(start, "start");
-        d.direction = ReadVector(direction, "direction", static_cast<int>(d.start.size()));
-        d.links = links;
-        d.link_length = link_length;
-        return ToArray(MakeLine(d));
+      [](OptionalArray start, OptionalArray direction, int links, double link_length) {
+        return ToArray(MakeLine(LineArgs(start, direction, links, link_length)));
       },
-      py::kw_only(), py::arg("start") = std::vector<double>{0.0, 0.0},
-      py::arg("direction") = std::vector<double>{1.0, 0.0}, py::arg("links") = 10,
-      py::arg("link_length") = 0.1,
-      "A straight line of `links` links of `link_length` from start (the leading end) along "
-      "direction: (links+1, dim) float64.");
+      py::kw_only(), py::arg("start") = py::none(), py::arg("direction") = py::none(),
+      py::arg("links") = 10, py::arg("link_length") = 0.1,
+      "A straight line of `links` links of `link_length` from start (the leading end, default "
+      "the origin) along direction (toward the trailing end, any nonzero length; default "
+      "[1, 0], or [1, 0, 0] with a 3D start), as a scenario file's {\"shape\": \"line\"}: "
+      "(links+1, dim) float64.");
   m.def(
       "parabola",
-      [](double a, int links, double link_length, int side) {
+      [](double a, int links, double link_length, NameText side) {
         ParabolaDef d;
         d.a = a;
         d.links = links;
         d.link_length = link_length;
-        d.side = side;
+        d.side = SideArg(side);
         return ToArray(MakeParabola(d));
       },
       py::kw_only(), py::arg("a") = 1.0, py::arg("links") = 20, py::arg("link_length") = 0.25,
-      py::arg("side") = 1,
-      "The parabola y = a x^2 from the vertex (the leading end) toward +x (side=1) or -x "
-      "(side=-1), every chord link_length: (links+1, 2) float64 (paper Sec. 5.1: a=1, 20 links "
-      "of 0.25).");
+      py::arg("side") = NameOf(Side::kPlusX),
+      "The parabola y = a x^2 from the vertex (the leading end) toward +x (side=\"+x\") or -x "
+      "(side=\"-x\"), every chord link_length, as a scenario file's {\"shape\": \"parabola\"}: "
+      "(links+1, 2) float64 (paper Sec. 5.1: a=1, 20 links of 0.25). side=1 and side=-1 are "
+      "the deprecated forms of \"+x\" and \"-x\".");
   m.def(
       "arc",
-      [](double radius, ArrayLike center, double start_angle, bool clockwise, int links,
-         double link_length) {
+      [](double radius, ArrayLike center, double start_angle, NameText turn, int links,
+         double link_length, OptionalBool clockwise) {
         ArcDef d;
         d.radius = radius;
         d.center = ReadVector(center, "center", 2);
         d.start_angle = start_angle;
-        d.clockwise = clockwise;
+        d.clockwise = TurnArg(turn, clockwise);
         d.links = links;
         d.link_length = link_length;
         return ToArray(MakeArc(d));
       },
       py::kw_only(), py::arg("radius") = 1.0, py::arg("center") = std::vector<double>{0.0, 0.0},
-      py::arg("start_angle") = 0.0, py::arg("clockwise") = false, py::arg("links") = 10,
-      py::arg("link_length") = 0.1,
-      "A circular arc about center, point 0 at start_angle (radians), every chord link_length: "
-      "(links+1, 2) float64.");
+      py::arg("start_angle") = 0.0, py::arg("turn") = NameOf(Turn::kCcw), py::arg("links") = 10,
+      py::arg("link_length") = 0.1, py::arg("clockwise") = py::none(),
+      "A circular arc about center, point 0 at start_angle (radians), the angle moving along "
+      "the chain counterclockwise (turn=\"ccw\") or clockwise (turn=\"cw\"), every chord "
+      "link_length, as a scenario file's {\"shape\": \"arc\"}: (links+1, 2) float64. "
+      "clockwise=True/False is the deprecated form of turn.");
   m.def(
       "helix",
-      [](double radius, double pitch, ArrayLike center, double start_angle, bool clockwise,
-         int links, double link_length) {
+      [](double radius, double pitch, ArrayLike center, double start_angle, NameText turn,
+         int links, double link_length, OptionalBool clockwise) {
         HelixDef d;
         d.radius = radius;
         d.pitch = pitch;
         d.center = ReadVector(center, "center", 3);
         d.start_angle = start_angle;
-        d.clockwise = clockwise;
+        d.clockwise = TurnArg(turn, clockwise);
         d.links = links;
         d.link_length = link_length;
         return ToArray(MakeHelix(d));
       },
       py::kw_only(), py::arg("radius") = 1.0, py::arg("pitch") = 1.0,
       py::arg("center") = std::vector<double>{0.0, 0.0, 0.0}, py::arg("start_angle") = 0.0,
-      py::arg("clockwise") = false, py::arg("links") = 20, py::arg("link_length") = 1.5,
-      "A circular helix about an axis parallel to z (rise `pitch` per turn), every chord "
-      "link_length: (links+1, 3) float64.");
+      py::arg("turn") = NameOf(Turn::kCcw), py::arg("links") = 20, py::arg("link_length") = 1.5,
+      py::arg("clockwise") = py::none(),
+      "A circular helix about an axis parallel to z (rise `pitch` per turn), turning "
+      "counterclockwise (turn=\"ccw\") or clockwise (turn=\"cw\") seen from +z, every chord "
+      "link_length, as a scenario file's {\"shape\": \"helix\"}: (links+1, 3) float64. "
+      "clockwise=True/False is the deprecated form of turn.");
 
   m.def(
       "split_pull",

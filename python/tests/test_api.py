@@ -16,7 +16,8 @@ import flexkin
 from conftest import EXAMPLES, SOURCE_DIR
 
 CLASSES = sorted(name for name in flexkin.__all__
-                 if isinstance(getattr(flexkin, name), type) and name != "InputError")
+                 if isinstance(getattr(flexkin, name), type)
+                 and not issubclass(getattr(flexkin, name), Exception))
 # Engines with state, not values: they neither pickle nor copy (a StrandBatch owns its threads).
 ENGINES = {"StrandBatch"}
 RENDER_CLASSES = {"AnimationOptions", "FigureOptions", "GltfOptions", "PlotOptions",

@@ -58,9 +58,10 @@ def points_of(model):
 ARRAYS = [
     ("Chain.points", lambda v: flexkin.Chain(v).points, P2, "points", "any rows"),
     ("Chain.lengths", lambda v: flexkin.Chain(P2, lengths=v).lengths, L2, "lengths", "optional"),
-    ("line.start", lambda v: flexkin.line(start=v, direction=[1, 2]), [0.5, 0.25], "start", ""),
+    ("line.start", lambda v: flexkin.line(start=v, direction=[1, 2]), [0.5, 0.25], "start",
+     "optional"),
     ("line.direction", lambda v: flexkin.line(start=[0, 0], direction=v), [1.0, 2.0],
-     "direction", ""),
+     "direction", "optional"),
     ("arc.center", lambda v: flexkin.arc(center=v), [0.5, 0.25], "center", ""),
     ("helix.center", lambda v: flexkin.helix(center=v), [0.5, 0.25, 1.0], "center", ""),
     ("split_pull.start", lambda v: flexkin.split_pull(v, [1, 0.5], 3), [0.5, 0.25], "start", ""),

@@ -140,6 +140,15 @@ std::unique_ptr<ResultFileWriter::Impl> MakeNpzResultWriter(const std::string& p
 
 ResultFile ReadNpzResult(const std::string& path) {
   ZipReader zip(path);
+  if (!zip.Has("result.json") && zip.Has("groom.json") && zip.Has("points.npy")) {
+    // The other .npz that flexkin writes (its members as IsStrandFile tests them,
+    // groom/strand_file.cc): say what it is and what reads it, not that result.json is missing.
+    throw InputError(
+        Problem("",
+                "is a strand file (the output of a groom run, docs/strands.md), not a chain "
+                "result; read it with numpy.load in Python or StrandFileReader in C++ "
+                "(flexkin/strand_file.h), or draw it with `flexkin render`"));
+  }
   ResultFile file;
   RunResult& r = file.result;
   nlohmann::json summary;
