@@ -30,6 +30,7 @@
 #include <utility>
 #include <vector>
 
+#include "flexkin/any_scenario.h"
 #include "flexkin/error.h"
 #include "flexkin/groom.h"
 #include "flexkin/propagate.h"
@@ -75,6 +76,13 @@ constexpr const char* kExitCodesHelp =
     "     output being written was not written and earlier files are unchanged";
 
 void PrintError(const std::string& message) { std::cerr << "flexkin: error: " << message << "\n"; }
+
+// How the command line reads scenarios: URDF robots through the URDF component.
+flexkin::ScenarioReadOptions ReadOptions() {
+  flexkin::ScenarioReadOptions options;
+  options.robot = flexkin::UrdfRobotScenarioOptions();
+  return options;
+}
 
 // After a signal, whatever exception ended the command (the interruption itself, or a failure
 // it caused, such as an ffmpeg that the terminal's Ctrl-C stopped too): 128 + the signal.
@@ -215,7 +223,7 @@ void CheckOutputSize(const RunArgs& args, const flexkin::Scenario& s,
 
 // A groom scenario (docs/groom-format.md) goes to the strand engine; the options it shares with
 // chain runs keep their meaning, those it has no use for are refused by name.
-int RunGroom(const RunArgs& args) {
+int RunGroom(const RunArgs& args, flexkin::GroomScenario scenario) {
   flexkin::cli::GroomRunArgs g;
   g.scenario = args.scenario;
   g.output = args.output;
@@ -236,7 +244,7 @@ int RunGroom(const RunArgs& args) {
     if (*option) g.unsupported = name;
   }
   try {
-    return flexkin::cli::RunGroomCommand(g);
+    return flexkin::cli::RunGroomCommand(g, std::move(scenario));
   } catch (const flexkin::InputError& e) {
     // Problems of the file are named by the file; those of options by the option.
     const std::string field = e.field();
@@ -249,20 +257,25 @@ int RunGroom(const RunArgs& args) {
 }
 
 int RunCommand(const RunArgs& args) {
-  if (flexkin::IsGroomFile(args.scenario)) return RunGroom(args);
+  // One read, one parse: the kind and every problem (flexkin/any_scenario.h).
+  flexkin::AnyScenario any = flexkin::ReadScenarioFile(args.scenario, ReadOptions());
+  if (!any.valid()) {
+    PrintError(args.scenario + ": " + any.problems.front().Text());
+    return kExitInvalidInput;
+  }
+  if (any.kind == flexkin::ScenarioKind::kRobot) {
+    throw flexkin::InputError(flexkin::Problem(
+        args.scenario, "is a robot scenario (docs/robot-format.md); run it with `flexkin robot " +
+                           args.scenario + " -o TRAJECTORY.json`"));
+  }
+  if (any.kind == flexkin::ScenarioKind::kGroom) return RunGroom(args, std::move(*any.groom));
   if (*args.threads_opt || *args.precision_opt) {
     throw flexkin::InputError(
         flexkin::Problem(*args.threads_opt ? "--threads" : "--precision",
                          "is an option of groom scenarios (docs/groom-format.md); " +
                              args.scenario + " is a chain scenario"));
   }
-  flexkin::Scenario scenario;
-  try {
-    scenario = flexkin::LoadScenarioFile(args.scenario);
-  } catch (const flexkin::InputError& e) {
-    PrintError(args.scenario + ": " + e.what());
-    return kExitInvalidInput;
-  }
+  flexkin::Scenario scenario = std::move(*any.chain);
   const flexkin::ResultFileFormat format = flexkin::ResultFileFormatOfPath(args.output, "-o");
   ApplyOverrides(args, &scenario.options);
   CheckOutputSize(args, scenario, format);
@@ -317,39 +330,18 @@ int RunCommand(const RunArgs& args) {
   return kExitOk;
 }
 
-// validate for a robot scenario (docs/robot-format.md): the robot reader's problems, or its
-// summary and the estimated sizes of the trajectory JSON and the joint CSV.
-int ValidateRobotCommand(const std::string& path) {
-  const flexkin::RobotScenarioOptions options = flexkin::UrdfRobotScenarioOptions();
-  const flexkin::Problems problems = flexkin::ValidateRobotScenarioFile(path, options);
-  if (!problems.empty()) {
-    for (const auto& p : problems) std::cout << path << ": " << p.Text() << "\n";
-    return kExitInvalidInput;
-  }
-  const flexkin::RobotScenario scenario = flexkin::LoadRobotScenarioFile(path, options);
-  std::cout << "ok: " << flexkin::RobotScenarioSummary(scenario) << "\n";
+// validate for a robot scenario (docs/robot-format.md): the estimated sizes of the trajectory
+// JSON and the joint CSV.
+void PrintRobotOutput(const flexkin::RobotScenario& scenario) {
   const flexkin::RobotOutputEstimate e = flexkin::EstimateRobotOutput(scenario);
   using flexkin::cli::FormatBytes;
   std::cout << "output: " << scenario.path.rows() + 1
             << " states (the initial one and one per target); trajectory about "
             << FormatBytes(e.json_bytes) << " as .json; --csv about " << FormatBytes(e.csv_bytes)
             << "; streamed, memory independent of the targets\n";
-  return kExitOk;
 }
 
-int ValidateCommand(const std::string& path) {
-  if (flexkin::IsRobotScenarioFile(path)) return ValidateRobotCommand(path);
-  if (flexkin::IsGroomFile(path)) return flexkin::cli::ValidateGroomCommand(path);
-  // Text that is not JSON is one problem, like any other.
-  const flexkin::Problems problems = flexkin::ValidateScenarioFile(path);
-  if (!problems.empty()) {
-    for (const auto& p : problems) {
-      std::cout << path << ": " << p.Text() << "\n";
-    }
-    return kExitInvalidInput;
-  }
-  const flexkin::Scenario scenario = flexkin::LoadScenarioFile(path);
-  std::cout << "ok: " << flexkin::ScenarioSummary(scenario) << "\n";
+void PrintChainOutput(const flexkin::Scenario& scenario) {
   const flexkin::ResultSizeEstimate e =
       flexkin::EstimateResultSize(scenario.chain.num_links(), scenario.chain.dim(),
                                   scenario.leader_steps.rows(), scenario.options);
@@ -360,6 +352,27 @@ int ValidateCommand(const std::string& path) {
             << FormatBytes(e.npz_bytes) << " as .npz; --csv about " << FormatBytes(e.csv_bytes)
             << "; keeping every frame in memory (Run without a sink) about "
             << FormatBytes(e.recorder_bytes) << "\n";
+}
+
+// Any kind of scenario, read once: every problem (exit 1), or its summary and output sizes.
+int ValidateCommand(const std::string& path) {
+  const flexkin::AnyScenario s = flexkin::ReadScenarioFile(path, ReadOptions());
+  if (!s.valid()) {
+    for (const auto& p : s.problems) std::cout << path << ": " << p.Text() << "\n";
+    return kExitInvalidInput;
+  }
+  std::cout << "ok: " << s.Summary() << "\n";
+  switch (s.kind) {
+    case flexkin::ScenarioKind::kChain:
+      PrintChainOutput(*s.chain);
+      break;
+    case flexkin::ScenarioKind::kGroom:
+      flexkin::cli::PrintGroomOutput(*s.groom);
+      break;
+    case flexkin::ScenarioKind::kRobot:
+      PrintRobotOutput(*s.robot);
+      break;
+  }
   return kExitOk;
 }
 

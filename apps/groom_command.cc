@@ -32,36 +32,13 @@ void ApplyOverrides(const GroomRunArgs& args, GroomScenario* s) {
                                                    args.scenario +
                                                    "); it applies to chain scenarios only"));
   }
-  if (args.method) {
-    const Method m = ParseName<Method>(*args.method, "--method");
-    if (m != Method::kTractrix && m != Method::kFollowTheLeader) {
-      throw InputError(Problem::Invalid("--method", "\"" + *args.method + "\"",
-                                        "\"tractrix\" or \"ftl\" (the strand engine's methods)"));
-    }
-    s->options.method = m;
-  }
-  if (args.substeps) s->options.substeps = *args.substeps;
-  if (args.threads) s->options.threads = *args.threads;
-  if (args.record_every) {
-    if (*args.record_every < 1) {
-      throw InputError(Problem::Invalid("--record-every", std::to_string(*args.record_every),
-                                        "an integer >= 1"));
-    }
-    s->record_every = *args.record_every;
-  }
-  if (args.precision) {
-    if (*args.precision != "float32" && *args.precision != "float64") {
-      throw InputError(Problem::Invalid("--precision", "\"" + *args.precision + "\"",
-                                        "\"float32\" or \"float64\""));
-    }
-    s->float32 = *args.precision == "float32";
-  }
-  const Problems problems = s->options.Validate();
-  if (!problems.empty()) {
-    Problem p = problems.front();
-    p.field = "--" + p.field;
-    throw InputError(p);
-  }
+  GroomOverrides overrides;
+  overrides.method = args.method;
+  overrides.precision = args.precision;
+  overrides.substeps = args.substeps;
+  overrides.threads = args.threads;
+  overrides.record_every = args.record_every;
+  ApplyGroomOverrides(overrides, /*command_line=*/true, s);
 }
 
 void CheckSize(const GroomRunArgs& args, const StrandFileHeader& h) {
@@ -97,8 +74,7 @@ bool ShowProgress(int64_t done, int64_t total) {
 
 }  // namespace
 
-int RunGroomCommand(const GroomRunArgs& args) {
-  GroomScenario scenario = LoadGroomFile(args.scenario);
+int RunGroomCommand(const GroomRunArgs& args, GroomScenario scenario) {
   ApplyOverrides(args, &scenario);
   const std::string& out = args.output;
   if (out.size() < 4 || out.compare(out.size() - 4, 4, ".npz") != 0) {
@@ -127,8 +103,8 @@ int RunGroomCommand(const GroomRunArgs& args) {
                   "thread%s: %.3f ms per frame; largest link-length error %.2g\n",
                   out.c_str(), header.num_strands(), static_cast<long long>(header.num_points()),
                   static_cast<long long>(frames), static_cast<long long>(header.num_frames),
-                  header.float32 ? "float32" : "float64", header.method.c_str(),
-                  report.engine.c_str(), report.threads, report.threads == 1 ? "" : "s",
+                  PrecisionName(header.float32), header.method.c_str(), report.engine.c_str(),
+                  report.threads, report.threads == 1 ? "" : "s",
                   frames > 1 ? 1e3 * report.seconds / static_cast<double>(frames - 1) : 0.0,
                   report.max_length_error);
     std::cout << line;
@@ -136,20 +112,11 @@ int RunGroomCommand(const GroomRunArgs& args) {
   return 0;
 }
 
-int ValidateGroomCommand(const std::string& path) {
-  const Problems problems = ValidateGroomFile(path);
-  if (!problems.empty()) {
-    for (const auto& p : problems) std::cout << path << ": " << p.Text() << "\n";
-    return 1;
-  }
-  const GroomScenario scenario = LoadGroomFile(path);
-  std::cout << "ok: " << GroomSummary(scenario) << "\n";
+void PrintGroomOutput(const GroomScenario& scenario) {
   const StrandFileHeader h = MakeStrandFileHeader(scenario);
   std::cout << "output: " << h.num_frames << " frames recorded of " << scenario.motion.num_frames()
             << "; strand file about " << FormatBytes(StrandFileBytes(h)) << " ("
-            << (h.float32 ? "float32" : "float64")
-            << "); streamed, memory independent of the frames\n";
-  return 0;
+            << PrecisionName(h.float32) << "); streamed, memory independent of the frames\n";
 }
 
 }  // namespace flexkin::cli

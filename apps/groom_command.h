@@ -6,6 +6,8 @@
 #include <optional>
 #include <string>
 
+#include "flexkin/groom.h"
+
 namespace flexkin::cli {
 
 struct GroomRunArgs {
@@ -19,10 +21,10 @@ struct GroomRunArgs {
 
 // Runs the groom and writes the strand file. Returns the exit status (0); throws InputError (exit
 // 1) and std::system_error (a file: exit 4) for flexkin_main to report.
-int RunGroomCommand(const GroomRunArgs& args);
+// `scenario` is the file's, read and checked by the front door (flexkin/any_scenario.h).
+int RunGroomCommand(const GroomRunArgs& args, GroomScenario scenario);
 
-// `flexkin validate` of a groom scenario: its problems (exit 1) or its summary and the strand
-// file's size (exit 0).
-int ValidateGroomCommand(const std::string& path);
+// `flexkin validate` of a groom scenario: the strand file's frames and size.
+void PrintGroomOutput(const GroomScenario& scenario);
 
 }  // namespace flexkin::cli

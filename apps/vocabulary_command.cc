@@ -5,6 +5,8 @@
 #include "flexkin/arm.h"
 #include "flexkin/overall.h"
 #include "flexkin/propagate.h"
+#include "flexkin/scenario_kind.h"
+#include "flexkin/strand_file.h"
 #include "flexkin/vocabulary.h"
 #include "gltf/gltf.h"
 #include "render/render.h"
@@ -32,6 +34,13 @@ void PrintVocabulary(std::ostream& out) {
   Table<Method>(out, "Methods",
                 "`\"method\"` of a scenario file and of a result file, `flexkin run --method` "
                 "(`Method`, flexkin/propagate.h).");
+  Table<ScenarioKind>(out, "Scenario kinds",
+                      "What `flexkin run`, `flexkin validate` and Python's `validate_scenario` "
+                      "tell apart by a file's keys (`ScenarioKind`, flexkin/scenario_kind.h).");
+  Table<StrandPrecision>(out, "Strand file precisions",
+                         "`\"record\"/\"precision\"` of a groom scenario, `flexkin run "
+                         "--precision`, `run_groom(precision=)` (`StrandPrecision`, "
+                         "flexkin/strand_file.h).");
   Table<ObjectiveTerm>(out, "Objective terms",
                        "The keys of `\"objective\"` in a scenario file (method `overall`) and of "
                        "`\"overall\"/\"objective\"` in a result file (`ObjectiveTerm`, "

@@ -517,7 +517,7 @@ const BadCase kBadCases[] = {
     {"record every zero", "{" GROOM "," MOTION R"(, "record": {"every": 0}})", "/record/every",
      "value 0 is not valid; expected an integer >= 1"},
     {"record precision", "{" GROOM "," MOTION R"(, "record": {"precision": "float16"}})",
-     "/record/precision", R"(expected one of "float32" or "float64")"},
+     "/record/precision", R"(unknown precision "float16"; expected "float32" or "float64")"},
     {"record key", "{" GROOM "," MOTION R"(, "record": {"evrey": 2}})", "/record/evrey",
      "(did you mean \"every\"?)"},
 };

@@ -15,6 +15,7 @@
 // Results do not depend on which threads run them, bit for bit (tests/thread_safety_test.cc runs
 // every example scenario in four threads at once, under ThreadSanitizer in make test).
 
+#include "flexkin/any_scenario.h"    // the front door: a scenario file of any kind, read once
 #include "flexkin/arm.h"             // fixed-base arms: models, forward kinematics, TrackPath
 #include "flexkin/chain.h"           // Chain, Points, MakeChain
 #include "flexkin/curves.h"          // generated initial curves: line, parabola, arc, helix
@@ -28,6 +29,7 @@
 #include "flexkin/robot_scenario.h"  // robot scenario files and trajectories
 #include "flexkin/run.h"             // Run: a chain through a list of targets, with metrics
 #include "flexkin/scenario.h"        // scenario files
+#include "flexkin/scenario_kind.h"   // the kinds of scenario file
 #include "flexkin/strand_file.h"     // strand files (.npz): every strand at every frame
 #include "flexkin/strands.h"         // many strands (hair, fur) stepped together
 #include "flexkin/vocabulary.h"      // the names of every enumerated choice

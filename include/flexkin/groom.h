@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -101,6 +102,22 @@ Problems ValidateGroomFile(const std::string& path);
 // scenario rather than a chain or robot one. Never throws.
 bool IsGroomText(const std::string& json_text);
 bool IsGroomFile(const std::string& path);
+// Values given to a front end (`flexkin run` options, Python's run_groom keywords) that replace
+// the scenario's; unset ones keep the file's.
+struct GroomOverrides {
+  std::optional<std::string> method;  // "tractrix" or "ftl": the strand engine's methods
+  std::optional<int> substeps, pinned, threads;
+  std::optional<int64_t> record_every;   // >= 1
+  std::optional<std::string> precision;  // "float32" or "float64"
+};
+
+// Applies `overrides` to `scenario`, each checked as the file's value is and with the same
+// messages (the valid names listed, a suggestion for a near miss). Throws InputError for the
+// first problem, named as the front end spells the option: "--record-every" (command_line) or
+// "record_every".
+void ApplyGroomOverrides(const GroomOverrides& overrides, bool command_line,
+                         GroomScenario* scenario);
+
 // One line: "3D, 10000 strands of 32 links (...), 90 frames at 30 fps, method tractrix, ...".
 std::string GroomSummary(const GroomScenario& scenario);
 

@@ -102,6 +102,10 @@ struct RunResult {
   Eigen::VectorXd lengths;  // the link lengths, fixed at the start
   int64_t num_steps = 0;    // leader steps
   std::vector<Frame> frames;
+  // Frames the run recorded (into RunResult::frames or a sink), and the link angles of the last
+  // one (empty without link angles): what the reports print, also when the frames were streamed.
+  int64_t recorded_frames = 0;
+  Eigen::VectorXd final_link_angles;
   Metrics metrics;
   AccuracyReport accuracy;
   OverallRunReport overall;  // method "overall" only

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "flexkin/strands.h"
+#include "flexkin/vocabulary.h"
 
 namespace flexkin {
 
@@ -30,6 +31,24 @@ struct ScalpShape {
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  // body coordinates
   Eigen::Vector3d radii = Eigen::Vector3d::Zero();   // semi-axes along body x, y, z
 };
+
+// The precision of a strand file's points ("record"/"precision" of a groom, --precision,
+// precision= in Python), named once.
+enum class StrandPrecision { kFloat32, kFloat64 };
+
+template <>
+struct Vocabulary<StrandPrecision> {
+  static constexpr const char* kKind = "precision";
+  static constexpr NamedValue<StrandPrecision> kEntries[] = {
+      {StrandPrecision::kFloat32, "float32", "4-byte points: half the file, ~1e-7 relative"},
+      {StrandPrecision::kFloat64, "float64", "8-byte points, as computed"},
+  };
+};
+
+// "float32" or "float64".
+inline const char* PrecisionName(bool float32) {
+  return NameOf(float32 ? StrandPrecision::kFloat32 : StrandPrecision::kFloat64);
+}
 
 // Everything of a strand file but its frames.
 struct StrandFileHeader {

@@ -41,6 +41,14 @@ struct StrandOptions {
   Problems Validate() const;
 };
 
+// The methods the strand engine runs, from the one table of link rules
+// (src/sequential/rule_table.h): "tractrix" and "ftl".
+bool IsStrandMethod(Method method);
+std::vector<std::string> StrandMethodNames();
+// The strand method named `name`; throws InputError naming `field`: for an unknown name (with a
+// suggestion for a near miss) or a method the strand engine does not run, listing those it does.
+Method ParseStrandMethod(std::string_view name, const std::string& field);
+
 // The pose of the body the strands grow from: x -> rotation x + translation. In 2D the top-left
 // 2x2 block of `rotation` and the first two components of `translation` are used. `rotation`
 // must be a rotation (orthonormal, determinant +1) to within 1e-9.

@@ -7,6 +7,7 @@
 #include <pybind11/stl.h>
 
 #include <functional>
+#include <limits>
 #include <string>
 #include <utility>
 
@@ -37,38 +38,44 @@ GroomScenario GroomArg(GroomSource scenario) {
   return OnFile(path, [&] { return LoadGroomFile(path); });
 }
 
+// An integer override of a groom's option (a Python int or another integer type, not a bool),
+// else InputError naming the keyword and the value; its range is StrandOptions::Validate's.
+int IntOverride(py::handle value, const char* name) {
+  if (!py::isinstance<py::bool_>(value) && PyIndex_Check(value.ptr())) {
+    const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+    if (!index) throw py::error_already_set();
+    int overflow = 0;
+    const long long v = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+    if (overflow == 0 && v >= std::numeric_limits<int>::min() &&
+        v <= std::numeric_limits<int>::max()) {
+      return static_cast<int>(v);
+    }
+    throw InputError(
+        Problem::Invalid(name, std::string(py::repr(value)), "an integer of magnitude below 2^31"));
+  }
+  throw InputError(Problem::Invalid(name, std::string(py::repr(value)), "an integer"));
+}
+
 StrandRunReport RunGroomTo(GroomSource source, PathLike output, OptionalStr method,
                            OptionalInt substeps, OptionalInt pinned, OptionalInt threads,
                            OptionalInt record_every, OptionalStr precision,
                            ProgressCallback progress) {
   GroomScenario s = GroomArg(source);
-  if (!method.is_none()) {
-    const std::string name = py::cast<std::string>(method);
-    const Method m = ParseName<Method>(name, "method");
-    if (m != Method::kTractrix && m != Method::kFollowTheLeader) {
-      ThrowInput("method", "\"" + name + "\" is not a method of the strand engine", name,
-                 "\"tractrix\" or \"ftl\"");
+  // Checked by the library as `flexkin run`'s options are (ApplyGroomOverrides, flexkin/groom.h).
+  GroomOverrides overrides;
+  const auto text = [](py::handle value, const char* name) {
+    if (!py::isinstance<py::str>(value)) {
+      throw InputError(Problem::Invalid(name, std::string(py::repr(value)), "a string"));
     }
-    s.options.method = m;
-  }
-  if (!substeps.is_none()) s.options.substeps = py::cast<int>(substeps);
-  if (!pinned.is_none()) s.options.pinned = py::cast<int>(pinned);
-  if (!threads.is_none()) s.options.threads = py::cast<int>(threads);
-  if (!record_every.is_none()) {
-    s.record_every = py::cast<int>(record_every);
-    if (s.record_every < 1) {
-      ThrowInput("record_every", "must be at least 1", std::to_string(s.record_every),
-                 "an integer >= 1");
-    }
-  }
-  if (!precision.is_none()) {
-    const std::string p = py::cast<std::string>(precision);
-    if (p != "float32" && p != "float64") {
-      ThrowInput("precision", "\"" + p + "\" is not a precision", p, "'float32' or 'float64'");
-    }
-    s.float32 = p == "float32";
-  }
-  ThrowIfAny(s.options.Validate());
+    return py::cast<std::string>(value);
+  };
+  if (!method.is_none()) overrides.method = text(method, "method");
+  if (!precision.is_none()) overrides.precision = text(precision, "precision");
+  if (!substeps.is_none()) overrides.substeps = IntOverride(substeps, "substeps");
+  if (!pinned.is_none()) overrides.pinned = IntOverride(pinned, "pinned");
+  if (!threads.is_none()) overrides.threads = IntOverride(threads, "threads");
+  if (!record_every.is_none()) overrides.record_every = IntOverride(record_every, "record_every");
+  ApplyGroomOverrides(overrides, /*command_line=*/false, &s);
   const std::string path = RequiredPath(output, "output", false);
   ProgressHook hook(progress);
   std::function<bool(int64_t, int64_t)> tick = [&hook](int64_t done, int64_t total) {

@@ -16,6 +16,7 @@
 
 #include "convert.h"
 #include "fields.h"
+#include "flexkin/any_scenario.h"
 #include "flexkin/groom.h"
 #include "flexkin/result_io.h"
 #include "flexkin/scenario.h"
@@ -171,7 +172,19 @@ Scenario ScenarioArg(ScenarioSource scenario) {
                "is a " + std::string(py::str(py::type::of(scenario).attr("__name__"))) +
                    "; expected a path to a scenario file, a dict of its JSON form or a Scenario");
   }
-  return OnFile(path, [&] { return LoadScenarioFile(path); });
+  const ScenarioReadOptions options{RobotReaderOptions(py::none())};
+  return OnFile(path, [&] {
+    // The front door (flexkin/any_scenario.h): one read, the kind told apart in the library.
+    AnyScenario any = ReadScenarioFile(path, options);
+    if (any.kind != ScenarioKind::kChain) {
+      const bool groom = any.kind == ScenarioKind::kGroom;
+      throw InputError(Problem("", std::string("is a ") + NameOf(any.kind) +
+                                       " scenario, not a chain one; run it with flexkin." +
+                                       (groom ? "run_groom" : "run_robot")));
+    }
+    any.ThrowIfInvalid();
+    return std::move(*any.chain);
+  });
 }
 
 std::string ResultRepr(const Result& r) {
@@ -184,15 +197,15 @@ std::string ResultRepr(const Result& r) {
          (r.scenario.empty() ? "" : ", scenario=" + Quoted(r.scenario)) + ")";
 }
 
-// The RunResult with placeholders for its frames, for the C++ full report (which counts them
-// and prints the last frame's link angles).
+// The C++ full report, with the frame count and final link angles of the arrays (a result read
+// from a file has no run to count them).
 std::string FullReport(const Result& r) {
   RunResult copy = r.run;
-  copy.frames.resize(static_cast<size_t>(r.steps.size()));
-  if (!r.link_angles.is_none() && !copy.frames.empty()) {
+  copy.recorded_frames = static_cast<int64_t>(r.steps.size());
+  if (!r.link_angles.is_none() && copy.recorded_frames > 0) {
     const auto angles = py::cast<py::array_t<double>>(r.link_angles);
     const int64_t n = angles.shape(1);
-    copy.frames.back().link_angles =
+    copy.final_link_angles =
         Eigen::Map<const Eigen::VectorXd>(angles.data() + (angles.shape(0) - 1) * n, n);
   }
   return copy.FullReport();
@@ -311,23 +324,17 @@ py::list ProblemList(const Problems& problems) {
 }
 
 py::list ValidateScenario(ScenarioFile scenario, OptionalPath directory) {
+  // Any kind, read once by the front door (flexkin/any_scenario.h).
+  ScenarioReadOptions options;
+  options.robot = RobotReaderOptions(directory);
   if (py::isinstance<py::dict>(scenario)) {
-    const std::string text = JsonOfDict(scenario, "scenario");
-    if (IsRobotScenarioText(text)) {
-      return ProblemList(ValidateRobotScenarioText(text, RobotReaderOptions(directory)));
-    }
-    if (IsGroomText(text)) return ProblemList(ValidateGroomText(text));
-    return ProblemList(ValidateScenarioText(text));
+    return ProblemList(ReadScenarioText(JsonOfDict(scenario, "scenario"), options).problems);
   }
   const std::string path = PathArg(scenario);
   if (path.empty()) {
     ThrowInput("scenario", "is not a path or a dict; expected a path to a scenario file or a dict");
   }
-  const RobotScenarioOptions options = RobotReaderOptions(directory);
-  return ProblemList(OnFile(path, [&] {
-    if (IsRobotScenarioFile(path)) return ValidateRobotScenarioFile(path, options);
-    return IsGroomFile(path) ? ValidateGroomFile(path) : ValidateScenarioFile(path);
-  }));
+  return ProblemList(OnFile(path, [&] { return ReadScenarioFile(path, options).problems; }));
 }
 
 py::dict EstimateOutput(int num_links, int dim, int64_t num_steps, int record_every,

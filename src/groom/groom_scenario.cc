@@ -15,10 +15,13 @@
 #include "flexkin/groom.h"
 #include "flexkin/propagate.h"
 #include "flexkin/result_io.h"
+#include "flexkin/scenario_kind.h"
 #include "flexkin/vocabulary.h"
+#include "groom/groom_reader.h"
 #include "groom/grow_internal.h"
 #include "io/json_file.h"
 #include "io/json_values.h"
+#include "io/scenario_kinds.h"
 
 namespace flexkin {
 namespace {
@@ -490,17 +493,10 @@ class GroomParser : public json_internal::JsonReader {
     const size_t before = problems.size();
     if (const json* v = Find(root, "method")) {
       if (const auto name = String(*v, "/method")) {
-        const std::vector<std::string> strand_methods = {"tractrix", "ftl"};
-        const NamedValue<Method>* entry = FindName<Method>(*name);
-        if (entry != nullptr &&
-            (entry->value == Method::kTractrix || entry->value == Method::kFollowTheLeader)) {
-          o.method = entry->value;
-        } else if (entry != nullptr) {
-          ValueProblem(*v, "/method",
-                       QuotedList(strand_methods) + " (the methods of the strand engine)");
-        } else {
-          problems.push_back(
-              UnknownName("/method", Vocabulary<Method>::kKind, *name, strand_methods));
+        try {
+          o.method = ParseStrandMethod(*name, "/method");
+        } catch (const InputError& e) {
+          problems.push_back(e.problem());
         }
       }
     }
@@ -516,8 +512,14 @@ class GroomParser : public json_internal::JsonReader {
         CheckKeys(*record, "/record", {"every", "precision"});
         Optional(*record, "/record", "every", integer(1, kMaxGroomFrames), &s->record_every);
         if (const json* p = Find(*record, "precision")) {
-          if (const auto name = Choice(*p, "/record/precision", {"float32", "float64"})) {
-            s->float32 = *name == "float32";
+          // As --precision and Python's precision= are read: ParseName, the same message.
+          if (const auto name = String(*p, "/record/precision")) {
+            try {
+              s->float32 = ParseName<StrandPrecision>(*name, "/record/precision") ==
+                           StrandPrecision::kFloat32;
+            } catch (const InputError& e) {
+              problems.push_back(e.problem());
+            }
           }
         }
       }
@@ -541,6 +543,15 @@ GroomScenario ParseGroomJson(const json& root) {
 
 }  // namespace
 
+namespace internal {
+GroomScenario ReadGroomScenario(const json& root, Problems* problems) {
+  GroomParser parser(/*grow=*/true);
+  GroomScenario scenario = parser.Parse(root);
+  for (Problem& p : parser.problems) problems->push_back(std::move(p));
+  return scenario;
+}
+}  // namespace internal
+
 GroomScenario ParseGroomText(const std::string& json_text) {
   return ParseGroomJson(ParseJsonText(json_text));
 }
@@ -563,13 +574,42 @@ Problems ValidateGroomFile(const std::string& path) {
   return ValidateGroomText(ReadTextFile(path));
 }
 
-bool IsGroomText(const std::string& json_text) {
-  try {
-    const json root = ParseJsonText(json_text);
-    return root.is_object() && (root.contains("groom") || root.contains("strands"));
-  } catch (const std::exception&) {
-    return false;
+void ApplyGroomOverrides(const GroomOverrides& overrides, bool command_line,
+                         GroomScenario* scenario) {
+  // "--record-every" on the command line, "record_every" in Python.
+  const auto name = [command_line](std::string field) {
+    if (!command_line) return field;
+    std::replace(field.begin(), field.end(), '_', '-');
+    return "--" + field;
+  };
+  StrandOptions& o = scenario->options;
+  if (overrides.method) o.method = ParseStrandMethod(*overrides.method, name("method"));
+  if (overrides.substeps) o.substeps = *overrides.substeps;
+  if (overrides.pinned) o.pinned = *overrides.pinned;
+  if (overrides.threads) o.threads = *overrides.threads;
+  if (overrides.record_every) {
+    const int64_t every = *overrides.record_every;
+    if (every < 1 || every > kMaxGroomFrames) {
+      throw InputError(Problem::Invalid(
+          name("record_every"), std::to_string(every),
+          every < 1 ? "an integer >= 1" : "at most " + std::to_string(kMaxGroomFrames)));
+    }
+    scenario->record_every = static_cast<int>(*overrides.record_every);
   }
+  if (overrides.precision) {
+    scenario->float32 = ParseName<StrandPrecision>(*overrides.precision, name("precision")) ==
+                        StrandPrecision::kFloat32;
+  }
+  const Problems problems = o.Validate();
+  if (!problems.empty()) {
+    Problem p = problems.front();
+    p.field = name(p.field);
+    throw InputError(p);
+  }
+}
+
+bool IsGroomText(const std::string& json_text) {
+  return ScenarioKindOfText(json_text) == ScenarioKind::kGroom;
 }
 
 bool IsGroomFile(const std::string& path) {

@@ -88,7 +88,7 @@ std::string GroomJson(const StrandFileHeader& h, const StrandRunReport& report) 
   j["num_strands"] = h.num_strands();
   j["num_points"] = h.num_points();
   j["num_frames"] = h.num_frames;
-  j["precision"] = h.float32 ? "float32" : "float64";
+  j["precision"] = PrecisionName(h.float32);
   j["fps"] = h.fps;
   j["method"] = h.method;
   j["substeps"] = h.substeps;
@@ -324,12 +324,8 @@ StrandFileReader::StrandFileReader(const std::string& path) : impl_(std::make_un
   h.dim = Get<int>(j, "dim");
   h.num_frames = Get<int64_t>(j, "num_frames");
   const std::string precision = Get<std::string>(j, "precision");
-  if (precision != "float32" && precision != "float64") {
-    throw InputError("groom.json/precision", "value \"" + precision +
-                                                 "\" is not valid; expected \"float32\" or "
-                                                 "\"float64\"");
-  }
-  h.float32 = precision == "float32";
+  h.float32 =
+      ParseName<StrandPrecision>(precision, "groom.json/precision") == StrandPrecision::kFloat32;
   h.fps = Get<double>(j, "fps");
   h.method = Get<std::string>(j, "method");
   h.substeps = Get<int>(j, "substeps");

@@ -29,9 +29,14 @@ class DomBuilder {
   bool string(json::string_t& value) { return Put(std::move(value)); }
   bool binary(json::binary_t& value) { return Put(json::binary(std::move(value))); }
   bool start_object(std::size_t) { return Open(json::object(), false); }
+  // A key seen twice in one object is refused: the later value would silently replace the
+  // earlier one ("links": 25, "links": 30 read as 30).
   bool key(json::string_t& key) {
-    stack_.back().key = key;
-    return true;
+    Frame& frame = stack_.back();
+    const bool repeated = frame.value->contains(key);
+    frame.key = key;
+    if (repeated) duplicate_pointer_ = Pointer();
+    return !repeated;
   }
   bool end_object() { return Close(); }
   bool start_array(std::size_t) { return Open(json::array(), true); }
@@ -108,6 +113,7 @@ class DomBuilder {
 
   json* root_;
   std::vector<Frame> stack_;
+  std::string duplicate_pointer_;  // the pointer of a repeated key, once one is read
   size_t error_position_ = 0;
   std::string error_token_, error_what_, error_pointer_;
   int error_id_ = 0;
@@ -127,6 +133,13 @@ std::string LineColumn(const std::string& text, size_t offset) {
 }
 
 void DomBuilder::Throw(const std::string& text) const {
+  if (!duplicate_pointer_.empty()) {
+    const std::string& key = stack_.back().key;
+    throw InputError(duplicate_pointer_, "key \"" + key +
+                                             "\" appears more than once in the same object; "
+                                             "give each key once (a later value would replace "
+                                             "the earlier one)");
+  }
   if (error_id_ == 406) {  // a number literal too large for a double
     const size_t start =
         error_position_ >= error_token_.size() ? error_position_ - error_token_.size() : 0;

@@ -16,9 +16,11 @@
 #include "flexkin/arm.h"
 #include "flexkin/error.h"
 #include "flexkin/leader.h"
+#include "flexkin/scenario_kind.h"
 #include "flexkin/vocabulary.h"
 #include "io/json_file.h"
 #include "io/json_values.h"
+#include "io/scenario_kinds.h"
 
 namespace flexkin {
 namespace {
@@ -492,6 +494,16 @@ std::string DirectoryOf(const std::string& path, const RobotScenarioOptions& opt
 
 }  // namespace
 
+namespace internal {
+RobotScenario ReadRobotScenario(const json& root, const RobotScenarioOptions& options,
+                                const std::string& directory, Problems* problems) {
+  RobotParser parser(options, directory);
+  RobotScenario scenario = parser.Parse(root);
+  for (Problem& p : parser.problems) problems->push_back(std::move(p));
+  return scenario;
+}
+}  // namespace internal
+
 RobotScenario ParseRobotScenarioText(const std::string& json_text,
                                      const RobotScenarioOptions& options) {
   return ParseRobotJson(ParseJsonText(json_text), options, options.directory);
@@ -511,18 +523,7 @@ Problems ValidateRobotScenarioFile(const std::string& path, const RobotScenarioO
 }
 
 bool IsRobotScenarioText(const std::string& json_text) {
-  json root;
-  try {
-    root = ParseJsonText(json_text);
-  } catch (const InputError&) {
-    return false;
-  }
-  if (!root.is_object()) return false;
-  if (const auto format = root.find("format"); format != root.end()) {
-    return *format == "flexkin-robot";
-  }
-  return (root.contains("arm") || root.contains("urdf")) && !root.contains("curve") &&
-         !root.contains("leader");
+  return ScenarioKindOfText(json_text) == ScenarioKind::kRobot;
 }
 
 bool IsRobotScenarioFile(const std::string& path) {

@@ -8,6 +8,7 @@
 #include "flexkin/error.h"
 #include "io/json_file.h"
 #include "io/scenario_json.h"
+#include "io/scenario_kinds.h"
 #include "io/scenario_parser.h"
 
 namespace flexkin {
@@ -92,6 +93,15 @@ Problem InScenarioFile(Problem problem) {
   }
   return problem;
 }
+
+namespace internal {
+Scenario ReadChainScenario(const nlohmann::json& root, Problems* problems) {
+  scenario_internal::Parser parser;
+  Scenario scenario = parser.Parse(root);
+  for (Problem& p : parser.problems) problems->push_back(std::move(p));
+  return scenario;
+}
+}  // namespace internal
 
 Scenario ParseScenario(const nlohmann::json& json) {
   Parser parser;

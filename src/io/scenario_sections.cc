@@ -199,7 +199,8 @@ void Parser::ParseOptions(const json& root, RunOptions* options) {
       if (const NamedValue<Method>* entry = FindName<Method>(*name)) {
         options->method = entry->value;
       } else {
-        problems.push_back(Problem::Invalid("/method", ShowJson(*m), QuotedNames<Method>()));
+        problems.push_back(
+            UnknownName("/method", Vocabulary<Method>::kKind, *name, NamesOf<Method>()));
       }
     }
   }

@@ -11,6 +11,7 @@
 #include "chain/substep.h"
 #include "flexkin/error.h"
 #include "overall/step.h"
+#include "sequential/rule_table.h"
 #include "sequential/sweep.h"
 
 namespace flexkin {
@@ -485,9 +486,8 @@ void StepDirection(const Points& start, const Points& leader_steps, int64_t s,
   *direction = fallback;
 }
 
-bool Pipelined(Method method) {
-  return method == Method::kTractrix || method == Method::kFollowTheLeader;
-}
+// Per-link rules go through the sweep pipeline (sweeps engine, wavefront).
+bool Pipelined(Method method) { return internal::RuleRunsOn(method, internal::kSweepsEngine); }
 
 }  // namespace
 
@@ -514,6 +514,8 @@ RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& 
   const auto add_frame = [&](int64_t step, const Points& points, const Eigen::VectorXd& direction) {
     if (options.link_angles) LinkAngles(points, direction, &angles, &across2);
     sink->Add(step, points, angles);
+    ++result.recorded_frames;
+    if (step == num_steps) result.final_link_angles = angles;
   };
   add_frame(0, chain.points, first_direction);
   const auto recorded = [&](int64_t done) {
@@ -604,7 +606,9 @@ std::string RunResult::BriefReport() const {
 std::string RunResult::FullReport() const {
   std::ostringstream out;
   out << BriefReport() << "\n";
-  out << "  recorded frames: " << frames.size() << "\n";
+  // Streamed runs keep no frames here; the run counted them.
+  const int64_t recorded = frames.empty() ? recorded_frames : static_cast<int64_t>(frames.size());
+  out << "  recorded frames: " << recorded << "\n";
   out << "  path length per point (leading end first):";
   const Eigen::Index n = metrics.path_length.size();
   // Long chains: print about 20 evenly spaced points so the profile fits on a screen.
@@ -616,8 +620,8 @@ std::string RunResult::FullReport() const {
   if ((n - 1) % stride != 0)
     out << " [" << n - 1 << "] " << Format("%.6g", metrics.path_length[n - 1]);
   out << "\n";
-  if (!frames.empty() && frames.back().link_angles.size() > 0) {
-    const Eigen::VectorXd& a = frames.back().link_angles;
+  const Eigen::VectorXd& a = frames.empty() ? final_link_angles : frames.back().link_angles;
+  if (a.size() > 0) {
     out << "  final link angles to the pull, degrees: first " << Format("%.4g", a[0] * 180 / M_PI)
         << ", largest " << Format("%.4g", a.maxCoeff() * 180 / M_PI) << ", last "
         << Format("%.4g", a[a.size() - 1] * 180 / M_PI) << "\n";

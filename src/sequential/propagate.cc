@@ -9,6 +9,7 @@
 #include "chain/substep.h"
 #include "flexkin/error.h"
 #include "sequential/link_rules.h"
+#include "sequential/rule_table.h"
 #include "sequential/sweep.h"
 
 namespace flexkin {
@@ -98,18 +99,13 @@ namespace internal {
 void TracedSweepsScalarFrom(Method method, int dim, const double* heads, int64_t first,
                             int64_t num_sweeps, const double* lengths, const double* inv_lengths,
                             int n, double* pts, SweepTrace* trace) {
-  const bool tractrix = method == Method::kTractrix;
-  if (dim == 2) {
-    tractrix ? TracedSweeps<TractrixRule<2>, 2>(heads, first, num_sweeps, lengths, inv_lengths, n,
-                                                pts, trace)
-             : TracedSweeps<FollowTheLeaderRule<2>, 2>(heads, first, num_sweeps, lengths,
-                                                       inv_lengths, n, pts, trace);
-  } else {
-    tractrix ? TracedSweeps<TractrixRule<3>, 3>(heads, first, num_sweeps, lengths, inv_lengths, n,
-                                                pts, trace)
-             : TracedSweeps<FollowTheLeaderRule<3>, 3>(heads, first, num_sweeps, lengths,
-                                                       inv_lengths, n, pts, trace);
-  }
+  DispatchRule<kSweepsEngine>(method, [&](auto rule) {
+    using Rule = decltype(rule);
+    dim == 2 ? TracedSweeps<typename Rule::template Step<2>, 2>(heads, first, num_sweeps, lengths,
+                                                                inv_lengths, n, pts, trace)
+             : TracedSweeps<typename Rule::template Step<3>, 3>(heads, first, num_sweeps, lengths,
+                                                                inv_lengths, n, pts, trace);
+  });
 }
 
 void TracedSweepsScalar(Method method, int dim, const double* heads, int64_t num_sweeps,
@@ -157,14 +153,13 @@ const WavefrontChoice& Wavefront() {
 
 void SweepsScalar(Method method, int dim, const double* heads, int64_t num_sweeps,
                   const double* lengths, const double* inv_lengths, int n, double* pts) {
-  const bool tractrix = method == Method::kTractrix;
-  if (dim == 2) {
-    tractrix ? Sweeps<TractrixRule<2>, 2>(heads, num_sweeps, lengths, inv_lengths, n, pts)
-             : Sweeps<FollowTheLeaderRule<2>, 2>(heads, num_sweeps, lengths, inv_lengths, n, pts);
-  } else {
-    tractrix ? Sweeps<TractrixRule<3>, 3>(heads, num_sweeps, lengths, inv_lengths, n, pts)
-             : Sweeps<FollowTheLeaderRule<3>, 3>(heads, num_sweeps, lengths, inv_lengths, n, pts);
-  }
+  DispatchRule<kSweepsEngine>(method, [&](auto rule) {
+    using Rule = decltype(rule);
+    dim == 2 ? Sweeps<typename Rule::template Step<2>, 2>(heads, num_sweeps, lengths, inv_lengths,
+                                                          n, pts)
+             : Sweeps<typename Rule::template Step<3>, 3>(heads, num_sweeps, lengths, inv_lengths,
+                                                          n, pts);
+  });
 }
 
 void SweepsWavefront(Method method, int dim, const double* heads, int64_t num_sweeps,
@@ -221,26 +216,15 @@ int WavefrontLanes() {
 
 }  // namespace internal
 
-int MethodOrder(Method method) {
-  switch (method) {
-    case Method::kTractrix:
-      return 2;
-    case Method::kFollowTheLeader:
-      return 1;
-    case Method::kMinRotation:
-    case Method::kMinJointAngle:
-    case Method::kOverall:
-      return 0;
-  }
-  return 0;
-}
+int MethodOrder(Method method) { return internal::RuleOrder(method); }
 
 Stepper MakeStepper(Method method, const Chain& chain) {
   ValidateChain(chain);
-  if (method == Method::kOverall) {
-    throw InputError("method",
-                     "\"overall\" is not a link rule; move the chain with Run or "
-                     "OverallStep (overall.h), or use \"tractrix\" or \"ftl\"");
+  if (!internal::RuleRunsOn(method, ~0u)) {
+    throw InputError("method", std::string("\"") + MethodName(method) +
+                                   "\" is not a link rule; move the chain with Run or "
+                                   "OverallStep (overall.h), or use " +
+                                   QuotedList(internal::RuleNamesOn(~0u)));
   }
   Stepper s;
   s.method = method;
@@ -286,18 +270,17 @@ void MoveLeader(const Stepper& stepper, const Eigen::Ref<const Eigen::VectorXd>&
     }
   }
   const int n = static_cast<int>(stepper.lengths.size());
+  if (internal::RuleRunsOn(stepper.method, internal::kWholeChainEngine)) {
+    internal::DispatchRule<internal::kWholeChainEngine>(stepper.method, [&](auto rule) {
+      decltype(rule)::WholeChainSweeps(dim, heads, substeps, stepper.lengths.data(),
+                                       stepper.inv_lengths.data(), n, points->data());
+    });
+    return;
+  }
   // The wavefront pays for a copy of the chain; it wins once several sweeps share it.
-  if (stepper.method == Method::kMinRotation) {
-    internal::SweepsMinRotation(dim, heads, substeps, n, points->data());
-    return;
-  }
-  if (stepper.method == Method::kMinJointAngle) {
-    internal::SweepsMinJointAngle(dim, heads, substeps, stepper.lengths.data(),
-                                  stepper.inv_lengths.data(), n, points->data());
-    return;
-  }
   const int lanes = internal::WavefrontLanes();
-  const bool wavefront = lanes > 1 && substeps >= 2 * lanes && n >= 8;
+  const bool wavefront = internal::RuleRunsOn(stepper.method, internal::kWavefrontEngine) &&
+                         lanes > 1 && substeps >= 2 * lanes && n >= 8;
   (wavefront ? internal::SweepsWavefront : internal::SweepsScalar)(
       stepper.method, dim, heads, substeps, stepper.lengths.data(), stepper.inv_lengths.data(), n,
       points->data());

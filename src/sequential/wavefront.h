@@ -12,6 +12,7 @@
 
 #include "flexkin/propagate.h"
 #include "sequential/link_rules.h"
+#include "sequential/rule_table.h"
 #include "sequential/sweep.h"
 
 namespace flexkin::internal {
@@ -285,25 +286,22 @@ int64_t WavefrontSweeps(const double* heads, int64_t num_sweeps, const double* l
                                                      n, points, trace);
 }
 
-// Entry point of one instruction set: picks the rule and the dimension; the sweeps left over
+// Entry point of one instruction set: takes the rule from the table (rule_table.h) and picks the
+// dimension; the sweeps left over
 // (fewer than the lanes) go through the one-pass loop.
 // Traced: `trace` observes every sweep, the engine's and the one-pass loop's.
 template <class Arch, bool Traced>
 void WavefrontDispatch(Method method, int dim, const double* heads, int64_t num_sweeps,
                        const double* lengths, const double* inv_lengths, int n, double* points,
                        SweepTrace* trace) {
-  const bool tractrix = method == Method::kTractrix;
-  auto run = [&](auto sweeps) {
-    return sweeps(heads, num_sweeps, lengths, inv_lengths, n, points, trace);
-  };
-  int64_t done;
-  if (dim == 2) {
-    done = tractrix ? run(WavefrontSweeps<Arch, TractrixRule<2, BatchExp>, 2, Traced>)
-                    : run(WavefrontSweeps<Arch, FollowTheLeaderRule<2>, 2, Traced>);
-  } else {
-    done = tractrix ? run(WavefrontSweeps<Arch, TractrixRule<3, BatchExp>, 3, Traced>)
-                    : run(WavefrontSweeps<Arch, FollowTheLeaderRule<3>, 3, Traced>);
-  }
+  int64_t done = 0;
+  DispatchRule<kWavefrontEngine>(method, [&](auto rule) {
+    using Rule = decltype(rule);
+    done = dim == 2 ? WavefrontSweeps<Arch, typename Rule::template Step<2, BatchExp>, 2, Traced>(
+                          heads, num_sweeps, lengths, inv_lengths, n, points, trace)
+                    : WavefrontSweeps<Arch, typename Rule::template Step<3, BatchExp>, 3, Traced>(
+                          heads, num_sweeps, lengths, inv_lengths, n, points, trace);
+  });
   if constexpr (Traced) {
     TracedSweepsScalarFrom(method, dim, heads, done, num_sweeps, lengths, inv_lengths, n, points,
                            trace);

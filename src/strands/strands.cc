@@ -17,6 +17,7 @@
 #include "chain/simd.h"
 #include "chain/substep.h"
 #include "sequential/link_rules.h"
+#include "sequential/rule_table.h"
 #include "strands/strand_engine.h"
 
 namespace flexkin {
@@ -277,29 +278,40 @@ void LaneSweeps(int lane, int n, int head, int num_sweeps, const double* heads,
 void StrandSweepsScalar(Method method, int dim, int n, int head, int num_sweeps,
                         const double* heads, const double* lengths, const double* inv_lengths,
                         double* points) {
-  const bool tractrix = method == Method::kTractrix;
-  for (int lane = 0; lane < L; ++lane) {
-    if (dim == 2) {
-      tractrix ? LaneSweeps<TractrixRule<2>, 2>(lane, n, head, num_sweeps, heads, lengths,
-                                                inv_lengths, points)
-               : LaneSweeps<FollowTheLeaderRule<2>, 2>(lane, n, head, num_sweeps, heads, lengths,
-                                                       inv_lengths, points);
-    } else {
-      tractrix ? LaneSweeps<TractrixRule<3>, 3>(lane, n, head, num_sweeps, heads, lengths,
-                                                inv_lengths, points)
-               : LaneSweeps<FollowTheLeaderRule<3>, 3>(lane, n, head, num_sweeps, heads, lengths,
-                                                       inv_lengths, points);
+  DispatchRule<kStrandEngine>(method, [&](auto rule) {
+    using Rule = decltype(rule);
+    for (int lane = 0; lane < L; ++lane) {
+      dim == 2 ? LaneSweeps<typename Rule::template Step<2>, 2>(lane, n, head, num_sweeps, heads,
+                                                                lengths, inv_lengths, points)
+               : LaneSweeps<typename Rule::template Step<3>, 3>(lane, n, head, num_sweeps, heads,
+                                                                lengths, inv_lengths, points);
     }
-  }
+  });
 }
 
 }  // namespace internal
 
+bool IsStrandMethod(Method method) { return internal::RuleRunsOn(method, internal::kStrandEngine); }
+
+std::vector<std::string> StrandMethodNames() {
+  return internal::RuleNamesOn(internal::kStrandEngine);
+}
+
+Method ParseStrandMethod(std::string_view name, const std::string& field) {
+  const NamedValue<Method>* entry = FindName<Method>(name);
+  if (entry == nullptr) {
+    throw InputError(UnknownName(field, Vocabulary<Method>::kKind, name, StrandMethodNames()));
+  }
+  if (!IsStrandMethod(entry->value)) {
+    throw InputError(internal::RuleRefused(field, entry->value, internal::kStrandEngine));
+  }
+  return entry->value;
+}
+
 Problems StrandOptions::Validate() const {
   Problems problems;
-  if (method != Method::kTractrix && method != Method::kFollowTheLeader) {
-    problems.push_back(Problem::Invalid("method", std::string("\"") + MethodName(method) + "\"",
-                                        "\"tractrix\" or \"ftl\""));
+  if (!internal::RuleRunsOn(method, internal::kStrandEngine)) {
+    problems.push_back(internal::RuleRefused("method", method, internal::kStrandEngine));
   }
   if (substeps < 1) {
     problems.push_back(Problem::Invalid("substeps", std::to_string(substeps), "an integer >= 1"));

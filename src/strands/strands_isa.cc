@@ -10,6 +10,7 @@
 #include <xsimd/xsimd.hpp>
 
 #include "sequential/link_rules.h"
+#include "sequential/rule_table.h"
 #include "sequential/wavefront.h"
 #include "strands/strand_engine.h"
 
@@ -90,18 +91,13 @@ void BlockSweeps(int n, int head, int num_sweeps, const double* heads, const dou
 void FLEXKIN_STRAND_ENTRY(Method method, int dim, int n, int head, int num_sweeps,
                           const double* heads, const double* lengths, const double* inv_lengths,
                           double* points) {
-  const bool tractrix = method == Method::kTractrix;
-  if (dim == 2) {
-    tractrix ? BlockSweeps<TractrixRule<2, BatchExp>, 2>(n, head, num_sweeps, heads, lengths,
-                                                         inv_lengths, points)
-             : BlockSweeps<FollowTheLeaderRule<2>, 2>(n, head, num_sweeps, heads, lengths,
-                                                      inv_lengths, points);
-  } else {
-    tractrix ? BlockSweeps<TractrixRule<3, BatchExp>, 3>(n, head, num_sweeps, heads, lengths,
-                                                         inv_lengths, points)
-             : BlockSweeps<FollowTheLeaderRule<3>, 3>(n, head, num_sweeps, heads, lengths,
-                                                      inv_lengths, points);
-  }
+  DispatchRule<kStrandEngine>(method, [&](auto rule) {
+    using Rule = decltype(rule);
+    dim == 2 ? BlockSweeps<typename Rule::template Step<2, BatchExp>, 2>(
+                   n, head, num_sweeps, heads, lengths, inv_lengths, points)
+             : BlockSweeps<typename Rule::template Step<3, BatchExp>, 3>(
+                   n, head, num_sweeps, heads, lengths, inv_lengths, points);
+  });
 }
 
 }  // namespace flexkin::internal

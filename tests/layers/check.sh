@@ -14,7 +14,8 @@ declare -A header_layer=(
   [overall]=overall
   [run]=run
   [arm]=arm [strands]=strands [groom]=groom [strand_file]=groom
-  [scenario]=io [result_io]=io [robot_scenario]=io [flexkin]=umbrella
+  [scenario]=io [result_io]=io [robot_scenario]=io [scenario_kind]=io [any_scenario]=scenario
+  [flexkin]=umbrella
   [render]=render [viewer]=viewer [gltf]=gltf [urdf]=urdf
 )
 # What each layer may include besides itself.
@@ -27,12 +28,13 @@ declare -A allowed=(
   [strands]="chain sequential"
   [io]="chain sequential overall run arm"
   [groom]="chain sequential overall run arm io strands"
-  [umbrella]="chain sequential overall run arm strands io groom"
+  [scenario]="chain sequential overall run arm io strands groom"
+  [umbrella]="chain sequential overall run arm strands io groom scenario"
   [render]="chain sequential overall run arm io strands groom"
   [viewer]="chain sequential overall run arm io strands groom"
   [gltf]="chain sequential overall run arm io render"
   [urdf]="chain sequential overall run arm io"
-  [apps]="chain sequential overall run arm io strands groom render viewer gltf urdf"
+  [apps]="chain sequential overall run arm io strands groom scenario render viewer gltf urdf"
 )
 
 layer_of_path() {  # a file of the tree -> its layer

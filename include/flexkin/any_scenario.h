@@ -1,0 +1,57 @@
+#pragma once
+// The one front door for scenario files: every kind (a chain, docs/scenario-format.md; a groom,
+// docs/groom-format.md; a robot, docs/robot-format.md) is read here, once, and told apart here.
+// The command line and the Python module call this and nothing else to read a scenario, so a kind
+// added to the library reaches both.
+//
+//   const AnyScenario s = ReadScenarioFile("tail.json", {UrdfRobotScenarioOptions()});
+//   if (!s.valid()) for (const Problem& p : s.problems) ...;  // every problem, by JSON pointer
+//   switch (s.kind) { case ScenarioKind::kChain: Run(s.chain->chain, ...); ... }
+
+#include <optional>
+#include <string>
+
+#include "flexkin/error.h"
+#include "flexkin/groom.h"
+#include "flexkin/robot_scenario.h"
+#include "flexkin/scenario.h"
+#include "flexkin/scenario_kind.h"
+
+namespace flexkin {
+
+struct ScenarioReadOptions {
+  // How a robot scenario's "urdf" is read and where a relative path is taken from
+  // (robot_scenario.h). The default refuses URDF robots; front ends pass
+  // UrdfRobotScenarioOptions() (flexkin/urdf.h). directory "": the file's directory for
+  // ReadScenarioFile, the working directory for ReadScenarioText.
+  RobotScenarioOptions robot;
+};
+
+// A scenario of any kind, read and checked.
+struct AnyScenario {
+  ScenarioKind kind = ScenarioKind::kChain;
+  // Every problem found, in the order checked, each named by its JSON pointer ("/leader/steps";
+  // "" for the document, e.g. text that is not JSON). Empty if and only if the scenario of `kind`
+  // below is set.
+  Problems problems;
+  std::optional<Scenario> chain;
+  std::optional<GroomScenario> groom;
+  std::optional<RobotScenario> robot;
+
+  bool valid() const { return problems.empty(); }
+  // One line, as `flexkin validate` prints it (ScenarioSummary, GroomSummary or
+  // RobotScenarioSummary); "" for an invalid scenario.
+  std::string Summary() const;
+  // Throws InputError for the first problem (its field the JSON pointer); does nothing if valid.
+  void ThrowIfInvalid() const;
+};
+
+// Parses the text once, tells its kind, checks everything and builds the scenario where there is
+// no problem. Problems of the text are listed, never thrown. Throws std::system_error for a URDF
+// file a robot scenario names that cannot be read.
+AnyScenario ReadScenarioText(const std::string& json_text, const ScenarioReadOptions& options = {});
+// The same for the file at `path` (read once); messages do not repeat the path, callers add it.
+// Throws std::system_error if the file cannot be read.
+AnyScenario ReadScenarioFile(const std::string& path, const ScenarioReadOptions& options = {});
+
+}  // namespace flexkin
