@@ -519,5 +519,31 @@ TEST(ArmRevolute, BadAxesAreRefusedWithTheField) {
   EXPECT_EQ(model.Validate().front().field, "joint_axes");
 }
 
+// Validate lists a problem of each independent part, not only the first (before: one).
+TEST(ArmModelValidate, ListsAProblemOfEachPart) {
+  ArmModel model = StraightArm(2, 3, 1.0);
+  model.base_direction = Eigen::Vector2d::Zero();
+  model.joint_min = Eigen::VectorXd::Constant(3, -1.0);
+  model.joint_max = Eigen::VectorXd::Constant(3, -2.0);  // min > max
+  model.joint_names = {"a", "b"};                        // 2 names for 3 joints
+  model.initial.angle[1] = 10.0;  // not checked against limits that are themselves invalid
+  const Problems problems = model.Validate();
+  ASSERT_EQ(problems.size(), 3u);
+  EXPECT_EQ(problems[0].field, "base_direction");
+  EXPECT_EQ(problems[1].field, "joint_min[0]");
+  EXPECT_EQ(problems[2].field, "joint_names");
+  ASSERT_TRUE(model.FirstProblem().has_value());
+  EXPECT_EQ(model.FirstProblem()->field, "base_direction");
+  // Valid limits: the initial angle is checked against them.
+  model.joint_max = Eigen::VectorXd::Constant(3, 1.0);
+  const Problems again = model.Validate();
+  ASSERT_EQ(again.size(), 3u);
+  EXPECT_EQ(again[2].field, "initial.angle[1]");
+  // Without links nothing else is checked.
+  model.link_lengths.resize(0);
+  ASSERT_EQ(model.Validate().size(), 1u);
+  EXPECT_EQ(model.Validate().front().field, "link_lengths");
+}
+
 }  // namespace
 }  // namespace flexkin

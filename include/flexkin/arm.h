@@ -123,8 +123,11 @@ struct ArmModel {
   int num_links() const { return static_cast<int>(link_lengths.size()); }
   bool has_limits() const { return joint_min.size() > 0 || max_bend.size() > 0; }
   double reach() const { return link_lengths.sum(); }
-  // The first problem that makes the model unusable (none if it is usable), its field the member
-  // as named above ("joint_min[2]", "initial.angle[0]").
+  // The problems that make the model unusable (none if it is usable), each field the member as
+  // named above ("joint_min[2]", "initial.angle[0]"): the first of each independent part (the
+  // base, the axes, the limits, the names and speeds, the initial angles, these checked against
+  // valid limits only); a model without a valid dimension or links has only that problem.
+  // FirstProblem is the first of them.
   Problems Validate() const;
   std::optional<Problem> FirstProblem() const;
 };

@@ -127,20 +127,22 @@ bool ClampDirection(int dim, const double* reference, double lo, double hi, doub
 
 }  // namespace arm_internal
 
-Problems ArmModel::Validate() const {
-  if (const std::optional<Problem> problem = FirstProblem(); problem) return {*problem};
-  return {};
-}
+// The checks of an arm model in independent sections, each giving its first problem: Validate lists
+// one problem per section, so a model with a bad base and bad limits hears of both. The dimension
+// and the links come first; nothing else can be checked without them.
+namespace {
 
-std::optional<Problem> ArmModel::FirstProblem() const {
+std::optional<Problem> ShapeProblem(const ArmModel& m) {
+  const int dim = m.dim;
+  const Eigen::VectorXd& link_lengths = m.link_lengths;
   if (dim != 2 && dim != 3) {
     return Problem("dim", "value " + std::to_string(dim) + " is not 2 or 3", std::to_string(dim),
                    "2 or 3");
   }
-  const int n = num_links();
+  const int n = m.num_links();
   if (n < 1) return Problem("link_lengths", "the arm has no links; expected at least 1");
   // With joint axes a link may have length 0 (joints at one point, a tip on its joint).
-  const bool zero_ok = has_axes();
+  const bool zero_ok = m.has_axes();
   for (int i = 0; i < n; ++i) {
     if (!(link_lengths[i] > 0.0 || (zero_ok && link_lengths[i] == 0.0)) ||
         !std::isfinite(link_lengths[i])) {
@@ -153,19 +155,37 @@ std::optional<Problem> ArmModel::FirstProblem() const {
   if (!(link_lengths.sum() > 0.0)) {
     return Problem("link_lengths", "every link has length 0; expected a positive total length");
   }
+  return std::nullopt;
+}
+
+std::optional<Problem> BaseProblem(const ArmModel& m) {
+  const int dim = m.dim;
+  const Eigen::VectorXd &base = m.base, &base_direction = m.base_direction;
   std::optional<Problem> why = CheckVector(base, "base", dim);
   if (!why) why = CheckVector(base_direction, "base_direction", dim);
   if (why) return why;
   if (!(base_direction.squaredNorm() > 0.0)) {
     return Problem("base_direction", "is zero; expected a non-zero vector");
   }
-  if (has_axes() || link_directions.size() != 0) {
-    if (!has_axes()) {
+  return std::nullopt;
+}
+
+std::optional<Problem> AxesProblem(const ArmModel& m) {
+  if (m.has_axes() || m.link_directions.size() != 0) {
+    if (!m.has_axes()) {
       return Problem("link_directions", "only arms with joint_axes have link directions");
     }
-    if ((why = arm_internal::ValidateAxes(*this))) return why;
+    return arm_internal::ValidateAxes(m);
   }
-  const bool revolute = joint() == ArmJoint::kRevolute;
+  return std::nullopt;
+}
+
+std::optional<Problem> LimitsProblem(const ArmModel& m) {
+  const int n = m.num_links();
+  const Eigen::VectorXd &joint_min = m.joint_min, &joint_max = m.joint_max, &max_bend = m.max_bend;
+  const auto has_axes = [&m] { return m.has_axes(); };
+  std::optional<Problem> why;
+  const bool revolute = m.joint() == ArmJoint::kRevolute;
   if (revolute) {
     if (max_bend.size() != 0) {
       return Problem("max_bend", "revolute joints have joint_min and joint_max instead");
@@ -215,6 +235,14 @@ std::optional<Problem> ArmModel::FirstProblem() const {
       }
     }
   }
+  return std::nullopt;
+}
+
+std::optional<Problem> NamesAndVelocityProblem(const ArmModel& m) {
+  const int n = m.num_links();
+  const bool revolute = m.joint() == ArmJoint::kRevolute;
+  const auto& joint_names = m.joint_names;
+  const Eigen::VectorXd& max_velocity = m.max_velocity;
   if (!joint_names.empty() && static_cast<int>(joint_names.size()) != n) {
     return Problem("joint_names", "has " + std::to_string(joint_names.size()) +
                                       " names; expected " + std::to_string(n) + " or none");
@@ -236,7 +264,17 @@ std::optional<Problem> ArmModel::FirstProblem() const {
       }
     }
   }
-  why = CheckVector(initial.angle, "initial.angle", n);
+  return std::nullopt;
+}
+
+// After LimitsProblem found nothing: the initial angles are checked against the limits.
+std::optional<Problem> InitialProblem(const ArmModel& m) {
+  const int n = m.num_links();
+  const bool revolute = m.joint() == ArmJoint::kRevolute;
+  const auto& initial = m.initial;
+  const Eigen::VectorXd &joint_min = m.joint_min, &joint_max = m.joint_max, &max_bend = m.max_bend;
+  const auto has_axes = [&m] { return m.has_axes(); };
+  std::optional<Problem> why = CheckVector(initial.angle, "initial.angle", n);
   if (!why && !revolute) why = CheckVector(initial.azimuth, "initial.azimuth", n);
   if (!why && revolute && initial.azimuth.size() != 0) {
     why = Problem("initial.azimuth", "revolute joints have no azimuths; expected none");
@@ -263,6 +301,30 @@ std::optional<Problem> ArmModel::FirstProblem() const {
     }
   }
   return std::nullopt;
+}
+
+}  // namespace
+
+Problems ArmModel::Validate() const {
+  if (std::optional<Problem> shape = ShapeProblem(*this)) return {*shape};
+  Problems problems;
+  const auto add = [&problems](std::optional<Problem> p) {
+    if (p) problems.push_back(std::move(*p));
+  };
+  add(BaseProblem(*this));
+  add(AxesProblem(*this));
+  std::optional<Problem> limits = LimitsProblem(*this);
+  const bool limits_ok = !limits;
+  add(std::move(limits));
+  add(NamesAndVelocityProblem(*this));
+  if (limits_ok) add(InitialProblem(*this));
+  return problems;
+}
+
+std::optional<Problem> ArmModel::FirstProblem() const {
+  const Problems problems = Validate();
+  if (problems.empty()) return std::nullopt;
+  return problems.front();
 }
 
 ArmModel StraightArm(int dim, int links, double link_length) {
