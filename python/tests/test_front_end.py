@@ -353,3 +353,21 @@ def test_groom_overrides_say_what_is_valid_as_the_file_does(tmp_path):
     assert not out.exists()
     report = flexkin.run_groom(GROOM, out, precision="float64", substeps=np.int64(2))
     assert report.max_length_error < 1e-12 and np.load(out)["points"].dtype == np.float64
+
+
+# The front door (flexkin/any_scenario.h): a change to a library reader reaches Python and the
+# command line with neither touched. A key given twice, refused by the JSON reader alone, is one
+# problem at the same pointer in both.
+def test_a_file_problem_reaches_python_and_the_command_line_alike(tmp_path, cli):
+    path = tmp_path / "twice.json"
+    path.write_text('{"curve": {"shape": "line", "links": 25, "links": 30, "link_length": 1},'
+                    ' "leader": {"pull": [1, 0]}}')
+    problems = flexkin.validate_scenario(str(path))
+    assert [p["field"] for p in problems] == ["/curve/links"]
+    assert '"links" appears more than once' in problems[0]["message"]
+    out = subprocess.run([cli, "validate", str(path)], capture_output=True, text=True)
+    assert out.returncode == 1
+    assert out.stdout == "%s: /curve/links: %s\n" % (path, problems[0]["message"])
+    # Every kind is told apart by the library: a groom file given to run_scenario is named.
+    with pytest.raises(flexkin.InputError, match="is a groom scenario, not a chain one"):
+        flexkin.run_scenario(str(EXAMPLES / "groom_grass_2d.json"))
