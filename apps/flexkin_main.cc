@@ -153,8 +153,8 @@ std::string MethodHelp() {
 class FanOutSink : public flexkin::FrameSink {
  public:
   explicit FanOutSink(std::vector<flexkin::FrameSink*> sinks) : sinks_(std::move(sinks)) {}
-  void Add(int64_t step, const flexkin::Points& points,
-           const Eigen::VectorXd& link_angles) override {
+  void Add(int64_t step, const flexkin::PointsRef& points,
+           const flexkin::VectorRef& link_angles) override {
     for (flexkin::FrameSink* sink : sinks_) sink->Add(step, points, link_angles);
   }
 

@@ -7,10 +7,10 @@
 //   chain10k    Run of a 10,000-link 3D chain, 200 leader steps, 4 sub-steps, every 10th frame
 //               recorded (flexkin.run); the chain and the steps are the formulas of
 //               python_benchmark.py's chain10k, evaluated with the same libm
-// The runs record their frames as the module does: into arrays allocated for each run (frames,
-// steps, link angles), filled by a FrameSink. fig12_recorder and chain10k_recorder are the same
-// runs through Run's plain form, whose frames are a std::vector<Frame> (one allocation per
-// frame's points and another for its angles).
+// The runs record their frames as the module does: through Run's plain form, into dense frames
+// (flexkin/frames.h) that the module's Result wraps without a copy. fig12_sink and chain10k_sink
+// are the same runs streamed to a FrameSink that copies each frame into arrays allocated for the
+// run (frames, steps, link angles): the module's way before the frames were dense.
 // Usage: python_baseline SCENARIO_DIR SAMPLES; prints one JSON object: case -> list of seconds per
 // call, one per sample (each sample repeats the call enough times to last about 0.2 s).
 
@@ -81,8 +81,8 @@ Points LongChainSteps() {
   return steps;
 }
 
-// The module's way of recording (python/src/run.cc ArraySink): every frame copied into the next
-// row of arrays allocated for the run, uninitialized as numpy.empty's are.
+// Every frame copied into the next row of arrays allocated for the run, uninitialized as
+// numpy.empty's are (the module's way of recording before the frames were dense).
 class ArraySink : public FrameSink {
  public:
   ArraySink(int64_t frames, int64_t links, int dim)
@@ -91,7 +91,7 @@ class ArraySink : public FrameSink {
         points_(new double[frames * frame_size_]),
         angles_(new double[frames * links]),
         steps_(new int64_t[frames]) {}
-  void Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) override {
+  void Add(int64_t step, const PointsRef& points, const VectorRef& link_angles) override {
     std::memcpy(points_.get() + count_ * frame_size_, points.data(), sizeof(double) * frame_size_);
     std::memcpy(angles_.get() + count_ * links_, link_angles.data(), sizeof(double) * links_);
     steps_[count_++] = step;
@@ -103,7 +103,7 @@ class ArraySink : public FrameSink {
   std::unique_ptr<int64_t[]> steps_;
 };
 
-// Run as flexkin.run does it: the frames counted, arrays allocated, the frames copied in.
+// The run streamed to arrays: the frames counted, arrays allocated, the frames copied in.
 RunResult RunToArrays(const Chain& chain, const Points& steps, const RunOptions& options) {
   ArraySink sink(CountRecordedFrames(steps.rows(), options.record_every), chain.num_links(),
                  chain.dim());
@@ -159,15 +159,15 @@ int Main(int argc, char** argv) {
   const auto fig12 = Time(
       [&] {
         const Scenario scenario = LoadScenarioFile(fig12_path);
-        RunResult result = RunToArrays(scenario.chain, scenario.leader_steps, scenario.options);
+        RunResult result = Run(scenario.chain, scenario.leader_steps, scenario.options);
         benchmark::DoNotOptimize(result.metrics.l2_total);
       },
       samples);
-  const auto fig12_recorder = Time(
+  const auto fig12_sink = Time(
       [&] {
         const Scenario scenario = LoadScenarioFile(fig12_path);
-        RunResult result = Run(scenario.chain, scenario.leader_steps, scenario.options);
-        benchmark::DoNotOptimize(result.frames.data());
+        RunResult result = RunToArrays(scenario.chain, scenario.leader_steps, scenario.options);
+        benchmark::DoNotOptimize(result.frames.points_data().data());
       },
       samples);
 
@@ -178,14 +178,14 @@ int Main(int argc, char** argv) {
   options.record_every = 10;
   const auto chain10k = Time(
       [&] {
-        RunResult result = RunToArrays(long_chain, long_steps, options);
+        RunResult result = Run(long_chain, long_steps, options);
         benchmark::DoNotOptimize(result.metrics.l2_total);
       },
       samples);
-  const auto chain10k_recorder = Time(
+  const auto chain10k_sink = Time(
       [&] {
-        RunResult result = Run(long_chain, long_steps, options);
-        benchmark::DoNotOptimize(result.frames.data());
+        RunResult result = RunToArrays(long_chain, long_steps, options);
+        benchmark::DoNotOptimize(result.frames.points_data().data());
       },
       samples);
 
@@ -194,8 +194,8 @@ int Main(int argc, char** argv) {
   Print("move10", move10, false);
   Print("fig12", fig12, false);
   Print("chain10k", chain10k, false);
-  Print("fig12_recorder", fig12_recorder, false);
-  Print("chain10k_recorder", chain10k_recorder, true);
+  Print("fig12_sink", fig12_sink, false);
+  Print("chain10k_sink", chain10k_sink, true);
   std::printf("}\n");
   return 0;
 }

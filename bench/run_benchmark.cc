@@ -87,7 +87,7 @@ void BM_Bare(benchmark::State& state, Bare kind) {
 // Copies each frame into one buffer: the least a caller that keeps or writes frames does.
 class CopySink : public FrameSink {
  public:
-  void Add(int64_t, const Points& points, const Eigen::VectorXd& angles) override {
+  void Add(int64_t, const PointsRef& points, const VectorRef& angles) override {
     last = points;
     last_angles = angles;
     ++frames;

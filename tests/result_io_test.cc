@@ -117,9 +117,11 @@ RunResult AwkwardResult(int dim, uint64_t seed) {
     } while (!std::isfinite(value));
     *x = value;
   };
-  for (Frame& f : r.frames) {
-    for (Eigen::Index i = 0; i < f.points.size(); ++i) awkward(f.points.data() + i);
-    for (Eigen::Index i = 0; i < f.link_angles.size(); ++i) awkward(f.link_angles.data() + i);
+  for (size_t i = 0; i < r.frames.points_data().size(); ++i) {
+    awkward(r.frames.mutable_points_data() + i);
+  }
+  for (size_t i = 0; i < r.frames.link_angles_data().size(); ++i) {
+    awkward(r.frames.mutable_link_angles_data() + i);
   }
   for (Eigen::Index i = 0; i < r.metrics.path_length.size(); ++i) {
     awkward(r.metrics.path_length.data() + i);
@@ -240,7 +242,7 @@ TEST(ResultAtomicWriteTest, NonFiniteValueWritesNothingAndKeepsTheOldFile) {
   const std::string path = dir / "result.json";
   WriteText(path, "old contents");
   RunResult r = AwkwardResult(2, 3);
-  r.frames[1].points(2, 1) = std::numeric_limits<double>::quiet_NaN();
+  r.frames.mutable_points(1)(2, 1) = std::numeric_limits<double>::quiet_NaN();
   try {
     WriteResultJson(r, path);
     FAIL() << "wrote a NaN";

@@ -141,9 +141,11 @@ RunResult AwkwardResult(int dim, uint64_t seed) {
       std::memcpy(x, &bits, sizeof *x);
     } while (!std::isfinite(*x));
   };
-  for (Frame& f : r.frames) {
-    for (Eigen::Index i = 0; i < f.points.size(); ++i) awkward(f.points.data() + i);
-    for (Eigen::Index i = 0; i < f.link_angles.size(); ++i) awkward(f.link_angles.data() + i);
+  for (size_t i = 0; i < r.frames.points_data().size(); ++i) {
+    awkward(r.frames.mutable_points_data() + i);
+  }
+  for (size_t i = 0; i < r.frames.link_angles_data().size(); ++i) {
+    awkward(r.frames.mutable_link_angles_data() + i);
   }
   for (Eigen::Index i = 0; i < r.metrics.path_length.size(); ++i) {
     awkward(r.metrics.path_length.data() + i);
@@ -166,7 +168,7 @@ TEST(ResultNpzTest, RoundTripIsBitExact) {
   ASSERT_EQ(r.method, Method::kOverall);
   WriteResultFile(r, dir / "overall.npz", ResultFileFormat::kNpz, s.name);
   ExpectSameResult(ReadResultFile(dir / "overall.npz"), r, 2, s.name);
-  for (Frame& f : r.frames) f.link_angles.resize(0);
+  r.frames.DropLinkAngles();
   WriteResultFile(r, dir / "no_angles.npz", ResultFileFormat::kNpz);
   ExpectSameResult(ReadResultFile(dir / "no_angles.npz"), r, 2, "");
   // ReadResultFile reads JSON too, as ReadResultJson does.
@@ -248,7 +250,7 @@ TEST(ResultStreamTest, NonFiniteFrameStopsTheRunAndWritesNothing) {
     // A run that throws (here: a sink after the writer that fails at frame 3) leaves nothing.
     struct Failing : FrameSink {
       ResultFileWriter* writer;
-      void Add(int64_t step, const Points& p, const Eigen::VectorXd& a) override {
+      void Add(int64_t step, const PointsRef& p, const VectorRef& a) override {
         writer->Add(step, p, a);
         if (step == 3) throw std::runtime_error("stop");
       }
@@ -316,7 +318,7 @@ TEST(ResultNpzTest, CorruptedFilesAreInputErrors) {
   TempDir dir(true);
   const Scenario s = Example("fig06_parabola_multi_step.json");
   RunResult r = flexkin::Run(s.chain, s.leader_steps, s.options);
-  r.frames.resize(3);
+  r.frames.Truncate(3);
   WriteResultFile(r, dir / "good.npz", ResultFileFormat::kNpz, s.name);
   const std::string good = ReadFile(dir / "good.npz");
   const std::string path = dir / "bad.npz";
@@ -329,7 +331,7 @@ TEST(ResultNpzTest, CorruptedFilesAreInputErrors) {
       RunResult expected;
       expected.frames = r.frames;
       if (!back.result.frames.empty() && back.result.frames[0].link_angles.size() == 0) {
-        for (Frame& f : expected.frames) f.link_angles.resize(0);  // its member's name was hit
+        expected.frames.DropLinkAngles();  // its member's name was hit
       }
       ExpectSameFrames(back.result, expected);
     } catch (const InputError& e) {

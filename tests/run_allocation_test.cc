@@ -29,7 +29,7 @@ namespace {
 // Counts the frames without keeping them.
 class CountingSink : public FrameSink {
  public:
-  void Add(int64_t, const Points&, const Eigen::VectorXd&) override { ++frames; }
+  void Add(int64_t, const PointsRef&, const VectorRef&) override { ++frames; }
   int frames = 0;
 };
 

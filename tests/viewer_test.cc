@@ -168,16 +168,15 @@ TEST_F(ViewerTest, BadResultIsRefusedAndExistingFileLeftUntouched) {
     EXPECT_FALSE(fs::exists(Path("new.html"))) << field;
     EXPECT_EQ(ReadFile(Path("existing.html")), "the old page") << field;
   };
-  expect([&](ResultFile& f) { f.result.frames[3].points(2, 1) = nan; }, "frames[3].points[2][1]");
-  expect([&](ResultFile& f) { f.result.frames[0].points(0, 0) = INFINITY; },
+  expect([&](ResultFile& f) { f.result.frames.mutable_points(3)(2, 1) = nan; },
+         "frames[3].points[2][1]");
+  expect([&](ResultFile& f) { f.result.frames.mutable_points(0)(0, 0) = INFINITY; },
          "frames[0].points[0][0]");
   expect([&](ResultFile& f) { f.result.metrics.l2_total = nan; }, "metrics.l2_total");
   expect([&](ResultFile& f) { f.result.metrics.path_length[6] = nan; }, "metrics.path_length[6]");
   expect([&](ResultFile& f) { f.result.lengths[0] = 0; }, "link_lengths[0]");
-  expect([&](ResultFile& f) { f.result.frames.clear(); }, "frames");
+  expect([&](ResultFile& f) { f.result.frames.Clear(); }, "frames");
   expect([&](ResultFile& f) { f.dim = 4; }, "dim");
-  expect([&](ResultFile& f) { f.result.frames[1].points.conservativeResize(6, 2); },
-         "frames[1].points");
   // Nothing else was left in the directory (no temporary files).
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
 }

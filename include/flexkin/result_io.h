@@ -68,7 +68,7 @@ class ResultFileWriter : public FrameSink {
   ResultFileWriter(const ResultFileWriter&) = delete;
   ResultFileWriter& operator=(const ResultFileWriter&) = delete;
 
-  void Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) override;
+  void Add(int64_t step, const PointsRef& points, const VectorRef& link_angles) override;
   // Writes the rest of the result (num_steps, metrics, accuracy, overall report, weights, seconds;
   // its frames, if any, are ignored: they came through Add), syncs the file and renames it over
   // the destination. Throws InputError (nothing written) if `result` does not match the header
@@ -95,7 +95,7 @@ class FramesCsvWriter : public FrameSink {
   ~FramesCsvWriter() override;
   FramesCsvWriter(const FramesCsvWriter&) = delete;
   FramesCsvWriter& operator=(const FramesCsvWriter&) = delete;
-  void Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) override;
+  void Add(int64_t step, const PointsRef& points, const VectorRef& link_angles) override;
   void Commit();
 
   class Impl;
@@ -167,9 +167,6 @@ struct ResultSizeEstimate {
   uint64_t bytes(ResultFileFormat format) const;
 };
 
-// Frames a run of `num_steps` leader steps records with `record_every`: 1 + ceil(num_steps /
-// record_every).
-int64_t CountRecordedFrames(int64_t num_steps, int record_every);
 ResultSizeEstimate EstimateResultSize(int num_links, int dim, int64_t num_steps,
                                       const RunOptions& options);
 uint64_t EstimateResultBytes(int num_links, int dim, int64_t num_steps, const RunOptions& options,

@@ -8,6 +8,7 @@
 
 #include "flexkin/chain.h"
 #include "flexkin/error.h"
+#include "flexkin/frames.h"
 #include "flexkin/overall.h"
 #include "flexkin/propagate.h"
 
@@ -44,17 +45,6 @@ struct RunOptions {
   // Every problem with the options (empty if valid), each naming its member ("substeps",
   // "overall.weights.l2").
   Problems Validate() const;
-};
-
-// One recorded configuration.
-struct Frame {
-  int64_t step = 0;  // leader steps done; 0 is the initial configuration
-  Points points;     // (n+1) by dim
-  // Angle in radians, in [0, pi], between each link (from its trailing to its leading end) and
-  // the leading end's current direction of motion (that of the last leader step that moved it;
-  // for frame 0, that of the first). 0 means aligned with the pull. Empty if the leader never
-  // moves.
-  Eigen::VectorXd link_angles;
 };
 
 // Metrics of a run (paper eq. 6 and Sec. 3.2).
@@ -101,7 +91,7 @@ struct RunResult {
   Method method = Method::kTractrix;
   Eigen::VectorXd lengths;  // the link lengths, fixed at the start
   int64_t num_steps = 0;    // leader steps
-  std::vector<Frame> frames;
+  Frames frames;            // dense: one (F, n+1, dim) array of points (frames.h)
   // Frames the run recorded (into RunResult::frames or a sink), and the link angles of the last
   // one (empty without link angles): what the reports print, also when the frames were streamed.
   int64_t recorded_frames = 0;
@@ -126,15 +116,19 @@ class FrameSink {
   virtual ~FrameSink() = default;
   // `points` is (n+1) by dim; `link_angles` as Frame::link_angles. Both are valid only during the
   // call. May throw: the run stops and the exception propagates.
-  virtual void Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) = 0;
+  virtual void Add(int64_t step, const PointsRef& points, const VectorRef& link_angles) = 0;
 };
 
 // The sink of Run's plain form: keeps every frame in memory, in `frames`.
 class FrameRecorder : public FrameSink {
  public:
-  void Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) override;
-  std::vector<Frame> frames;
+  void Add(int64_t step, const PointsRef& points, const VectorRef& link_angles) override;
+  Frames frames;
 };
+
+// Frames a run of `num_steps` leader steps records with `record_every`: 1 + ceil(num_steps /
+// record_every).
+int64_t CountRecordedFrames(int64_t num_steps, int record_every);
 
 // Runs `chain` with its leading end moved in straight lines through the rows of `leader_steps`
 // (m by dim, the successive targets, not including the start). The recorded frames go to `sink`

@@ -148,9 +148,9 @@ void ThrowIfAnyArmOptions(const ArmOptions& options);
 // The robot scenario readers' options: URDF arms read where the URDF component is built,
 // relative "urdf" files looked up in `directory` (None: the default).
 RobotScenarioOptions RobotReaderOptions(py::handle directory);
-// A flexkin.Result as the ResultFile the render, viewer and glTF writers take (run.cc); InputError
-// for another object.
-ResultFile ResultFileOfObject(py::handle object);
+// A flexkin.Result as the ResultFile the render, viewer and glTF writers take, no copy: it lives
+// as long as `object` (run.cc); InputError for another object.
+const ResultFile& ResultFileOfObject(py::handle object);
 // flexkin.render (render.cc; built where the render, viewer and glTF components are).
 void BindRender(py::module_& m);
 // flexkin.arm_from_urdf, urdf_from_arm (urdf.cc; built where the URDF component is).

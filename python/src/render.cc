@@ -210,15 +210,15 @@ std::vector<std::string> Render(Drawable result, PathLike out_dir, OptionalForma
   CheckOptions(job.figure.Validate());
   CheckOptions(job.plot.Validate());
   CheckOptions(job.animation.Validate());
-  ResultFile file;
+  const ResultFile* file = nullptr;
   if (!trajectory) {
-    file = ResultFileOfObject(result);
-    if (file.result.frames.empty()) ThrowInput("result.frames", "no frames; nothing to draw");
+    file = &ResultFileOfObject(result);
+    if (file->result.frames.empty()) ThrowInput("result.frames", "no frames; nothing to draw");
   }
   // The drawing's last point: n for a chain, the base (g - 1, point 0 the end effector) for a
   // trajectory.
   const Eigen::Index last =
-      trajectory ? trajectory->states.front().rows() - 1 : file.result.lengths.size();
+      trajectory ? trajectory->states.front().rows() - 1 : file->result.lengths.size();
   for (size_t i = 0; i < job.viewer.trail_points.size(); ++i) {
     if (job.viewer.trail_points[i] > last) {
       ThrowInput("viewer.trail_points[" + std::to_string(i) + "]",
@@ -226,7 +226,7 @@ std::vector<std::string> Render(Drawable result, PathLike out_dir, OptionalForma
                  std::to_string(job.viewer.trail_points[i]));
     }
   }
-  job.file = &file;
+  job.file = file;
   if (trajectory) job.trajectory = &*trajectory;
   job.base = dir + "/" + stem;
   {

@@ -1,8 +1,9 @@
 // Runs: flexkin.run (a chain and its leader steps), flexkin.load_scenario and run_scenario (the
-// `flexkin run` of a scenario file or dict), and their Result. The frames stream from the run
-// into preallocated numpy arrays through a FrameSink (flexkin/run.h), with the GIL released;
-// the progress callback takes it back, and Ctrl-C (or an exception in the callback) stops the
-// run.
+// `flexkin run` of a scenario file or dict), and their Result. The run records its frames densely
+// (flexkin/frames.h) with the GIL released; the progress callback takes it back, and Ctrl-C (or
+// an exception in the callback) stops the run. Result.frames, steps and link_angles are numpy
+// views of those dense arrays, as are those of a result file read back: nothing is copied or
+// converted on the way to Python or back to the writers and renderers.
 #include "flexkin/run.h"
 
 #include <pybind11/eigen.h>
@@ -25,90 +26,107 @@
 namespace flexkin::python {
 namespace {
 
-// A run's result with its frames as numpy arrays.
+// A run's result, or a result file read back: its frames dense in file.result.frames, which
+// the arrays of the Python object view.
 struct Result {
-  RunResult run;               // frames empty: they are in the arrays below
-  py::array_t<double> frames;  // (F, n+1, dim)
-  py::array_t<int64_t> steps;  // (F,)
-  py::object link_angles;      // (F, n) float64, or None
-  std::string scenario;        // the scenario's name, "" if none
-  int dim = 2;
+  ResultFile file;
 };
 
-// Copies each recorded frame into the next row of preallocated arrays: no Python object is
-// touched, so it runs with the GIL released.
-class ArraySink : public FrameSink {
- public:
-  ArraySink(double* frames, int64_t* steps, double* angles, int64_t capacity, int64_t frame_size,
-            int64_t links)
-      : frames_(frames),
-        steps_(steps),
-        angles_(angles),
-        capacity_(capacity),
-        frame_size_(frame_size),
-        links_(links) {}
-  void Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) override {
-    if (count_ >= capacity_ || points.size() != frame_size_) {
-      throw std::logic_error("flexkin: a run recorded more frames than it counted");
-    }
-    std::memcpy(frames_ + count_ * frame_size_, points.data(),
-                sizeof(double) * static_cast<size_t>(frame_size_));
-    steps_[count_] = step;
-    if (angles_ != nullptr) {
-      if (link_angles.size() == links_) {
-        std::memcpy(angles_ + count_ * links_, link_angles.data(),
-                    sizeof(double) * static_cast<size_t>(links_));
-      } else {
-        has_angles_ = false;  // the leader never moves: no angles (as in result files)
-      }
-    }
-    ++count_;
+// A numpy view of `count` values at `data` shaped `shape`, kept alive by the Python Result that
+// holds them (`r` is always one: these are its attributes' getters).
+template <typename T>
+py::array View(const Result& r, std::vector<py::ssize_t> shape, const T* data) {
+  const py::object owner = py::cast(&r, py::return_value_policy::reference);
+  return py::array_t<T>(std::move(shape), data, owner);
+}
+
+py::array FramesView(const Result& r) {
+  const Frames& f = r.file.result.frames;
+  return View(r, {static_cast<py::ssize_t>(f.size()), f.num_points(), f.dim()},
+              f.points_data().data());
+}
+
+py::array StepsView(const Result& r) {
+  const Frames& f = r.file.result.frames;
+  return View(r, {static_cast<py::ssize_t>(f.size())}, f.steps().data());
+}
+
+py::object LinkAnglesView(const Result& r) {
+  const Frames& f = r.file.result.frames;
+  if (!f.has_link_angles()) return py::none();
+  return View(r, {static_cast<py::ssize_t>(f.size()), f.num_points() - 1},
+              f.link_angles_data().data());
+}
+
+// The setters of unpickling: frames, then steps, then link angles, each checked against the
+// ones before.
+void SetFrames(Result& r, py::handle value) {
+  const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
+  if (!a || a.ndim() != 3 || (a.shape(2) != 2 && a.shape(2) != 3) || a.shape(1) < 2) {
+    PyErr_Clear();
+    ThrowInput("state", "the pickled Result's frames are not an (F, n+1, dim) array");
   }
-  int64_t count() const { return count_; }
-  bool has_angles() const { return angles_ != nullptr && has_angles_; }
+  Frames& f = r.file.result.frames;
+  f.Resize(a.shape(0), a.shape(1), static_cast<int>(a.shape(2)), false);
+  std::memcpy(f.mutable_points_data(), a.data(), sizeof(double) * static_cast<size_t>(a.size()));
+  r.file.dim = static_cast<int>(a.shape(2));
+}
 
- private:
-  double* frames_;
-  int64_t* steps_;
-  double* angles_;
-  int64_t capacity_, frame_size_, links_, count_ = 0;
-  bool has_angles_ = true;
-};
+void SetSteps(Result& r, py::handle value) {
+  const auto a = py::array_t<int64_t, py::array::c_style | py::array::forcecast>::ensure(value);
+  Frames& f = r.file.result.frames;
+  if (!a || a.ndim() != 1 || a.shape(0) != static_cast<py::ssize_t>(f.size())) {
+    PyErr_Clear();
+    ThrowInput("state", "the pickled Result's frames and steps disagree");
+  }
+  std::memcpy(f.mutable_steps(), a.data(), sizeof(int64_t) * f.size());
+}
+
+void SetLinkAngles(Result& r, py::handle value) {
+  Frames& f = r.file.result.frames;
+  if (value.is_none()) {
+    f.DropLinkAngles();
+    return;
+  }
+  const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
+  if (!a || a.ndim() != 2 || a.shape(0) != static_cast<py::ssize_t>(f.size()) ||
+      a.shape(1) != f.num_points() - 1) {
+    PyErr_Clear();
+    ThrowInput("state", "the pickled Result's link_angles and frames disagree");
+  }
+  Frames with;
+  with.Resize(static_cast<int64_t>(f.size()), f.num_points(), f.dim(), true);
+  std::memcpy(with.mutable_points_data(), f.points_data().data(),
+              sizeof(double) * f.points_data().size());
+  std::memcpy(with.mutable_steps(), f.steps().data(), sizeof(int64_t) * f.size());
+  std::memcpy(with.mutable_link_angles_data(), a.data(),
+              sizeof(double) * static_cast<size_t>(a.size()));
+  f = std::move(with);
+}
+
+// A member of the run (result.metrics, result.seconds) as a read-only attribute (a copy).
+template <typename M>
+auto RunGet(M RunResult::*member) {
+  return [member](const Result& r) -> M { return r.file.result.*member; };
+}
+template <typename M>
+auto RunSet(M RunResult::*member) {
+  return [member](Result& r, py::handle value) { r.file.result.*member = py::cast<M>(value); };
+}
 
 Result RunToArrays(const Chain& chain, const Points& leader_steps, RunOptions options,
                    py::object progress, std::string scenario) {
-  ThrowIfAny(options.Validate());
-  ValidateChain(chain, "points");
-  if (leader_steps.rows() < 1 || leader_steps.cols() != chain.dim()) {
-    ThrowInput("leader_steps", "has shape (" + std::to_string(leader_steps.rows()) + ", " +
-                                   std::to_string(leader_steps.cols()) + "); expected (m, " +
-                                   std::to_string(chain.dim()) +
-                                   ") with m >= 1, the chain's dimension");
-  }
-  const int64_t n = chain.num_links(), dim = chain.dim();
-  const int64_t count = CountRecordedFrames(leader_steps.rows(), options.record_every);
   Result result;
-  result.dim = static_cast<int>(dim);
-  result.scenario = std::move(scenario);
-  result.frames = py::array_t<double>({count, n + 1, dim});
-  result.steps = py::array_t<int64_t>(count);
-  py::array_t<double> angles;
-  if (options.link_angles) angles = py::array_t<double>({count, n});
-  ArraySink sink(result.frames.mutable_data(), result.steps.mutable_data(),
-                 options.link_angles ? angles.mutable_data() : nullptr, count, (n + 1) * dim, n);
+  result.file.dim = chain.dim();
+  result.file.scenario_name = std::move(scenario);
   ProgressHook hook(std::move(progress));
   hook.Install(&options.progress);
   try {
     py::gil_scoped_release release;
-    result.run = Run(chain, leader_steps, options, &sink);
+    result.file.result = Run(chain, leader_steps, options);  // checks the inputs (InputError)
   } catch (const StopRun&) {
     hook.Rethrow();
   }
-  if (sink.count() != count) {
-    throw std::logic_error("flexkin: a run recorded " + std::to_string(sink.count()) +
-                           " frames; it counted " + std::to_string(count));
-  }
-  result.link_angles = sink.has_angles() ? py::object(angles) : py::none();
   return result;
 }
 
@@ -188,27 +206,14 @@ Scenario ScenarioArg(ScenarioSource scenario) {
 }
 
 std::string ResultRepr(const Result& r) {
-  return "Result(method=" + Quoted(MethodName(r.run.method)) + ", " + std::to_string(r.dim) +
-         "D, " + std::to_string(r.run.lengths.size()) + " links, " +
-         std::to_string(r.run.num_steps) + " leader steps, " + std::to_string(r.steps.size()) +
-         " frames, substeps=" + std::to_string(r.run.accuracy.substeps) +
-         ", l2_total=" + Num(r.run.metrics.l2_total) +
-         ", max_relative_length_error=" + Num(r.run.metrics.max_relative_length_error) +
-         (r.scenario.empty() ? "" : ", scenario=" + Quoted(r.scenario)) + ")";
-}
-
-// The C++ full report, with the frame count and final link angles of the arrays (a result read
-// from a file has no run to count them).
-std::string FullReport(const Result& r) {
-  RunResult copy = r.run;
-  copy.recorded_frames = static_cast<int64_t>(r.steps.size());
-  if (!r.link_angles.is_none() && copy.recorded_frames > 0) {
-    const auto angles = py::cast<py::array_t<double>>(r.link_angles);
-    const int64_t n = angles.shape(1);
-    copy.final_link_angles =
-        Eigen::Map<const Eigen::VectorXd>(angles.data() + (angles.shape(0) - 1) * n, n);
-  }
-  return copy.FullReport();
+  const RunResult& run = r.file.result;
+  return "Result(method=" + Quoted(MethodName(run.method)) + ", " + std::to_string(r.file.dim) +
+         "D, " + std::to_string(run.lengths.size()) + " links, " + std::to_string(run.num_steps) +
+         " leader steps, " + std::to_string(run.frames.size()) +
+         " frames, substeps=" + std::to_string(run.accuracy.substeps) +
+         ", l2_total=" + Num(run.metrics.l2_total) +
+         ", max_relative_length_error=" + Num(run.metrics.max_relative_length_error) +
+         (r.file.scenario_name.empty() ? "" : ", scenario=" + Quoted(r.file.scenario_name)) + ")";
 }
 
 const char* kRunDoc = R"doc(
@@ -236,78 +241,20 @@ for invalid input, naming the argument ("leader_steps[2][0]", "substeps").
 
 }  // namespace
 
-// A result file read back, as the Result of a run.
-Result ResultOfFile(ResultFile&& file) {
-  Result r;
-  r.dim = file.dim;
-  r.scenario = std::move(file.scenario_name);
-  std::vector<Frame> frames = std::move(file.result.frames);
-  r.run = std::move(file.result);
-  r.run.frames.clear();
-  const int64_t count = static_cast<int64_t>(frames.size()), n = r.run.lengths.size();
-  const int64_t size = (n + 1) * r.dim;
-  r.frames = py::array_t<double>({count, n + 1, static_cast<int64_t>(r.dim)});
-  r.steps = py::array_t<int64_t>(count);
-  bool angles = count > 0;
-  for (const Frame& f : frames) angles = angles && f.link_angles.size() == n;
-  py::array_t<double> angle_array;
-  if (angles) angle_array = py::array_t<double>({count, n});
-  for (int64_t k = 0; k < count; ++k) {
-    const Frame& f = frames[static_cast<size_t>(k)];
-    if (f.points.size() != size) ThrowInput("frames", "a frame of another shape");
-    std::memcpy(r.frames.mutable_data() + k * size, f.points.data(),
-                sizeof(double) * static_cast<size_t>(size));
-    r.steps.mutable_data()[k] = f.step;
-    if (angles) {
-      std::memcpy(angle_array.mutable_data() + k * n, f.link_angles.data(),
-                  sizeof(double) * static_cast<size_t>(n));
-    }
-  }
-  r.link_angles = angles ? py::object(angle_array) : py::none();
-  return r;
-}
-
-// The RunResult of a Result, its frames copied back from the arrays.
-RunResult RunResultOf(const Result& r) {
-  RunResult run = r.run;
-  const int64_t count = r.frames.shape(0), n = run.lengths.size(), dim = r.dim;
-  const bool angles = !r.link_angles.is_none();
-  py::array_t<double, py::array::c_style | py::array::forcecast> angle_array;
-  if (angles) angle_array = py::cast<py::array_t<double, py::array::c_style>>(r.link_angles);
-  const auto frames = py::array_t<double, py::array::c_style | py::array::forcecast>(r.frames);
-  const auto steps = py::array_t<int64_t, py::array::c_style | py::array::forcecast>(r.steps);
-  run.frames.resize(static_cast<size_t>(count));
-  for (int64_t k = 0; k < count; ++k) {
-    Frame& f = run.frames[static_cast<size_t>(k)];
-    f.step = steps.data()[k];
-    f.points = Points(n + 1, dim);
-    std::memcpy(f.points.data(), frames.data() + k * (n + 1) * dim,
-                sizeof(double) * static_cast<size_t>((n + 1) * dim));
-    if (angles) {
-      f.link_angles.resize(n);
-      std::memcpy(f.link_angles.data(), angle_array.data() + k * n,
-                  sizeof(double) * static_cast<size_t>(n));
-    }
-  }
-  return run;
-}
-
 Result ReadResult(PathLike path_arg) {
   const std::string path = RequiredPath(path_arg, "path");
-  return ResultOfFile(OnFile(path, [&] { return ReadResultFile(path); }));
+  return Result{OnFile(path, [&] { return ReadResultFile(path); })};
 }
 
 void WriteResult(const Result& r, PathLike path_arg) {
   const std::string path = RequiredPath(path_arg, "path");
   const ResultFileFormat format = ResultFileFormatOfPath(path);
-  const RunResult run = RunResultOf(r);
-  OnFile(path, [&] { WriteResultFile(run, path, format, r.scenario); });
+  OnFile(path, [&] { WriteResultFile(r.file.result, path, format, r.file.scenario_name); });
 }
 
 void WriteCsv(const Result& r, PathLike path_arg) {
   const std::string path = RequiredPath(path_arg, "path");
-  const RunResult run = RunResultOf(r);
-  OnFile(path, [&] { WriteFramesCsv(run, path); });
+  OnFile(path, [&] { WriteFramesCsv(r.file.result, path); });
 }
 
 py::list ProblemList(const Problems& problems) {
@@ -357,18 +304,13 @@ py::dict EstimateOutput(int num_links, int dim, int64_t num_steps, int record_ev
   return d;
 }
 
-ResultFile ResultFileOfObject(py::handle object) {
+const ResultFile& ResultFileOfObject(py::handle object) {
   if (!py::isinstance<Result>(object)) {
     ThrowInput("result",
                "is a " + std::string(py::str(py::type::of(object).attr("__name__"))) +
                    "; expected a flexkin.Result (flexkin.run, run_scenario, read_result)");
   }
-  const Result& r = py::cast<const Result&>(object);
-  ResultFile file;
-  file.result = RunResultOf(r);
-  file.dim = r.dim;
-  file.scenario_name = r.scenario;
-  return file;
+  return py::cast<const Result&>(object).file;
 }
 
 void BindRun(py::module_& m) {
@@ -383,62 +325,64 @@ The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
 )doc");
   Fields<Result>(result, "Result")
       .Property(
-          "method", [](const Result& r) { return std::string(MethodName(r.run.method)); },
-          [](Result& r, py::handle name) { r.run.method = MethodArg(py::cast<std::string>(name)); },
+          "method", [](const Result& r) { return std::string(MethodName(r.file.result.method)); },
+          [](Result& r, py::handle name) {
+            r.file.result.method = MethodArg(py::cast<std::string>(name));
+          },
           "The method of the run: 'tractrix', 'ftl', 'min_rotation', 'min_joint_angle' or "
           "'overall'.")
-      .Nested("lengths", &Result::run, &RunResult::lengths,
-              "(n,) float64, a copy: the link lengths, fixed at the start (length unit).")
-      .Nested("num_steps", &Result::run, &RunResult::num_steps, "Leader steps of the run.")
-      .Member("frames", &Result::frames,
-              "(F, n+1, dim) float64: the recorded configurations, row 0 the leading end: frame "
-              "0, every record_every-th leader step and the last (length unit).")
-      .Member("steps", &Result::steps,
-              "(F,) int64: the leader steps done at each frame (0: the initial configuration).")
-      .Member("link_angles", &Result::link_angles,
-              "(F, n) float64: each link's angle to the pull (radians, [0, pi]); None if the run "
-              "computed none (link_angles=False).")
-      .Nested("metrics", &Result::run, &RunResult::metrics,
-              "Metrics: L2 per step and total, length error, path length of each point.")
-      .Nested("accuracy", &Result::run, &RunResult::accuracy,
-              "AccuracyReport: what the accuracy control did (RunOptions.tolerance).")
-      .Nested("overall", &Result::run, &RunResult::overall,
-              "OverallRunReport: what the overall solver did (method 'overall'; zeros otherwise).")
-      .Nested("weights", &Result::run, &RunResult::weights,
-              "ObjectiveWeights: the overall method's metric (method 'overall').")
-      .Nested("seconds", &Result::run, &RunResult::seconds,
-              "Wall time of the computation (seconds).")
-      .Member("scenario", &Result::scenario, "The scenario's name; '' if none.")
+      .Property("lengths", RunGet(&RunResult::lengths), RunSet(&RunResult::lengths),
+                "(n,) float64, a copy: the link lengths, fixed at the start (length unit).")
+      .Property("num_steps", RunGet(&RunResult::num_steps), RunSet(&RunResult::num_steps),
+                "Leader steps of the run.")
+      .Property("frames", &FramesView, &SetFrames,
+                "(F, n+1, dim) float64, a view (no copy) of the result's frames: the recorded "
+                "configurations, row 0 the leading end: frame 0, every record_every-th leader "
+                "step and the last (length unit). Changing its values changes what write, "
+                "write_csv and render see.")
+      .Property("steps", &StepsView, &SetSteps,
+                "(F,) int64, a view: the leader steps done at each frame (0: the initial "
+                "configuration).")
+      .Property("link_angles", &LinkAnglesView, &SetLinkAngles,
+                "(F, n) float64, a view: each link's angle to the pull (radians, [0, pi]); None "
+                "if the run computed none (link_angles=False).")
+      .Property("metrics", RunGet(&RunResult::metrics), RunSet(&RunResult::metrics),
+                "Metrics: L2 per step and total, length error, path length of each point.")
+      .Property("accuracy", RunGet(&RunResult::accuracy), RunSet(&RunResult::accuracy),
+                "AccuracyReport: what the accuracy control did (RunOptions.tolerance).")
+      .Property(
+          "overall", RunGet(&RunResult::overall), RunSet(&RunResult::overall),
+          "OverallRunReport: what the overall solver did (method 'overall'; zeros otherwise).")
+      .Property("weights", RunGet(&RunResult::weights), RunSet(&RunResult::weights),
+                "ObjectiveWeights: the overall method's metric (method 'overall').")
+      .Property("seconds", RunGet(&RunResult::seconds), RunSet(&RunResult::seconds),
+                "Wall time of the computation (seconds).")
+      .Property(
+          "scenario", [](const Result& r) { return r.file.scenario_name; },
+          [](Result& r, py::handle name) { r.file.scenario_name = py::cast<std::string>(name); },
+          "The scenario's name; '' if none.")
       .Finish(false, [](Result& r) {
-        if (r.frames.ndim() != 3 || r.steps.ndim() != 1 || r.frames.shape(0) != r.steps.shape(0) ||
-            r.frames.shape(1) != r.run.lengths.size() + 1 ||
-            (r.frames.shape(2) != 2 && r.frames.shape(2) != 3)) {
+        // The setters checked frames, steps and link angles against each other.
+        if (r.file.result.frames.num_points() != r.file.result.lengths.size() + 1) {
           ThrowInput("state", "the pickled Result's frames, steps and lengths disagree");
         }
-        if (!r.link_angles.is_none()) {
-          const auto angles =
-              py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(r.link_angles);
-          if (!angles || angles.ndim() != 2 || angles.shape(0) != r.frames.shape(0) ||
-              angles.shape(1) != r.run.lengths.size()) {
-            PyErr_Clear();
-            ThrowInput("state", "the pickled Result's link_angles and frames disagree");
-          }
-          r.link_angles = angles;
-        }
-        r.dim = static_cast<int>(r.frames.shape(2));
       });
   result
       .def_property_readonly(
-          "substeps", [](const Result& r) { return r.run.accuracy.substeps; },
+          "substeps", [](const Result& r) { return r.file.result.accuracy.substeps; },
           "Sub-steps per leader step used (accuracy.substeps).")
-      .def_readonly("dim", &Result::dim, "2 or 3.")
       .def_property_readonly(
-          "num_links", [](const Result& r) { return static_cast<int>(r.run.lengths.size()); },
+          "dim", [](const Result& r) { return r.file.dim; }, "2 or 3.")
+      .def_property_readonly(
+          "num_links",
+          [](const Result& r) { return static_cast<int>(r.file.result.lengths.size()); },
           "n, the number of links.")
       .def(
-          "brief_report", [](const Result& r) { return r.run.BriefReport(); },
+          "brief_report", [](const Result& r) { return r.file.result.BriefReport(); },
           "One line: method, steps, length error, L2 total, accuracy, time.")
-      .def("full_report", &FullReport, "Several lines, with the path-length profile.")
+      .def(
+          "full_report", [](const Result& r) { return r.file.result.FullReport(); },
+          "Several lines, with the path-length profile.")
       .def("__repr__", &ResultRepr, "A summary: method, size, frames, L2 total, length error.")
       .def("write", &WriteResult, py::arg("path"),
            "Writes the result file `path`: JSON (.json) or NumPy .npz (.npz) by its extension, "

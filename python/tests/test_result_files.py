@@ -94,8 +94,8 @@ def test_write_is_all_or_nothing(tmp_path):
     res = flexkin.run(flexkin.parabola(links=4), [[0.1, 0.0]])
     target = tmp_path / "keep.json"
     target.write_text("old")
-    res.frames.setflags(write=True)
-    frames = res.frames
+    frames = res.frames  # a writable view of the result's own frames
+    assert frames.flags.writeable
     frames[0, 0, 0] = np.nan
     with pytest.raises(flexkin.InputError, match="frames"):
         res.write(target)
@@ -127,3 +127,30 @@ def test_estimate_output():
     assert flexkin.estimate_output(10, 2, 100, link_angles=False)["frames"] == 101
     with pytest.raises(flexkin.InputError):
         flexkin.estimate_output(10, 4, 100)
+
+
+def test_result_arrays_are_views_of_the_dense_frames(tmp_path):
+    # A run's frames, steps and link angles reach Python without a copy: every access is a view
+    # of the same memory, owned by the Result; an edit through it is what write() writes.
+    res = flexkin.run(flexkin.parabola(links=6), [[0.1, 0.0], [0.2, 0.05]])
+    assert res.frames.base is res and res.steps.base is res and res.link_angles.base is res
+    assert np.shares_memory(res.frames, res.frames)
+    assert res.frames.__array_interface__["data"][0] == res.frames.__array_interface__["data"][0]
+    res.frames[1, 2, 0] += 0.5
+    res.write(tmp_path / "r.npz")
+    back = flexkin.read_result(tmp_path / "r.npz")
+    assert back.frames[1, 2, 0] == res.frames[1, 2, 0]
+    # A result file read back is the same form: views of its dense arrays.
+    assert back.frames.base is back and back.frames.flags.c_contiguous
+    assert back.frames.shape == (3, 7, 2) and back.link_angles.shape == (3, 6)
+    # The view keeps its Result alive.
+    frames = flexkin.read_result(tmp_path / "r.npz").frames
+    import gc
+    gc.collect()
+    assert np.array_equal(frames, back.frames)
+    # Pickling copies the arrays out and back into a new Result's dense frames.
+    import pickle
+    again = pickle.loads(pickle.dumps(back))
+    assert np.array_equal(again.frames, back.frames) and again.frames.base is again
+    assert np.array_equal(again.link_angles, back.link_angles)
+    assert again == back

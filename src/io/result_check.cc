@@ -40,8 +40,8 @@ std::optional<Problem> ResultHeaderProblem(const Eigen::VectorXd& lengths, int d
   return std::nullopt;
 }
 
-std::optional<Problem> ResultFrameProblem(size_t f, int64_t step, const Points& p,
-                                          const Eigen::VectorXd& link_angles, int64_t previous_step,
+std::optional<Problem> ResultFrameProblem(size_t f, int64_t step, const PointsRef& p,
+                                          const VectorRef& link_angles, int64_t previous_step,
                                           Eigen::Index n, int dim) {
   const std::string field = Index("frames", static_cast<Eigen::Index>(f));
   if (p.rows() != n + 1 || p.cols() != dim) {

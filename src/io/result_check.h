@@ -16,8 +16,8 @@ namespace flexkin {
 std::optional<Problem> ResultHeaderProblem(const Eigen::VectorXd& lengths, int dim);
 // Frame `f` (named "frames[f]..."): (n+1) by dim points, link angles one per link or none, every
 // number finite, step >= 0 and above `previous_step` (-1 for the first frame).
-std::optional<Problem> ResultFrameProblem(size_t f, int64_t step, const Points& points,
-                                          const Eigen::VectorXd& link_angles, int64_t previous_step,
+std::optional<Problem> ResultFrameProblem(size_t f, int64_t step, const PointsRef& points,
+                                          const VectorRef& link_angles, int64_t previous_step,
                                           Eigen::Index n, int dim);
 // The rest: every number of the metrics, the accuracy report, the overall report and the
 // seconds finite.

@@ -26,12 +26,6 @@ double Digits(double x) { return x < 10 ? 1 : std::floor(std::log10(x)) + 1; }
 
 }  // namespace
 
-int64_t CountRecordedFrames(int64_t num_steps, int record_every) {
-  if (num_steps <= 0) return 1;
-  const int64_t every = std::max(record_every, 1);
-  return 1 + num_steps / every + (num_steps % every != 0 ? 1 : 0);
-}
-
 uint64_t ResultSizeEstimate::bytes(ResultFileFormat format) const {
   return format == ResultFileFormat::kNpz ? npz_bytes : json_bytes;
 }

@@ -41,7 +41,7 @@ class NpzResultWriter : public ResultFileWriter::Impl {
     zip_.BeginMember("frames.npy", FramesHeader(0));
   }
 
-  void Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) override {
+  void Add(int64_t step, const PointsRef& points, const VectorRef& link_angles) override {
     const bool angles = link_angles.size() > 0;
     if (steps_.empty()) {
       have_angles_ = angles;
@@ -191,16 +191,12 @@ ResultFile ReadNpzResult(const std::string& path) {
     ExpectShape(ReadNpyHeader(angles.get(), "link_angles.npy", "<f8"), "link_angles.npy",
                 {count, n});
   }
-  r.frames.resize(count);
-  for (Frame& frame : r.frames) {
-    frame.points.resize(static_cast<Eigen::Index>(n + 1), static_cast<Eigen::Index>(dim));
-    frames.Read(frame.points.data(), sizeof(double) * (n + 1) * dim);
-    steps.Read(&frame.step, sizeof frame.step);
-    if (angles) {
-      frame.link_angles.resize(static_cast<Eigen::Index>(n));
-      angles->Read(frame.link_angles.data(), sizeof(double) * n);
-    }
-  }
+  // Each member straight into the dense arrays of the result, in one read.
+  r.frames.Resize(static_cast<int64_t>(count), static_cast<int64_t>(n + 1), file.dim,
+                  angles != nullptr);
+  frames.Read(r.frames.mutable_points_data(), sizeof(double) * count * (n + 1) * dim);
+  steps.Read(r.frames.mutable_steps(), sizeof(int64_t) * count);
+  if (angles) angles->Read(r.frames.mutable_link_angles_data(), sizeof(double) * count * n);
   frames.Finish();
   steps.Finish();
   if (angles) angles->Finish();

@@ -150,15 +150,23 @@ ResultFile ResultFromJson(const json& j) {
   if (!frames.is_array() || frames.empty()) {
     throw InputError("/frames", "is not valid; expected an array of at least one frame");
   }
-  r.frames.reserve(frames.size());
+  // Every frame has link angles or none has (the first frame says which).
+  const bool with_angles = !Member(frames[0], "/frames/0", "link_angles").empty();
+  r.frames.Reserve(static_cast<int64_t>(frames.size()), n + 1, file.dim, with_angles);
   for (size_t f = 0; f < frames.size(); ++f) {
     const std::string ptr = "/frames/" + std::to_string(f);
-    Frame frame;
-    frame.step = ReadInteger(Member(frames[f], ptr, "step"), ptr + "/step", 0);
-    frame.points = ReadPoints(Member(frames[f], ptr, "points"), ptr + "/points", n + 1, file.dim);
+    const int64_t step = ReadInteger(Member(frames[f], ptr, "step"), ptr + "/step", 0);
+    const Points points =
+        ReadPoints(Member(frames[f], ptr, "points"), ptr + "/points", n + 1, file.dim);
     const json& angles = Member(frames[f], ptr, "link_angles");
-    frame.link_angles = ReadVector(angles, ptr + "/link_angles", angles.empty() ? 0 : n);
-    r.frames.push_back(std::move(frame));
+    if (angles.empty() == with_angles) {
+      throw InputError(ptr + "/link_angles",
+                       with_angles ? "is empty while frame 0 has link angles; expected " +
+                                         std::to_string(n) + " values, as in every frame"
+                                   : "has values while frame 0 has none; expected [] in every "
+                                     "frame or link angles in every frame");
+    }
+    r.frames.Add(step, points, ReadVector(angles, ptr + "/link_angles", with_angles ? n : 0));
   }
   // What the shapes read above do not say (positive lengths, increasing steps, ...): the one check
   // of results, its member path made the file's JSON pointer.

@@ -91,7 +91,7 @@ class JsonResultStream {
     AppendResultHeaderJson(header, true, &t);
     t += "\"frames\": [\n";
   }
-  void Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) {
+  void Add(int64_t step, const PointsRef& points, const VectorRef& link_angles) {
     std::string& t = writer_.text();
     t += first_ ? "{\"step\": " : ",\n{\"step\": ";
     first_ = false;
@@ -149,7 +149,7 @@ class JsonResultWriter : public ResultFileWriter::Impl {
  public:
   JsonResultWriter(const std::string& path, const ResultHeader& header)
       : file_(path), stream_(file_.stream(), header) {}
-  void Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) override {
+  void Add(int64_t step, const PointsRef& points, const VectorRef& link_angles) override {
     try {
       stream_.Add(step, points, link_angles);
     } catch (const std::system_error&) {
@@ -304,7 +304,7 @@ ResultFileWriter::~ResultFileWriter() = default;
 
 int64_t ResultFileWriter::frames() const { return frames_; }
 
-void ResultFileWriter::Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) {
+void ResultFileWriter::Add(int64_t step, const PointsRef& points, const VectorRef& link_angles) {
   if (impl_ == nullptr) {
     throw std::logic_error("ResultFileWriter::Add after Commit or after a failure");
   }
@@ -385,7 +385,7 @@ FramesCsvWriter::FramesCsvWriter(const std::string& path, int dim) {
 
 FramesCsvWriter::~FramesCsvWriter() = default;
 
-void FramesCsvWriter::Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) {
+void FramesCsvWriter::Add(int64_t step, const PointsRef& points, const VectorRef& link_angles) {
   if (impl_ == nullptr) throw std::logic_error("FramesCsvWriter::Add after Commit or a failure");
   Impl& s = *impl_;
   if (s.n < 0) s.n = points.rows() - 1;

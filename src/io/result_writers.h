@@ -15,7 +15,7 @@ namespace flexkin {
 class ResultFileWriter::Impl {
  public:
   virtual ~Impl() = default;
-  virtual void Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) = 0;
+  virtual void Add(int64_t step, const PointsRef& points, const VectorRef& link_angles) = 0;
   virtual void Commit(const RunResult& result) = 0;
 };
 

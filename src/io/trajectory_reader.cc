@@ -188,13 +188,11 @@ ResultFile RobotTrajectoryAsResult(const RobotTrajectoryFile& t) {
   r.seconds = t.seconds;
   r.lengths = Eigen::VectorXd::Zero(g - 1);
   for (size_t s = 0; s < t.states.size(); ++s) {
-    Frame frame;
-    frame.step = static_cast<int64_t>(s);
-    frame.points = t.states[s].colwise().reverse();  // the end effector first
+    const Points points = t.states[s].colwise().reverse();  // the end effector first
     for (Eigen::Index i = 0; i + 1 < g; ++i) {
-      r.lengths[i] = std::max(r.lengths[i], (frame.points.row(i + 1) - frame.points.row(i)).norm());
+      r.lengths[i] = std::max(r.lengths[i], (points.row(i + 1) - points.row(i)).norm());
     }
-    r.frames.push_back(std::move(frame));
+    r.frames.Add(static_cast<int64_t>(s), points);
   }
   for (Eigen::Index i = 0; i + 1 < g; ++i) {
     if (!(r.lengths[i] > 0.0)) r.lengths[i] = 1.0;

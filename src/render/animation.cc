@@ -51,7 +51,7 @@ void DrawMoment(render::Canvas* canvas, const ChainScene& scene, const ResultFil
                 const std::vector<int>& drawn, size_t d) {
   cairo_t* cr = canvas->cr();
   const double ui = canvas->ui();
-  const std::vector<Frame>& frames = file.result.frames;
+  const Frames& frames = file.result.frames;
   const int f = drawn[d];
   const int rows = static_cast<int>(frames[f].points.rows());
   if (f > 0) {

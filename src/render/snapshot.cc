@@ -92,7 +92,7 @@ void DrawSnapshotFigure(const ResultFile& file, const Look& look, const FigureOp
   const ImageFormat format = ImageFormatFromPath(path);
   CheckDrawable(file);
 
-  const std::vector<Frame>& frames = file.result.frames;
+  const Frames& frames = file.result.frames;
   const int num_frames = static_cast<int>(frames.size()), dim = file.dim;
   const int rows = static_cast<int>(frames[0].points.rows());
   const SnapshotLayout layout = LayoutSnapshot(file, options, look);

@@ -50,7 +50,7 @@ std::string Ordinal(int k) {
 std::vector<LegendEntry> LegendEntries(const ResultFile& file, const Look& look,
                                        const FigureOptions& options, const std::vector<int>& drawn,
                                        double ui) {
-  const std::vector<Frame>& frames = file.result.frames;
+  const Frames& frames = file.result.frames;
   std::vector<LegendEntry> entries;
   if (frames.size() > 1) {
     entries.push_back({LegendEntry::kLine,

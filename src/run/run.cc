@@ -223,8 +223,14 @@ Eigen::VectorXd FirstDirection(const Points& start, const Points& leader_steps) 
 
 }  // namespace
 
-void FrameRecorder::Add(int64_t step, const Points& points, const Eigen::VectorXd& link_angles) {
-  frames.push_back({step, points, link_angles});
+int64_t CountRecordedFrames(int64_t num_steps, int record_every) {
+  if (num_steps <= 0) return 1;
+  const int64_t every = std::max(record_every, 1);
+  return 1 + num_steps / every + (num_steps % every != 0 ? 1 : 0);
+}
+
+void FrameRecorder::Add(int64_t step, const PointsRef& points, const VectorRef& link_angles) {
+  frames.Add(step, points, link_angles);
 }
 
 namespace {
@@ -577,6 +583,11 @@ RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& 
 
 RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& options) {
   FrameRecorder recorder;
+  // One allocation for the frames (Run checks the inputs and refuses bad ones).
+  if (chain.points.size() > 0 && options.record_every >= 1) {
+    recorder.frames.Reserve(CountRecordedFrames(leader_steps.rows(), options.record_every),
+                            chain.points.rows(), chain.dim(), options.link_angles);
+  }
   RunResult result = Run(chain, leader_steps, options, &recorder);
   result.frames = std::move(recorder.frames);
   return result;
@@ -620,7 +631,8 @@ std::string RunResult::FullReport() const {
   if ((n - 1) % stride != 0)
     out << " [" << n - 1 << "] " << Format("%.6g", metrics.path_length[n - 1]);
   out << "\n";
-  const Eigen::VectorXd& a = frames.empty() ? final_link_angles : frames.back().link_angles;
+  const Eigen::VectorXd a =
+      frames.empty() ? final_link_angles : Eigen::VectorXd(frames.back().link_angles);
   if (a.size() > 0) {
     out << "  final link angles to the pull, degrees: first " << Format("%.4g", a[0] * 180 / M_PI)
         << ", largest " << Format("%.4g", a.maxCoeff() * 180 / M_PI) << ", last "

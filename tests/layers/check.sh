@@ -12,7 +12,7 @@ declare -A header_layer=(
   [error]=chain [chain]=chain [vocabulary]=chain [curves]=chain [leader]=chain
   [link_step]=sequential [propagate]=sequential
   [overall]=overall
-  [run]=run
+  [run]=run [frames]=run
   [arm]=arm [strands]=strands [groom]=groom [strand_file]=groom
   [scenario]=io [result_io]=io [robot_scenario]=io [scenario_kind]=io [any_scenario]=scenario
   [flexkin]=umbrella
