@@ -1,9 +1,10 @@
 // Tests of the viewer for many strands (WriteStrandsViewerHtml, src/viewer/strands_viewer.h): the
 // page is self-contained, its embedded frames decode (here, independently of the page's script)
 // to the file's points within the quantization step, bad options and pages over the limits are
-// refused without touching the output file, and the page works in headless Chromium
-// (tests/viewer/strands_browser_check.mjs), playing 10,000 strands of 32 links at >= 30 frames
-// per second with software rendering.
+// refused without touching the output file, the page is the one both viewers share (the shared
+// page, style sheet and script of src/viewer/viewer_common.*, each once, and none of the chain
+// viewer's own), and the page works in headless Chromium (tests/viewer/strands_browser_check.mjs),
+// playing 10,000 strands of 32 links at >= 30 frames per second with software rendering.
 #include "viewer/strands_viewer.h"
 
 #include <gtest/gtest.h>
@@ -22,8 +23,11 @@
 #include <vector>
 
 #include "flexkin/error.h"
+#include "flexkin/run.h"
 #include "flexkin/strand_file.h"
+#include "scenes/scenes.h"
 #include "test_util.h"
+#include "viewer/viewer.h"
 
 namespace flexkin {
 namespace {
@@ -306,6 +310,97 @@ TEST_F(StrandsViewerTest, PageOverTheLimitsIsRefusedAndAnEarlierFileLeftUntouche
   StrandFileReader reader(Path("s.npz"));
   WriteStrandsViewerHtml(&reader, fewer, Path("existing.html"));
   EXPECT_EQ(ParsePage(ReadFile(Path("existing.html"))).meta["num_points"], 20 * 17);
+}
+
+// How many times `part` occurs in `text` (overlapping occurrences included).
+size_t Count(const std::string& text, const std::string& part) {
+  size_t count = 0;
+  for (size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++count;
+  return count;
+}
+
+// The two viewers' pages are one page: the shared page (viewer_common.html) with each viewer's
+// parts in its slots, one style element holding the shared style sheet and then the viewer's own,
+// one script element holding the shared script and then the viewer's own; nothing of the other
+// viewer's styles or script, and the shared assets once each, not copied into either viewer's.
+TEST_F(StrandsViewerTest, BothViewersWriteTheSharedPageStyleSheetAndScriptOnce) {
+  MakeStrandFile(Path("s.npz"), 3, 12, 5, 4);
+  {
+    StrandFileReader reader(Path("s.npz"));
+    WriteStrandsViewerHtml(&reader, StrandsViewerOptions(), Path("strands.html"));
+  }
+  const Chain chain = scenes::CurvedChain(3, 6, 1.0, 0.4);
+  Points targets(5, 3);
+  for (int s = 0; s < 5; ++s) {
+    targets.row(s) = chain.points.row(0);
+    targets(s, 0) -= 0.05 * (s + 1);
+  }
+  ResultFile result;
+  result.result = flexkin::Run(chain, targets, RunOptions());
+  result.dim = 3;
+  WriteViewerHtml(result, ViewerOptions(), Path("chain.html"));
+
+  const std::string source = std::string(FLEXKIN_SOURCE_DIR) + "/src/viewer/";
+  const auto asset = [&](const std::string& name) {
+    const std::string text = ReadFile(source + name);
+    EXPECT_GT(text.size(), 100u) << name;
+    return text;
+  };
+  const std::string shell = asset("viewer_common.html"), common_css = asset("viewer_common.css"),
+                    common_js = asset("viewer_common.js");
+  struct Viewer {
+    std::string page, css, js;
+  };
+  const Viewer chain_viewer{ReadFile(Path("chain.html")), asset("viewer.css"), asset("viewer.js")};
+  const Viewer strands_viewer{ReadFile(Path("strands.html")), asset("strands_viewer.css"),
+                              asset("strands_viewer.js")};
+  // Each viewer's own assets hold nothing of the shared ones (no copied rule or function).
+  for (const std::string& own :
+       {chain_viewer.css, chain_viewer.js, strands_viewer.css, strands_viewer.js}) {
+    EXPECT_EQ(own.find("html, body {"), std::string::npos);
+    EXPECT_EQ(own.find("#controls,"), std::string::npos);
+    EXPECT_EQ(own.find("addEventListener('keydown'"), std::string::npos);
+    EXPECT_EQ(own.find("addEventListener('pointerdown'"), std::string::npos);
+  }
+  for (const auto& [viewer, other] :
+       {std::pair(&chain_viewer, &strands_viewer), std::pair(&strands_viewer, &chain_viewer)}) {
+    const std::string& page = viewer->page;
+    SCOPED_TRACE(viewer == &chain_viewer ? "chain viewer" : "strands viewer");
+    EXPECT_EQ(Count(page, common_css), 1u);
+    EXPECT_EQ(Count(page, common_js), 1u);
+    EXPECT_EQ(Count(page, "<style>\n" + common_css + viewer->css + "</style>"), 1u);
+    EXPECT_EQ(Count(page, "<script>\n" + common_js + viewer->js + "</script>"), 1u);
+    EXPECT_EQ(Count(page, "<style>"), 1u);
+    EXPECT_EQ(Count(page, "<script>"), 1u);
+    EXPECT_EQ(page.find(other->css), std::string::npos);
+    EXPECT_EQ(page.find(other->js), std::string::npos);
+    // The shared page's text between its slots, in order, and every slot filled.
+    size_t at = 0, from = 0;
+    for (size_t slot = shell.find("<!--slot "); from < shell.size();
+         slot = shell.find("<!--slot ", from)) {
+      const std::string piece = shell.substr(from, slot == std::string::npos ? slot : slot - from);
+      const size_t found = page.find(piece, at);
+      ASSERT_NE(found, std::string::npos) << piece;
+      at = found + piece.size();
+      from = slot == std::string::npos ? shell.size() : shell.find("-->", slot) + 3;
+    }
+    EXPECT_EQ(page.find("<!--slot"), std::string::npos);
+    EXPECT_EQ(page.find("<!--part"), std::string::npos);
+    // The controls the scripts and the browser checks look for, once each.
+    for (const char* id : {"title", "subtitle", "view", "hint", "message", "play", "prev", "next",
+                           "timeline", "counter", "speed", "reset", "facts", "now"}) {
+      EXPECT_EQ(Count(page, std::string("id=\"") + id + "\""), 1u) << id;
+    }
+  }
+  // Each viewer's own controls on its page only.
+  for (const char* id : {"leader", "trails", "trail-points", "perspective", "profile", "l2plot"}) {
+    EXPECT_EQ(Count(chain_viewer.page, std::string("id=\"") + id + "\""), 1u) << id;
+    EXPECT_EQ(Count(strands_viewer.page, std::string("id=\"") + id + "\""), 0u) << id;
+  }
+  for (const char* id : {"soft-view", "blend", "scalp", "perf"}) {
+    EXPECT_EQ(Count(strands_viewer.page, std::string("id=\"") + id + "\""), 1u) << id;
+    EXPECT_EQ(Count(chain_viewer.page, std::string("id=\"") + id + "\""), 0u) << id;
+  }
 }
 
 // Runs `command`, returns its exit status and appends its stdout and stderr to `output`.

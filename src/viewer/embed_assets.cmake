@@ -1,8 +1,10 @@
-# Writes a C++ header with the bytes of a page, its style sheet and its script as arrays
-# (kViewerHtml, kViewerCss, kViewerJs from viewer.*; with -DPAGE=strands_viewer -DNAME=StrandsViewer,
-# kStrandsViewerHtml... from strands_viewer.*), so the library carries them and needs no files at
-# run time. Byte arrays rather than string literals: any content is safe, whatever its quotes or
-# delimiters. Run as: cmake -DSOURCE_DIR=... -DOUTPUT=... [-DPAGE=... -DNAME=...] -P embed_assets.cmake
+# Writes a C++ header with the bytes of one set of viewer assets, PAGE.html, PAGE.css and PAGE.js,
+# as arrays kNAMEHtml, kNAMECss and kNAMEJs: the shared page, style sheet and script of both viewers
+# (-DPAGE=viewer_common -DNAME=ViewerCommon), the chain viewer's own (the default, viewer.* as
+# kViewerHtml...) or the strands viewer's (-DPAGE=strands_viewer -DNAME=StrandsViewer), so the
+# library carries them and needs no files at run time. Byte arrays rather than string literals: any
+# content is safe, whatever its quotes or delimiters. Run as:
+#   cmake -DSOURCE_DIR=... -DOUTPUT=... [-DPAGE=... -DNAME=...] -P embed_assets.cmake
 if(NOT DEFINED PAGE)
   set(PAGE viewer)
   set(NAME Viewer)

@@ -13,10 +13,13 @@
 // same buffers, the picture then shown with putImageData on a 2D canvas laid over the WebGL one
 // (going through SwiftShader again would cost a texture upload and a read-back per picture).
 // The G key switches renderers.
+// The page, its controls, keys and view handling are shared with the chain viewer
+// (viewer_common.html, .css, .js: flexkinViewerCommon); this is the strands' part.
 (function () {
   'use strict';
 
-  const $ = (id) => document.getElementById(id);
+  const common = flexkinViewerCommon;
+  const $ = common.$;
   const api = {
     ready: false, renderer: null, frame: 0, playing: false, error: null,
     // draws: pictures drawn; newPictures: those showing another moment of the motion than the one
@@ -26,9 +29,7 @@
   window.flexkinStrandsViewer = api;
 
   function fail(text) {
-    const box = $('message');
-    box.textContent = text;
-    box.hidden = false;
+    common.showMessage(text);
     api.error = text;
   }
 
@@ -326,7 +327,6 @@
   }
 
   // ----- State ------------------------------------------------------------------------------------
-  const speeds = [0.25, 0.5, 1, 2, 4, 8];
   const state = {
     position: 0,  // frames, fractional while blending
     playing: false,
@@ -337,8 +337,8 @@
   };
   const view = { azimuth: 0, elevation: 0, zoom: 1, panX: 0, panY: 0 };
   function resetView() {
-    view.azimuth = options.azimuth * Math.PI / 180;
-    view.elevation = options.elevation * Math.PI / 180;
+    view.azimuth = common.radians(options.azimuth);
+    view.elevation = common.radians(options.elevation);
     view.zoom = 1;
     view.panX = 0;
     view.panY = 0;
@@ -358,6 +358,7 @@
   }
 
   // View and projection matrices, and the depths for the fade.
+  const basis = new Float64Array(9);  // the screen's right and up, towards the eye (3D)
   function camera() {
     const aspect = width / height;
     if (dim === 2) {
@@ -369,11 +370,11 @@
     }
     const fovy = 30 * Math.PI / 180;
     const distance = 1.15 * radius / Math.sin(fovy / 2) / Math.min(1, aspect) / view.zoom;
-    const ce = Math.cos(view.elevation), se = Math.sin(view.elevation);
-    const dir = [ce * Math.cos(view.azimuth), ce * Math.sin(view.azimuth), se];
+    const b = common.orbitBasis(view.azimuth, view.elevation, basis);
+    const dir = [b[6], b[7], b[8]];
+    const se = dir[2];
     // Panning moves the target in the screen's plane, in units of the view's half height.
-    const right = normalize(cross([-dir[0], -dir[1], -dir[2]], [0, 0, 1]));
-    const up = cross(right, [-dir[0], -dir[1], -dir[2]]);
+    const right = [b[0], b[1], b[2]], up = [b[3], b[4], b[5]];
     const panScale = distance * Math.tan(fovy / 2);
     const target = [0, 1, 2].map((c) => center[c] - (view.panX * right[c] + view.panY * up[c]) * panScale);
     const eye = [0, 1, 2].map((c) => target[c] + distance * dir[c]);
@@ -402,14 +403,10 @@
     if (state.renderer === 'software') drawSoftware(cam, a, b, t);
     else drawWebGL(cam, a, b, t);
 
-    const ms = performance.now() - start;
-    const s = api.stats;
-    s.draws += 1;
+    common.countDraw(api.stats, start);
     const key = `${a},${b},${t}`;
-    if (key !== lastShown) s.newPictures += 1;
+    if (key !== lastShown) api.stats.newPictures += 1;
     lastShown = key;
-    s.drawMs += ms;
-    s.maxDrawMs = Math.max(s.maxDrawMs, ms);
     drawRequested = false;
   }
 
@@ -738,7 +735,7 @@
     if (on && state.position >= numFrames - 1 && !options.loop) setFrame(0);
     state.playing = on;
     api.playing = on;
-    $('play').textContent = on ? 'Pause' : 'Play';
+    common.showPlaying(on);
     if (!on) {
       api.stats.fps = 0;
       recent.length = 0;
@@ -746,21 +743,11 @@
   }
   function setSpeed(x) {
     state.speed = x;
-    $('speed').value = String(x);
+    common.showSpeed(x);
   }
 
   // ----- Panel --------------------------------------------------------------------------------------
-  function fill(id, rows) {
-    const list = $(id);
-    list.replaceChildren();
-    for (const [name, value] of rows) {
-      const dt = document.createElement('dt');
-      dt.textContent = name;
-      const dd = document.createElement('dd');
-      dd.textContent = value;
-      list.append(dt, dd);
-    }
-  }
+  const fill = common.fillFacts;
   const number = (x, digits = 4) => (Number.isFinite(x) ? Number(x.toPrecision(digits)).toString() : String(x));
   function showFacts() {
     const links = numPoints - numStrands;
@@ -805,13 +792,23 @@
 
   // ----- Input ----------------------------------------------------------------------------------
   function bind() {
-    $('play').addEventListener('click', () => setPlaying(!state.playing));
-    $('prev').addEventListener('click', () => { setPlaying(false); setFrame(api.frame - 1); });
-    $('next').addEventListener('click', () => { setPlaying(false); setFrame(api.frame + 1); });
-    const timeline = $('timeline');
-    timeline.max = String(numFrames - 1);
-    timeline.addEventListener('input', () => { setPlaying(false); setFrame(Number(timeline.value)); });
-    $('speed').addEventListener('change', () => setSpeed(Number($('speed').value)));
+    // Moving the timeline pauses.
+    common.bindControls({
+      numFrames,
+      frame: () => api.frame,
+      playing: () => state.playing,
+      setPlaying,
+      setFrame,
+      speed: () => state.speed,
+      setSpeed,
+      resetView,
+      scrubPauses: true,
+      keys: {
+        i: () => $('blend').click(),
+        b: () => { if (scalp) $('scalp').click(); },
+        g: () => setRenderer(state.renderer === 'software' ? 'webgl' : 'software'),
+      },
+    });
     $('blend').addEventListener('change', () => {
       state.blend = $('blend').checked;
       if (!state.blend) setPosition(Math.floor(state.position), false);
@@ -819,70 +816,19 @@
     });
     $('scalp-control').hidden = !scalp;
     $('scalp').addEventListener('change', () => { state.showScalp = $('scalp').checked; requestDraw(); });
-    $('reset').addEventListener('click', resetView);
-    document.addEventListener('keydown', onKey);
-    document.addEventListener('keyup', (e) => {
-      if (e.key === ' ') e.preventDefault();
-    });
-    bindPointer();
-    new ResizeObserver(resize).observe(canvas);
-  }
-
-  function onKey(e) {
-    if (e.ctrlKey || e.metaKey || e.altKey) return;
-    const jump = e.shiftKey ? 10 : 1;
-    let handled = true;
-    switch (e.key) {
-      case ' ': setPlaying(!state.playing); break;
-      case 'ArrowRight': setPlaying(false); setFrame(api.frame + jump); break;
-      case 'ArrowLeft': setPlaying(false); setFrame(api.frame - jump); break;
-      case 'ArrowUp': setPlaying(false); setFrame(api.frame + 10 * jump); break;
-      case 'ArrowDown': setPlaying(false); setFrame(api.frame - 10 * jump); break;
-      case 'Home': setPlaying(false); setFrame(0); break;
-      case 'End': setPlaying(false); setFrame(numFrames - 1); break;
-      case '+': case '=': setSpeed(speeds[Math.min(speeds.length - 1, speeds.indexOf(state.speed) + 1)]); break;
-      case '-': setSpeed(speeds[Math.max(0, speeds.indexOf(state.speed) - 1)]); break;
-      case 'r': case 'R': resetView(); break;
-      case 'i': case 'I': $('blend').click(); break;
-      case 'b': case 'B': if (scalp) $('scalp').click(); break;
-      case 'g': case 'G': setRenderer(state.renderer === 'software' ? 'webgl' : 'software'); break;
-      default: handled = false;
-    }
-    if (handled) e.preventDefault();
-  }
-
-  function bindPointer() {
-    let drag = null;
-    canvas.addEventListener('pointerdown', (e) => {
-      canvas.setPointerCapture(e.pointerId);
-      canvas.focus();
-      drag = { x: e.clientX, y: e.clientY, pan: dim === 2 || e.shiftKey || e.button !== 0 };
-      canvas.classList.add('dragging');
-    });
-    canvas.addEventListener('pointermove', (e) => {
-      if (!drag) return;
-      const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
-      drag.x = e.clientX;
-      drag.y = e.clientY;
-      const h = canvas.clientHeight || 1;
-      if (drag.pan) {
+    common.bindView(canvas, dim, view, {
+      // In units of the view's half height.
+      pan(dx, dy) {
+        const h = canvas.clientHeight || 1;
         view.panX += 2 * dx / h;
         view.panY -= 2 * dy / h;
-      } else {
-        view.azimuth -= dx * 0.01;
-        view.elevation = Math.max(-Math.PI / 2, Math.min(Math.PI / 2, view.elevation + dy * 0.01));
-      }
-      requestDraw();
+      },
+      zoom(e) {
+        view.zoom = Math.max(0.05, Math.min(200, view.zoom * Math.exp(-e.deltaY * 0.0015)));
+      },
+      moved: requestDraw,
+      resize,
     });
-    const end = () => { drag = null; canvas.classList.remove('dragging'); };
-    canvas.addEventListener('pointerup', end);
-    canvas.addEventListener('pointercancel', end);
-    canvas.addEventListener('contextmenu', (e) => e.preventDefault());
-    canvas.addEventListener('wheel', (e) => {
-      e.preventDefault();
-      view.zoom = Math.max(0.05, Math.min(200, view.zoom * Math.exp(-e.deltaY * 0.0015)));
-      requestDraw();
-    }, { passive: false });
   }
 
   // ----- For tests: the picture now, and a decoded point ------------------------------------------
@@ -933,8 +879,7 @@
     resize();
     api.frame = 0;
     showFrame();
-    $('hint').textContent = dim === 3 ? 'drag: orbit \u00b7 shift-drag: pan \u00b7 wheel: zoom'
-                                      : 'drag: pan \u00b7 wheel: zoom';
+    common.showHint(dim);
     api.ready = true;
     setPlaying(options.autoplay);
     requestAnimationFrame(tick);

@@ -3,20 +3,21 @@
 // src/viewer/viewer_data.cc. Drawing runs in requestAnimationFrame and allocates no arrays per
 // frame: positions sit in one Float64Array, projected points in preallocated typed arrays, and
 // the grid and the whole leader path are drawn once per view change into a background layer.
+// The page, its controls, keys and view handling are shared with the strands viewer
+// (viewer_common.html, .css, .js: flexkinViewerCommon); this is the chain's part.
 (function () {
   'use strict';
 
-  const $ = (id) => document.getElementById(id);
+  const common = flexkinViewerCommon;
+  const $ = common.$;
 
   // ----- Data ----------------------------------------------------------------------------------
   let data;
   try {
     data = JSON.parse($('flexkin-data').textContent);
   } catch (e) {
-    const box = $('message');
-    box.textContent = 'This page holds no result data. Write it with flexkin ' +
-        '(flexkin render, or WriteViewerHtml in C++).';
-    box.hidden = false;
+    common.showMessage('This page holds no result data. Write it with flexkin ' +
+                       '(flexkin render, or WriteViewerHtml in C++).');
     return;
   }
   const dim = data.dim;
@@ -55,8 +56,8 @@
   const view = {
     scale: 1,              // CSS pixels per length unit
     panX: 0, panY: 0,      // CSS pixels
-    azimuth: options.azimuth * Math.PI / 180,
-    elevation: options.elevation * Math.PI / 180,
+    azimuth: common.radians(options.azimuth),
+    elevation: common.radians(options.elevation),
     perspective: options.perspective,
   };
   // Camera basis for 3D: right, up and towards the viewer, 3 numbers each.
@@ -64,9 +65,7 @@
   const cameraDistance = 3 * radius;  // perspective: eye distance from the centre
 
   function updateBasis() {
-    const ca = Math.cos(view.azimuth), sa = Math.sin(view.azimuth);
-    const ce = Math.cos(view.elevation), se = Math.sin(view.elevation);
-    basis.set([-sa, ca, 0, -se * ca, -se * sa, ce, ce * ca, ce * sa, se]);
+    common.orbitBasis(view.azimuth, view.elevation, basis);
   }
 
   function fitView() {
@@ -366,10 +365,7 @@
     }
     drawChain(g, state.frame);
     state.dirty = false;
-    const ms = performance.now() - t0;
-    stats.draws += 1;
-    stats.drawMs += ms;
-    stats.maxDrawMs = Math.max(stats.maxDrawMs, ms);
+    common.countDraw(stats, t0);
   }
 
   function resize() {
@@ -399,14 +395,7 @@
     return String(Number(x.toPrecision(5)));
   }
 
-  function addFact(list, name, value) {
-    const dt = document.createElement('dt');
-    const dd = document.createElement('dd');
-    dt.textContent = name;
-    dd.textContent = value;
-    list.append(dt, dd);
-    return dd;
-  }
+  const addFact = common.addFact;
 
   const metrics = data.metrics;
   const nowFields = {};
@@ -450,9 +439,7 @@
       buildChainPanel();
     }
     $('perspective-control').hidden = dim !== 3;
-    $('hint').textContent = dim === 2
-        ? 'drag: pan \u00b7 wheel: zoom \u00b7 click a point: trail'
-        : 'drag: orbit \u00b7 shift+drag: pan \u00b7 wheel: zoom \u00b7 click a point: trail';
+    common.showHint(dim, 'click a point: trail');
   }
 
   function buildChainPanel() {
@@ -604,13 +591,12 @@
     state.playing = playing && numFrames > 1;
     if (state.playing && state.frame === numFrames - 1 && !options.loop) setFrame(0);
     state.playhead = state.frame;
-    $('play').textContent = state.playing ? 'Pause' : 'Play';
+    common.showPlaying(state.playing);
   }
 
-  const speeds = [0.25, 0.5, 1, 2, 4, 8];
   function setSpeed(speed) {
     state.speed = speed;
-    $('speed').value = String(speed);
+    common.showSpeed(speed);
   }
 
   function setTrails(text) {
@@ -637,20 +623,31 @@
   }
 
   function resetView() {
-    view.azimuth = options.azimuth * Math.PI / 180;
-    view.elevation = options.elevation * Math.PI / 180;
+    view.azimuth = common.radians(options.azimuth);
+    view.elevation = common.radians(options.elevation);
     fitView();
     state.backgroundDirty = true;
     state.dirty = true;
   }
 
   function bindControls() {
-    $('timeline').max = String(numFrames - 1);
-    $('play').addEventListener('click', () => setPlaying(!state.playing));
-    $('prev').addEventListener('click', () => { setPlaying(false); setFrame(state.frame - 1); });
-    $('next').addEventListener('click', () => { setPlaying(false); setFrame(state.frame + 1); });
-    $('timeline').addEventListener('input', (e) => setFrame(Number(e.target.value)));
-    $('speed').addEventListener('change', (e) => setSpeed(Number(e.target.value)));
+    // Moving the timeline while playing plays on from there.
+    common.bindControls({
+      numFrames,
+      frame: () => state.frame,
+      playing: () => state.playing,
+      setPlaying,
+      setFrame,
+      speed: () => state.speed,
+      setSpeed,
+      resetView,
+      scrubPauses: false,
+      keys: {
+        l: () => $('leader').click(),
+        t: () => $('trails').click(),
+        p: () => { if (dim === 3) $('perspective').click(); },
+      },
+    });
     $('leader').checked = state.showLeader;
     $('leader').addEventListener('change', (e) => {
       state.showLeader = e.target.checked;
@@ -671,91 +668,29 @@
       view.perspective = e.target.checked;
       resetView();
     });
-    $('reset').addEventListener('click', resetView);
-    document.addEventListener('keydown', onKey);
-    // A focused button or checkbox would also act on the space bar's release.
-    document.addEventListener('keyup', (e) => {
-      if (e.key === ' ' && !isTextField(e.target)) e.preventDefault();
-    });
-    bindPointer();
-    new ResizeObserver(resize).observe(canvas);
-  }
-
-  function isTextField(target) {
-    return target instanceof HTMLInputElement && target.type === 'text';
-  }
-
-  function onKey(e) {
-    if (isTextField(e.target) || e.ctrlKey || e.metaKey || e.altKey) return;
-    const jump = e.shiftKey ? 10 : 1;
-    let handled = true;
-    switch (e.key) {
-      case ' ': setPlaying(!state.playing); break;
-      case 'ArrowRight': setPlaying(false); setFrame(state.frame + jump); break;
-      case 'ArrowLeft': setPlaying(false); setFrame(state.frame - jump); break;
-      case 'ArrowUp': setPlaying(false); setFrame(state.frame + 10 * jump); break;
-      case 'ArrowDown': setPlaying(false); setFrame(state.frame - 10 * jump); break;
-      case 'Home': setPlaying(false); setFrame(0); break;
-      case 'End': setPlaying(false); setFrame(numFrames - 1); break;
-      case '+': case '=': setSpeed(speeds[Math.min(speeds.length - 1, speeds.indexOf(state.speed) + 1)]); break;
-      case '-': setSpeed(speeds[Math.max(0, speeds.indexOf(state.speed) - 1)]); break;
-      case 'r': case 'R': resetView(); break;
-      case 'l': case 'L': $('leader').click(); break;
-      case 't': case 'T': $('trails').click(); break;
-      case 'p': case 'P': if (dim === 3) $('perspective').click(); break;
-      default: handled = false;
-    }
-    if (handled) e.preventDefault();
-  }
-
-  function bindPointer() {
-    let drag = null;  // {x, y, moved, pan}
-    canvas.addEventListener('pointerdown', (e) => {
-      canvas.setPointerCapture(e.pointerId);
-      canvas.focus();
-      drag = { x: e.clientX, y: e.clientY, moved: 0, pan: dim === 2 || e.shiftKey || e.button !== 0 };
-      canvas.classList.add('dragging');
-    });
-    canvas.addEventListener('pointermove', (e) => {
-      if (!drag) return;
-      const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
-      drag.x = e.clientX;
-      drag.y = e.clientY;
-      drag.moved += Math.abs(dx) + Math.abs(dy);
-      if (drag.pan) {
+    common.bindView(canvas, dim, view, {
+      pan(dx, dy) {
         view.panX += dx;
         view.panY += dy;
-      } else {
-        view.azimuth -= dx * 0.01;
-        view.elevation = Math.max(-Math.PI / 2, Math.min(Math.PI / 2, view.elevation + dy * 0.01));
-        updateBasis();
-      }
-      state.viewMoved = true;
-      state.backgroundDirty = true;
-      state.dirty = true;
+      },
+      orbited: updateBasis,
+      zoom(e) {
+        const rect = canvas.getBoundingClientRect();
+        const mx = e.clientX - rect.left - width / 2, my = e.clientY - rect.top - height / 2;
+        const k = Math.exp(-e.deltaY * (e.deltaMode === 1 ? 0.05 : 0.0015));
+        // Zoom about the cursor: the point under it stays put.
+        view.scale *= k;
+        view.panX = mx - (mx - view.panX) * k;
+        view.panY = my - (my - view.panY) * k;
+      },
+      moved() {
+        state.viewMoved = true;
+        state.backgroundDirty = true;
+        state.dirty = true;
+      },
+      click: pick,
+      resize,
     });
-    const end = (e) => {
-      if (!drag) return;
-      if (drag.moved < 4) pick(e);
-      drag = null;
-      canvas.classList.remove('dragging');
-    };
-    canvas.addEventListener('pointerup', end);
-    canvas.addEventListener('pointercancel', () => { drag = null; });
-    canvas.addEventListener('contextmenu', (e) => e.preventDefault());
-    canvas.addEventListener('wheel', (e) => {
-      e.preventDefault();
-      const rect = canvas.getBoundingClientRect();
-      const mx = e.clientX - rect.left - width / 2, my = e.clientY - rect.top - height / 2;
-      const k = Math.exp(-e.deltaY * (e.deltaMode === 1 ? 0.05 : 0.0015));
-      // Zoom about the cursor: the point under it stays put.
-      view.scale *= k;
-      view.panX = mx - (mx - view.panX) * k;
-      view.panY = my - (my - view.panY) * k;
-      state.viewMoved = true;
-      state.backgroundDirty = true;
-      state.dirty = true;
-    }, { passive: false });
   }
 
   // A click near a point of the current frame adds or removes its trail.
