@@ -6,8 +6,6 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "render/render.h"
-
 namespace flexkin::cli {
 
 class RenderCommand {
@@ -17,23 +15,21 @@ class RenderCommand {
 
   // Whether the command line chose this subcommand.
   bool Parsed() const { return command_->parsed(); }
-  // Reads the result (or robot trajectory, told apart by content) and writes the chosen formats.
+  // Reads the result (or robot trajectory or strand file, told apart by content) and writes the
+  // chosen formats (flexkin/draw.h).
   // Returns the exit status for failures it reports itself (ffmpeg missing or failing: 1); throws
   // InputError (bad option or result: exit 1) and std::system_error (a file: exit 4) for
   // flexkin_main to report.
   int Run() const;
 
   struct Args {
-    std::string result, output_dir, formats = "svg,png,plots", title;
+    std::string result, output_dir, formats, title;
     int every = 0, width = 0, height = 0, fps = 0, max_frames = 0, max_strands = 0;
     double azimuth = 0.0, elevation = 0.0;
     bool quiet = false;
   };
 
  private:
-  // A strand file (docs/rendering.md, "Strand files"): its figure and animation.
-  int RunStrands() const;
-
   CLI::App* command_ = nullptr;
   Args args_;
   // Which of the shared options were given (the defaults differ per output).

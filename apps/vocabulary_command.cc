@@ -3,13 +3,13 @@
 #include <iostream>
 
 #include "flexkin/arm.h"
+#include "flexkin/gltf.h"
 #include "flexkin/overall.h"
 #include "flexkin/propagate.h"
+#include "flexkin/render.h"
 #include "flexkin/scenario_kind.h"
 #include "flexkin/strand_file.h"
 #include "flexkin/vocabulary.h"
-#include "gltf/gltf.h"
-#include "render/render.h"
 
 namespace flexkin::cli {
 namespace {
@@ -53,13 +53,13 @@ void PrintVocabulary(std::ostream& out) {
                   "from the arm's dimension and axes.");
   Table<PlotKind>(out, "Plots",
                   "The plots of `flexkin render --formats plots`, named in their files "
-                  "(`PlotKind`, src/render/render.h).");
+                  "(`PlotKind`, include/flexkin/render.h).");
   Table<OutputFormat>(out, "Output formats",
-                      "`flexkin render --formats` (`OutputFormat`, src/render/render.h); the "
+                      "`flexkin render --formats` (`OutputFormat`, include/flexkin/render.h); the "
                       "meaning column says which files each writes.");
   Table<GltfUpAxis>(out, "glTF up axes",
                     "Which flexkin axis points up in an exported glTF scene (`GltfUpAxis`, "
-                    "src/gltf/gltf.h).");
+                    "include/flexkin/gltf.h).");
 }
 
 VocabularyCommand::VocabularyCommand(CLI::App* app, const std::string& footer) {

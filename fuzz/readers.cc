@@ -10,12 +10,12 @@
 #include <system_error>
 
 #include "flexkin/error.h"
+#include "flexkin/gltf.h"
 #include "flexkin/result_io.h"
 #include "flexkin/robot_scenario.h"
 #include "flexkin/scenario.h"
 #include "flexkin/strand_file.h"
 #include "flexkin/urdf.h"
-#include "gltf/gltf.h"
 
 namespace flexkin::fuzz {
 namespace {

@@ -26,7 +26,7 @@ void ReadRobotScenario(const std::string& bytes);
 void ReadResult(const std::string& bytes);
 // URDF text through urdfdom (flexkin/urdf.h): ArmFromUrdf with the default chain.
 void ReadUrdf(const std::string& bytes);
-// glTF read-back (src/gltf/gltf.h): ReadGltfJointPositions of the bytes in a temporary file.
+// glTF read-back (include/flexkin/gltf.h): ReadGltfJointPositions of the bytes in a temporary file.
 void ReadGltf(const std::string& bytes);
 
 struct Target {

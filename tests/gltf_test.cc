@@ -1,6 +1,6 @@
-// glTF export (src/gltf/gltf.h): positions read back from .gltf and .glb files, the rig and
+// glTF export (include/flexkin/gltf.h): positions read back from .gltf and .glb files, the rig and
 // the tube, the Khronos glTF validator on written files, and bad input.
-#include "gltf/gltf.h"
+#include "flexkin/gltf.h"
 
 #include <dirent.h>
 #include <gtest/gtest.h>

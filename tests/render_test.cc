@@ -5,7 +5,7 @@
 // Regenerate the goldens (tests/golden/*.png) after an intended change of the look with
 //   FLEXKIN_UPDATE_GOLDEN=1 build/tests/render_test --gtest_filter='*Golden*'
 // and look at them before committing.
-#include "render/render.h"
+#include "flexkin/render.h"
 
 #include <cairo.h>
 #include <gtest/gtest.h>

@@ -1,8 +1,8 @@
-// Tests of the strand file pictures (src/render/strands_render.h) and of `flexkin render` of a
+// Tests of the strand file pictures (include/flexkin/strands_render.h) and of `flexkin render` of a
 // strand file: valid images with the scalp and the strands in them, deterministic output,
 // animations of the right size and length, options refused by name, files written whole or not
 // at all, and chain results drawn as before.
-#include "render/strands_render.h"
+#include "flexkin/strands_render.h"
 
 #include <cairo.h>
 #include <gtest/gtest.h>
@@ -488,7 +488,7 @@ TEST_F(StrandsRenderCliTest, FormatsOfChainsAreRefusedByName) {
   EXPECT_FALSE(Exists(dir_.Path("out")));
 }
 
-// html is the strand viewer (src/viewer/strands_viewer.h, docs/viewer.md).
+// html is the strand viewer (include/flexkin/strands_viewer.h, docs/viewer.md).
 TEST_F(StrandsRenderCliTest, HtmlIsTheStrandViewer) {
   const auto r = Cli("render hair.npz -o out --formats png,html --max-frames 5 --title Hair");
   ASSERT_EQ(r.exit_code, 0) << r.err;

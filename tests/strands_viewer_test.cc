@@ -1,11 +1,11 @@
-// Tests of the viewer for many strands (WriteStrandsViewerHtml, src/viewer/strands_viewer.h): the
-// page is self-contained, its embedded frames decode (here, independently of the page's script)
+// Tests of the viewer for many strands (WriteStrandsViewerHtml, include/flexkin/strands_viewer.h):
+// the page is self-contained, its embedded frames decode (here, independently of the page's script)
 // to the file's points within the quantization step, bad options and pages over the limits are
 // refused without touching the output file, the page is the one both viewers share (the shared
 // page, style sheet and script of src/viewer/viewer_common.*, each once, and none of the chain
 // viewer's own), and the page works in headless Chromium (tests/viewer/strands_browser_check.mjs),
 // playing 10,000 strands of 32 links at >= 30 frames per second with software rendering.
-#include "viewer/strands_viewer.h"
+#include "flexkin/strands_viewer.h"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -25,9 +25,9 @@
 #include "flexkin/error.h"
 #include "flexkin/run.h"
 #include "flexkin/strand_file.h"
+#include "flexkin/viewer.h"
 #include "scenes/scenes.h"
 #include "test_util.h"
-#include "viewer/viewer.h"
 
 namespace flexkin {
 namespace {

@@ -3,7 +3,7 @@
 // works in a real browser (headless Chromium driven by tests/viewer/browser_check.mjs) for a small
 // 2D run and the two large runs it must play smoothly: 20 links in 3D over 2650 steps and 80
 // links in 2D over 250 steps.
-#include "viewer/viewer.h"
+#include "flexkin/viewer.h"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>

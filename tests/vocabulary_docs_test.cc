@@ -14,8 +14,8 @@
 #include "flexkin/arm.h"
 #include "flexkin/overall.h"
 #include "flexkin/propagate.h"
+#include "flexkin/render.h"
 #include "flexkin/vocabulary.h"
-#include "render/render.h"
 #include "test_util.h"
 
 namespace flexkin {

@@ -312,12 +312,13 @@ class GltfOptions:
     def validate(self) -> None: ...
 
 def gltf_joint_positions(path: PathLike) -> Tuple[Float64Array, Float64Array]: ...
-def render(result: Union[Result, RobotResult], out_dir: PathLike,
+def render(result: Union[Result, RobotResult, PathLike], out_dir: PathLike,
            formats: Union[str, Sequence[str], None] = None, *,
-           stem: str = "result", every: Optional[int] = None, width: Optional[int] = None,
+           stem: Optional[str] = None, every: Optional[int] = None, width: Optional[int] = None,
            height: Optional[int] = None, azimuth: Optional[float] = None,
            elevation: Optional[float] = None, fps: Optional[int] = None,
-           max_frames: Optional[int] = None, title: Optional[str] = None,
+           max_frames: Optional[int] = None, max_strands: Optional[int] = None,
+           title: Optional[str] = None,
            ffmpeg: Optional[str] = None,
            figure: Union[None, FigureOptions, Dict[str, Any]] = None,
            plot: Union[None, PlotOptions, Dict[str, Any]] = None,

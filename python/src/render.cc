@@ -1,15 +1,12 @@
-// flexkin.render: the pictures, viewer page and glTF files of a Result (and the figure, animation
-// and viewer page of a RobotResult), as `flexkin render` writes them (apps/render_command.cc): one
-// writer per format of the vocabulary of src/render/render.h, each file written whole or not at
-// all, with the GIL released. Every member
-// of the components' options is reachable through FigureOptions, PlotOptions, AnimationOptions,
+// flexkin.render: the pictures, viewer page and glTF files of a Result, a RobotResult or a file of
+// any kind flexkin writes (a result, a robot trajectory, a strand file), through the library's one
+// call (flexkin/draw.h), as `flexkin render` writes them (apps/render_command.cc), with the GIL
+// released. This file maps the keywords and option objects to its options; every member of the
+// components' options is reachable through FigureOptions, PlotOptions, AnimationOptions,
 // ViewerOptions and GltfOptions (or dicts of their fields).
-#include "render/render.h"
-
 #include <pybind11/stl.h>
 
 #include <algorithm>
-#include <filesystem>
 #include <optional>
 #include <string>
 #include <system_error>
@@ -17,9 +14,8 @@
 
 #include "convert.h"
 #include "fields.h"
+#include "flexkin/draw.h"
 #include "flexkin/vocabulary.h"
-#include "gltf/gltf.h"
-#include "viewer/viewer.h"
 
 namespace flexkin::python {
 
@@ -31,7 +27,7 @@ namespace {
 
 // render()'s own argument types, named in help() as convert.h's are.
 struct DrawableTag {
-  static constexpr char kText[] = "Union[Result, RobotResult]";
+  static constexpr char kText[] = "Union[Result, RobotResult, str, os.PathLike]";
 };
 using Drawable = Typed<DrawableTag>;
 struct OptionalFormatsTag {
@@ -39,122 +35,34 @@ struct OptionalFormatsTag {
 };
 using OptionalFormats = Typed<OptionalFormatsTag>;
 
-struct RenderJob {
-  const ResultFile* file = nullptr;
-  const RobotTrajectoryFile* trajectory = nullptr;  // instead of `file`: kTrajectoryFormats
-  std::string base;                                 // out_dir/<stem>
-  FigureOptions figure;
-  PlotOptions plot;
-  AnimationOptions animation;
-  ViewerOptions viewer;
-  GltfOptions gltf;
-  std::vector<std::string> written;
-};
-
-void WriteFormat(OutputFormat format, RenderJob* job) {
-  const std::string& base = job->base;
-  auto add = [job](const std::string& path) { job->written.push_back(path); };
-  switch (format) {
-    case OutputFormat::kSvg:
-    case OutputFormat::kPng:
-    case OutputFormat::kPdf: {
-      const std::string path = base + "." + NameOf(format);
-      if (job->trajectory != nullptr) {
-        WriteSnapshotFigure(*job->trajectory, job->figure, path);
-      } else {
-        WriteSnapshotFigure(*job->file, job->figure, path);
-      }
-      add(path);
-      return;
-    }
-    case OutputFormat::kPlots: {
-      const bool have_angles = job->file->result.frames.front().link_angles.size() > 0;
-      for (const auto& entry : Vocabulary<PlotKind>::kEntries) {
-        if (entry.value == PlotKind::kLinkAngles && !have_angles) continue;
-        for (const char* extension : {".svg", ".png"}) {
-          const std::string path = base + "_" + entry.name + extension;
-          WritePlot(*job->file, entry.value, job->plot, path);
-          add(path);
-        }
-      }
-      return;
-    }
-    case OutputFormat::kMp4:
-    case OutputFormat::kGif: {
-      const std::string path = base + "." + NameOf(format);
-      if (job->trajectory != nullptr) {
-        WriteAnimation(*job->trajectory, job->animation, path);
-      } else {
-        WriteAnimation(*job->file, job->animation, path);
-      }
-      add(path);
-      return;
-    }
-    case OutputFormat::kHtml: {
-      const std::string path = base + ".html";
-      if (job->trajectory != nullptr) {
-        WriteViewerHtml(*job->trajectory, job->viewer, path);
-      } else {
-        WriteViewerHtml(*job->file, job->viewer, path);
-      }
-      add(path);
-      return;
-    }
-    case OutputFormat::kGltf:
-    case OutputFormat::kGlb: {
-      const std::string path = base + "." + NameOf(format);
-      WriteGltf(*job->file, job->gltf, path);
-      add(path);
-      return;
-    }
-  }
-}
-
-// The formats, from a list of names or one comma-separated string, in the vocabulary's order,
-// each once.
+// The formats, from a list of names or one comma-separated string.
 std::vector<OutputFormat> FormatsArg(py::handle formats) {
-  std::vector<std::string> names;
   if (py::isinstance<py::str>(formats)) {
-    const std::string list = py::cast<std::string>(formats);
-    size_t start = 0;
-    while (start <= list.size()) {
-      size_t end = list.find(',', start);
-      if (end == std::string::npos) end = list.size();
-      names.push_back(list.substr(start, end - start));
-      start = end + 1;
-    }
-  } else {
-    for (py::handle item : formats) {
-      if (!py::isinstance<py::str>(item)) ThrowInput("formats", "expected a list of format names");
-      names.push_back(py::cast<std::string>(item));
-    }
+    return ParseOutputFormats(py::cast<std::string>(formats), "formats");
   }
-  std::vector<bool> chosen(std::size(Vocabulary<OutputFormat>::kEntries), false);
-  for (const std::string& name : names) {
-    const NamedValue<OutputFormat>* entry = FindName<OutputFormat>(name);
-    if (entry == nullptr) {
-      std::string valid;
-      for (const std::string& n : NamesOf<OutputFormat>()) valid += (valid.empty() ? "" : ", ") + n;
-      ThrowInput("formats", "unknown format \"" + name + "\"; expected a list of " + valid,
-                 "\"" + name + "\"", valid);
-    }
-    chosen[static_cast<size_t>(entry - Vocabulary<OutputFormat>::kEntries)] = true;
+  std::vector<std::string> names;
+  for (py::handle item : formats) {
+    if (!py::isinstance<py::str>(item)) ThrowInput("formats", "expected a list of format names");
+    names.push_back(py::cast<std::string>(item));
   }
-  std::vector<OutputFormat> out;
-  for (size_t i = 0; i < chosen.size(); ++i) {
-    if (chosen[i]) out.push_back(Vocabulary<OutputFormat>::kEntries[i].value);
-  }
-  if (out.empty()) ThrowInput("formats", "is empty; expected at least one format name");
-  return out;
+  return ParseOutputFormats(names, "formats");
 }
 
-// The first problem of options, its field the keyword that set the member ("every" for every_k)
-// or, for an options object, `prefix` and the member ("gltf.tube_sides").
-void CheckOptions(const Problems& problems, const std::string& prefix = "") {
+// The first problem of options, its field `prefix` and the member ("gltf.tube_sides") for an
+// options object; for the keywords, the keyword that set the member ("figure.every_k" -> "every").
+void CheckOptions(const Problems& problems, const std::string& prefix) {
   if (problems.empty()) return;
   Problem p = problems.front();
-  if (prefix.empty() && p.field == "every_k") p.field = "every";
   p.field = prefix + p.field;
+  throw InputError(p);
+}
+
+void CheckKeywords(const Problems& problems) {
+  if (problems.empty()) return;
+  Problem p = problems.front();
+  const size_t dot = p.field.find('.');
+  if (p.field != "formats" && dot != std::string::npos) p.field = p.field.substr(dot + 1);
+  if (p.field == "every_k") p.field = "every";
   throw InputError(p);
 }
 
@@ -165,78 +73,69 @@ T CheckedOptions(py::handle object, const std::string& name) {
   return options;
 }
 
+template <typename T>
+std::optional<T> Optional(py::handle value) {
+  if (value.is_none()) return std::nullopt;
+  return py::cast<T>(value);
+}
+
 std::vector<std::string> Render(Drawable result, PathLike out_dir, OptionalFormats formats,
-                                const std::string& stem, OptionalInt every, OptionalInt width,
+                                OptionalStr stem_arg, OptionalInt every, OptionalInt width,
                                 OptionalInt height, OptionalFloat azimuth, OptionalFloat elevation,
-                                OptionalInt fps, OptionalInt max_frames, OptionalStr title,
-                                OptionalStr ffmpeg, FigureLike figure, PlotLike plot,
-                                AnimationLike animation, ViewerLike viewer, GltfLike gltf) {
-  // A RobotResult is drawn as `flexkin render` draws a trajectory file: its figure by default.
+                                OptionalInt fps, OptionalInt max_frames, OptionalInt max_strands,
+                                OptionalStr title, OptionalStr ffmpeg, FigureLike figure,
+                                PlotLike plot, AnimationLike animation, ViewerLike viewer,
+                                GltfLike gltf) {
+  // What is drawn: a Result, a RobotResult (as `flexkin render` draws a trajectory file) or a
+  // file of any kind, told apart by its content.
   const std::optional<RobotTrajectoryFile> trajectory = RobotTrajectoryOfObject(result);
-  const std::vector<OutputFormat> chosen = FormatsArg(!formats.is_none() ? py::handle(formats)
-                                                      : trajectory       ? py::str("svg,png")
-                                                                   : py::str("svg,png,plots"));
-  if (trajectory) {
-    for (OutputFormat format : chosen) CheckTrajectoryFormat(format, "formats");
-  }
+  const std::string path = trajectory ? "" : PathArg(result);
+  const ResultFile* file = trajectory || !path.empty() ? nullptr : &ResultFileOfObject(result);
+  const DrawnKind kind = trajectory ? DrawnKind::kRobotTrajectory
+                         : file     ? DrawnKind::kChainResult
+                                    : OnFile(path, [&] { return KindOfDrawnFile(path); });
+  DrawOptions options;
+  if (!formats.is_none()) options.formats = FormatsArg(formats);
   const std::string dir = RequiredPath(out_dir, "out_dir");
-  if (stem.empty() || stem.find('/') != std::string::npos) {
+  const std::string stem = stem_arg.is_none() ? "" : py::cast<std::string>(stem_arg);
+  if (!stem_arg.is_none() && (stem.empty() || stem.find('/') != std::string::npos)) {
     ThrowInput("stem", "must be a file name without '/'", Quoted(stem));
   }
-  RenderJob job;
-  job.figure = CheckedOptions<FigureOptions>(figure, "figure");
-  job.plot = CheckedOptions<PlotOptions>(plot, "plot");
-  job.animation = CheckedOptions<AnimationOptions>(animation, "animation");
-  job.viewer = CheckedOptions<ViewerOptions>(viewer, "viewer");
-  job.gltf = CheckedOptions<GltfOptions>(gltf, "gltf");
+  // A file's outputs are named after it, as the command names them; an object's "result".
+  options.base = !stem.empty()   ? dir + "/" + stem
+                 : !path.empty() ? OutputBaseOf(path, dir)
+                                 : dir + "/result";
+  options.figure = CheckedOptions<FigureOptions>(figure, "figure");
+  options.plot = CheckedOptions<PlotOptions>(plot, "plot");
+  options.animation = CheckedOptions<AnimationOptions>(animation, "animation");
+  options.viewer = CheckedOptions<ViewerOptions>(viewer, "viewer");
+  options.gltf = CheckedOptions<GltfOptions>(gltf, "gltf");
   // The keywords of `flexkin render`, set as the command sets them.
-  if (!every.is_none()) job.figure.every_k = py::cast<int>(every);
-  if (!title.is_none()) job.figure.title = job.animation.title = py::cast<std::string>(title);
-  if (!width.is_none()) {
-    job.figure.width = job.plot.width = job.animation.width = py::cast<int>(width);
+  DrawShorthands keywords;
+  keywords.every = Optional<int>(every);
+  keywords.width = Optional<int>(width);
+  keywords.height = Optional<int>(height);
+  keywords.azimuth = Optional<double>(azimuth);
+  keywords.elevation = Optional<double>(elevation);
+  keywords.fps = Optional<int>(fps);
+  keywords.max_frames = Optional<int>(max_frames);
+  keywords.max_strands = Optional<int>(max_strands);
+  keywords.title = Optional<std::string>(title);
+  keywords.ffmpeg = Optional<std::string>(ffmpeg);
+  ApplyShorthands(keywords, &options);
+  CheckKeywords(ValidateDrawOptions(kind, options));
+  if (file != nullptr && file->result.frames.empty()) {
+    ThrowInput("result.frames", "no frames; nothing to draw");
   }
-  if (!height.is_none()) {
-    job.figure.height = job.animation.height = py::cast<int>(height);
-    if (job.figure.height != 0) job.plot.height = job.figure.height;
-  }
-  if (!azimuth.is_none()) job.figure.azimuth = job.animation.azimuth = py::cast<double>(azimuth);
-  if (!elevation.is_none()) {
-    job.figure.elevation = job.animation.elevation = py::cast<double>(elevation);
-  }
-  if (!fps.is_none()) job.animation.fps = py::cast<int>(fps);
-  if (!max_frames.is_none()) job.animation.max_frames = py::cast<int>(max_frames);
-  if (!ffmpeg.is_none()) job.animation.ffmpeg = py::cast<std::string>(ffmpeg);
-  if (job.viewer.title.empty()) job.viewer.title = job.figure.title;
-  CheckOptions(job.figure.Validate());
-  CheckOptions(job.plot.Validate());
-  CheckOptions(job.animation.Validate());
-  const ResultFile* file = nullptr;
-  if (!trajectory) {
-    file = &ResultFileOfObject(result);
-    if (file->result.frames.empty()) ThrowInput("result.frames", "no frames; nothing to draw");
-  }
-  // The drawing's last point: n for a chain, the base (g - 1, point 0 the end effector) for a
-  // trajectory.
-  const Eigen::Index last =
-      trajectory ? trajectory->states.front().rows() - 1 : file->result.lengths.size();
-  for (size_t i = 0; i < job.viewer.trail_points.size(); ++i) {
-    if (job.viewer.trail_points[i] > last) {
-      ThrowInput("viewer.trail_points[" + std::to_string(i) + "]",
-                 "is not a point of the result; expected a point index <= " + std::to_string(last),
-                 std::to_string(job.viewer.trail_points[i]));
-    }
-  }
-  job.file = file;
-  if (trajectory) job.trajectory = &*trajectory;
-  job.base = dir + "/" + stem;
-  {
+  try {
     py::gil_scoped_release release;
-    std::error_code error;
-    std::filesystem::create_directories(dir, error);
-    if (error) throw std::system_error(error, "cannot create the output directory '" + dir + "'");
-    for (OutputFormat format : chosen) WriteFormat(format, &job);
+    if (trajectory) return Draw(*trajectory, options);
+    if (file != nullptr) return Draw(*file, options);
+    return DrawFile(path, options);  // names the file in its problems
+  } catch (const std::system_error& e) {
+    if (path.empty()) throw;
+    RethrowWithPath(e, path);
   }
-  return job.written;
 }
 
 void BindOptionClasses(py::module_& m) {
@@ -416,34 +315,39 @@ that is not valid glTF, has no skin, or uses what the reader does not support.
     formats_doc += std::string("\n  ") + entry.name + ": " + entry.summary;
   }
   m.def("render", &Render, py::arg("result"), py::arg("out_dir"), py::arg("formats") = py::none(),
-        py::kw_only(), py::arg("stem") = "result", py::arg("every") = py::none(),
+        py::kw_only(), py::arg("stem") = py::none(), py::arg("every") = py::none(),
         py::arg("width") = py::none(), py::arg("height") = py::none(),
         py::arg("azimuth") = py::none(), py::arg("elevation") = py::none(),
         py::arg("fps") = py::none(), py::arg("max_frames") = py::none(),
-        py::arg("title") = py::none(), py::arg("ffmpeg") = py::none(),
-        py::arg("figure") = py::none(), py::arg("plot") = py::none(),
-        py::arg("animation") = py::none(), py::arg("viewer") = py::none(),
-        py::arg("gltf") = py::none(),
+        py::arg("max_strands") = py::none(), py::arg("title") = py::none(),
+        py::arg("ffmpeg") = py::none(), py::arg("figure") = py::none(),
+        py::arg("plot") = py::none(), py::arg("animation") = py::none(),
+        py::arg("viewer") = py::none(), py::arg("gltf") = py::none(),
         (R"doc(
-Draws a Result (or a RobotResult) as `flexkin render` draws a result file (or a robot
-trajectory, docs/rendering.md) and returns the paths written.
+Draws a Result, a RobotResult, or a file flexkin wrote (a result file, a robot trajectory or a
+strand file, told apart by content) as `flexkin render` draws it (docs/rendering.md), through the
+same library call, and returns the paths written.
 
-render(result, out_dir, formats=None, *, stem="result", every=None,
+render(result, out_dir, formats=None, *, stem=None, every=None,
        width=None, height=None, azimuth=None, elevation=None, fps=None, max_frames=None,
-       title=None, ffmpeg=None, figure=None, plot=None, animation=None, viewer=None, gltf=None)
+       max_strands=None, title=None, ffmpeg=None, figure=None, plot=None, animation=None,
+       viewer=None, gltf=None)
   formats: a list of names or a comma-separated string, written to out_dir/<stem>.<ext>
     (out_dir created if missing), each file whole or not at all. None: svg, png, plots for a
-    Result; svg, png for a RobotResult, which is drawn in svg, png, pdf, mp4, gif and html only
-    (its arm as a chain whose end effector leads, the fixed base marked).
+    Result; svg, png for a RobotResult or a strand file, which are drawn in svg, png, pdf, mp4,
+    gif and html only (an arm as a chain whose end effector leads, the fixed base marked).
+  stem: the outputs' name; None: the file's name without .json/.npz, or "result" for an object.
   The command's options, None = its default: every (figures: every K-th frame, 0 automatic),
     width, height (pixels; height 0 = from the data), azimuth, elevation (3D view, degrees),
-    fps, max_frames (animations), title, ffmpeg (the program for mp4 and gif).
+    fps, max_frames (animations), max_strands (strand files), title, ffmpeg (the program for mp4
+    and gif).
   Every other member of the components' options: figure (FigureOptions), plot (PlotOptions),
     animation (AnimationOptions), viewer (ViewerOptions: playback, trails, digits, ...), gltf
     (GltfOptions: tube_radius, tube_sides, scale, up_axis, ...), each an options object or a
     dict of its fields; the keywords above are applied on top of them.
 The GIL is released while drawing. Raises InputError for an unknown format (listing the valid
-names), a format a RobotResult is not drawn in (naming the ones it is), or an invalid option (field the keyword, or "gltf.tube_sides" for an options object),
+names), a format a RobotResult or strand file is not drawn in (naming the ones it is), or an
+invalid option (field the keyword, or "gltf.tube_sides" for an options object),
 OSError for a file that cannot be written, RuntimeError when ffmpeg is missing or fails.
 Formats:)doc" +
          formats_doc)

@@ -45,8 +45,43 @@ def test_unknown_format_and_bad_options_refused(small_result, tmp_path):
     with pytest.raises(flexkin.InputError, match="width"):
         flexkin.render(small_result, tmp_path, ["png"], width=3)
     with pytest.raises(flexkin.InputError):
-        flexkin.render("not a result", tmp_path, ["png"])
+        flexkin.render(42, tmp_path, ["png"])
+    with pytest.raises(FileNotFoundError, match="no_such.json"):
+        flexkin.render(tmp_path / "no_such.json", tmp_path, ["png"])
     assert list(tmp_path.iterdir()) == []
+
+
+EXAMPLES = __import__("pathlib").Path(__file__).resolve().parents[2] / "examples"
+
+
+def test_files_of_every_kind_drawn_by_path_as_the_command_draws_them(small_result, tmp_path):
+    # One library call (flexkin/draw.h) draws what a file holds: a result, a robot trajectory or a
+    # strand file, told apart by content; the outputs are named after the file.
+    small_result.write(tmp_path / "chain.npz")
+    assert flexkin.render(tmp_path / "chain.npz", tmp_path / "out", "svg", width=128) == [
+        str(tmp_path / "out" / "chain.svg")]
+    flexkin.run_robot(EXAMPLES / "robot_planar_8link.json", output=tmp_path / "arm.json")
+    written = flexkin.render(tmp_path / "arm.json", tmp_path / "out", width=128)
+    assert written == [str(tmp_path / "out" / "arm.svg"), str(tmp_path / "out" / "arm.png")]
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.render(tmp_path / "arm.json", tmp_path / "out", "glb")
+    assert info.value.field == "formats" and "robot trajectories" in str(info.value)
+    flexkin.run_groom(EXAMPLES / "groom_grass_2d.json", tmp_path / "grass.npz")
+    written = flexkin.render(tmp_path / "grass.npz", tmp_path / "out", "png,html", width=160,
+                             max_strands=5)
+    assert written == [str(tmp_path / "out" / "grass.png"), str(tmp_path / "out" / "grass.html")]
+    assert (tmp_path / "out" / "grass.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.render(tmp_path / "grass.npz", tmp_path / "out", "plots")
+    assert info.value.field == "formats" and "strand files" in str(info.value)
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.render(tmp_path / "grass.npz", tmp_path / "out", "png", max_strands=-1)
+    assert info.value.field == "max_strands"
+    # A problem of the file is named by the file, as on the command line.
+    (tmp_path / "bad.json").write_text('{"format": "flexkin-result"}')
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.render(tmp_path / "bad.json", tmp_path / "out", "svg")
+    assert info.value.field.startswith(str(tmp_path / "bad.json"))
 
 
 def test_glb_and_html_hold_the_data(small_result, tmp_path):

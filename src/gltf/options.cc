@@ -3,7 +3,7 @@
 #include <string>
 
 #include "flexkin/error.h"
-#include "gltf/gltf.h"
+#include "flexkin/gltf.h"
 
 namespace flexkin {
 

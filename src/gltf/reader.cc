@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "flexkin/error.h"
-#include "gltf/gltf.h"
+#include "flexkin/gltf.h"
 #include "gltf/rig.h"
 
 namespace flexkin {

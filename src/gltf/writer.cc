@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "flexkin/error.h"
+#include "flexkin/gltf.h"
 #include "flexkin/propagate.h"
-#include "gltf/gltf.h"
 #include "gltf/rig.h"
 #include "gltf/tube.h"
 #include "io/atomic_file.h"

@@ -11,10 +11,10 @@
 #include <vector>
 
 #include "flexkin/error.h"
+#include "flexkin/render.h"
 #include "render/canvas.h"
 #include "render/checks.h"
 #include "render/ffmpeg_pipe.h"
-#include "render/render.h"
 #include "render/scene.h"
 #include "render/snapshot.h"
 

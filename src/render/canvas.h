@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "render/render.h"
+#include "flexkin/render.h"
 #include "render/style.h"
 
 namespace flexkin::render {

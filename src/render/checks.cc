@@ -8,7 +8,7 @@
 
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
-#include "render/render.h"
+#include "flexkin/render.h"
 
 namespace flexkin {
 namespace render {

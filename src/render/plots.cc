@@ -5,10 +5,10 @@
 #include <vector>
 
 #include "flexkin/error.h"
+#include "flexkin/render.h"
 #include "render/axes.h"
 #include "render/canvas.h"
 #include "render/checks.h"
-#include "render/render.h"
 #include "render/snapshot.h"
 
 namespace flexkin {

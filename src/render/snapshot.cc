@@ -6,9 +6,9 @@
 #include <cmath>
 #include <string>
 
+#include "flexkin/render.h"
 #include "render/canvas.h"
 #include "render/checks.h"
-#include "render/render.h"
 
 namespace flexkin {
 namespace render {

@@ -7,10 +7,10 @@
 #include <string>
 #include <vector>
 
+#include "flexkin/render.h"
 #include "render/axes.h"
 #include "render/checks.h"
 #include "render/legend.h"
-#include "render/render.h"
 #include "render/scene.h"
 
 namespace flexkin::render {

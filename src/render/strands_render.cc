@@ -1,6 +1,6 @@
 // RenderStrandsSnapshot and RenderStrandsAnimation: strand files read frame by frame, drawn with
 // the scene of strands_scene.h; the figure through SaveCanvas, the animation piped into ffmpeg.
-#include "render/strands_render.h"
+#include "flexkin/strands_render.h"
 
 #include <unistd.h>
 
@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
+#include "flexkin/render.h"
 #include "render/canvas.h"
 #include "render/checks.h"
 #include "render/ffmpeg_pipe.h"
-#include "render/render.h"
 #include "render/snapshot.h"
 #include "render/strands_scene.h"
 

@@ -156,7 +156,7 @@ class ChainMover {
       internal::CheckOverallOptionsForChain(options.overall, chain.dim());
       workspace_.emplace();
     } else {
-      stepper_ = MakeStepper(options.method, chain);
+      stepper_ = internal::MakeStepperUnchecked(options.method, chain);
     }
   }
   void Step(const Eigen::VectorXd& head, int64_t step, int substep, Points* points) {
@@ -433,7 +433,7 @@ AccuracyReport ChooseSubsteps(const Chain& chain, const Points& leader_steps,
   report.tolerance = options.tolerance;
   report.max_substeps = options.max_substeps;
   report.order = MethodOrder(options.method);
-  const Stepper stepper = MakeStepper(options.method, chain);
+  const Stepper stepper = internal::MakeStepperUnchecked(options.method, chain);
   const int64_t num_steps = leader_steps.rows();
   // Blocks of at most 32 MiB of configurations.
   const int64_t block =
@@ -536,7 +536,7 @@ RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& 
   };
 
   if (Pipelined(options.method)) {
-    const Stepper stepper = MakeStepper(options.method, chain);
+    const Stepper stepper = internal::MakeStepperUnchecked(options.method, chain);
     SweepPipeline pipeline(stepper, chain.points, leader_steps, substeps, &result.metrics);
     Eigen::VectorXd direction = first_direction;
     const auto on_frame = [&](int64_t done, const Points& points) {

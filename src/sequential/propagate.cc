@@ -1,5 +1,6 @@
 #include "flexkin/propagate.h"
 
+#include <cassert>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -226,6 +227,11 @@ Stepper MakeStepper(Method method, const Chain& chain) {
                                    "OverallStep (overall.h), or use " +
                                    QuotedList(internal::RuleNamesOn(~0u)));
   }
+  return internal::MakeStepperUnchecked(method, chain);
+}
+
+Stepper internal::MakeStepperUnchecked(Method method, const Chain& chain) {
+  assert(internal::RuleRunsOn(method, ~0u));
   Stepper s;
   s.method = method;
   s.dim = chain.dim();

@@ -11,6 +11,10 @@
 namespace flexkin::internal {
 
 // One sweep after another: the reference order of operations.
+// MakeStepper without its checks, for callers that validated `chain` and know `method` is a link
+// rule (Run: checked once, at the boundary).
+Stepper MakeStepperUnchecked(Method method, const Chain& chain);
+
 void SweepsScalar(Method method, int dim, const double* heads, int64_t num_sweeps,
                   const double* lengths, const double* inv_lengths, int num_links, double* points);
 

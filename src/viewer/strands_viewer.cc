@@ -1,4 +1,4 @@
-#include "viewer/strands_viewer.h"
+#include "flexkin/strands_viewer.h"
 
 #include <zlib.h>
 

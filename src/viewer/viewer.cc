@@ -1,4 +1,4 @@
-#include "viewer/viewer.h"
+#include "flexkin/viewer.h"
 
 #include <cassert>
 #include <cmath>

@@ -29,7 +29,7 @@
   data.positions = null;
   const steps = Float64Array.from(data.steps);
   const options = data.options;
-  // A robot trajectory (src/viewer/viewer.h): point 0 the end effector, the last the fixed base.
+  // A robot trajectory (include/flexkin/viewer.h): point 0 the end effector, the last the fixed base.
   const robot = data.robot || null;
 
   // Bounding box of the whole motion, its centre and the radius of its bounding sphere.

@@ -2,7 +2,7 @@
 
 #include <string>
 
-#include "viewer/viewer.h"
+#include "flexkin/viewer.h"
 
 namespace flexkin::viewer_internal {
 
@@ -10,7 +10,7 @@ namespace flexkin::viewer_internal {
 // result's frames as one flat array of coordinates, per-frame steps and link-length errors, the
 // metrics and the page options. Strings have '<', '>' and '&' escaped as \u003c and so on, so the
 // text can sit inside a <script> element without closing it. Throws InputError as
-// WriteViewerHtml (src/viewer/viewer.h) for a result that cannot be shown; `options` must be
+// WriteViewerHtml (include/flexkin/viewer.h) for a result that cannot be shown; `options` must be
 // valid.
 // `robot`: the trajectory that `result` was made from (RobotTrajectoryAsResult), whose facts go
 // into a "robot" object (method, targets, unreached, max_ee_error) that the page shows instead of

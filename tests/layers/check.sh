@@ -16,7 +16,8 @@ declare -A header_layer=(
   [arm]=arm [strands]=strands [groom]=groom [strand_file]=groom
   [scenario]=io [result_io]=io [robot_scenario]=io [scenario_kind]=io [any_scenario]=scenario
   [flexkin]=umbrella
-  [render]=render [viewer]=viewer [gltf]=gltf [urdf]=urdf
+  [render]=render [strands_render]=render [viewer]=viewer [strands_viewer]=viewer [gltf]=gltf
+  [urdf]=urdf [draw]=draw
 )
 # What each layer may include besides itself.
 declare -A allowed=(
@@ -34,7 +35,8 @@ declare -A allowed=(
   [viewer]="chain sequential overall run arm io strands groom"
   [gltf]="chain sequential overall run arm io render"
   [urdf]="chain sequential overall run arm io"
-  [apps]="chain sequential overall run arm io strands groom scenario render viewer gltf urdf"
+  [draw]="chain sequential overall run arm io strands groom render viewer gltf"
+  [apps]="chain sequential overall run arm io strands groom scenario render viewer gltf urdf draw"
 )
 
 layer_of_path() {  # a file of the tree -> its layer

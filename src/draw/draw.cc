@@ -1,0 +1,395 @@
+// Draw: the table of output formats and the one dispatch from a file of any kind to its writers
+// (include/flexkin/draw.h), shared by `flexkin render` and flexkin.render.
+#include "flexkin/draw.h"
+
+#include <filesystem>
+#include <memory>
+#include <system_error>
+
+#include "flexkin/error.h"
+#include "flexkin/strand_file.h"
+
+namespace flexkin {
+namespace {
+
+// How each format is written for each kind: the suffix of its file and the writer. A format a
+// kind has no writer for is not drawn in for it (FormatsOf).
+struct Output {
+  const ResultFile* result = nullptr;
+  const RobotTrajectoryFile* trajectory = nullptr;
+  const std::string* strand_path = nullptr;
+  const DrawOptions* options = nullptr;
+  std::vector<std::string>* written = nullptr;
+
+  void Write(const std::string& path, const std::function<void()>& write) const {
+    if (options->writing) options->writing(path);
+    write();
+    written->push_back(path);
+  }
+};
+
+std::string Extension(OutputFormat format) { return std::string(".") + NameOf(format); }
+
+void Figure(const Output& o, OutputFormat format) {
+  const std::string path = o.options->base + Extension(format);
+  o.Write(path, [&] {
+    if (o.trajectory != nullptr) {
+      WriteSnapshotFigure(*o.trajectory, o.options->figure, path);
+    } else {
+      WriteSnapshotFigure(*o.result, o.options->figure, path);
+    }
+  });
+}
+
+void Plots(const Output& o) {
+  const bool have_angles = o.result->result.frames.front().link_angles.size() > 0;
+  for (const auto& [kind, name, summary] : Vocabulary<PlotKind>::kEntries) {
+    if (kind == PlotKind::kLinkAngles && !have_angles) {
+      if (o.options->note) o.options->note("no link_angles plot: the leading end never moves");
+      continue;
+    }
+    for (const char* extension : {".svg", ".png"}) {
+      const std::string path = o.options->base + "_" + name + extension;
+      o.Write(path, [&] { WritePlot(*o.result, kind, o.options->plot, path); });
+    }
+  }
+}
+
+void Animation(const Output& o, OutputFormat format) {
+  const std::string path = o.options->base + Extension(format);
+  o.Write(path, [&] {
+    if (o.trajectory != nullptr) {
+      WriteAnimation(*o.trajectory, o.options->animation, path);
+    } else {
+      WriteAnimation(*o.result, o.options->animation, path);
+    }
+  });
+}
+
+ViewerOptions ViewerWithTitle(const DrawOptions& options) {
+  ViewerOptions viewer = options.viewer;
+  if (viewer.title.empty()) viewer.title = options.figure.title;
+  return viewer;
+}
+
+void Viewer(const Output& o) {
+  const std::string path = o.options->base + ".html";
+  o.Write(path, [&] {
+    if (o.trajectory != nullptr) {
+      WriteViewerHtml(*o.trajectory, ViewerWithTitle(*o.options), path);
+    } else {
+      WriteViewerHtml(*o.result, ViewerWithTitle(*o.options), path);
+    }
+  });
+}
+
+void Gltf(const Output& o, OutputFormat format) {
+  const std::string path = o.options->base + Extension(format);
+  o.Write(path, [&] { WriteGltf(*o.result, o.options->gltf, path); });
+}
+
+// A strand file's outputs: each writer reads the whole file, with a reader of its own.
+void StrandOutput(const Output& o, OutputFormat format) {
+  const std::string path = o.options->base + Extension(format);
+  o.Write(path, [&] {
+    StrandFileReader reader(*o.strand_path);
+    switch (format) {
+      case OutputFormat::kMp4:
+      case OutputFormat::kGif:
+        RenderStrandsAnimation(&reader, o.options->strands, path);
+        return;
+      case OutputFormat::kHtml:
+        WriteStrandsViewerHtml(&reader, o.options->strands_viewer, path);
+        return;
+      default:
+        RenderStrandsSnapshot(&reader, o.options->strands, path);
+        return;
+    }
+  });
+}
+
+// The one table: for each format, its writer for each kind (null: not drawn in for that kind).
+// Add a format with one line here and one in the vocabulary (flexkin/render.h).
+struct FormatWriters {
+  OutputFormat format;
+  void (*chain)(const Output&, OutputFormat);
+  void (*trajectory)(const Output&, OutputFormat);
+  void (*strands)(const Output&, OutputFormat);
+};
+void PlotsOf(const Output& o, OutputFormat) { Plots(o); }
+void ViewerOf(const Output& o, OutputFormat) { Viewer(o); }
+constexpr FormatWriters kWriters[] = {
+    {OutputFormat::kSvg, Figure, Figure, StrandOutput},
+    {OutputFormat::kPng, Figure, Figure, StrandOutput},
+    {OutputFormat::kPdf, Figure, Figure, StrandOutput},
+    {OutputFormat::kPlots, PlotsOf, nullptr, nullptr},
+    {OutputFormat::kMp4, Animation, Animation, StrandOutput},
+    {OutputFormat::kGif, Animation, Animation, StrandOutput},
+    {OutputFormat::kHtml, ViewerOf, ViewerOf, StrandOutput},
+    {OutputFormat::kGltf, Gltf, nullptr, nullptr},
+    {OutputFormat::kGlb, Gltf, nullptr, nullptr},
+};
+static_assert(std::size(kWriters) == std::size(Vocabulary<OutputFormat>::kEntries),
+              "every output format has a row of writers");
+
+using Writer = void (*)(const Output&, OutputFormat);
+Writer WriterOf(DrawnKind kind, OutputFormat format) {
+  for (const FormatWriters& w : kWriters) {
+    if (w.format != format) continue;
+    return kind == DrawnKind::kChainResult       ? w.chain
+           : kind == DrawnKind::kRobotTrajectory ? w.trajectory
+                                                 : w.strands;
+  }
+  return nullptr;
+}
+
+const char* KindName(DrawnKind kind) {
+  return kind == DrawnKind::kChainResult       ? "chain results"
+         : kind == DrawnKind::kRobotTrajectory ? "robot trajectories"
+                                               : "strand files";
+}
+
+void Prefixed(const Problems& problems, const std::string& prefix, Problems* out) {
+  for (Problem p : problems) {
+    p.field = prefix + p.field;
+    out->push_back(std::move(p));
+  }
+}
+
+// The viewer's trails name points of the drawing: at most its last point (n for a chain, the
+// base for a trajectory, point 0 its end effector).
+void CheckTrailPoints(const Output& o) {
+  const std::vector<int>& trails = o.options->viewer.trail_points;
+  Eigen::Index last = -1;
+  if (o.result != nullptr) last = o.result->result.lengths.size();
+  if (o.trajectory != nullptr && !o.trajectory->states.empty()) {
+    last = o.trajectory->states.front().rows() - 1;
+  }
+  if (last < 0) return;
+  for (size_t i = 0; i < trails.size(); ++i) {
+    if (trails[i] > last) {
+      throw InputError(
+          Problem("viewer.trail_points[" + std::to_string(i) + "]",
+                  "is not a point of the result; expected a point index <= " + std::to_string(last),
+                  std::to_string(trails[i]), "<= " + std::to_string(last)));
+    }
+  }
+}
+
+// Draws with options already validated for `kind`.
+std::vector<std::string> DrawChecked(DrawnKind kind, const Output& o) {
+  CheckTrailPoints(o);
+  const std::filesystem::path dir = std::filesystem::path(o.options->base).parent_path();
+  if (!dir.empty()) {
+    std::error_code error;
+    std::filesystem::create_directories(dir, error);
+    if (error) {
+      throw std::system_error(error, "cannot create the output directory '" + dir.string() + "'");
+    }
+  }
+  const std::vector<OutputFormat> formats =
+      o.options->formats.empty() ? DefaultFormats(kind) : o.options->formats;
+  for (OutputFormat format : formats) WriterOf(kind, format)(o, format);
+  return *o.written;
+}
+
+}  // namespace
+
+void ApplyShorthands(const DrawShorthands& s, DrawOptions* o) {
+  if (s.every) o->figure.every_k = o->strands.every_k = *s.every;
+  if (s.title) {
+    o->figure.title = o->animation.title = o->strands.title = o->strands_viewer.title = *s.title;
+  }
+  if (s.width) o->figure.width = o->plot.width = o->animation.width = o->strands.width = *s.width;
+  if (s.height) {
+    o->figure.height = o->animation.height = o->strands.height = *s.height;
+    if (*s.height != 0) o->plot.height = *s.height;
+  }
+  if (s.azimuth) {
+    o->figure.azimuth = o->animation.azimuth = o->strands.azimuth = o->strands_viewer.azimuth =
+        *s.azimuth;
+  }
+  if (s.elevation) {
+    o->figure.elevation = o->animation.elevation = o->strands.elevation =
+        o->strands_viewer.elevation = *s.elevation;
+  }
+  if (s.fps) o->animation.fps = o->strands.fps = *s.fps;
+  if (s.max_frames) {
+    o->animation.max_frames = o->strands.max_frames = o->strands_viewer.max_frames = *s.max_frames;
+  }
+  if (s.max_strands) o->strands.max_strands = o->strands_viewer.max_strands = *s.max_strands;
+  if (s.ffmpeg) o->animation.ffmpeg = o->strands.ffmpeg = *s.ffmpeg;
+}
+
+std::vector<OutputFormat> FormatsOf(DrawnKind kind) {
+  std::vector<OutputFormat> formats;
+  for (const FormatWriters& w : kWriters) {
+    if (WriterOf(kind, w.format) != nullptr) formats.push_back(w.format);
+  }
+  return formats;
+}
+
+Problems ValidateDrawOptions(DrawnKind kind, const DrawOptions& options) {
+  Problems problems;
+  for (OutputFormat format : options.formats) {
+    if (WriterOf(kind, format) != nullptr) continue;
+    std::string valid;
+    for (OutputFormat f : FormatsOf(kind))
+      valid += (valid.empty() ? "" : ", ") + std::string(NameOf(f));
+    const std::string name = NameOf(format);
+    problems.push_back(Problem("formats",
+                               "format \"" + name + "\" is not available for " + KindName(kind) +
+                                   " (it draws chain results only); expected formats among " +
+                                   valid,
+                               "\"" + name + "\"", valid));
+  }
+  if (kind == DrawnKind::kStrandFile) {
+    Prefixed(options.strands.Validate(), "strands.", &problems);
+    Prefixed(options.strands_viewer.Validate(), "strands_viewer.", &problems);
+  } else {
+    Prefixed(options.figure.Validate(), "figure.", &problems);
+    Prefixed(options.animation.Validate(), "animation.", &problems);
+    Prefixed(options.viewer.Validate(), "viewer.", &problems);
+    if (kind == DrawnKind::kChainResult) {
+      Prefixed(options.plot.Validate(), "plot.", &problems);
+      Prefixed(options.gltf.Validate(), "gltf.", &problems);
+    }
+  }
+  return problems;
+}
+
+std::vector<OutputFormat> DefaultFormats(DrawnKind kind) {
+  if (kind == DrawnKind::kChainResult) {
+    return {OutputFormat::kSvg, OutputFormat::kPng, OutputFormat::kPlots};
+  }
+  return {OutputFormat::kSvg, OutputFormat::kPng};
+}
+
+std::vector<OutputFormat> ParseOutputFormats(const std::vector<std::string>& names,
+                                             const std::string& field) {
+  std::vector<bool> chosen(std::size(Vocabulary<OutputFormat>::kEntries), false);
+  for (const std::string& name : names) {
+    const NamedValue<OutputFormat>* entry = FindName<OutputFormat>(name);
+    if (entry == nullptr) {
+      std::string valid;
+      for (const std::string& n : NamesOf<OutputFormat>()) valid += (valid.empty() ? "" : ", ") + n;
+      throw InputError(Problem(
+          field, "unknown format \"" + name + "\"; expected a comma-separated list of " + valid,
+          "\"" + name + "\"", valid));
+    }
+    chosen[static_cast<size_t>(entry - Vocabulary<OutputFormat>::kEntries)] = true;
+  }
+  std::vector<OutputFormat> formats;
+  for (size_t i = 0; i < chosen.size(); ++i) {
+    if (chosen[i]) formats.push_back(Vocabulary<OutputFormat>::kEntries[i].value);
+  }
+  if (formats.empty()) throw InputError(field, "is empty; expected at least one format name");
+  return formats;
+}
+
+std::vector<OutputFormat> ParseOutputFormats(const std::string& list, const std::string& field) {
+  std::vector<std::string> names;
+  size_t start = 0;
+  while (start <= list.size()) {
+    size_t end = list.find(',', start);
+    if (end == std::string::npos) end = list.size();
+    names.push_back(list.substr(start, end - start));
+    start = end + 1;
+  }
+  return ParseOutputFormats(names, field);
+}
+
+std::vector<std::string> Draw(const ResultFile& result, const DrawOptions& options) {
+  ThrowIfAny(ValidateDrawOptions(DrawnKind::kChainResult, options));
+  if (result.result.frames.empty()) throw InputError("frames", "no frames; nothing to draw");
+  std::vector<std::string> written;
+  Output o;
+  o.result = &result;
+  o.options = &options;
+  o.written = &written;
+  return DrawChecked(DrawnKind::kChainResult, o);
+}
+
+std::vector<std::string> Draw(const RobotTrajectoryFile& trajectory, const DrawOptions& options) {
+  ThrowIfAny(ValidateDrawOptions(DrawnKind::kRobotTrajectory, options));
+  std::vector<std::string> written;
+  Output o;
+  o.trajectory = &trajectory;
+  o.options = &options;
+  o.written = &written;
+  return DrawChecked(DrawnKind::kRobotTrajectory, o);
+}
+
+std::vector<std::string> DrawStrandFile(const std::string& path, const DrawOptions& options) {
+  ThrowIfAny(ValidateDrawOptions(DrawnKind::kStrandFile, options));
+  StrandFileReader check(path);  // the file's own problems before any output
+  std::vector<std::string> written;
+  Output o;
+  o.strand_path = &path;
+  o.options = &options;
+  o.written = &written;
+  return DrawChecked(DrawnKind::kStrandFile, o);
+}
+
+DrawnKind KindOfDrawnFile(const std::string& path) {
+  if (IsStrandFile(path)) return DrawnKind::kStrandFile;
+  if (IsRobotTrajectoryFile(path)) return DrawnKind::kRobotTrajectory;
+  return DrawnKind::kChainResult;
+}
+
+std::vector<std::string> DrawFile(const std::string& path, const DrawOptions& options) {
+  const DrawnKind kind = KindOfDrawnFile(path);
+  ThrowIfAny(ValidateDrawOptions(kind, options));  // the options' problems first, once
+  std::vector<std::string> written;
+  Output o;
+  o.options = &options;
+  o.written = &written;
+  ResultFile result;
+  RobotTrajectoryFile trajectory;
+  try {
+    // The file read once; its problems, found reading or drawing, are named by the file
+    // ("r.json: /frames/3/points/2/1"), except an option found wrong only against the file
+    // ("options.max_frames": the viewer page's size; "viewer.trail_points[0]"), which is the
+    // options'.
+    switch (kind) {
+      case DrawnKind::kStrandFile: {
+        StrandFileReader check(path);
+        o.strand_path = &path;
+        break;
+      }
+      case DrawnKind::kRobotTrajectory:
+        trajectory = ReadRobotTrajectoryFile(path);
+        o.trajectory = &trajectory;
+        break;
+      case DrawnKind::kChainResult:
+        result = ReadResultFile(path);  // JSON or .npz, by content
+        if (result.result.frames.empty()) throw InputError("/frames", "no frames; nothing to draw");
+        o.result = &result;
+        break;
+    }
+    return DrawChecked(kind, o);
+  } catch (const InputError& e) {
+    if (e.field().rfind("options.", 0) == 0 || e.field().rfind("viewer.", 0) == 0) throw;
+    Problem p = e.problem();
+    p.field = path + (p.field.empty() ? "" : ": " + p.field);
+    throw InputError(p);
+  }
+}
+
+std::string OutputBaseOf(const std::string& path, const std::string& output_dir) {
+  std::string stem = std::filesystem::path(path).filename().string();
+  for (const std::string extension : {".json", ".npz"}) {
+    if (stem.size() > extension.size() &&
+        stem.compare(stem.size() - extension.size(), extension.size(), extension) == 0) {
+      stem.resize(stem.size() - extension.size());
+    }
+  }
+  std::string dir = output_dir;
+  if (dir.empty()) {
+    dir = std::filesystem::path(path).parent_path().string();
+    if (dir.empty()) dir = ".";
+  }
+  return dir + "/" + stem;
+}
+
+}  // namespace flexkin
