@@ -149,19 +149,6 @@ std::string MethodHelp() {
   return help;
 }
 
-// Hands every frame to each of the sinks (the result file and the CSV file).
-class FanOutSink : public flexkin::FrameSink {
- public:
-  explicit FanOutSink(std::vector<flexkin::FrameSink*> sinks) : sinks_(std::move(sinks)) {}
-  void Add(int64_t step, const flexkin::PointsRef& points,
-           const flexkin::VectorRef& link_angles) override {
-    for (flexkin::FrameSink* sink : sinks_) sink->Add(step, points, link_angles);
-  }
-
- private:
-  std::vector<flexkin::FrameSink*> sinks_;
-};
-
 // The smallest record_every (above the scenario's) whose output fits in `limit`; 0 if none does.
 int64_t RecordEveryThatFits(const flexkin::Scenario& s, flexkin::ResultFileFormat format, bool csv,
                             uint64_t limit) {
@@ -290,21 +277,10 @@ int RunCommand(const RunArgs& args) {
   flexkin::cli::Writing(args.output + (args.csv.empty() ? "" : " or " + args.csv));
 
   // The frames stream to the files as the run records them; the files are renamed into place
-  // only after the run, and removed if it fails.
-  flexkin::ResultFileWriter writer(
-      args.output, format,
-      flexkin::MakeResultHeader(scenario.chain, scenario.options, scenario.name));
-  std::vector<flexkin::FrameSink*> sinks = {&writer};
-  std::unique_ptr<flexkin::FramesCsvWriter> csv;
-  if (!args.csv.empty()) {
-    csv = std::make_unique<flexkin::FramesCsvWriter>(args.csv, scenario.chain.dim());
-    sinks.push_back(csv.get());
-  }
-  FanOutSink sink(sinks);
+  // only after the run, and removed if it fails (flexkin/result_io.h).
   const flexkin::RunResult result =
-      flexkin::Run(scenario.chain, scenario.leader_steps, scenario.options, &sink);
-  writer.Commit(result);
-  if (csv) csv->Commit();
+      flexkin::RunToFiles(scenario.chain, scenario.leader_steps, scenario.options, scenario.name,
+                          {args.output, args.csv});
 
   if (!args.quiet) {
     std::cout << (args.report == "full" ? result.FullReport() : result.BriefReport() + "\n");

@@ -88,23 +88,16 @@ int RobotCommand::Run() const {
   CheckOutputDirectory(output_);
   if (!csv_.empty()) CheckOutputDirectory(csv_);
   // Streamed: the steps go to the files as they are produced, so memory does not grow with the
-  // targets; each file is renamed into place only when complete.
-  RobotTrajectoryWriter json_writer(s, output_);
-  std::optional<RobotJointsCsvWriter> csv_writer;
+  // targets; each file is renamed into place only when complete (flexkin/robot_scenario.h).
   InterruptCheck interrupt_check;
-  std::vector<ArmStepSink*> sinks = {&interrupt_check, &json_writer};
   Writing(output_ + (csv_.empty() ? "" : " or " + csv_));
-  if (!csv_.empty()) sinks.push_back(&csv_writer.emplace(s, csv_));
-  ArmStepFanOut sink(sinks);
   if (!quiet_) std::cout << JointGroupsReport(s.model);
   if (fixed_point) {  // what the user chose, in the library's words, before the wait
     std::cerr << "flexkin: note: method fixed_point is "
               << MethodSummary(FixedBaseMethod::kFixedPoint)
               << "; method newton (the default) is the one to use\n";
   }
-  const ArmTrajectory t = TrackPath(s.model, s.path, s.options, &sink);
-  json_writer.Commit(t);
-  if (csv_writer) csv_writer->Commit(t);
+  const ArmTrajectory t = TrackToFiles(s, output_, csv_, &interrupt_check);
   if (!quiet_) std::cout << t.BriefReport() << "\n";
   if (t.unreached > 0) {
     std::cerr << "flexkin: warning: " << t.unreached << " of " << t.num_steps

@@ -44,6 +44,35 @@ struct ResultHeader {
 ResultHeader MakeResultHeader(const Chain& chain, const RunOptions& options,
                               const std::string& scenario_name = "");
 
+// A FrameSink that hands every frame to each of `sinks` in turn (a result file, a CSV file,
+// arrays).
+class FrameFanOut : public FrameSink {
+ public:
+  explicit FrameFanOut(std::vector<FrameSink*> sinks) : sinks_(std::move(sinks)) {}
+  void Add(int64_t step, const PointsRef& points, const VectorRef& link_angles) override {
+    for (FrameSink* sink : sinks_) sink->Add(step, points, link_angles);
+  }
+
+ private:
+  std::vector<FrameSink*> sinks_;
+};
+
+// Where a run writes as it goes: the result file (JSON or .npz by the extension of `result`,
+// ResultFileFormatOfPath) and the frames CSV; an empty path writes no such file.
+struct RunFiles {
+  std::string result;
+  std::string csv;
+};
+
+// The one call that runs a chain into files, as `flexkin run` and Python's run_scenario(output=)
+// do: the frames stream to the files (and to `also`, if not null: arrays, a viewer) while the run
+// records them, in bounded memory; each file is renamed into place only when the run and the file
+// are complete, and removed, an existing file untouched, if either fails. Returns the run's result
+// without its frames (they went to the sinks). Throws what Run and the writers throw.
+RunResult RunToFiles(const Chain& chain, const Points& leader_steps, const RunOptions& options,
+                     const std::string& scenario_name, const RunFiles& files,
+                     FrameSink* also = nullptr);
+
 // A FrameSink that writes a result file while the run produces its frames, in bounded memory
 // (one frame and a buffer; the .npz writer keeps the frames' step numbers, 8 bytes a frame, and
 // puts the link angles in an unlinked scratch file in the destination's directory until Commit):

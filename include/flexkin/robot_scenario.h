@@ -193,6 +193,15 @@ class RobotJointsCsvWriter : public ArmStepSink {
   int64_t steps_ = 0;
 };
 
+// The one call that tracks a robot scenario into files, as `flexkin robot -o --csv` and Python's
+// run_robot(output=, csv=) do: the steps stream to the trajectory JSON `trajectory` and, if `csv`
+// is not empty, the joint CSV (each renamed into place only when complete, removed if the tracking
+// or the file fails), and to `also` if not null (arrays, an interrupt check; it sees each step
+// after the files). Either path may be empty: that file is not written. Returns the trajectory
+// summary (its steps went to the sinks).
+ArmTrajectory TrackToFiles(const RobotScenario& scenario, const std::string& trajectory,
+                           const std::string& csv, ArmStepSink* also = nullptr);
+
 // A trajectory file (WriteRobotTrajectoryJson, RobotTrajectoryWriter) read back: what drawing
 // it takes (docs/rendering.md, "Robot trajectories"). Robot order: point 0 of each state is the
 // base.

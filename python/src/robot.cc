@@ -190,16 +190,7 @@ RobotResult Track(const RobotScenario& s, py::object progress, const std::string
   StepArrays arrays(count, model, spherical, &hook);
   try {
     py::gil_scoped_release release;
-    std::optional<RobotTrajectoryWriter> json;
-    std::optional<RobotJointsCsvWriter> table;
-    std::vector<ArmStepSink*> sinks;
-    if (!output.empty()) sinks.push_back(&json.emplace(s, output));
-    if (!csv.empty()) sinks.push_back(&table.emplace(s, csv));
-    sinks.push_back(&arrays);
-    ArmStepFanOut sink(sinks);
-    r.summary = TrackPath(model, s.path, s.options, &sink);
-    if (json) json->Commit(r.summary);
-    if (table) table->Commit(r.summary);
+    r.summary = TrackToFiles(s, output, csv, &arrays);  // the files only if paths were given
   } catch (const StopRun&) {
     hook.Rethrow();
   }

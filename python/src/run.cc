@@ -114,8 +114,10 @@ auto RunSet(M RunResult::*member) {
   return [member](Result& r, py::handle value) { r.file.result.*member = py::cast<M>(value); };
 }
 
+// The run, its frames kept densely for the Result; with `files`, streamed to them as well
+// through the library's one call (RunToFiles), as `flexkin run -o --csv` writes them.
 Result RunToArrays(const Chain& chain, const Points& leader_steps, RunOptions options,
-                   py::object progress, std::string scenario) {
+                   py::object progress, std::string scenario, const RunFiles& files = {}) {
   Result result;
   result.file.dim = chain.dim();
   result.file.scenario_name = std::move(scenario);
@@ -123,7 +125,14 @@ Result RunToArrays(const Chain& chain, const Points& leader_steps, RunOptions op
   hook.Install(&options.progress);
   try {
     py::gil_scoped_release release;
-    result.file.result = Run(chain, leader_steps, options);  // checks the inputs (InputError)
+    if (files.result.empty() && files.csv.empty()) {
+      result.file.result = Run(chain, leader_steps, options);  // checks the inputs (InputError)
+    } else {
+      FrameRecorder recorder;
+      result.file.result =
+          RunToFiles(chain, leader_steps, options, result.file.scenario_name, files, &recorder);
+      result.file.result.frames = std::move(recorder.frames);
+    }
   } catch (const StopRun&) {
     hook.Rethrow();
   }
@@ -465,13 +474,20 @@ changed before flexkin.run_scenario runs it.
         "problem (field '/leader/steps'), OSError for a file that cannot be read.");
   m.def(
       "run_scenario",
-      [](ScenarioSource scenario, ProgressCallback progress) {
+      [](ScenarioSource scenario, ProgressCallback progress, OptionalPath output,
+         OptionalPath csv) {
         const Scenario s = ScenarioArg(scenario);
-        return RunToArrays(s.chain, s.leader_steps, s.options, std::move(progress), s.name);
+        const RunFiles files{RequiredPath(output, "output", true), RequiredPath(csv, "csv", true)};
+        if (!files.result.empty()) ResultFileFormatOfPath(files.result, "output");
+        return RunToArrays(s.chain, s.leader_steps, s.options, std::move(progress), s.name, files);
       },
       py::arg("scenario"), py::kw_only(), py::arg("progress") = py::none(),
+      py::arg("output") = py::none(), py::arg("csv") = py::none(),
       "Runs a scenario (a path, a dict of the scenario JSON form, or a Scenario) as `flexkin "
-      "run` does, with the same result bit for bit. Returns a Result; progress as in run.");
+      "run` does, with the same result bit for bit. Returns a Result; progress as in run. "
+      "output, csv: None or the paths of the result file (.json or .npz) and the frames CSV, "
+      "written as `flexkin run -o --csv` writes them, through the same library call "
+      "(RunToFiles): streamed while the run goes, renamed into place only when complete.");
 }
 
 }  // namespace flexkin::python

@@ -154,3 +154,27 @@ def test_result_arrays_are_views_of_the_dense_frames(tmp_path):
     assert np.array_equal(again.frames, back.frames) and again.frames.base is again
     assert np.array_equal(again.link_angles, back.link_angles)
     assert again == back
+
+
+def test_run_scenario_writes_result_and_csv_files(tmp_path):
+    # run_scenario(output=, csv=) goes through the library's one call (RunToFiles), as
+    # `flexkin run -o --csv` does; the Result keeps its frames.
+    scenario = EXAMPLES / "fig10_planar_curve.json"
+    res = flexkin.run_scenario(scenario, output=tmp_path / "py.npz", csv=tmp_path / "py.csv")
+    back = flexkin.read_result(tmp_path / "py.npz")
+    assert np.array_equal(back.frames, res.frames) and np.array_equal(back.steps, res.steps)
+    assert back.scenario == res.scenario != ""
+    assert (tmp_path / "py.csv").read_text().startswith("step,point,x,y\n")
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.run_scenario(scenario, output=tmp_path / "r.txt")
+    assert info.value.field == "output"
+    assert not (tmp_path / "r.txt").exists()
+
+
+def test_run_scenario_files_equal_the_command_lines(cli, tmp_path):
+    scenario = EXAMPLES / "fig10_planar_curve.json"
+    res = flexkin.run_scenario(scenario, output=tmp_path / "py.npz", csv=tmp_path / "py.csv")
+    subprocess.run([cli, "run", str(scenario), "-o", str(tmp_path / "cli.npz"), "--csv",
+                    str(tmp_path / "cli.csv"), "-q"], check=True)
+    assert (tmp_path / "cli.csv").read_bytes() == (tmp_path / "py.csv").read_bytes()
+    assert np.array_equal(flexkin.read_result(tmp_path / "cli.npz").frames, res.frames)

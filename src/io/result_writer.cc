@@ -434,4 +434,22 @@ void WriteFramesCsv(const RunResult& result, const std::string& path) {
   writer.Commit();
 }
 
+RunResult RunToFiles(const Chain& chain, const Points& leader_steps, const RunOptions& options,
+                     const std::string& scenario_name, const RunFiles& files, FrameSink* also) {
+  std::optional<ResultFileWriter> writer;
+  std::vector<FrameSink*> sinks;
+  if (!files.result.empty()) {
+    sinks.push_back(&writer.emplace(files.result, ResultFileFormatOfPath(files.result),
+                                    MakeResultHeader(chain, options, scenario_name)));
+  }
+  std::optional<FramesCsvWriter> csv;
+  if (!files.csv.empty()) sinks.push_back(&csv.emplace(files.csv, chain.dim()));
+  if (also != nullptr) sinks.push_back(also);
+  FrameFanOut sink(sinks);
+  RunResult result = Run(chain, leader_steps, options, &sink);
+  if (writer) writer->Commit(result);
+  if (csv) csv->Commit();
+  return result;
+}
+
 }  // namespace flexkin

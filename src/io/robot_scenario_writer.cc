@@ -428,4 +428,19 @@ void RobotJointsCsvWriter::Commit(const ArmTrajectory& trajectory) {
   impl->file.Commit();
 }
 
+ArmTrajectory TrackToFiles(const RobotScenario& scenario, const std::string& trajectory,
+                           const std::string& csv, ArmStepSink* also) {
+  std::optional<RobotTrajectoryWriter> json;
+  std::optional<RobotJointsCsvWriter> table;
+  std::vector<ArmStepSink*> sinks;
+  if (!trajectory.empty()) sinks.push_back(&json.emplace(scenario, trajectory));
+  if (!csv.empty()) sinks.push_back(&table.emplace(scenario, csv));
+  if (also != nullptr) sinks.push_back(also);
+  ArmStepFanOut sink(sinks);
+  const ArmTrajectory summary = TrackPath(scenario.model, scenario.path, scenario.options, &sink);
+  if (json) json->Commit(summary);
+  if (table) table->Commit(summary);
+  return summary;
+}
+
 }  // namespace flexkin
