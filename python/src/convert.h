@@ -124,36 +124,36 @@ void BindErrors(py::module_& m);
 [[noreturn]] void ThrowInput(const std::string& field, const std::string& message,
                              const std::string& value = "", const std::string& expected = "");
 
-// Option and report classes (options.cc), chains, curves, link steps (chains.cc), runs and
-// scenarios (run.cc), fixed-base arms (robot.cc).
+// Option and report classes (options_bindings.cc), chains, curves, link steps (chains_bindings.cc),
+// runs and scenarios (run_bindings.cc), fixed-base arms (robot_bindings.cc).
 void BindOptions(py::module_& m);
 void BindChains(py::module_& m);
 void BindRun(py::module_& m);
 void BindRobot(py::module_& m);
 void BindArms(py::module_& m);
-// The strand engine: StrandOptions, BodyPose, StrandBatch, run_strands (strands.cc).
+// The strand engine: StrandOptions, BodyPose, StrandBatch, run_strands (strands_bindings.cc).
 void BindStrands(py::module_& m);
 void BindGroom(py::module_& m);
 // TrackPath of a robot scenario's model along its path with the GIL released, as a
-// flexkin.RobotResult (robot.cc): `progress` a callable(done, total) or None; `output`, `csv`
-// None or the paths of the trajectory JSON and the joint CSV, written while the steps come and
-// renamed into place only when complete.
+// flexkin.RobotResult (robot_bindings.cc): `progress` a callable(done, total) or None; `output`,
+// `csv` None or the paths of the trajectory JSON and the joint CSV, written while the steps come
+// and renamed into place only when complete.
 py::object TrackToResult(const RobotScenario& scenario, py::object progress, py::handle output,
                          py::handle csv);
-// The model argument: an ArmModel, else InputError naming "model" (arm.cc).
+// The model argument: an ArmModel, else InputError naming "model" (arm_bindings.cc).
 const ArmModel& ModelArg(py::handle model);
 // Raises InputError for the first problem of ArmOptions::Validate, the pointing members named
 // as the Python keywords (pointing.direction -> pointing_direction, pointing.point -> look_at).
 void ThrowIfAnyArmOptions(const ArmOptions& options);
 // The robot scenario readers' options: URDF arms read where the URDF component is built,
-// relative "urdf" files looked up in `directory` (None: the default).
+// relative "urdf" files looked up in `directory` (None: the default) (files.cc).
 RobotScenarioOptions RobotReaderOptions(py::handle directory);
 // A flexkin.Result as the ResultFile the render, viewer and glTF writers take, no copy: it lives
-// as long as `object` (run.cc); InputError for another object.
+// as long as `object` (run_bindings.cc); InputError for another object.
 const ResultFile& ResultFileOfObject(py::handle object);
-// flexkin.render (render.cc; built where the render, viewer and glTF components are).
+// flexkin.render (render_bindings.cc; built where the render, viewer and glTF components are).
 void BindRender(py::module_& m);
-// flexkin.arm_from_urdf, urdf_from_arm (urdf.cc; built where the URDF component is).
+// flexkin.arm_from_urdf, urdf_from_arm (urdf_bindings.cc; built where the URDF component is).
 void BindUrdf(py::module_& m);
 
 }  // namespace flexkin::python
@@ -166,7 +166,7 @@ Method MethodArg(const std::string& name, const std::string& field = "method");
 // The overall options from an `overall` argument: None (the defaults), OverallOptions,
 // ObjectiveWeights or a dict of term weights (only the terms given count).
 OverallOptions OverallArg(py::handle object);
-// RunOptions from the keyword arguments of flexkin.run (options.cc).
+// RunOptions from the keyword arguments of flexkin.run (options_bindings.cc).
 RunOptions MakeRunOptions(const std::string& method, int substeps, int record_every,
                           double tolerance, int max_substeps, bool link_angles,
                           OverallLike overall);
@@ -174,6 +174,7 @@ RunOptions MakeRunOptions(const std::string& method, int substeps, int record_ev
 Chain ChainArg(py::handle object, const std::string& name = "points");
 }  // namespace flexkin::python
 
+// Paths and files (files.cc).
 namespace flexkin::python {
 // JSON text of a dict (numpy arrays and scalars as lists and numbers) for the scenario readers;
 // InputError naming `name` if it cannot be written.

@@ -1,7 +1,5 @@
 // Fixed-base arms from Python: flexkin.ArmModel, ArmOptions, ArmStepReport, forward_kinematics,
 // joint_angles_from_points, arm_step and track_path (flexkin/arm.h; robot order, base first).
-#include "flexkin/arm.h"
-
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
@@ -13,6 +11,7 @@
 
 #include "convert.h"
 #include "fields.h"
+#include "flexkin/arm.h"
 #include "flexkin/curves.h"
 
 namespace flexkin::python {

@@ -4,8 +4,6 @@
 // an exception in the callback) stops the run. Result.frames, steps and link_angles are numpy
 // views of those dense arrays, as are those of a result file read back: nothing is copied or
 // converted on the way to Python or back to the writers and renderers.
-#include "flexkin/run.h"
-
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
@@ -20,6 +18,7 @@
 #include "flexkin/any_scenario.h"
 #include "flexkin/groom.h"
 #include "flexkin/result_io.h"
+#include "flexkin/run.h"
 #include "flexkin/scenario.h"
 #include "progress.h"
 
@@ -138,56 +137,6 @@ Result RunToArrays(const Chain& chain, const Points& leader_steps, RunOptions op
   }
   return result;
 }
-
-}  // namespace
-
-// JSON text of a dict (numpy arrays and numbers as lists and numbers) for the scenario readers.
-std::string JsonOfDict(py::handle dict, const std::string& name) {
-  py::module_ json = py::module_::import("json");
-  py::object to_list = py::cpp_function([](py::handle o) -> py::object {
-    if (py::hasattr(o, "tolist")) return o.attr("tolist")();
-    throw py::type_error(std::string("an object of type ") +
-                         std::string(py::str(py::type::of(o).attr("__name__"))) +
-                         " cannot be written as JSON");
-  });
-  try {
-    return py::cast<std::string>(json.attr("dumps")(dict, py::arg("default") = to_list));
-  } catch (py::error_already_set& e) {
-    ThrowInput(name, "cannot be written as JSON: " + std::string(e.what()));
-  }
-}
-
-// A path (str or os.PathLike) as a string, or "" if `object` is not one.
-std::string PathArg(py::handle object) {
-  if (py::isinstance<py::str>(object) || py::hasattr(object, "__fspath__")) {
-    return py::cast<std::string>(py::module_::import("os").attr("fsdecode")(object));
-  }
-  return "";
-}
-
-std::string RequiredPath(py::handle object, const std::string& name, bool optional) {
-  if (optional && object.is_none()) return "";
-  const std::string path = PathArg(object);
-  if (path.empty()) {
-    ThrowInput(name, std::string("is not a path; expected a str or os.PathLike") +
-                         (optional ? ", or None" : ""));
-  }
-  return path;
-}
-
-void RethrowWithPath(const std::system_error& error, const std::string& path) {
-  const std::string what = error.what();
-  if (what.find(path) != std::string::npos) throw error;
-  throw std::system_error(error.code(), path + ": " + what);
-}
-
-void RethrowInFile(const InputError& error, const std::string& path) {
-  Problem p = error.problem();
-  p.field = p.field.empty() ? path : path + ": " + p.field;
-  throw InputError(p);
-}
-
-namespace {
 
 Scenario ScenarioArg(ScenarioSource scenario) {
   if (py::isinstance<Scenario>(scenario)) return py::cast<Scenario>(scenario);

@@ -20,7 +20,7 @@
 namespace flexkin::python {
 
 // A flexkin.RobotResult as the trajectory the pictures and the viewer take; nullopt for another
-// object (robot.cc). Declared here, its one user, rather than in convert.h.
+// object (robot_bindings.cc). Declared here, its one user, rather than in convert.h.
 std::optional<RobotTrajectoryFile> RobotTrajectoryOfObject(py::handle object);
 
 namespace {

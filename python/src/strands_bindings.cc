@@ -1,8 +1,6 @@
 // The strand engine from Python (flexkin/strands.h, docs/strands.md): flexkin.StrandOptions,
 // BodyPose, StrandBatch and run_strands. Steps run with the GIL released; a batch's own mutex
 // keeps a step and a read of its points from overlapping when Python threads share it.
-#include "flexkin/strands.h"
-
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
@@ -15,6 +13,7 @@
 
 #include "convert.h"
 #include "fields.h"
+#include "flexkin/strands.h"
 
 namespace flexkin::python {
 namespace {

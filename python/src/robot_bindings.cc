@@ -16,9 +16,6 @@
 #include "flexkin/arm.h"
 #include "flexkin/robot_scenario.h"
 #include "progress.h"
-#ifdef FLEXKIN_PYTHON_URDF
-#include "flexkin/urdf.h"
-#endif
 
 namespace flexkin::python {
 namespace {
@@ -315,16 +312,6 @@ std::optional<RobotTrajectoryFile> RobotTrajectoryOfObject(py::handle object) {
   t.max_ee_error = r.summary.max_ee_error;
   t.seconds = r.summary.seconds;
   return t;
-}
-
-RobotScenarioOptions RobotReaderOptions(py::handle directory) {
-#ifdef FLEXKIN_PYTHON_URDF
-  RobotScenarioOptions options = UrdfRobotScenarioOptions();
-#else
-  RobotScenarioOptions options;
-#endif
-  options.directory = RequiredPath(directory, "directory", true);
-  return options;
 }
 
 py::object TrackToResult(const RobotScenario& scenario, py::object progress, py::handle output,

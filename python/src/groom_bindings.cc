@@ -2,8 +2,6 @@
 // scenario (a path or a dict of its JSON form) into a strand file as `flexkin run` does, with
 // the GIL released; flexkin.groom_summary describes one. The strand file is read with
 // numpy.load (docs/strands.md).
-#include "flexkin/groom.h"
-
 #include <pybind11/stl.h>
 
 #include <functional>
@@ -13,6 +11,7 @@
 
 #include "convert.h"
 #include "fields.h"
+#include "flexkin/groom.h"
 #include "flexkin/strand_file.h"
 #include "flexkin/vocabulary.h"
 #include "progress.h"

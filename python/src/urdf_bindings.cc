@@ -1,11 +1,10 @@
 // URDF arms from Python: flexkin.arm_from_urdf and urdf_from_arm (flexkin/urdf.h), built where
 // the URDF component (flexkin_urdf, Debian's urdfdom) is.
-#include "flexkin/urdf.h"
-
 #include <string>
 #include <system_error>
 
 #include "convert.h"
+#include "flexkin/urdf.h"
 
 namespace flexkin::python {
 namespace {
