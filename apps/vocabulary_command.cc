@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "flexkin/arm.h"
+#include "flexkin/curves.h"
 #include "flexkin/gltf.h"
 #include "flexkin/overall.h"
 #include "flexkin/propagate.h"
@@ -41,6 +42,12 @@ void PrintVocabulary(std::ostream& out) {
                          "`\"record\"/\"precision\"` of a groom scenario, `flexkin run "
                          "--precision`, `run_groom(precision=)` (`StrandPrecision`, "
                          "flexkin/strand_file.h).");
+  Table<CurveTurn>(out, "Curve turns",
+                   "`\"curve\"/\"turn\"` of an arc or a helix in a scenario file, the `turn=` of "
+                   "Python's `arc` and `helix` (`CurveTurn`, flexkin/curves.h).");
+  Table<CurveSide>(out, "Parabola sides",
+                   "`\"curve\"/\"side\"` of a parabola in a scenario file, the `side=` of Python's "
+                   "`parabola` (`CurveSide`, flexkin/curves.h).");
   Table<ObjectiveTerm>(out, "Objective terms",
                        "The keys of `\"objective\"` in a scenario file (method `overall`) and of "
                        "`\"overall\"/\"objective\"` in a result file (`ObjectiveTerm`, "

@@ -5,8 +5,32 @@
 
 #include "flexkin/chain.h"
 #include "flexkin/error.h"
+#include "flexkin/vocabulary.h"
 
 namespace flexkin {
+
+// The values of a "curve" object's "turn" (arc, helix) and "side" (parabola), named once for the
+// scenario files (io/scenario_sections.cc) and Python's curve generators (keywords of the same
+// names): ArcDef::clockwise and HelixDef::clockwise are `turn == CurveTurn::kCw`,
+// ParabolaDef::side is +1 for CurveSide::kPlusX and -1 for kMinusX.
+enum class CurveTurn { kCcw, kCw };
+enum class CurveSide { kPlusX, kMinusX };
+template <>
+struct Vocabulary<CurveTurn> {
+  static constexpr const char* kKind = "turn";
+  static constexpr NamedValue<CurveTurn> kEntries[] = {
+      {CurveTurn::kCcw, "ccw", "counterclockwise: the angle grows along the chain"},
+      {CurveTurn::kCw, "cw", "clockwise: the angle shrinks along the chain"},
+  };
+};
+template <>
+struct Vocabulary<CurveSide> {
+  static constexpr const char* kKind = "side";
+  static constexpr NamedValue<CurveSide> kEntries[] = {
+      {CurveSide::kPlusX, "+x", "from the vertex toward +x"},
+      {CurveSide::kMinusX, "-x", "from the vertex toward -x"},
+  };
+};
 
 // Generated initial curves. Each one is sampled so that every link has the same chord length
 // `link_length` (to rounding, a few times 1e-16 times the coordinates' magnitude over the link

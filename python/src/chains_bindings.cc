@@ -16,34 +16,6 @@
 #include "flexkin/vocabulary.h"
 
 namespace flexkin::python {
-// The values of a scenario file's "curve" "turn" (arc, helix) and "side" (parabola),
-// docs/scenario-format.md, for the curve generators' keywords of the same names.
-enum class Turn { kCcw, kCw };
-enum class Side { kPlusX, kMinusX };
-}  // namespace flexkin::python
-
-namespace flexkin {
-// The names as scenario files spell them. The scenario parser (src/io/scenario_sections.cc)
-// spells them too; python/tests/test_front_end.py checks that both accept the same names.
-template <>
-struct Vocabulary<python::Turn> {
-  static constexpr const char* kKind = "turn";
-  static constexpr NamedValue<python::Turn> kEntries[] = {
-      {python::Turn::kCcw, "ccw", "counterclockwise: the angle grows along the chain"},
-      {python::Turn::kCw, "cw", "clockwise: the angle shrinks along the chain"},
-  };
-};
-template <>
-struct Vocabulary<python::Side> {
-  static constexpr const char* kKind = "side";
-  static constexpr NamedValue<python::Side> kEntries[] = {
-      {python::Side::kPlusX, "+x", "from the vertex toward +x"},
-      {python::Side::kMinusX, "-x", "from the vertex toward -x"},
-  };
-};
-}  // namespace flexkin
-
-namespace flexkin::python {
 namespace {
 
 // A DeprecationWarning attributed to the caller of the module's function (stack level 2: the
@@ -64,7 +36,7 @@ Enum NameArg(py::handle value, const std::string& name) {
 
 // turn="ccw" or "cw"; the deprecated clockwise=True/False, where given, agreeing with it.
 bool TurnArg(py::handle turn, py::handle clockwise) {
-  const bool cw = NameArg<Turn>(turn, "turn") == Turn::kCw;
+  const bool cw = NameArg<CurveTurn>(turn, "turn") == CurveTurn::kCw;
   if (clockwise.is_none()) return cw;
   if (!py::isinstance<py::bool_>(clockwise)) {
     throw InputError(
@@ -89,7 +61,7 @@ int SideArg(py::handle side) {
         "in scenario files");
     return side.cast<int>();
   }
-  return NameArg<Side>(side, "side") == Side::kPlusX ? 1 : -1;
+  return NameArg<CurveSide>(side, "side") == CurveSide::kPlusX ? 1 : -1;
 }
 
 // A line as a scenario file defines it: a start sets the dimension (and the default direction
@@ -250,7 +222,7 @@ Chain(points, *, link_length=None, lengths=None)
         return ToArray(MakeParabola(d));
       },
       py::kw_only(), py::arg("a") = 1.0, py::arg("links") = 20, py::arg("link_length") = 0.25,
-      py::arg("side") = NameOf(Side::kPlusX),
+      py::arg("side") = NameOf(CurveSide::kPlusX),
       "The parabola y = a x^2 from the vertex (the leading end) toward +x (side=\"+x\") or -x "
       "(side=\"-x\"), every chord link_length, as a scenario file's {\"shape\": \"parabola\"}: "
       "(links+1, 2) float64 (paper Sec. 5.1: a=1, 20 links of 0.25). side=1 and side=-1 are "
@@ -269,8 +241,8 @@ Chain(points, *, link_length=None, lengths=None)
         return ToArray(MakeArc(d));
       },
       py::kw_only(), py::arg("radius") = 1.0, py::arg("center") = std::vector<double>{0.0, 0.0},
-      py::arg("start_angle") = 0.0, py::arg("turn") = NameOf(Turn::kCcw), py::arg("links") = 10,
-      py::arg("link_length") = 0.1, py::arg("clockwise") = py::none(),
+      py::arg("start_angle") = 0.0, py::arg("turn") = NameOf(CurveTurn::kCcw),
+      py::arg("links") = 10, py::arg("link_length") = 0.1, py::arg("clockwise") = py::none(),
       "A circular arc about center, point 0 at start_angle (radians), the angle moving along "
       "the chain counterclockwise (turn=\"ccw\") or clockwise (turn=\"cw\"), every chord "
       "link_length, as a scenario file's {\"shape\": \"arc\"}: (links+1, 2) float64. "
@@ -291,8 +263,8 @@ Chain(points, *, link_length=None, lengths=None)
       },
       py::kw_only(), py::arg("radius") = 1.0, py::arg("pitch") = 1.0,
       py::arg("center") = std::vector<double>{0.0, 0.0, 0.0}, py::arg("start_angle") = 0.0,
-      py::arg("turn") = NameOf(Turn::kCcw), py::arg("links") = 20, py::arg("link_length") = 1.5,
-      py::arg("clockwise") = py::none(),
+      py::arg("turn") = NameOf(CurveTurn::kCcw), py::arg("links") = 20,
+      py::arg("link_length") = 1.5, py::arg("clockwise") = py::none(),
       "A circular helix about an axis parallel to z (rise `pitch` per turn), turning "
       "counterclockwise (turn=\"ccw\") or clockwise (turn=\"cw\") seen from +z, every chord "
       "link_length, as a scenario file's {\"shape\": \"helix\"}: (links+1, 3) float64. "

@@ -76,12 +76,12 @@ std::optional<Chain> Parser::ParseShape(const json& v, const std::string& ptr) {
     return [this, dim](const json& x, const std::string& p) { return Vector(x, p, dim); };
   };
   const auto clockwise = [this](const json& x, const std::string& p) {
-    const auto turn = Choice(x, p, {"ccw", "cw"});
-    return turn ? std::optional<bool>(*turn == "cw") : std::nullopt;
+    const auto turn = Choice(x, p, NamesOf<CurveTurn>());
+    return turn ? std::optional<bool>(*turn == NameOf(CurveTurn::kCw)) : std::nullopt;
   };
   const auto side = [this](const json& x, const std::string& p) {
-    const auto name = Choice(x, p, {"+x", "-x"});
-    return name ? std::optional<int>(*name == "+x" ? 1 : -1) : std::nullopt;
+    const auto name = Choice(x, p, NamesOf<CurveSide>());
+    return name ? std::optional<int>(*name == NameOf(CurveSide::kPlusX) ? 1 : -1) : std::nullopt;
   };
   int links = 1;
   double link_length = 1.0;
