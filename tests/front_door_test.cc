@@ -230,4 +230,34 @@ TEST(RuleTableTest, WholeChainRulesRunThroughMoveLeader) {
 }
 
 }  // namespace
+// A scenario option added in the library once (the leader's "closed") reaches every front end
+// through the parser: here the library's view; python/tests/test_front_end.py checks Python and
+// the command line, neither of which was changed for it.
+TEST(FrontDoorTest, AClosedPathReturnsExactlyToItsStart) {
+  const std::string curve = R"("curve": {"points": [[0.25, 0.5], [0, 0.5], [-0.5, 0.5]]})";
+  const Scenario plain =
+      ParseScenarioText("{" + curve + R"(, "leader": {"path": [[1, 0.5], [1, 1.5]]}})");
+  const Scenario closed = ParseScenarioText(
+      "{" + curve + R"(, "leader": {"path": [[1, 0.5], [1, 1.5]], "closed": true}})");
+  ASSERT_EQ(closed.leader_steps.rows(), plain.leader_steps.rows() + 1);
+  EXPECT_EQ(Points(closed.leader_steps.topRows(2)), plain.leader_steps);
+  EXPECT_EQ(Points(closed.leader_steps.bottomRows(1)), Points(plain.chain.points.topRows(1)));
+  // Resampled: every vertex kept, the way back split too, its last step the start exactly.
+  const Scenario resampled = ParseScenarioText(
+      "{" + curve + R"(, "leader": {"path": [[1, 0.5]], "max_step": 0.25, "closed": true}})");
+  ASSERT_EQ(resampled.leader_steps.rows(), 6);  // 0.75 out and 0.75 back, 3 steps each
+  EXPECT_EQ(resampled.leader_steps(2, 0), 1.0);
+  EXPECT_EQ(Points(resampled.leader_steps.bottomRows(1)), Points(plain.chain.points.topRows(1)));
+  // With a pull, or not a boolean: a problem naming the key, from the same reader every front
+  // end uses.
+  const AnyScenario pull = ReadScenarioText(
+      "{" + curve + R"(, "leader": {"pull": [1, 0], "steps": 4, "closed": true}})");
+  ASSERT_FALSE(pull.problems.empty());
+  EXPECT_EQ(pull.problems.front().field, "/leader/closed");
+  const AnyScenario word =
+      ReadScenarioText("{" + curve + R"(, "leader": {"path": [[1, 0.5]], "closed": "yes"}})");
+  ASSERT_FALSE(word.problems.empty());
+  EXPECT_EQ(word.problems.front().field, "/leader/closed");
+}
+
 }  // namespace flexkin

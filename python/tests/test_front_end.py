@@ -371,3 +371,32 @@ def test_a_file_problem_reaches_python_and_the_command_line_alike(tmp_path, cli)
     # Every kind is told apart by the library: a groom file given to run_scenario is named.
     with pytest.raises(flexkin.InputError, match="is a groom scenario, not a chain one"):
         flexkin.run_scenario(str(EXAMPLES / "groom_grass_2d.json"))
+
+
+# A scenario option added in the library only (the leader's "closed": true, src/io/
+# scenario_sections.cc) reaches Python and the command line without a change to either.
+CLOSED = {"curve": {"points": [[0.25, 0.5], [0, 0.5], [-0.5, 0.5]]},
+          "leader": {"path": [[1, 0.5], [1, 1.5]], "closed": True}}
+
+
+def test_a_library_option_reaches_python_untouched():
+    scenario = flexkin.load_scenario(CLOSED)
+    assert scenario.leader_steps.shape == (3, 2)
+    assert list(scenario.leader_steps[-1]) == [0.25, 0.5]
+    result = flexkin.run_scenario(CLOSED)
+    assert list(result.frames[-1, 0]) == [0.25, 0.5]
+    bad = dict(CLOSED, leader={"pull": [1, 0], "closed": True})
+    assert [p["field"] for p in flexkin.validate_scenario(bad)] == ["/leader/closed"]
+
+
+def test_a_library_option_reaches_the_command_line_untouched(cli, tmp_path):
+    import json
+    import subprocess
+    path = tmp_path / "closed.json"
+    path.write_text(json.dumps(CLOSED))
+    subprocess.run([cli, "run", str(path), "-o", str(tmp_path / "r.npz"), "-q"], check=True)
+    frames = flexkin.read_result(tmp_path / "r.npz").frames
+    assert np.array_equal(frames, flexkin.run_scenario(CLOSED).frames)
+    path.write_text(json.dumps(dict(CLOSED, leader={"pull": [1, 0], "closed": True})))
+    done = subprocess.run([cli, "validate", str(path)], capture_output=True, text=True)
+    assert done.returncode != 0 and "/leader/closed" in done.stderr + done.stdout

@@ -136,7 +136,7 @@ std::optional<Points> Parser::ParseLeader(const json& v, const std::string& ptr,
       "an object: {\"path\": [[x, y], ...]}, {\"path\": [...], \"max_step\": s} or "
       "{\"pull\": [dx, dy], \"steps\": n}";
   if (!ExpectObject(v, ptr, expected)) return std::nullopt;
-  CheckKeys(v, ptr, {"path", "pull", "steps", "max_step", "substeps"});
+  CheckKeys(v, ptr, {"path", "pull", "steps", "max_step", "closed", "substeps"});
   if (const json* s = Find(v, "substeps")) {
     if (const auto n = Integer(*s, ptr + "/substeps", 1, kMaxCount)) {
       options->substeps = static_cast<int>(*n);
@@ -156,6 +156,10 @@ std::optional<Points> Parser::ParseLeader(const json& v, const std::string& ptr,
     if (v.contains("max_step")) {
       Add(ptr + "/max_step", "is only valid with \"path\"; use \"steps\" to split a \"pull\"");
     }
+    if (v.contains("closed")) {
+      Add(ptr + "/closed",
+          "is only valid with \"path\"; give the way back as a \"path\" ending at the start");
+    }
     int64_t count = 1;
     if (const json* s = Find(v, "steps")) {
       if (const auto n = Integer(*s, ptr + "/steps", 1, kMaxLeaderSteps)) count = *n;
@@ -171,8 +175,22 @@ std::optional<Points> Parser::ParseLeader(const json& v, const std::string& ptr,
     if (const json* s = Find(v, "max_step")) {
       max_step = Number(*s, ptr + "/max_step", Range::kPositive);
     }
-    const auto path = PointList(v["path"], ptr + "/path", dim, 1);
+    bool closed = false;
+    if (const json* c = Find(v, "closed")) {
+      if (c->is_boolean()) {
+        closed = c->get<bool>();
+      } else {
+        TypeProblem(*c, ptr + "/closed", "true or false");
+      }
+    }
+    auto path = PointList(v["path"], ptr + "/path", dim, 1);
     if (problems.size() != before || chain == nullptr) return std::nullopt;
+    if (closed) {  // back to the start, exactly, as the last target
+      const Points open = std::move(*path);
+      path.emplace(open.rows() + 1, open.cols());
+      path->topRows(open.rows()) = open;
+      path->bottomRows(1) = chain->points.row(0);
+    }
     if (!max_step) return path;
     try {
       steps = ResamplePath(chain->points.row(0).transpose(), *path, *max_step);
