@@ -142,7 +142,7 @@ ResultFile ReadNpzResult(const std::string& path) {
   ZipReader zip(path);
   if (!zip.Has("result.json") && zip.Has("groom.json") && zip.Has("points.npy")) {
     // The other .npz that flexkin writes (its members as IsStrandFile tests them,
-    // groom/strand_file.cc): say what it is and what reads it, not that result.json is missing.
+    // io/strand_file.cc): say what it is and what reads it, not that result.json is missing.
     throw InputError(
         Problem("",
                 "is a strand file (the output of a groom run, docs/strands.md), not a chain "

@@ -95,56 +95,6 @@ void Record(const OverallReport& report, int64_t step, int substep, OverallRunRe
   }
 }
 
-std::string Format(const char* fmt, double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, x);
-  return buf;
-}
-
-}  // namespace
-
-Problems RunOptions::Validate() const {
-  Problems problems;
-  if (substeps < 1) {
-    problems.emplace_back("substeps", std::to_string(substeps) + " is not valid; must be >= 1",
-                          std::to_string(substeps), ">= 1");
-  }
-  if (record_every < 1) {
-    problems.emplace_back("record_every",
-                          std::to_string(record_every) + " is not valid; must be >= 1",
-                          std::to_string(record_every), ">= 1");
-  }
-  if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) {
-    problems.emplace_back("tolerance",
-                          FormatNumber(tolerance) +
-                              " is not valid; must be a finite number >= 0 (0 turns accuracy "
-                              "control off)",
-                          FormatNumber(tolerance), "a finite number >= 0");
-  } else if (tolerance > 0.0 && MethodOrder(method) == 0) {
-    problems.emplace_back("tolerance",
-                          std::string("accuracy control is available for the tractrix and ftl "
-                                      "methods; with \"") +
-                              MethodName(method) + "\" set it to 0 and choose the sub-steps",
-                          FormatNumber(tolerance), "0 with this method");
-  }
-  if (tolerance > 0.0 && max_substeps < 2) {
-    problems.emplace_back("max_substeps",
-                          std::to_string(max_substeps) +
-                              " is not valid; accuracy control compares two runs and needs "
-                              "max_substeps >= 2",
-                          std::to_string(max_substeps), ">= 2");
-  } else if (max_substeps < substeps && substeps >= 1) {
-    problems.emplace_back("max_substeps",
-                          std::to_string(max_substeps) + " is not valid; must be >= substeps (" +
-                              std::to_string(substeps) + ")",
-                          std::to_string(max_substeps), ">= substeps");
-  }
-  if (method == Method::kOverall) AppendNested("overall", overall.Validate(), &problems);
-  return problems;
-}
-
-namespace {
-
 // Moves the chain by one sub-step with the run's method: the sequential link rule of a stepper, or
 // the overall solve in a workspace reused by every sub-step (the chain, the head and the options
 // are checked once, before the run).
@@ -220,20 +170,6 @@ Eigen::VectorXd FirstDirection(const Points& start, const Points& leader_steps) 
   }
   return {};
 }
-
-}  // namespace
-
-int64_t CountRecordedFrames(int64_t num_steps, int record_every) {
-  if (num_steps <= 0) return 1;
-  const int64_t every = std::max(record_every, 1);
-  return 1 + num_steps / every + (num_steps % every != 0 ? 1 : 0);
-}
-
-void FrameRecorder::Add(int64_t step, const PointsRef& points, const VectorRef& link_angles) {
-  frames.Add(step, points, link_angles);
-}
-
-namespace {
 
 // Moves a chain through the leader steps of a run, every sub-step of every leader step a sweep,
 // in chunks of sweeps through the traced engines (src/sequential/sweep.h) with one set of buffers:
@@ -591,54 +527,6 @@ RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& 
   RunResult result = Run(chain, leader_steps, options, &recorder);
   result.frames = std::move(recorder.frames);
   return result;
-}
-
-std::string RunResult::BriefReport() const {
-  std::ostringstream out;
-  out << MethodName(method) << ": " << lengths.size() << " links, " << num_steps
-      << " leader steps x " << accuracy.substeps << " sub-steps, max relative length error "
-      << Format("%.3g", metrics.max_relative_length_error) << ", L2 total "
-      << Format("%.10g", metrics.l2_total) << " (arc-length weighted "
-      << Format("%.10g", metrics.l2_weighted_total) << ")";
-  if (method == Method::kOverall) {
-    out << ", overall solver: " << overall.solves - overall.failures << "/" << overall.solves
-        << " steps converged, " << overall.iterations << " iterations (at most "
-        << overall.max_iterations << " per step)";
-    if (overall.failures > 0) out << ", FIRST FAILURE " << overall.first_failure;
-  }
-  if (accuracy.enabled) {
-    out << ", estimated error " << Format("%.3g", accuracy.estimated_error)
-        << (accuracy.met ? " (tolerance met)" : " (TOLERANCE NOT MET)");
-  }
-  out << ", " << Format("%.3g", seconds) << " s";
-  return out.str();
-}
-
-std::string RunResult::FullReport() const {
-  std::ostringstream out;
-  out << BriefReport() << "\n";
-  // Streamed runs keep no frames here; the run counted them.
-  const int64_t recorded = frames.empty() ? recorded_frames : static_cast<int64_t>(frames.size());
-  out << "  recorded frames: " << recorded << "\n";
-  out << "  path length per point (leading end first):";
-  const Eigen::Index n = metrics.path_length.size();
-  // Long chains: print about 20 evenly spaced points so the profile fits on a screen.
-  const Eigen::Index stride = std::max<Eigen::Index>(1, n / 20);
-  for (Eigen::Index j = 0; j < n; j += stride) {
-    out << (j % (8 * stride) == 0 ? "\n    " : " ") << "[" << j << "] "
-        << Format("%.6g", metrics.path_length[j]);
-  }
-  if ((n - 1) % stride != 0)
-    out << " [" << n - 1 << "] " << Format("%.6g", metrics.path_length[n - 1]);
-  out << "\n";
-  const Eigen::VectorXd a =
-      frames.empty() ? final_link_angles : Eigen::VectorXd(frames.back().link_angles);
-  if (a.size() > 0) {
-    out << "  final link angles to the pull, degrees: first " << Format("%.4g", a[0] * 180 / M_PI)
-        << ", largest " << Format("%.4g", a.maxCoeff() * 180 / M_PI) << ", last "
-        << Format("%.4g", a[a.size() - 1] * 180 / M_PI) << "\n";
-  }
-  return out.str();
 }
 
 }  // namespace flexkin

@@ -13,7 +13,7 @@ declare -A header_layer=(
   [link_step]=sequential [propagate]=sequential
   [overall]=overall
   [run]=run [frames]=run
-  [arm]=arm [strands]=strands [groom]=groom [strand_file]=groom
+  [arm]=arm [strands]=strands [groom]=groom [strand_file]=io
   [scenario]=io [result_io]=io [robot_scenario]=io [scenario_kind]=io [any_scenario]=scenario
   [flexkin]=umbrella
   [render]=render [strands_render]=render [viewer]=viewer [strands_viewer]=viewer [gltf]=gltf
@@ -27,7 +27,7 @@ declare -A allowed=(
   [run]="chain sequential overall"
   [arm]="chain sequential"
   [strands]="chain sequential"
-  [io]="chain sequential overall run arm"
+  [io]="chain sequential overall run arm strands"
   [groom]="chain sequential overall run arm io strands"
   [scenario]="chain sequential overall run arm io strands groom"
   [umbrella]="chain sequential overall run arm strands io groom scenario"

@@ -1,0 +1,61 @@
+// A run's options (RunOptions::Validate) and how many frames it records.
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "flexkin/error.h"
+#include "flexkin/run.h"
+
+namespace flexkin {
+
+Problems RunOptions::Validate() const {
+  Problems problems;
+  if (substeps < 1) {
+    problems.emplace_back("substeps", std::to_string(substeps) + " is not valid; must be >= 1",
+                          std::to_string(substeps), ">= 1");
+  }
+  if (record_every < 1) {
+    problems.emplace_back("record_every",
+                          std::to_string(record_every) + " is not valid; must be >= 1",
+                          std::to_string(record_every), ">= 1");
+  }
+  if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) {
+    problems.emplace_back("tolerance",
+                          FormatNumber(tolerance) +
+                              " is not valid; must be a finite number >= 0 (0 turns accuracy "
+                              "control off)",
+                          FormatNumber(tolerance), "a finite number >= 0");
+  } else if (tolerance > 0.0 && MethodOrder(method) == 0) {
+    problems.emplace_back("tolerance",
+                          std::string("accuracy control is available for the tractrix and ftl "
+                                      "methods; with \"") +
+                              MethodName(method) + "\" set it to 0 and choose the sub-steps",
+                          FormatNumber(tolerance), "0 with this method");
+  }
+  if (tolerance > 0.0 && max_substeps < 2) {
+    problems.emplace_back("max_substeps",
+                          std::to_string(max_substeps) +
+                              " is not valid; accuracy control compares two runs and needs "
+                              "max_substeps >= 2",
+                          std::to_string(max_substeps), ">= 2");
+  } else if (max_substeps < substeps && substeps >= 1) {
+    problems.emplace_back("max_substeps",
+                          std::to_string(max_substeps) + " is not valid; must be >= substeps (" +
+                              std::to_string(substeps) + ")",
+                          std::to_string(max_substeps), ">= substeps");
+  }
+  if (method == Method::kOverall) AppendNested("overall", overall.Validate(), &problems);
+  return problems;
+}
+
+int64_t CountRecordedFrames(int64_t num_steps, int record_every) {
+  if (num_steps <= 0) return 1;
+  const int64_t every = std::max(record_every, 1);
+  return 1 + num_steps / every + (num_steps % every != 0 ? 1 : 0);
+}
+
+void FrameRecorder::Add(int64_t step, const PointsRef& points, const VectorRef& link_angles) {
+  frames.Add(step, points, link_angles);
+}
+
+}  // namespace flexkin

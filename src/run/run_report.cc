@@ -1,0 +1,69 @@
+// What a run prints about itself: RunResult::BriefReport and FullReport.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <string>
+
+#include "flexkin/run.h"
+
+namespace flexkin {
+namespace {
+
+std::string Format(const char* fmt, double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, x);
+  return buf;
+}
+
+}  // namespace
+
+std::string RunResult::BriefReport() const {
+  std::ostringstream out;
+  out << MethodName(method) << ": " << lengths.size() << " links, " << num_steps
+      << " leader steps x " << accuracy.substeps << " sub-steps, max relative length error "
+      << Format("%.3g", metrics.max_relative_length_error) << ", L2 total "
+      << Format("%.10g", metrics.l2_total) << " (arc-length weighted "
+      << Format("%.10g", metrics.l2_weighted_total) << ")";
+  if (method == Method::kOverall) {
+    out << ", overall solver: " << overall.solves - overall.failures << "/" << overall.solves
+        << " steps converged, " << overall.iterations << " iterations (at most "
+        << overall.max_iterations << " per step)";
+    if (overall.failures > 0) out << ", FIRST FAILURE " << overall.first_failure;
+  }
+  if (accuracy.enabled) {
+    out << ", estimated error " << Format("%.3g", accuracy.estimated_error)
+        << (accuracy.met ? " (tolerance met)" : " (TOLERANCE NOT MET)");
+  }
+  out << ", " << Format("%.3g", seconds) << " s";
+  return out.str();
+}
+
+std::string RunResult::FullReport() const {
+  std::ostringstream out;
+  out << BriefReport() << "\n";
+  // Streamed runs keep no frames here; the run counted them.
+  const int64_t recorded = frames.empty() ? recorded_frames : static_cast<int64_t>(frames.size());
+  out << "  recorded frames: " << recorded << "\n";
+  out << "  path length per point (leading end first):";
+  const Eigen::Index n = metrics.path_length.size();
+  // Long chains: print about 20 evenly spaced points so the profile fits on a screen.
+  const Eigen::Index stride = std::max<Eigen::Index>(1, n / 20);
+  for (Eigen::Index j = 0; j < n; j += stride) {
+    out << (j % (8 * stride) == 0 ? "\n    " : " ") << "[" << j << "] "
+        << Format("%.6g", metrics.path_length[j]);
+  }
+  if ((n - 1) % stride != 0)
+    out << " [" << n - 1 << "] " << Format("%.6g", metrics.path_length[n - 1]);
+  out << "\n";
+  const Eigen::VectorXd a =
+      frames.empty() ? final_link_angles : Eigen::VectorXd(frames.back().link_angles);
+  if (a.size() > 0) {
+    out << "  final link angles to the pull, degrees: first " << Format("%.4g", a[0] * 180 / M_PI)
+        << ", largest " << Format("%.4g", a.maxCoeff() * 180 / M_PI) << ", last "
+        << Format("%.4g", a[a.size() - 1] * 180 / M_PI) << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace flexkin
