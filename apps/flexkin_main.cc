@@ -210,7 +210,7 @@ void CheckOutputSize(const RunArgs& args, const flexkin::Scenario& s,
 
 // A groom scenario (docs/groom-format.md) goes to the strand engine; the options it shares with
 // chain runs keep their meaning, those it has no use for are refused by name.
-int RunGroom(const RunArgs& args, flexkin::GroomScenario scenario) {
+int RunGroom(const RunArgs& args, flexkin::AnyScenario scenario) {
   flexkin::cli::GroomRunArgs g;
   g.scenario = args.scenario;
   g.output = args.output;
@@ -255,14 +255,14 @@ int RunCommand(const RunArgs& args) {
         args.scenario, "is a robot scenario (docs/robot-format.md); run it with `flexkin robot " +
                            args.scenario + " -o TRAJECTORY.json`"));
   }
-  if (any.kind == flexkin::ScenarioKind::kGroom) return RunGroom(args, std::move(*any.groom));
+  if (any.kind == flexkin::ScenarioKind::kGroom) return RunGroom(args, std::move(any));
   if (*args.threads_opt || *args.precision_opt) {
     throw flexkin::InputError(
         flexkin::Problem(*args.threads_opt ? "--threads" : "--precision",
                          "is an option of groom scenarios (docs/groom-format.md); " +
                              args.scenario + " is a chain scenario"));
   }
-  flexkin::Scenario scenario = std::move(*any.chain);
+  flexkin::Scenario& scenario = *any.chain;
   const flexkin::ResultFileFormat format = flexkin::ResultFileFormatOfPath(args.output, "-o");
   ApplyOverrides(args, &scenario.options);
   CheckOutputSize(args, scenario, format);
@@ -276,11 +276,10 @@ int RunCommand(const RunArgs& args) {
   };
   flexkin::cli::Writing(args.output + (args.csv.empty() ? "" : " or " + args.csv));
 
-  // The frames stream to the files as the run records them; the files are renamed into place
-  // only after the run, and removed if it fails (flexkin/result_io.h).
-  const flexkin::RunResult result =
-      flexkin::RunToFiles(scenario.chain, scenario.leader_steps, scenario.options, scenario.name,
-                          {args.output, args.csv});
+  // The library's one call for every kind (flexkin/any_scenario.h): the frames stream to the
+  // files as the run records them; the files are renamed into place only after the run, and
+  // removed if it fails.
+  const flexkin::RunResult result = flexkin::RunScenarioToFiles(any, {args.output, args.csv}).chain;
 
   if (!args.quiet) {
     std::cout << (args.report == "full" ? result.FullReport() : result.BriefReport() + "\n");

@@ -74,7 +74,8 @@ bool ShowProgress(int64_t done, int64_t total) {
 
 }  // namespace
 
-int RunGroomCommand(const GroomRunArgs& args, GroomScenario scenario) {
+int RunGroomCommand(const GroomRunArgs& args, AnyScenario any) {
+  GroomScenario& scenario = *any.groom;
   ApplyOverrides(args, &scenario);
   const std::string& out = args.output;
   if (out.size() < 4 || out.compare(out.size() - 4, 4, ".npz") != 0) {
@@ -85,16 +86,15 @@ int RunGroomCommand(const GroomRunArgs& args, GroomScenario scenario) {
   const StrandFileHeader header = MakeStrandFileHeader(scenario);
   CheckSize(args, header);
   CheckOutputDirectory(out);
-  StrandFileWriter writer(out, header);
   const bool progress = !args.quiet && ::isatty(STDERR_FILENO);
   Writing(out);
-  // Called after every frame: where a signal stops the run (by throwing).
+  // The library's one call for every kind (flexkin/any_scenario.h). Called after every frame:
+  // where a signal stops the run (by throwing).
   const StrandRunReport report =
-      RunGroom(scenario, &writer, [progress](int64_t done, int64_t total) {
+      RunScenarioToFiles(any, {out, ""}, [progress](int64_t done, int64_t total) {
         ThrowIfInterrupted();
-        return !progress || ShowProgress(done, total);
-      });
-  writer.Commit(report);
+        if (progress) ShowProgress(done, total);
+      }).strands;
   if (!args.quiet) {
     const int64_t frames = scenario.motion.num_frames();
     char line[512];

@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "flexkin/any_scenario.h"
 #include "flexkin/groom.h"
 
 namespace flexkin::cli {
@@ -22,7 +23,7 @@ struct GroomRunArgs {
 // Runs the groom and writes the strand file. Returns the exit status (0); throws InputError (exit
 // 1) and std::system_error (a file: exit 4) for flexkin_main to report.
 // `scenario` is the file's, read and checked by the front door (flexkin/any_scenario.h).
-int RunGroomCommand(const GroomRunArgs& args, GroomScenario scenario);
+int RunGroomCommand(const GroomRunArgs& args, AnyScenario scenario);
 
 // `flexkin validate` of a groom scenario: the strand file's frames and size.
 void PrintGroomOutput(const GroomScenario& scenario);

@@ -92,7 +92,7 @@ TEST(FramesTest, TruncateDropAndClear) {
   EXPECT_EQ(frames.num_points(), 6);
 }
 
-// A block of a wider matrix (outer stride above dim) is copied row by row, not as one block.
+// A block of a wider matrix (outer stride above dim) is packed on the way in.
 TEST(FramesTest, AddsAStridedView) {
   const Points wide = Config(7, 4, 3);
   Frames frames;

@@ -15,6 +15,7 @@
 #include "flexkin/error.h"
 #include "flexkin/groom.h"
 #include "flexkin/propagate.h"
+#include "flexkin/result_io.h"
 #include "flexkin/robot_scenario.h"
 #include "flexkin/scenario.h"
 #include "flexkin/strands.h"
@@ -22,6 +23,7 @@
 #include "io/atomic_file.h"  // ReadTextFile
 #include "sequential/rule_table.h"
 #include "sequential/sweep.h"
+#include "test_util.h"
 
 namespace flexkin {
 namespace {
@@ -258,6 +260,49 @@ TEST(FrontDoorTest, AClosedPathReturnsExactlyToItsStart) {
       ReadScenarioText("{" + curve + R"(, "leader": {"path": [[1, 0.5]], "closed": "yes"}})");
   ASSERT_FALSE(word.problems.empty());
   EXPECT_EQ(word.problems.front().field, "/leader/closed");
+}
+
+// The one call that runs any kind into its files: a chain's result file holds what Run gives, a
+// groom refuses a CSV, an invalid scenario its first problem, before any file is made.
+class RunScenarioToFilesTest : public test_util::TempDirTest {};
+
+TEST_F(RunScenarioToFilesTest, RunsEachKindIntoItsFiles) {
+  const AnyScenario chain = ReadScenarioText(
+      R"({"curve": {"points": [[0, 0], [-1, 0], [-2, 0.5]]}, "leader": {"pull": [1, 1], "steps": 5}})");
+  const ScenarioRunReport report =
+      RunScenarioToFiles(chain, {Path("c.npz"), Path("c.csv")}, nullptr);
+  EXPECT_EQ(report.kind, ScenarioKind::kChain);
+  EXPECT_TRUE(report.chain.frames.empty());  // streamed to the files
+  const RunResult direct =
+      flexkin::Run(chain.chain->chain, chain.chain->leader_steps, chain.chain->options);
+  const ResultFile back = ReadResultFile(Path("c.npz"));
+  EXPECT_EQ(back.result.frames.points_data(), direct.frames.points_data());
+  EXPECT_TRUE(std::filesystem::exists(Path("c.csv")));
+  int64_t calls = 0;
+  RunScenarioToFiles(chain, {Path("d.json"), ""}, [&](int64_t, int64_t) { ++calls; });
+  EXPECT_GE(calls, 1);
+
+  const AnyScenario groom =
+      ReadScenarioFile(std::string(FLEXKIN_SOURCE_DIR) + "/examples/groom_grass_2d.json");
+  ASSERT_TRUE(groom.valid());
+  test_util::ExpectInputError(
+      [&] {
+        RunScenarioToFiles(groom, {Path("g.npz"), Path("g.csv")});
+      },
+      "csv", "strand file");
+  test_util::ExpectInputError(
+      [&] {
+        RunScenarioToFiles(groom, {Path("g.json"), ""});
+      },
+      "output", ".npz");
+  const ScenarioRunReport strands = RunScenarioToFiles(groom, {Path("g.npz"), ""});
+  EXPECT_EQ(strands.kind, ScenarioKind::kGroom);
+  EXPECT_LT(strands.strands.max_length_error, 1e-12);
+
+  const AnyScenario bad = ReadScenarioText(R"({"curve": {"points": [[0, 0]]}, "leader": {}})");
+  ASSERT_FALSE(bad.valid());
+  EXPECT_THROW(RunScenarioToFiles(bad, {Path("b.npz"), ""}), InputError);
+  EXPECT_FALSE(std::filesystem::exists(Path("b.npz")));
 }
 
 }  // namespace flexkin

@@ -8,11 +8,14 @@
 //   if (!s.valid()) for (const Problem& p : s.problems) ...;  // every problem, by JSON pointer
 //   switch (s.kind) { case ScenarioKind::kChain: Run(s.chain->chain, ...); ... }
 
+#include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 
 #include "flexkin/error.h"
 #include "flexkin/groom.h"
+#include "flexkin/result_io.h"
 #include "flexkin/robot_scenario.h"
 #include "flexkin/scenario.h"
 #include "flexkin/scenario_kind.h"
@@ -53,5 +56,32 @@ AnyScenario ReadScenarioText(const std::string& json_text, const ScenarioReadOpt
 // The same for the file at `path` (read once); messages do not repeat the path, callers add it.
 // Throws std::system_error if the file cannot be read.
 AnyScenario ReadScenarioFile(const std::string& path, const ScenarioReadOptions& options = {});
+
+// Where a run of any kind writes: `output` (a chain's result file, .json or .npz; a groom's strand
+// file, .npz; a robot's trajectory JSON) and `csv` (a chain's frames CSV, a robot's joint CSV; ""
+// for none; a groom has none).
+struct ScenarioOutputs {
+  std::string output;
+  std::string csv;
+};
+
+// What a run of any kind did: the report of its kind (the others are left at their defaults).
+struct ScenarioRunReport {
+  ScenarioKind kind = ScenarioKind::kChain;
+  RunResult chain;          // frames not kept: they went to the files
+  StrandRunReport strands;  // a groom's
+  ArmTrajectory robot;      // the summary; the steps went to the files
+  // One line: the kind's own brief report.
+  std::string BriefReport() const;
+};
+
+// The one call that runs a valid scenario of any kind into its files, each streamed while the run
+// goes and renamed into place only when complete (RunToFiles, RunGroomToFile, TrackToFiles): the
+// command line's `flexkin run` and Python's run_scenario(output=) call it, so a kind added here
+// reaches both. `progress(done, total)`, if set, is called now and then and may throw to stop the
+// run. Throws InputError for an invalid scenario (its first problem), for an output the kind does
+// not write ("csv" for a groom; "output" not ending in .npz for a groom), and what the run throws.
+ScenarioRunReport RunScenarioToFiles(const AnyScenario& scenario, const ScenarioOutputs& outputs,
+                                     const std::function<void(int64_t, int64_t)>& progress = {});
 
 }  // namespace flexkin

@@ -11,8 +11,9 @@
 namespace flexkin {
 
 // A configuration or a vector handed to a sink or a writer, from a Points/VectorXd or a Frame's
-// view alike, without a copy.
-using PointsRef = Eigen::Ref<const Points>;
+// view alike, without a copy. Packed (Stride<0, 0>): the rows are contiguous, so a copy out of it
+// is one linear copy (a block of a wider matrix is first copied into a packed temporary).
+using PointsRef = Eigen::Ref<const Points, 0, Eigen::Stride<0, 0>>;
 using VectorRef = Eigen::Ref<const Eigen::VectorXd>;
 
 // One recorded configuration: a view into the Frames that holds it, valid while those Frames

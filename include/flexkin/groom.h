@@ -130,5 +130,9 @@ StrandFileHeader MakeStrandFileHeader(const GroomScenario& scenario);
 // "interrupted"). Allocates nothing per frame beyond the writer's buffer.
 StrandRunReport RunGroom(const GroomScenario& scenario, StrandFileWriter* writer,
                          const std::function<bool(int64_t, int64_t)>& progress = {});
+// The groom run into the strand file `path` (.npz), as `flexkin run -o` and Python's run_groom
+// write it: streamed, renamed into place only when complete, removed if the run fails.
+StrandRunReport RunGroomToFile(const GroomScenario& scenario, const std::string& path,
+                               const std::function<bool(int64_t, int64_t)>& progress = {});
 
 }  // namespace flexkin

@@ -225,7 +225,8 @@ def run(points: PointsArg, leader_steps: ArrayLike, *, method: str = "tractrix",
 def load_scenario(scenario: Union[PathLike, Dict[str, Any]]) -> Scenario: ...
 def run_scenario(scenario: Union[PathLike, Dict[str, Any], Scenario], *,
                  progress: Progress = None, output: Optional[PathLike] = None,
-                 csv: Optional[PathLike] = None) -> Result: ...
+                 csv: Optional[PathLike] = None) -> Union[Result, "RobotResult",
+                                                           "StrandRunReport"]: ...
 def run_robot(scenario: Union[PathLike, Dict[str, Any], "RobotScenario"], *,
               directory: Optional[PathLike] = None, method: Optional[str] = None,
               progress: Progress = None, output: Optional[PathLike] = None,

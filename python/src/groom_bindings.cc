@@ -11,6 +11,7 @@
 
 #include "convert.h"
 #include "fields.h"
+#include "flexkin/any_scenario.h"
 #include "flexkin/groom.h"
 #include "flexkin/strand_file.h"
 #include "flexkin/vocabulary.h"
@@ -77,17 +78,15 @@ StrandRunReport RunGroomTo(GroomSource source, PathLike output, OptionalStr meth
   ApplyGroomOverrides(overrides, /*command_line=*/false, &s);
   const std::string path = RequiredPath(output, "output", false);
   ProgressHook hook(progress);
-  std::function<bool(int64_t, int64_t)> tick = [&hook](int64_t done, int64_t total) {
+  const std::function<void(int64_t, int64_t)> tick = [&hook](int64_t done, int64_t total) {
     hook.Tick(done, total);
-    return true;
   };
   try {
-    return OnFile(path, [&] {
-      StrandFileWriter writer(path, MakeStrandFileHeader(s));
-      const StrandRunReport report = RunGroom(s, &writer, tick);
-      writer.Commit(report);
-      return report;
-    });
+    // The library's one call for every kind (flexkin/any_scenario.h), as `flexkin run` makes it.
+    AnyScenario any;
+    any.kind = ScenarioKind::kGroom;
+    any.groom = std::move(s);
+    return OnFile(path, [&] { return RunScenarioToFiles(any, {path, ""}, tick).strands; });
   } catch (const StopRun&) {
     hook.Rethrow();
   }

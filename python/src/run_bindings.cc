@@ -271,6 +271,75 @@ const ResultFile& ResultFileOfObject(py::handle object) {
   return py::cast<const Result&>(object).file;
 }
 
+namespace {
+
+// A scenario of any kind from a path or a dict, through the front door (flexkin/any_scenario.h);
+// InputError for its first problem (named by the file for a path).
+AnyScenario AnyScenarioArg(py::handle scenario) {
+  const ScenarioReadOptions options{RobotReaderOptions(py::none())};
+  if (py::isinstance<py::dict>(scenario)) {
+    AnyScenario any = ReadScenarioText(JsonOfDict(scenario, "scenario"), options);
+    any.ThrowIfInvalid();
+    return any;
+  }
+  const std::string path = PathArg(scenario);
+  if (path.empty()) {
+    ThrowInput("scenario",
+               "is a " + std::string(py::str(py::type::of(scenario).attr("__name__"))) +
+                   "; expected a path to a scenario file, a dict of its JSON form or a Scenario");
+  }
+  return OnFile(path, [&] {
+    AnyScenario any = ReadScenarioFile(path, options);
+    any.ThrowIfInvalid();
+    return any;
+  });
+}
+
+// flexkin.run_scenario: a chain to a Result, a robot to a RobotResult, any other kind into its
+// files through the library's one call, its report returned.
+py::object RunAnyScenario(ScenarioSource scenario, ProgressCallback progress, OptionalPath output,
+                          OptionalPath csv) {
+  const RunFiles files{RequiredPath(output, "output", true), RequiredPath(csv, "csv", true)};
+  if (py::isinstance<Scenario>(scenario)) {
+    const Scenario& s = py::cast<const Scenario&>(scenario);
+    if (!files.result.empty()) ResultFileFormatOfPath(files.result, "output");
+    return py::cast(
+        RunToArrays(s.chain, s.leader_steps, s.options, std::move(progress), s.name, files));
+  }
+  AnyScenario any = AnyScenarioArg(scenario);
+  switch (any.kind) {
+    case ScenarioKind::kChain: {
+      const Scenario& s = *any.chain;
+      if (!files.result.empty()) ResultFileFormatOfPath(files.result, "output");
+      return py::cast(
+          RunToArrays(s.chain, s.leader_steps, s.options, std::move(progress), s.name, files));
+    }
+    case ScenarioKind::kRobot:
+      return TrackToResult(*any.robot, std::move(progress), output, csv);
+    default:
+      break;
+  }
+  // Every other kind runs into its files.
+  if (files.result.empty()) {
+    ThrowInput("output",
+               std::string("is required for a ") + NameOf(any.kind) +
+                   " scenario, which runs into its file; expected a path",
+               "None", "a path");
+  }
+  ProgressHook hook(std::move(progress));
+  try {
+    const ScenarioRunReport report = OnFile(files.result, [&] {
+      return RunScenarioToFiles(any, {files.result, files.csv},
+                                [&hook](int64_t done, int64_t total) { hook.Tick(done, total); });
+    });
+    return py::cast(report.strands);
+  } catch (const StopRun&) {
+    hook.Rethrow();
+  }
+}
+
+}  // namespace
+
 void BindRun(py::module_& m) {
   py::class_<Result> result(m, "Result", R"doc(
 The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
@@ -421,22 +490,18 @@ changed before flexkin.run_scenario runs it.
         "Reads a scenario: a path (str or os.PathLike) to a scenario file, or a dict of its JSON "
         "form (docs/scenario-format.md). Raises InputError naming the JSON pointer of the first "
         "problem (field '/leader/steps'), OSError for a file that cannot be read.");
-  m.def(
-      "run_scenario",
-      [](ScenarioSource scenario, ProgressCallback progress, OptionalPath output,
-         OptionalPath csv) {
-        const Scenario s = ScenarioArg(scenario);
-        const RunFiles files{RequiredPath(output, "output", true), RequiredPath(csv, "csv", true)};
-        if (!files.result.empty()) ResultFileFormatOfPath(files.result, "output");
-        return RunToArrays(s.chain, s.leader_steps, s.options, std::move(progress), s.name, files);
-      },
-      py::arg("scenario"), py::kw_only(), py::arg("progress") = py::none(),
-      py::arg("output") = py::none(), py::arg("csv") = py::none(),
-      "Runs a scenario (a path, a dict of the scenario JSON form, or a Scenario) as `flexkin "
-      "run` does, with the same result bit for bit. Returns a Result; progress as in run. "
-      "output, csv: None or the paths of the result file (.json or .npz) and the frames CSV, "
-      "written as `flexkin run -o --csv` writes them, through the same library call "
-      "(RunToFiles): streamed while the run goes, renamed into place only when complete.");
+  m.def("run_scenario", &RunAnyScenario, py::arg("scenario"), py::kw_only(),
+        py::arg("progress") = py::none(), py::arg("output") = py::none(),
+        py::arg("csv") = py::none(),
+        "Runs a scenario of any kind (a path or a dict of its JSON form, told apart as `flexkin "
+        "validate` does; or a Scenario) as `flexkin run` (or `flexkin robot`) does, with the "
+        "same result bit for bit. A chain returns a Result (progress as in run); a robot a "
+        "RobotResult, as run_robot; a groom runs into its strand file `output` (required, .npz) "
+        "and returns a StrandRunReport, as run_groom. output, csv: None or the paths of the "
+        "files `flexkin run -o --csv` writes (a chain's result file, .json or .npz, and frames "
+        "CSV; a robot's trajectory JSON and joint CSV; a groom's strand file), written through "
+        "the library's one call (RunScenarioToFiles): streamed while the run goes, renamed into "
+        "place only when complete.");
 }
 
 }  // namespace flexkin::python

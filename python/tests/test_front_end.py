@@ -368,9 +368,12 @@ def test_a_file_problem_reaches_python_and_the_command_line_alike(tmp_path, cli)
     out = subprocess.run([cli, "validate", str(path)], capture_output=True, text=True)
     assert out.returncode == 1
     assert out.stdout == "%s: /curve/links: %s\n" % (path, problems[0]["message"])
-    # Every kind is told apart by the library: a groom file given to run_scenario is named.
-    with pytest.raises(flexkin.InputError, match="is a groom scenario, not a chain one"):
+    # Every kind is told apart by the library: a groom file given to run_scenario runs as a
+    # groom, into the file it needs; a groom given to load_scenario (chains only) is named.
+    with pytest.raises(flexkin.InputError, match="required for a groom scenario"):
         flexkin.run_scenario(str(EXAMPLES / "groom_grass_2d.json"))
+    with pytest.raises(flexkin.InputError, match="is a groom scenario, not a chain one"):
+        flexkin.load_scenario(str(EXAMPLES / "groom_grass_2d.json"))
 
 
 # A scenario option added in the library only (the leader's "closed": true, src/io/
@@ -400,3 +403,27 @@ def test_a_library_option_reaches_the_command_line_untouched(cli, tmp_path):
     path.write_text(json.dumps(dict(CLOSED, leader={"pull": [1, 0], "closed": True})))
     done = subprocess.run([cli, "validate", str(path)], capture_output=True, text=True)
     assert done.returncode != 0 and "/leader/closed" in done.stderr + done.stdout
+
+
+def test_run_scenario_runs_every_kind_through_the_library(tmp_path):
+    # One Python entry for every kind, over the library's one call (RunScenarioToFiles): a chain
+    # to a Result, a robot to a RobotResult, a groom into its strand file.
+    chain = flexkin.run_scenario(EXAMPLES / "fig10_planar_curve.json")
+    assert isinstance(chain, flexkin.Result)
+    robot = flexkin.run_scenario(EXAMPLES / "robot_planar_8link.json",
+                                 output=tmp_path / "arm.json", csv=tmp_path / "arm.csv")
+    assert isinstance(robot, flexkin.RobotResult) and (tmp_path / "arm.csv").exists()
+    same = flexkin.run_robot(EXAMPLES / "robot_planar_8link.json")
+    assert np.array_equal(robot.points, same.points)
+    report = flexkin.run_scenario(EXAMPLES / "groom_grass_2d.json", output=tmp_path / "g.npz")
+    assert report.max_length_error < 1e-12
+    flexkin.run_groom(EXAMPLES / "groom_grass_2d.json", tmp_path / "g2.npz")
+    a, b = np.load(tmp_path / "g.npz"), np.load(tmp_path / "g2.npz")
+    assert np.array_equal(a["points"], b["points"])
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.run_scenario(EXAMPLES / "groom_grass_2d.json")
+    assert info.value.field == "output"
+    with pytest.raises(flexkin.InputError) as info:
+        flexkin.run_scenario(EXAMPLES / "groom_grass_2d.json", output=tmp_path / "g.npz",
+                             csv=tmp_path / "g.csv")
+    assert info.value.field.endswith("csv")

@@ -112,4 +112,12 @@ StrandRunReport RunGroom(const GroomScenario& scenario, StrandFileWriter* writer
   return report;
 }
 
+StrandRunReport RunGroomToFile(const GroomScenario& scenario, const std::string& path,
+                               const std::function<bool(int64_t, int64_t)>& progress) {
+  StrandFileWriter writer(path, MakeStrandFileHeader(scenario));
+  const StrandRunReport report = RunGroom(scenario, &writer, progress);
+  writer.Commit(report);
+  return report;
+}
+
 }  // namespace flexkin

@@ -22,16 +22,11 @@ void Frames::Add(int64_t step, const PointsRef& points, const VectorRef& link_an
                                 " link angles added to frames with " +
                                 std::to_string(has_angles_ ? num_points_ - 1 : 0));
   }
-  // Row-major with unit inner stride: the coordinates are contiguous when the outer stride is
-  // dim (a Ref may view a block of a wider matrix).
+  // A PointsRef is packed: its coordinates are contiguous.
   const size_t at = points_.size();
   points_.resize(at + static_cast<size_t>(points.size()));
-  double* out = points_.data() + at;
-  if (points.outerStride() == dim_) {
-    std::memcpy(out, points.data(), sizeof(double) * static_cast<size_t>(points.size()));
-  } else {
-    Eigen::Map<Points>(out, num_points_, dim_) = points;
-  }
+  std::memcpy(points_.data() + at, points.data(),
+              sizeof(double) * static_cast<size_t>(points.size()));
   angles_.insert(angles_.end(), link_angles.data(), link_angles.data() + link_angles.size());
   steps_.push_back(step);
 }
