@@ -34,7 +34,7 @@ TEST(FramesTest, LayoutIsTheArrayOfTheResultFile) {
     EXPECT_EQ(frames.dim(), dim);
     ASSERT_TRUE(frames.has_link_angles());
     // Element [f][i][k] of the (F, n+1, dim) C-order array is at (f * (n+1) + i) * dim + k.
-    const std::vector<double>& data = frames.points_data();
+    const FrameArray<double>& data = frames.points_data();
     ASSERT_EQ(data.size(), static_cast<size_t>(4 * rows * dim));
     for (int64_t f = 0; f < 4; ++f) {
       for (int i = 0; i < rows; ++i) {

@@ -3,12 +3,41 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <iterator>
 #include <vector>
 
 #include "flexkin/chain.h"
 
 namespace flexkin {
+
+namespace internal {
+// Memory for dense frames: a block of 4 MiB or more is aligned to 2 MiB and advised as
+// transparent huge pages (as numpy does for its arrays), so a run filling it does not fault a
+// page every 4 KiB; smaller blocks come from malloc. Either is freed with std::free.
+void* AllocateFrameBlock(size_t bytes);
+template <typename T>
+struct FrameBlockAllocator {
+  using value_type = T;
+  FrameBlockAllocator() = default;
+  template <typename U>
+  FrameBlockAllocator(const FrameBlockAllocator<U>&) {}  // NOLINT: allocators convert
+  T* allocate(size_t n) { return static_cast<T*>(AllocateFrameBlock(n * sizeof(T))); }
+  void deallocate(T* p, size_t) { std::free(p); }
+  template <typename U>
+  bool operator==(const FrameBlockAllocator<U>&) const {
+    return true;
+  }
+  template <typename U>
+  bool operator!=(const FrameBlockAllocator<U>&) const {
+    return false;
+  }
+};
+}  // namespace internal
+
+// The arrays of dense frames.
+template <typename T>
+using FrameArray = std::vector<T, internal::FrameBlockAllocator<T>>;
 
 // A configuration or a vector handed to a sink or a writer, from a Points/VectorXd or a Frame's
 // view alike, without a copy. Packed (Stride<0, 0>): the rows are contiguous, so a copy out of it
@@ -88,9 +117,9 @@ class Frames {
 
   // The dense arrays: size() * num_points() * dim() coordinates, size() steps, and
   // size() * (num_points() - 1) link angles (none without them).
-  const std::vector<double>& points_data() const { return points_; }
-  const std::vector<int64_t>& steps() const { return steps_; }
-  const std::vector<double>& link_angles_data() const { return angles_; }
+  const FrameArray<double>& points_data() const { return points_; }
+  const FrameArray<int64_t>& steps() const { return steps_; }
+  const FrameArray<double>& link_angles_data() const { return angles_; }
   // Every frame's points stacked: (size() * num_points()) by dim.
   Eigen::Map<const Points> all_points() const;
   // Makes `count` frames of `num_points` points in `dim` dimensions, with link angles or not,
@@ -105,9 +134,9 @@ class Frames {
   double* mutable_link_angles_data() { return angles_.data(); }
 
  private:
-  std::vector<double> points_;
-  std::vector<int64_t> steps_;
-  std::vector<double> angles_;
+  FrameArray<double> points_;
+  FrameArray<int64_t> steps_;
+  FrameArray<double> angles_;
   int64_t num_points_ = 0;
   int dim_ = 0;
   bool has_angles_ = false;

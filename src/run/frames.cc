@@ -1,10 +1,27 @@
 #include "flexkin/frames.h"
 
+#include <sys/mman.h>
+
 #include <cstring>
+#include <new>
 #include <stdexcept>
 #include <string>
 
 namespace flexkin {
+
+void* internal::AllocateFrameBlock(size_t bytes) {
+  constexpr size_t kHuge = size_t{2} << 20;
+  void* p = nullptr;
+  if (bytes >= 2 * kHuge) {
+    const size_t rounded = (bytes + kHuge - 1) / kHuge * kHuge;
+    p = std::aligned_alloc(kHuge, rounded);
+    if (p != nullptr) ::madvise(p, rounded, MADV_HUGEPAGE);  // advice only: errors are harmless
+  } else {
+    p = std::malloc(bytes == 0 ? 1 : bytes);
+  }
+  if (p == nullptr) throw std::bad_alloc();
+  return p;
+}
 
 void Frames::Add(int64_t step, const PointsRef& points, const VectorRef& link_angles) {
   if (empty()) {
@@ -22,11 +39,8 @@ void Frames::Add(int64_t step, const PointsRef& points, const VectorRef& link_an
                                 " link angles added to frames with " +
                                 std::to_string(has_angles_ ? num_points_ - 1 : 0));
   }
-  // A PointsRef is packed: its coordinates are contiguous.
-  const size_t at = points_.size();
-  points_.resize(at + static_cast<size_t>(points.size()));
-  std::memcpy(points_.data() + at, points.data(),
-              sizeof(double) * static_cast<size_t>(points.size()));
+  // A PointsRef is packed: its coordinates are contiguous, appended in one copy (no zero fill).
+  points_.insert(points_.end(), points.data(), points.data() + points.size());
   angles_.insert(angles_.end(), link_angles.data(), link_angles.data() + link_angles.size());
   steps_.push_back(step);
 }
