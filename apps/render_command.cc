@@ -17,8 +17,8 @@ namespace flexkin::cli {
 namespace {
 
 // A problem of the options, named by the command-line option that set the member
-// ("figure.every_k" -> "--every", "strands.max_frames" -> "--max-frames", "options.max_frames"
-// from a writer -> "--max-frames").
+// ("figure.every_k" -> "--every", "strands.max_frames" -> "--max-frames", "formats" ->
+// "--formats", "options.max_frames" from a writer -> "--max-frames").
 [[noreturn]] void ThrowForFlag(Problem p) {
   const size_t dot = p.field.find('.');
   std::string flag = dot == std::string::npos ? p.field : p.field.substr(dot + 1);
@@ -43,14 +43,8 @@ RenderCommand::RenderCommand(CLI::App* app, const std::string& footer) {
   std::string formats_help = "Comma-separated outputs (default svg,png,plots):";
   for (const auto& entry : Vocabulary<OutputFormat>::kEntries)
     formats_help += std::string("\n  ") + entry.name + ": " + entry.summary;
-  auto names = [](DrawnKind kind) {
-    std::string list;
-    for (OutputFormat f : FormatsOf(kind))
-      list += (list.empty() ? "" : ", ") + std::string(NameOf(f));
-    return list;
-  };
-  formats_help += "\n  (robot trajectories: " + names(DrawnKind::kRobotTrajectory) +
-                  "; strand files: " + names(DrawnKind::kStrandFile) + "; default svg,png)";
+  formats_help += "\n  (robot trajectories: " + FormatNamesOf(DrawnKind::kRobotTrajectory) +
+                  "; strand files: " + FormatNamesOf(DrawnKind::kStrandFile) + "; default svg,png)";
   formats_ = command_->add_option("--formats", args_.formats, formats_help);
   command_->add_option("--every", args_.every,
                        "Figures: draw every K-th recorded frame (default: about 16 frames)");
@@ -94,16 +88,13 @@ int RenderCommand::Run() const {
   options.base = OutputBaseOf(args_.result, args_.output_dir);
   options.writing = Writing;
   options.note = [](const std::string& note) { std::cerr << "flexkin: note: " << note << "\n"; };
-  if (const Problems problems = ValidateDrawOptions(KindOfDrawnFile(args_.result), options);
-      !problems.empty()) {
-    ThrowForFlag(problems.front());
-  }
   std::vector<std::string> written;
   try {
     written = DrawFile(args_.result, options);
   } catch (const InputError& e) {
-    if (e.field().rfind("options.", 0) == 0) ThrowForFlag(e.problem());
-    throw;
+    // DrawFile checks the options first, once; a problem of the file is named by the file.
+    if (!IsDrawOptionsProblem(e.problem())) throw;
+    ThrowForFlag(e.problem());
   } catch (const std::system_error&) {
     throw;
   } catch (const std::runtime_error& e) {  // ffmpeg missing or failing, cairo

@@ -71,8 +71,9 @@ std::vector<OutputFormat> DefaultFormats(DrawnKind kind);
 std::vector<OutputFormat> ParseOutputFormats(const std::string& list, const std::string& field);
 std::vector<OutputFormat> ParseOutputFormats(const std::vector<std::string>& names,
                                              const std::string& field);
-// The formats a file of `kind` can be drawn in.
+// The formats a file of `kind` can be drawn in, and their names ("svg, png, ...").
 std::vector<OutputFormat> FormatsOf(DrawnKind kind);
+std::string FormatNamesOf(DrawnKind kind);
 
 // Draws a chain result, a robot trajectory or the strand file at `path` and returns the paths
 // written, in order. Throws InputError for invalid options (ValidateDrawOptions's first problem)
@@ -82,6 +83,12 @@ std::vector<OutputFormat> FormatsOf(DrawnKind kind);
 std::vector<std::string> Draw(const ResultFile& result, const DrawOptions& options);
 std::vector<std::string> Draw(const RobotTrajectoryFile& trajectory, const DrawOptions& options);
 std::vector<std::string> DrawStrandFile(const std::string& path, const DrawOptions& options);
+
+// Whether a problem Draw, DrawStrandFile or DrawFile threw is one of the options (its field
+// "formats", a component's member such as "figure.width" or "strands.max_frames", or a writer's
+// "options.max_frames"), which a front end names by its own flag or keyword, rather than one of
+// what is drawn.
+bool IsDrawOptionsProblem(const Problem& problem);
 
 // A file of any kind, told apart by its content (IsStrandFile, IsRobotTrajectoryFile, else a
 // result file, JSON or .npz), read once and drawn. A problem of the file is named by it

@@ -57,12 +57,17 @@ void CheckOptions(const Problems& problems, const std::string& prefix) {
   throw InputError(p);
 }
 
-void CheckKeywords(const Problems& problems) {
-  if (problems.empty()) return;
-  Problem p = problems.front();
+// A problem Draw found in the options, named by the keyword that set the member where a keyword
+// did ("figure.every_k" -> "every", "animation.fps" -> "fps"), else as Draw names it: the option
+// objects were checked on their own before the keywords were applied.
+[[noreturn]] void ThrowForKeyword(Problem p) {
   const size_t dot = p.field.find('.');
-  if (p.field != "formats" && dot != std::string::npos) p.field = p.field.substr(dot + 1);
-  if (p.field == "every_k") p.field = "every";
+  std::string member = dot == std::string::npos ? p.field : p.field.substr(dot + 1);
+  if (member == "every_k") member = "every";
+  for (const char* keyword : {"every", "width", "height", "azimuth", "elevation", "fps",
+                              "max_frames", "max_strands", "title", "ffmpeg"}) {
+    if (member == keyword) p.field = member;
+  }
   throw InputError(p);
 }
 
@@ -91,9 +96,6 @@ std::vector<std::string> Render(Drawable result, PathLike out_dir, OptionalForma
   const std::optional<RobotTrajectoryFile> trajectory = RobotTrajectoryOfObject(result);
   const std::string path = trajectory ? "" : PathArg(result);
   const ResultFile* file = trajectory || !path.empty() ? nullptr : &ResultFileOfObject(result);
-  const DrawnKind kind = trajectory ? DrawnKind::kRobotTrajectory
-                         : file     ? DrawnKind::kChainResult
-                                    : OnFile(path, [&] { return KindOfDrawnFile(path); });
   DrawOptions options;
   if (!formats.is_none()) options.formats = FormatsArg(formats);
   const std::string dir = RequiredPath(out_dir, "out_dir");
@@ -123,7 +125,6 @@ std::vector<std::string> Render(Drawable result, PathLike out_dir, OptionalForma
   keywords.title = Optional<std::string>(title);
   keywords.ffmpeg = Optional<std::string>(ffmpeg);
   ApplyShorthands(keywords, &options);
-  CheckKeywords(ValidateDrawOptions(kind, options));
   if (file != nullptr && file->result.frames.empty()) {
     ThrowInput("result.frames", "no frames; nothing to draw");
   }
@@ -132,6 +133,10 @@ std::vector<std::string> Render(Drawable result, PathLike out_dir, OptionalForma
     if (trajectory) return Draw(*trajectory, options);
     if (file != nullptr) return Draw(*file, options);
     return DrawFile(path, options);  // names the file in its problems
+  } catch (const InputError& e) {
+    // Draw checks the options first, once; a problem of the result or the file stays as it is.
+    if (IsDrawOptionsProblem(e.problem())) ThrowForKeyword(e.problem());
+    throw;
   } catch (const std::system_error& e) {
     if (path.empty()) throw;
     RethrowWithPath(e, path);

@@ -300,24 +300,22 @@ AnyScenario AnyScenarioArg(py::handle scenario) {
 py::object RunAnyScenario(ScenarioSource scenario, ProgressCallback progress, OptionalPath output,
                           OptionalPath csv) {
   const RunFiles files{RequiredPath(output, "output", true), RequiredPath(csv, "csv", true)};
+  // A Scenario object, or a chain read from a path or a dict: a Result.
+  AnyScenario any;
+  const Scenario* chain = nullptr;
   if (py::isinstance<Scenario>(scenario)) {
-    const Scenario& s = py::cast<const Scenario&>(scenario);
-    if (!files.result.empty()) ResultFileFormatOfPath(files.result, "output");
-    return py::cast(
-        RunToArrays(s.chain, s.leader_steps, s.options, std::move(progress), s.name, files));
-  }
-  AnyScenario any = AnyScenarioArg(scenario);
-  switch (any.kind) {
-    case ScenarioKind::kChain: {
-      const Scenario& s = *any.chain;
-      if (!files.result.empty()) ResultFileFormatOfPath(files.result, "output");
-      return py::cast(
-          RunToArrays(s.chain, s.leader_steps, s.options, std::move(progress), s.name, files));
-    }
-    case ScenarioKind::kRobot:
+    chain = &py::cast<const Scenario&>(scenario);
+  } else {
+    any = AnyScenarioArg(scenario);
+    if (any.kind == ScenarioKind::kChain) chain = &*any.chain;
+    if (any.kind == ScenarioKind::kRobot) {
       return TrackToResult(*any.robot, std::move(progress), output, csv);
-    default:
-      break;
+    }
+  }
+  if (chain != nullptr) {
+    if (!files.result.empty()) ResultFileFormatOfPath(files.result, "output");
+    return py::cast(RunToArrays(chain->chain, chain->leader_steps, chain->options,
+                                std::move(progress), chain->name, files));
   }
   // Every other kind runs into its files.
   if (files.result.empty()) {

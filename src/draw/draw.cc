@@ -15,28 +15,29 @@ namespace {
 // How each format is written for each kind: the suffix of its file and the writer. A format a
 // kind has no writer for is not drawn in for it (FormatsOf).
 struct Output {
-  const ResultFile* result = nullptr;
+  explicit Output(const DrawOptions& draw_options) : options(draw_options) {}
+  const DrawOptions& options;
+  const ResultFile* result = nullptr;  // what is drawn: one of these three
   const RobotTrajectoryFile* trajectory = nullptr;
   const std::string* strand_path = nullptr;
-  const DrawOptions* options = nullptr;
-  std::vector<std::string>* written = nullptr;
+  mutable std::vector<std::string> written;  // the paths, in order
 
   void Write(const std::string& path, const std::function<void()>& write) const {
-    if (options->writing) options->writing(path);
+    if (options.writing) options.writing(path);
     write();
-    written->push_back(path);
+    written.push_back(path);
   }
 };
 
 std::string Extension(OutputFormat format) { return std::string(".") + NameOf(format); }
 
 void Figure(const Output& o, OutputFormat format) {
-  const std::string path = o.options->base + Extension(format);
+  const std::string path = o.options.base + Extension(format);
   o.Write(path, [&] {
     if (o.trajectory != nullptr) {
-      WriteSnapshotFigure(*o.trajectory, o.options->figure, path);
+      WriteSnapshotFigure(*o.trajectory, o.options.figure, path);
     } else {
-      WriteSnapshotFigure(*o.result, o.options->figure, path);
+      WriteSnapshotFigure(*o.result, o.options.figure, path);
     }
   });
 }
@@ -45,23 +46,23 @@ void Plots(const Output& o) {
   const bool have_angles = o.result->result.frames.front().link_angles.size() > 0;
   for (const auto& [kind, name, summary] : Vocabulary<PlotKind>::kEntries) {
     if (kind == PlotKind::kLinkAngles && !have_angles) {
-      if (o.options->note) o.options->note("no link_angles plot: the leading end never moves");
+      if (o.options.note) o.options.note("no link_angles plot: the leading end never moves");
       continue;
     }
     for (const char* extension : {".svg", ".png"}) {
-      const std::string path = o.options->base + "_" + name + extension;
-      o.Write(path, [&] { WritePlot(*o.result, kind, o.options->plot, path); });
+      const std::string path = o.options.base + "_" + name + extension;
+      o.Write(path, [&] { WritePlot(*o.result, kind, o.options.plot, path); });
     }
   }
 }
 
 void Animation(const Output& o, OutputFormat format) {
-  const std::string path = o.options->base + Extension(format);
+  const std::string path = o.options.base + Extension(format);
   o.Write(path, [&] {
     if (o.trajectory != nullptr) {
-      WriteAnimation(*o.trajectory, o.options->animation, path);
+      WriteAnimation(*o.trajectory, o.options.animation, path);
     } else {
-      WriteAnimation(*o.result, o.options->animation, path);
+      WriteAnimation(*o.result, o.options.animation, path);
     }
   });
 }
@@ -73,36 +74,36 @@ ViewerOptions ViewerWithTitle(const DrawOptions& options) {
 }
 
 void Viewer(const Output& o) {
-  const std::string path = o.options->base + ".html";
+  const std::string path = o.options.base + ".html";
   o.Write(path, [&] {
     if (o.trajectory != nullptr) {
-      WriteViewerHtml(*o.trajectory, ViewerWithTitle(*o.options), path);
+      WriteViewerHtml(*o.trajectory, ViewerWithTitle(o.options), path);
     } else {
-      WriteViewerHtml(*o.result, ViewerWithTitle(*o.options), path);
+      WriteViewerHtml(*o.result, ViewerWithTitle(o.options), path);
     }
   });
 }
 
 void Gltf(const Output& o, OutputFormat format) {
-  const std::string path = o.options->base + Extension(format);
-  o.Write(path, [&] { WriteGltf(*o.result, o.options->gltf, path); });
+  const std::string path = o.options.base + Extension(format);
+  o.Write(path, [&] { WriteGltf(*o.result, o.options.gltf, path); });
 }
 
 // A strand file's outputs: each writer reads the whole file, with a reader of its own.
 void StrandOutput(const Output& o, OutputFormat format) {
-  const std::string path = o.options->base + Extension(format);
+  const std::string path = o.options.base + Extension(format);
   o.Write(path, [&] {
     StrandFileReader reader(*o.strand_path);
     switch (format) {
       case OutputFormat::kMp4:
       case OutputFormat::kGif:
-        RenderStrandsAnimation(&reader, o.options->strands, path);
+        RenderStrandsAnimation(&reader, o.options.strands, path);
         return;
       case OutputFormat::kHtml:
-        WriteStrandsViewerHtml(&reader, o.options->strands_viewer, path);
+        WriteStrandsViewerHtml(&reader, o.options.strands_viewer, path);
         return;
       default:
-        RenderStrandsSnapshot(&reader, o.options->strands, path);
+        RenderStrandsSnapshot(&reader, o.options.strands, path);
         return;
     }
   });
@@ -159,7 +160,7 @@ void Prefixed(const Problems& problems, const std::string& prefix, Problems* out
 // The viewer's trails name points of the drawing: at most its last point (n for a chain, the
 // base for a trajectory, point 0 its end effector).
 void CheckTrailPoints(const Output& o) {
-  const std::vector<int>& trails = o.options->viewer.trail_points;
+  const std::vector<int>& trails = o.options.viewer.trail_points;
   Eigen::Index last = -1;
   if (o.result != nullptr) last = o.result->result.lengths.size();
   if (o.trajectory != nullptr && !o.trajectory->states.empty()) {
@@ -179,7 +180,7 @@ void CheckTrailPoints(const Output& o) {
 // Draws with options already validated for `kind`.
 std::vector<std::string> DrawChecked(DrawnKind kind, const Output& o) {
   CheckTrailPoints(o);
-  const std::filesystem::path dir = std::filesystem::path(o.options->base).parent_path();
+  const std::filesystem::path dir = std::filesystem::path(o.options.base).parent_path();
   if (!dir.empty()) {
     std::error_code error;
     std::filesystem::create_directories(dir, error);
@@ -188,9 +189,9 @@ std::vector<std::string> DrawChecked(DrawnKind kind, const Output& o) {
     }
   }
   const std::vector<OutputFormat> formats =
-      o.options->formats.empty() ? DefaultFormats(kind) : o.options->formats;
+      o.options.formats.empty() ? DefaultFormats(kind) : o.options.formats;
   for (OutputFormat format : formats) WriterOf(kind, format)(o, format);
-  return *o.written;
+  return o.written;
 }
 
 }  // namespace
@@ -229,13 +230,18 @@ std::vector<OutputFormat> FormatsOf(DrawnKind kind) {
   return formats;
 }
 
+std::string FormatNamesOf(DrawnKind kind) {
+  std::string names;
+  for (OutputFormat f : FormatsOf(kind))
+    names += (names.empty() ? "" : ", ") + std::string(NameOf(f));
+  return names;
+}
+
 Problems ValidateDrawOptions(DrawnKind kind, const DrawOptions& options) {
   Problems problems;
   for (OutputFormat format : options.formats) {
     if (WriterOf(kind, format) != nullptr) continue;
-    std::string valid;
-    for (OutputFormat f : FormatsOf(kind))
-      valid += (valid.empty() ? "" : ", ") + std::string(NameOf(f));
+    const std::string valid = FormatNamesOf(kind);
     const std::string name = NameOf(format);
     problems.push_back(Problem("formats",
                                "format \"" + name + "\" is not available for " + KindName(kind) +
@@ -302,33 +308,34 @@ std::vector<OutputFormat> ParseOutputFormats(const std::string& list, const std:
 std::vector<std::string> Draw(const ResultFile& result, const DrawOptions& options) {
   ThrowIfAny(ValidateDrawOptions(DrawnKind::kChainResult, options));
   if (result.result.frames.empty()) throw InputError("frames", "no frames; nothing to draw");
-  std::vector<std::string> written;
-  Output o;
+  Output o(options);
   o.result = &result;
-  o.options = &options;
-  o.written = &written;
   return DrawChecked(DrawnKind::kChainResult, o);
 }
 
 std::vector<std::string> Draw(const RobotTrajectoryFile& trajectory, const DrawOptions& options) {
   ThrowIfAny(ValidateDrawOptions(DrawnKind::kRobotTrajectory, options));
-  std::vector<std::string> written;
-  Output o;
+  Output o(options);
   o.trajectory = &trajectory;
-  o.options = &options;
-  o.written = &written;
   return DrawChecked(DrawnKind::kRobotTrajectory, o);
 }
 
 std::vector<std::string> DrawStrandFile(const std::string& path, const DrawOptions& options) {
   ThrowIfAny(ValidateDrawOptions(DrawnKind::kStrandFile, options));
   StrandFileReader check(path);  // the file's own problems before any output
-  std::vector<std::string> written;
-  Output o;
+  Output o(options);
   o.strand_path = &path;
-  o.options = &options;
-  o.written = &written;
   return DrawChecked(DrawnKind::kStrandFile, o);
+}
+
+bool IsDrawOptionsProblem(const Problem& problem) {
+  const std::string& field = problem.field;
+  if (field == "formats") return true;
+  for (const char* prefix : {"figure.", "plot.", "animation.", "viewer.", "gltf.", "strands.",
+                             "strands_viewer.", "options."}) {
+    if (field.rfind(prefix, 0) == 0) return true;
+  }
+  return false;
 }
 
 DrawnKind KindOfDrawnFile(const std::string& path) {
@@ -340,17 +347,14 @@ DrawnKind KindOfDrawnFile(const std::string& path) {
 std::vector<std::string> DrawFile(const std::string& path, const DrawOptions& options) {
   const DrawnKind kind = KindOfDrawnFile(path);
   ThrowIfAny(ValidateDrawOptions(kind, options));  // the options' problems first, once
-  std::vector<std::string> written;
-  Output o;
-  o.options = &options;
-  o.written = &written;
+  Output o(options);
   ResultFile result;
   RobotTrajectoryFile trajectory;
   try {
     // The file read once; its problems, found reading or drawing, are named by the file
     // ("r.json: /frames/3/points/2/1"), except an option found wrong only against the file
-    // ("options.max_frames": the viewer page's size; "viewer.trail_points[0]"), which is the
-    // options'.
+    // ("options.max_frames": the viewer page's size; "viewer.trail_points[0]"), which stays the
+    // options' (IsDrawOptionsProblem).
     switch (kind) {
       case DrawnKind::kStrandFile: {
         StrandFileReader check(path);
@@ -369,7 +373,7 @@ std::vector<std::string> DrawFile(const std::string& path, const DrawOptions& op
     }
     return DrawChecked(kind, o);
   } catch (const InputError& e) {
-    if (e.field().rfind("options.", 0) == 0 || e.field().rfind("viewer.", 0) == 0) throw;
+    if (IsDrawOptionsProblem(e.problem())) throw;
     Problem p = e.problem();
     p.field = path + (p.field.empty() ? "" : ": " + p.field);
     throw InputError(p);
