@@ -6,6 +6,8 @@
 //   flexkin run GROOM.json -o HAIR.npz [--method tractrix|ftl] [--substeps N] [--threads N]
 //       [--record-every N] [--precision float32|float64] [--max-output-size SIZE] [--quiet]
 //       (a groom scenario, recognised by its keys: groom_command.h)
+//   flexkin run ROBOT.json -o TRAJECTORY.json [--csv JOINTS.csv] [--method newton|fixed_point]
+//       [--max-output-size SIZE] [--quiet]   (a robot scenario: robot_command.h; = flexkin robot)
 //   flexkin validate SCENARIO.json   (chain, robot or groom scenario, recognised by its keys)
 //   flexkin render RESULT.json ...   (render_command.h)
 //   flexkin robot SCENARIO.json ...  (robot_command.h)
@@ -31,6 +33,7 @@
 #include <vector>
 
 #include "flexkin/any_scenario.h"
+#include "flexkin/arm.h"
 #include "flexkin/error.h"
 #include "flexkin/groom.h"
 #include "flexkin/propagate.h"
@@ -38,7 +41,6 @@
 #include "flexkin/robot_scenario.h"
 #include "flexkin/run.h"
 #include "flexkin/scenario.h"
-#include "flexkin/urdf.h"
 #include "groom_command.h"
 #include "interrupt.h"
 #include "output_check.h"
@@ -76,13 +78,6 @@ constexpr const char* kExitCodesHelp =
     "     output being written was not written and earlier files are unchanged";
 
 void PrintError(const std::string& message) { std::cerr << "flexkin: error: " << message << "\n"; }
-
-// How the command line reads scenarios: URDF robots through the URDF component.
-flexkin::ScenarioReadOptions ReadOptions() {
-  flexkin::ScenarioReadOptions options;
-  options.robot = flexkin::UrdfRobotScenarioOptions();
-  return options;
-}
 
 // After a signal, whatever exception ended the command (the interruption itself, or a failure
 // it caused, such as an ffmpeg that the terminal's Ctrl-C stopped too): 128 + the signal.
@@ -144,6 +139,10 @@ void ApplyOverrides(const RunArgs& args, flexkin::RunOptions* options) {
 std::string MethodHelp() {
   std::string help = "Overrides the scenario's method:";
   for (const auto& entry : flexkin::Vocabulary<flexkin::Method>::kEntries) {
+    help += std::string("\n  ") + entry.name + ": " + entry.summary;
+  }
+  help += "\nOf a robot scenario:";
+  for (const auto& entry : flexkin::Vocabulary<flexkin::FixedBaseMethod>::kEntries) {
     help += std::string("\n  ") + entry.name + ": " + entry.summary;
   }
   return help;
@@ -243,18 +242,39 @@ int RunGroom(const RunArgs& args, flexkin::AnyScenario scenario) {
   }
 }
 
+// A robot scenario (docs/robot-format.md) is tracked into its trajectory JSON (and joint CSV), as
+// `flexkin robot` does; --method names a FixedBaseMethod, the options of chain runs are refused.
+int RunRobot(const RunArgs& args, flexkin::AnyScenario scenario) {
+  flexkin::cli::RobotRunArgs r;
+  r.scenario = args.scenario;
+  r.output = args.output;
+  r.csv = args.csv;
+  r.max_output_size = args.max_output_size;
+  r.quiet = args.quiet;
+  if (*args.method_opt) r.method = args.method;
+  const std::pair<CLI::Option*, const char*> unsupported[] = {
+      {args.substeps_opt, "--substeps"},
+      {args.tolerance_opt, "--tolerance"},
+      {args.max_substeps_opt, "--max-substeps"},
+      {args.record_every_opt, "--record-every"},
+      {args.threads_opt, "--threads"},
+      {args.precision_opt, "--precision"},
+      {args.no_link_angles_opt, "--no-link-angles"},
+      {args.report_opt, "--report"}};
+  for (const auto& [option, name] : unsupported) {
+    if (*option) r.unsupported = name;
+  }
+  return flexkin::cli::RunRobotCommand(r, std::move(scenario));
+}
+
 int RunCommand(const RunArgs& args) {
   // One read, one parse: the kind and every problem (flexkin/any_scenario.h).
-  flexkin::AnyScenario any = flexkin::ReadScenarioFile(args.scenario, ReadOptions());
+  flexkin::AnyScenario any = flexkin::ReadScenarioFile(args.scenario, flexkin::cli::RobotReadOptions());
   if (!any.valid()) {
     PrintError(args.scenario + ": " + any.problems.front().Text());
     return kExitInvalidInput;
   }
-  if (any.kind == flexkin::ScenarioKind::kRobot) {
-    throw flexkin::InputError(flexkin::Problem(
-        args.scenario, "is a robot scenario (docs/robot-format.md); run it with `flexkin robot " +
-                           args.scenario + " -o TRAJECTORY.json`"));
-  }
+  if (any.kind == flexkin::ScenarioKind::kRobot) return RunRobot(args, std::move(any));
   if (any.kind == flexkin::ScenarioKind::kGroom) return RunGroom(args, std::move(any));
   if (*args.threads_opt || *args.precision_opt) {
     throw flexkin::InputError(
@@ -331,7 +351,7 @@ void PrintChainOutput(const flexkin::Scenario& scenario) {
 
 // Any kind of scenario, read once: every problem (exit 1), or its summary and output sizes.
 int ValidateCommand(const std::string& path) {
-  const flexkin::AnyScenario s = flexkin::ReadScenarioFile(path, ReadOptions());
+  const flexkin::AnyScenario s = flexkin::ReadScenarioFile(path, flexkin::cli::RobotReadOptions());
   if (!s.valid()) {
     for (const auto& p : s.problems) std::cout << path << ": " << p.Text() << "\n";
     return kExitInvalidInput;
@@ -363,13 +383,15 @@ int Main(int argc, char** argv) {
   RunArgs args;
   CLI::App* run = app.add_subcommand("run", "Run a scenario file and write the result.");
   run->add_option("scenario", args.scenario,
-                  "Scenario file (JSON): a chain (docs/scenario-format.md) or a groom "
-                  "(docs/groom-format.md)")
+                  "Scenario file (JSON): a chain (docs/scenario-format.md), a groom "
+                  "(docs/groom-format.md) or a robot (docs/robot-format.md)")
       ->required();
   run->add_option("-o,--output", args.output,
-                  "Result file to write: .json (JSON) or .npz (NumPy archive), by its extension")
+                  "File to write: a chain's result (.json or .npz, by its extension), a groom's "
+                  "strand file (.npz), a robot's trajectory (.json)")
       ->required();
-  args.csv_opt = run->add_option("--csv", args.csv, "Also write the recorded frames as CSV");
+  args.csv_opt = run->add_option(
+      "--csv", args.csv, "Also write the recorded frames (a robot's joint angles) as CSV");
   args.method_opt = run->add_option("--method", args.method, MethodHelp());
   args.substeps_opt =
       run->add_option("--substeps", args.substeps, "Sub-steps per leader step (>= 1)");

@@ -6,9 +6,29 @@
 // flexkin_main.cc, which only registers it.
 
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
 
+#include "flexkin/any_scenario.h"
+
 namespace flexkin::cli {
+
+// What `flexkin robot` and `flexkin run` (which hands a robot scenario here) pass on.
+struct RobotRunArgs {
+  std::string scenario, output, csv, max_output_size;
+  std::optional<std::string> method;  // a FixedBaseMethod's name
+  // An option of chain runs with no meaning for a robot ("--substeps"), refused by name.
+  std::string unsupported;
+  bool quiet = false;
+};
+
+// Runs a robot scenario read and checked by the front door (flexkin/any_scenario.h) into its
+// trajectory JSON (and joint CSV). Returns 0, or 3 if some target was not reached (the outputs are
+// written); throws InputError (exit 1) and std::system_error (exit 4).
+int RunRobotCommand(const RobotRunArgs& args, AnyScenario scenario);
+
+// How the command line reads scenarios: URDF robots through the URDF component (flexkin/urdf.h).
+ScenarioReadOptions RobotReadOptions();
 
 class RobotCommand {
  public:
@@ -22,8 +42,9 @@ class RobotCommand {
 
  private:
   CLI::App* command_ = nullptr;
-  std::string scenario_, output_, csv_, method_, max_output_size_;
-  bool quiet_ = false;
+  RobotRunArgs args_;
+  std::string method_;
+  CLI::Option* method_option_ = nullptr;
 };
 
 }  // namespace flexkin::cli

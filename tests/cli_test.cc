@@ -123,12 +123,37 @@ TEST_F(CliTest, ValidateSaysOkWithASummary) {
   EXPECT_CONTAINS(r.out, "\noutput: 2651 frames");
 }
 
-// `run` reads a scenario of any kind through the front door: a robot is sent to `flexkin robot`.
-TEST_F(CliTest, RunOfARobotScenarioSaysHowToRunIt) {
-  const CliResult r = Cli("run '" + Example("robot_planar_8link.json") + "' -o out.json");
+// `run` reads a scenario of any kind through the front door: a robot scenario is tracked as
+// `flexkin robot` tracks it, the same files byte for byte (the joint CSV carries no timings); the
+// options of chain runs are refused by name, and --method takes the robot's methods.
+TEST_F(CliTest, RunOfARobotScenarioIsFlexkinRobot) {
+  const std::string scenario = "'" + Example("robot_planar_8link.json") + "'";
+  CliResult r = Cli("run " + scenario + " -o run.json --csv run.csv");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_CONTAINS(r.out, "200 steps, 0 not reached");
+  r = Cli("robot " + scenario + " -o robot.json --csv robot.csv");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string csv = ReadFile(Path("run.csv"));
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 202);  // header, initial state, 200 steps
+  EXPECT_EQ(csv, ReadFile(Path("robot.csv")));
+
+  for (const char* option : {"--substeps 2", "--record-every 2", "--tolerance 1e-3",
+                             "--threads 1", "--precision float32", "--report full"}) {
+    r = Cli("run " + scenario + " -o other.json " + option);
+    EXPECT_EQ(r.exit_code, 1) << option;
+    const std::string name = std::string(option).substr(0, std::string(option).find(' '));
+    EXPECT_CONTAINS(r.err, name + ": is not available for a robot scenario");
+  }
+  r = Cli("run " + scenario + " -o other.json --method tractrix");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_CONTAINS(r.err, "is a robot scenario");
-  EXPECT_CONTAINS(r.err, "flexkin robot");
+  EXPECT_CONTAINS(r.err, "--method: unknown fixed-base method \"tractrix\"");
+  EXPECT_FALSE(std::filesystem::exists(Path("other.json")));
+
+  // And `flexkin robot` of a chain scenario says how to run it.
+  r = Cli("robot '" + Example("fig07_straight_link.json") + "' -o other.json");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "is a chain scenario, not a robot scenario");
+  EXPECT_CONTAINS(r.err, "flexkin run");
 }
 
 TEST_F(CliTest, ValidateListsEveryProblem) {
