@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <limits>
 
 #include "flexkin/run.h"
 #include "test_util.h"
@@ -102,6 +103,29 @@ TEST_F(DrawFileTest, AResultFileIsDrawnUnderItsOwnName) {
   options.viewer.trail_points = {4};
   test_util::ExpectInputError([&] { DrawFile(Path("pull.npz"), options); },
                               "viewer.trail_points[0]", "<= 3");
+}
+
+// A result in memory is checked once, by Draw, before any output: a non-finite point is named
+// and nothing is written, whichever formats were asked for (the writers Draw calls do not check
+// again: flexkin/render.h, internal::CheckedDrawing). Written as a file, the same result draws.
+TEST_F(DrawFileTest, AResultInMemoryIsCheckedOnceBeforeAnyOutput) {
+  const Chain chain = MakeChain((Points(3, 2) << 0, 0, -1, 0, -2, 0.5).finished());
+  const RunResult run =
+      flexkin::Run(chain, (Points(3, 2) << 0.2, 0.1, 0.4, 0.3, 0.5, 0.6).finished(), RunOptions());
+  ResultFile file;
+  file.dim = 2;
+  file.result = run;
+  DrawOptions options;
+  options.formats = {OutputFormat::kSvg, OutputFormat::kHtml, OutputFormat::kGlb};
+  options.base = Path("drawn/pull");
+  const std::vector<std::string> written = Draw(file, options);
+  ASSERT_EQ(written.size(), 3u);
+  for (const std::string& path : written) EXPECT_TRUE(std::filesystem::exists(path)) << path;
+
+  file.result.frames.mutable_points(2)(1, 0) = std::numeric_limits<double>::quiet_NaN();
+  options.base = Path("bad/pull");
+  test_util::ExpectInputError([&] { Draw(file, options); }, "frames[2].points[1][0]");
+  EXPECT_FALSE(std::filesystem::exists(Path("bad")));
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "flexkin/chain.h"
+#include "flexkin/render.h"
 #include "flexkin/result_io.h"
 #include "flexkin/vocabulary.h"
 
@@ -81,6 +82,12 @@ struct GltfOptions {
 // consecutive points; "frames[f].step" not increasing; more than 65535 points), before anything
 // is written; std::system_error if the file cannot be written.
 void WriteGltf(const ResultFile& result, const GltfOptions& options, const std::string& path);
+
+namespace internal {
+// The same for a drawing and options Draw (flexkin/draw.h) has checked: only glTF's own limits
+// (joints, float32, link directions) are checked here.
+void WriteGltf(const CheckedDrawing& drawing, const GltfOptions& options, const std::string& path);
+}  // namespace internal
 
 // Joint positions read back from a glTF file.
 struct GltfJointMotion {

@@ -85,4 +85,12 @@ void RenderStrandsSnapshot(StrandFileReader* reader, const StrandsRenderOptions&
 void RenderStrandsAnimation(StrandFileReader* reader, const StrandsRenderOptions& options,
                             const std::string& path);
 
+namespace internal {
+// The same with options Draw (flexkin/draw.h) has checked: not checked again.
+void RenderStrandsSnapshot(StrandFileReader* reader, const StrandsRenderOptions& options,
+                           const std::string& path);
+void RenderStrandsAnimation(StrandFileReader* reader, const StrandsRenderOptions& options,
+                            const std::string& path);
+}  // namespace internal
+
 }  // namespace flexkin

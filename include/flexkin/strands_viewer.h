@@ -58,4 +58,10 @@ struct StrandsViewerOptions {
 void WriteStrandsViewerHtml(StrandFileReader* reader, const StrandsViewerOptions& options,
                             const std::string& path);
 
+namespace internal {
+// The same with options Draw (flexkin/draw.h) has checked: not checked again.
+void WriteStrandsViewerHtml(StrandFileReader* reader, const StrandsViewerOptions& options,
+                            const std::string& path);
+}  // namespace internal
+
 }  // namespace flexkin

@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "flexkin/render.h"
 #include "flexkin/result_io.h"
 #include "flexkin/robot_scenario.h"
 
@@ -59,5 +60,12 @@ void WriteViewerHtml(const ResultFile& result, const ViewerOptions& options,
 // above.
 void WriteViewerHtml(const RobotTrajectoryFile& trajectory, const ViewerOptions& options,
                      const std::string& path);
+
+namespace internal {
+// The page of a drawing Draw (flexkin/draw.h) has checked, with options it has checked (the trail
+// points against the drawing included): nothing is checked again.
+void WriteViewerHtml(const CheckedDrawing& drawing, const ViewerOptions& options,
+                     const std::string& path);
+}  // namespace internal
 
 }  // namespace flexkin

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <system_error>
 
 #include "flexkin/error.h"
@@ -17,8 +18,8 @@ namespace {
 struct Output {
   explicit Output(const DrawOptions& draw_options) : options(draw_options) {}
   const DrawOptions& options;
-  const ResultFile* result = nullptr;  // what is drawn: one of these three
-  const RobotTrajectoryFile* trajectory = nullptr;
+  // What is drawn, checked (a chain result or a robot trajectory), or the strand file's path.
+  std::optional<internal::CheckedDrawing> drawing;
   const std::string* strand_path = nullptr;
   mutable std::vector<std::string> written;  // the paths, in order
 
@@ -33,17 +34,11 @@ std::string Extension(OutputFormat format) { return std::string(".") + NameOf(fo
 
 void Figure(const Output& o, OutputFormat format) {
   const std::string path = o.options.base + Extension(format);
-  o.Write(path, [&] {
-    if (o.trajectory != nullptr) {
-      WriteSnapshotFigure(*o.trajectory, o.options.figure, path);
-    } else {
-      WriteSnapshotFigure(*o.result, o.options.figure, path);
-    }
-  });
+  o.Write(path, [&] { internal::WriteSnapshotFigure(*o.drawing, o.options.figure, path); });
 }
 
 void Plots(const Output& o) {
-  const bool have_angles = o.result->result.frames.front().link_angles.size() > 0;
+  const bool have_angles = o.drawing->result.result.frames.front().link_angles.size() > 0;
   for (const auto& [kind, name, summary] : Vocabulary<PlotKind>::kEntries) {
     if (kind == PlotKind::kLinkAngles && !have_angles) {
       if (o.options.note) o.options.note("no link_angles plot: the leading end never moves");
@@ -51,20 +46,14 @@ void Plots(const Output& o) {
     }
     for (const char* extension : {".svg", ".png"}) {
       const std::string path = o.options.base + "_" + name + extension;
-      o.Write(path, [&] { WritePlot(*o.result, kind, o.options.plot, path); });
+      o.Write(path, [&] { internal::WritePlot(*o.drawing, kind, o.options.plot, path); });
     }
   }
 }
 
 void Animation(const Output& o, OutputFormat format) {
   const std::string path = o.options.base + Extension(format);
-  o.Write(path, [&] {
-    if (o.trajectory != nullptr) {
-      WriteAnimation(*o.trajectory, o.options.animation, path);
-    } else {
-      WriteAnimation(*o.result, o.options.animation, path);
-    }
-  });
+  o.Write(path, [&] { internal::WriteAnimation(*o.drawing, o.options.animation, path); });
 }
 
 ViewerOptions ViewerWithTitle(const DrawOptions& options) {
@@ -75,21 +64,17 @@ ViewerOptions ViewerWithTitle(const DrawOptions& options) {
 
 void Viewer(const Output& o) {
   const std::string path = o.options.base + ".html";
-  o.Write(path, [&] {
-    if (o.trajectory != nullptr) {
-      WriteViewerHtml(*o.trajectory, ViewerWithTitle(o.options), path);
-    } else {
-      WriteViewerHtml(*o.result, ViewerWithTitle(o.options), path);
-    }
-  });
+  o.Write(path,
+          [&] { internal::WriteViewerHtml(*o.drawing, ViewerWithTitle(o.options), path); });
 }
 
 void Gltf(const Output& o, OutputFormat format) {
   const std::string path = o.options.base + Extension(format);
-  o.Write(path, [&] { WriteGltf(*o.result, o.options.gltf, path); });
+  o.Write(path, [&] { internal::WriteGltf(*o.drawing, o.options.gltf, path); });
 }
 
-// A strand file's outputs: each writer reads the whole file, with a reader of its own.
+// A strand file's outputs: each writer reads the whole file, with a reader of its own (a strand
+// file is streamed, not held).
 void StrandOutput(const Output& o, OutputFormat format) {
   const std::string path = o.options.base + Extension(format);
   o.Write(path, [&] {
@@ -97,13 +82,13 @@ void StrandOutput(const Output& o, OutputFormat format) {
     switch (format) {
       case OutputFormat::kMp4:
       case OutputFormat::kGif:
-        RenderStrandsAnimation(&reader, o.options.strands, path);
+        internal::RenderStrandsAnimation(&reader, o.options.strands, path);
         return;
       case OutputFormat::kHtml:
-        WriteStrandsViewerHtml(&reader, o.options.strands_viewer, path);
+        internal::WriteStrandsViewerHtml(&reader, o.options.strands_viewer, path);
         return;
       default:
-        RenderStrandsSnapshot(&reader, o.options.strands, path);
+        internal::RenderStrandsSnapshot(&reader, o.options.strands, path);
         return;
     }
   });
@@ -161,12 +146,8 @@ void Prefixed(const Problems& problems, const std::string& prefix, Problems* out
 // base for a trajectory, point 0 its end effector).
 void CheckTrailPoints(const Output& o) {
   const std::vector<int>& trails = o.options.viewer.trail_points;
-  Eigen::Index last = -1;
-  if (o.result != nullptr) last = o.result->result.lengths.size();
-  if (o.trajectory != nullptr && !o.trajectory->states.empty()) {
-    last = o.trajectory->states.front().rows() - 1;
-  }
-  if (last < 0) return;
+  if (!o.drawing) return;
+  const Eigen::Index last = o.drawing->result.result.lengths.size();
   for (size_t i = 0; i < trails.size(); ++i) {
     if (trails[i] > last) {
       throw InputError(
@@ -177,7 +158,14 @@ void CheckTrailPoints(const Output& o) {
   }
 }
 
-// Draws with options already validated for `kind`.
+// A trajectory as the chain result the writers draw, made and checked once for every output.
+ResultFile TrajectoryAsCheckedResult(const RobotTrajectoryFile& trajectory) {
+  ResultFile result = RobotTrajectoryAsResult(trajectory);
+  ThrowIfAny(ValidateResult(result.result, result.dim));
+  return result;
+}
+
+// Draws what was checked, with options checked for `kind`: the writers check nothing again.
 std::vector<std::string> DrawChecked(DrawnKind kind, const Output& o) {
   CheckTrailPoints(o);
   const std::filesystem::path dir = std::filesystem::path(o.options.base).parent_path();
@@ -308,15 +296,17 @@ std::vector<OutputFormat> ParseOutputFormats(const std::string& list, const std:
 std::vector<std::string> Draw(const ResultFile& result, const DrawOptions& options) {
   ThrowIfAny(ValidateDrawOptions(DrawnKind::kChainResult, options));
   if (result.result.frames.empty()) throw InputError("frames", "no frames; nothing to draw");
+  ThrowIfAny(ValidateResult(result.result, result.dim));
   Output o(options);
-  o.result = &result;
+  o.drawing.emplace(internal::CheckedDrawing{result});
   return DrawChecked(DrawnKind::kChainResult, o);
 }
 
 std::vector<std::string> Draw(const RobotTrajectoryFile& trajectory, const DrawOptions& options) {
   ThrowIfAny(ValidateDrawOptions(DrawnKind::kRobotTrajectory, options));
+  const ResultFile result = TrajectoryAsCheckedResult(trajectory);
   Output o(options);
-  o.trajectory = &trajectory;
+  o.drawing.emplace(internal::CheckedDrawing{result, &trajectory});
   return DrawChecked(DrawnKind::kRobotTrajectory, o);
 }
 
@@ -363,12 +353,13 @@ std::vector<std::string> DrawFile(const std::string& path, const DrawOptions& op
       }
       case DrawnKind::kRobotTrajectory:
         trajectory = ReadRobotTrajectoryFile(path);
-        o.trajectory = &trajectory;
+        result = TrajectoryAsCheckedResult(trajectory);
+        o.drawing.emplace(internal::CheckedDrawing{result, &trajectory});
         break;
       case DrawnKind::kChainResult:
-        result = ReadResultFile(path);  // JSON or .npz, by content
+        result = ReadResultFile(path);  // JSON or .npz, by content; checked by the reader
         if (result.result.frames.empty()) throw InputError("/frames", "no frames; nothing to draw");
-        o.result = &result;
+        o.drawing.emplace(internal::CheckedDrawing{result});
         break;
     }
     return DrawChecked(kind, o);

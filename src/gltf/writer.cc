@@ -30,11 +30,10 @@ std::string Index(const std::string& name, size_t i) {
   return name + "[" + std::to_string(i) + "]";
 }
 
-// Checks that `result` can be exported: the library's check of results, then glTF's own limits
-// (16-bit joint indices, float32 coordinates, a direction for every link); throws InputError
-// naming the field otherwise.
-void CheckResult(const ResultFile& file, double scale) {
-  ThrowIfAny(ValidateResult(file.result, file.dim));
+// Checks that a valid result (ValidateResult) can be exported: glTF's own limits (16-bit joint
+// indices, float32 coordinates, a direction for every link); throws InputError naming the field
+// otherwise.
+void CheckGltfLimits(const ResultFile& file, double scale) {
   const RunResult& result = file.result;
   const Eigen::Index n = result.lengths.size();
   if (n + 1 > kMaxJoints) {
@@ -240,8 +239,15 @@ void AddMesh(const ResultFile& file, const GltfOptions& options, const Eigen::Ma
 
 void WriteGltf(const ResultFile& file, const GltfOptions& options, const std::string& path) {
   ThrowIfAny(options.Validate());
+  ThrowIfAny(ValidateResult(file.result, file.dim));
+  internal::WriteGltf({file}, options, path);
+}
+
+void internal::WriteGltf(const CheckedDrawing& drawing, const GltfOptions& options,
+                         const std::string& path) {
+  const ResultFile& file = drawing.result;
   const bool binary = IsBinaryPath(path);
-  CheckResult(file, options.scale);
+  CheckGltfLimits(file, options.scale);
   const RunResult& result = file.result;
   const std::vector<float> times = KeyframeTimes(result, options.steps_per_second);
   const int n = static_cast<int>(result.lengths.size());

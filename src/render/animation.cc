@@ -96,9 +96,7 @@ void DrawMoment(render::Canvas* canvas, const ChainScene& scene, const ResultFil
 
 void DrawAnimation(const ResultFile& file, const render::Look& look,
                    const AnimationOptions& options, const std::string& path) {
-  ThrowIfAny(options.Validate());
   const VideoFormat format = render::VideoFormatFromPath(path);
-  render::CheckDrawable(file);
   const int width = options.width + options.width % 2;
   int height = options.height != 0
                    ? options.height
@@ -146,14 +144,22 @@ void DrawAnimation(const ResultFile& file, const render::Look& look,
 
 void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
                     const std::string& path) {
-  DrawAnimation(file, render::ChainLook(file), options, path);
+  ThrowIfAny(options.Validate());
+  render::CheckDrawable(file);
+  internal::WriteAnimation({file}, options, path);
 }
 
 void WriteAnimation(const RobotTrajectoryFile& trajectory, const AnimationOptions& options,
                     const std::string& path) {
   ThrowIfAny(options.Validate());
-  DrawAnimation(RobotTrajectoryAsResult(trajectory), render::TrajectoryLook(trajectory), options,
-                path);
+  const ResultFile result = RobotTrajectoryAsResult(trajectory);
+  render::CheckDrawable(result);
+  internal::WriteAnimation({result, &trajectory}, options, path);
+}
+
+void internal::WriteAnimation(const CheckedDrawing& drawing, const AnimationOptions& options,
+                              const std::string& path) {
+  DrawAnimation(drawing.result, render::LookOf(drawing), options, path);
 }
 
 }  // namespace flexkin

@@ -39,6 +39,11 @@ std::string RunSummary(const ResultFile& file) {
 
 Look ChainLook(const ResultFile& file) { return {RunSummary(file), "leading end", false}; }
 
+Look LookOf(const internal::CheckedDrawing& drawing) {
+  return drawing.trajectory != nullptr ? TrajectoryLook(*drawing.trajectory)
+                                       : ChainLook(drawing.result);
+}
+
 Look TrajectoryLook(const RobotTrajectoryFile& t) {
   const long long n = t.link_lengths.size(), targets = t.targets.rows();
   std::string summary = "robot \u00b7 " + t.method + " \u00b7 " + std::to_string(t.dim) +

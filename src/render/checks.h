@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "flexkin/render.h"
 #include "flexkin/result_io.h"
 #include "flexkin/robot_scenario.h"
 
@@ -32,5 +33,7 @@ struct Look {
 Look ChainLook(const ResultFile& file);
 // "robot · newton · 3D · 16 links · 60 targets · 24 not reached".
 Look TrajectoryLook(const RobotTrajectoryFile& trajectory);
+// The look of a drawing: its trajectory's if it has one, else its chain's.
+Look LookOf(const internal::CheckedDrawing& drawing);
 
 }  // namespace flexkin::render

@@ -202,8 +202,14 @@ void LengthErrorPlot(render::Canvas* canvas, const ResultFile& file) {
 void WritePlot(const ResultFile& file, PlotKind kind, const PlotOptions& options,
                const std::string& path) {
   ThrowIfAny(options.Validate());
-  const ImageFormat format = ImageFormatFromPath(path);
   render::CheckDrawable(file);
+  internal::WritePlot({file}, kind, options, path);
+}
+
+void internal::WritePlot(const CheckedDrawing& drawing, PlotKind kind, const PlotOptions& options,
+                         const std::string& path) {
+  const ResultFile& file = drawing.result;
+  const ImageFormat format = ImageFormatFromPath(path);
   render::Canvas canvas(format, options.width, options.height);
   static const char* kTitles[] = {"Path length of each point", "Angle of each link to the pull",
                                   "Link-length error"};

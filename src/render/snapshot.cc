@@ -88,9 +88,7 @@ void DrawPathArrow(cairo_t* cr, const ChainScene& scene, const std::vector<doubl
 
 void DrawSnapshotFigure(const ResultFile& file, const Look& look, const FigureOptions& options,
                         const std::string& path) {
-  ThrowIfAny(options.Validate());
   const ImageFormat format = ImageFormatFromPath(path);
-  CheckDrawable(file);
 
   const Frames& frames = file.result.frames;
   const int num_frames = static_cast<int>(frames.size()), dim = file.dim;
@@ -162,14 +160,22 @@ void DrawSnapshotFigure(const ResultFile& file, const Look& look, const FigureOp
 
 void WriteSnapshotFigure(const ResultFile& file, const FigureOptions& options,
                          const std::string& path) {
-  render::DrawSnapshotFigure(file, render::ChainLook(file), options, path);
+  ThrowIfAny(options.Validate());
+  render::CheckDrawable(file);
+  internal::WriteSnapshotFigure({file}, options, path);
 }
 
 void WriteSnapshotFigure(const RobotTrajectoryFile& trajectory, const FigureOptions& options,
                          const std::string& path) {
   ThrowIfAny(options.Validate());
-  render::DrawSnapshotFigure(RobotTrajectoryAsResult(trajectory),
-                             render::TrajectoryLook(trajectory), options, path);
+  const ResultFile result = RobotTrajectoryAsResult(trajectory);
+  render::CheckDrawable(result);
+  internal::WriteSnapshotFigure({result, &trajectory}, options, path);
+}
+
+void internal::WriteSnapshotFigure(const CheckedDrawing& drawing, const FigureOptions& options,
+                                   const std::string& path) {
+  render::DrawSnapshotFigure(drawing.result, render::LookOf(drawing), options, path);
 }
 
 }  // namespace flexkin

@@ -68,8 +68,8 @@ struct Drawing {
   int num_frames = 0;
 };
 
+// `options` valid (checked by the caller, once).
 Drawing Prepare(const StrandFileReader& reader, const StrandsRenderOptions& options) {
-  ThrowIfAny(options.Validate());
   Drawing d;
   const StrandFileHeader& h = reader.header();
   d.header = &h;
@@ -239,6 +239,18 @@ Problems StrandsRenderOptions::Validate() const {
 
 void RenderStrandsSnapshot(StrandFileReader* reader, const StrandsRenderOptions& options,
                            const std::string& path) {
+  ThrowIfAny(options.Validate());
+  internal::RenderStrandsSnapshot(reader, options, path);
+}
+
+void RenderStrandsAnimation(StrandFileReader* reader, const StrandsRenderOptions& options,
+                            const std::string& path) {
+  ThrowIfAny(options.Validate());
+  internal::RenderStrandsAnimation(reader, options, path);
+}
+
+void internal::RenderStrandsSnapshot(StrandFileReader* reader, const StrandsRenderOptions& options,
+                                     const std::string& path) {
   const ImageFormat format = ImageFormatFromPath(path);
   const Drawing d = Prepare(*reader, options);
   const std::vector<StrandFrame>& info = reader->frame_info();
@@ -304,8 +316,9 @@ void RenderStrandsSnapshot(StrandFileReader* reader, const StrandsRenderOptions&
   render::SaveCanvas(&canvas, path);
 }
 
-void RenderStrandsAnimation(StrandFileReader* reader, const StrandsRenderOptions& options,
-                            const std::string& path) {
+void internal::RenderStrandsAnimation(StrandFileReader* reader,
+                                      const StrandsRenderOptions& options,
+                                      const std::string& path) {
   const render::VideoFormat video = render::VideoFormatFromPath(path);
   const Drawing d = Prepare(*reader, options);
   const std::vector<StrandFrame>& info = reader->frame_info();

@@ -189,10 +189,16 @@ Problems StrandsViewerOptions::Validate() const {
 
 void WriteStrandsViewerHtml(StrandFileReader* reader, const StrandsViewerOptions& options,
                             const std::string& path) {
-  assert(reader != nullptr);
   Problems problems;
   AppendNested("options", options.Validate(), &problems);
   ThrowIfAny(problems);
+  internal::WriteStrandsViewerHtml(reader, options, path);
+}
+
+void internal::WriteStrandsViewerHtml(StrandFileReader* reader,
+                                      const StrandsViewerOptions& options,
+                                      const std::string& path) {
+  assert(reader != nullptr);
   const StrandFileHeader& h = reader->header();
   if (h.dim != 2 && h.dim != 3) {
     throw InputError("dim", std::to_string(h.dim) + " is not valid; the viewer shows 2 or 3");

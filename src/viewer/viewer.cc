@@ -90,16 +90,23 @@ void CheckOptions(const ViewerOptions& options) {
 
 void WriteViewerHtml(const ResultFile& result, const ViewerOptions& options,
                      const std::string& path) {
-  CheckOptions(options);
   // All checks happen here, before the file is touched.
-  WritePage(viewer_internal::ViewerDataJson(result, options), path);
+  CheckOptions(options);
+  viewer_internal::CheckResult(result, options);
+  internal::WriteViewerHtml({result}, options, path);
 }
 
 void WriteViewerHtml(const RobotTrajectoryFile& trajectory, const ViewerOptions& options,
                      const std::string& path) {
   CheckOptions(options);
   const ResultFile result = RobotTrajectoryAsResult(trajectory);
-  WritePage(viewer_internal::ViewerDataJson(result, options, &trajectory), path);
+  viewer_internal::CheckResult(result, options);
+  internal::WriteViewerHtml({result, &trajectory}, options, path);
+}
+
+void internal::WriteViewerHtml(const CheckedDrawing& drawing, const ViewerOptions& options,
+                               const std::string& path) {
+  WritePage(viewer_internal::ViewerDataJson(drawing.result, options, drawing.trajectory), path);
 }
 
 }  // namespace flexkin

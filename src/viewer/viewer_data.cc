@@ -10,10 +10,7 @@
 #include "flexkin/propagate.h"
 
 namespace flexkin::viewer_internal {
-namespace {
 
-// Everything the page would show must be a finite number and every frame (n+1) by dim (the
-// library's check of results); the trail points must be points of the chain.
 void CheckResult(const ResultFile& file, const ViewerOptions& options) {
   ThrowIfAny(ValidateResult(file.result, file.dim));
   const Eigen::Index n = file.result.lengths.size();
@@ -25,6 +22,8 @@ void CheckResult(const ResultFile& file, const ViewerOptions& options) {
     }
   }
 }
+
+namespace {
 
 // Appends `x` with `digits` significant digits (JSON number syntax; x is finite).
 void AppendNumber(double x, int digits, std::string* out) {
@@ -83,7 +82,6 @@ double FrameLengthError(const Points& p, const Eigen::VectorXd& lengths) {
 
 std::string ViewerDataJson(const ResultFile& file, const ViewerOptions& options,
                            const RobotTrajectoryFile* robot) {
-  CheckResult(file, options);
   const RunResult& r = file.result;
   const size_t num_frames = r.frames.size();
   std::string out = "{";

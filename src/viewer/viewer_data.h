@@ -6,12 +6,16 @@
 
 namespace flexkin::viewer_internal {
 
+// Everything the page would show must be a finite number and every frame (n+1) by dim (the
+// library's check of results); the trail points must be points of the chain. Throws InputError as
+// WriteViewerHtml (include/flexkin/viewer.h) for a result that cannot be shown.
+void CheckResult(const ResultFile& result, const ViewerOptions& options);
+
 // The data the viewer page shows, as one line of JSON (layout in viewer.js, loadData): the
 // result's frames as one flat array of coordinates, per-frame steps and link-length errors, the
 // metrics and the page options. Strings have '<', '>' and '&' escaped as \u003c and so on, so the
-// text can sit inside a <script> element without closing it. Throws InputError as
-// WriteViewerHtml (include/flexkin/viewer.h) for a result that cannot be shown; `options` must be
-// valid.
+// text can sit inside a <script> element without closing it. `result` and `options` are valid
+// (CheckResult and ViewerOptions::Validate; checked once, by the caller).
 // `robot`: the trajectory that `result` was made from (RobotTrajectoryAsResult), whose facts go
 // into a "robot" object (method, targets, unreached, max_ee_error) that the page shows instead of
 // the chain's (and "links", the arm's n); null for a chain result.
