@@ -269,7 +269,8 @@ int RunRobot(const RunArgs& args, flexkin::AnyScenario scenario) {
 
 int RunCommand(const RunArgs& args) {
   // One read, one parse: the kind and every problem (flexkin/any_scenario.h).
-  flexkin::AnyScenario any = flexkin::ReadScenarioFile(args.scenario, flexkin::cli::RobotReadOptions());
+  flexkin::AnyScenario any =
+      flexkin::ReadScenarioFile(args.scenario, flexkin::cli::RobotReadOptions());
   if (!any.valid()) {
     PrintError(args.scenario + ": " + any.problems.front().Text());
     return kExitInvalidInput;
@@ -390,8 +391,8 @@ int Main(int argc, char** argv) {
                   "File to write: a chain's result (.json or .npz, by its extension), a groom's "
                   "strand file (.npz), a robot's trajectory (.json)")
       ->required();
-  args.csv_opt = run->add_option(
-      "--csv", args.csv, "Also write the recorded frames (a robot's joint angles) as CSV");
+  args.csv_opt = run->add_option("--csv", args.csv,
+                                 "Also write the recorded frames (a robot's joint angles) as CSV");
   args.method_opt = run->add_option("--method", args.method, MethodHelp());
   args.substeps_opt =
       run->add_option("--substeps", args.substeps, "Sub-steps per leader step (>= 1)");

@@ -60,8 +60,8 @@ int RunRobotCommand(const RobotRunArgs& args, AnyScenario any) {
   const bool fixed_point = s.options.method == FixedBaseMethod::kFixedPoint;
   const std::string& output = args.output;
   const std::string& csv = args.csv;
-  const uint64_t limit = args.max_output_size.empty() ? kDefaultMaxOutputSize
-                                                      : ParseByteSize(args.max_output_size);
+  const uint64_t limit =
+      args.max_output_size.empty() ? kDefaultMaxOutputSize : ParseByteSize(args.max_output_size);
   const RobotOutputEstimate estimate = EstimateRobotOutput(s);
   const bool json_over = estimate.json_bytes > limit;
   if (limit > 0 && (json_over || (!csv.empty() && estimate.csv_bytes > limit))) {
@@ -87,8 +87,7 @@ int RunRobotCommand(const RobotRunArgs& args, AnyScenario any) {
   // files as they are produced, each renamed into place only when complete. Called now and then:
   // where a signal stops the tracking (by throwing).
   const ArmTrajectory t =
-      RunScenarioToFiles(any, {output, csv}, [](int64_t, int64_t) { ThrowIfInterrupted(); })
-          .robot;
+      RunScenarioToFiles(any, {output, csv}, [](int64_t, int64_t) { ThrowIfInterrupted(); }).robot;
   if (!args.quiet) std::cout << t.BriefReport() << "\n";
   if (t.unreached > 0) {
     std::cerr << "flexkin: warning: " << t.unreached << " of " << t.num_steps
@@ -130,7 +129,8 @@ int RobotCommand::Run() const {
     throw InputError(Problem(args_.scenario, std::string("is a ") + NameOf(any.kind) +
                                                  " scenario, not a robot scenario "
                                                  "(docs/robot-format.md); run it with `flexkin "
-                                                 "run " + args_.scenario + " -o ...`"));
+                                                 "run " +
+                                                 args_.scenario + " -o ...`"));
   }
   RobotRunArgs args = args_;
   if (*method_option_) args.method = method_;

@@ -137,8 +137,8 @@ TEST_F(CliTest, RunOfARobotScenarioIsFlexkinRobot) {
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 202);  // header, initial state, 200 steps
   EXPECT_EQ(csv, ReadFile(Path("robot.csv")));
 
-  for (const char* option : {"--substeps 2", "--record-every 2", "--tolerance 1e-3",
-                             "--threads 1", "--precision float32", "--report full"}) {
+  for (const char* option : {"--substeps 2", "--record-every 2", "--tolerance 1e-3", "--threads 1",
+                             "--precision float32", "--report full"}) {
     r = Cli("run " + scenario + " -o other.json " + option);
     EXPECT_EQ(r.exit_code, 1) << option;
     const std::string name = std::string(option).substr(0, std::string(option).find(' '));

@@ -4,8 +4,8 @@
 #include <vector>
 
 #include "flexkin/chain.h"
-#include "flexkin/render.h"
 #include "flexkin/result_io.h"
+#include "flexkin/robot_scenario.h"
 #include "flexkin/vocabulary.h"
 
 namespace flexkin {

@@ -198,15 +198,6 @@ void WriteAnimation(const RobotTrajectoryFile& trajectory, const AnimationOption
 
 namespace internal {
 
-// What Draw (flexkin/draw.h) hands the writers once it has checked the drawing and every option,
-// once, where they entered the library (docs/architecture.md, "Checked once"): `result` is valid
-// (ValidateResult); for a robot trajectory `trajectory` is the file and `result` its
-// RobotTrajectoryAsResult, made once for every output. The writers below check neither again
-// (the path's extension they still read).
-struct CheckedDrawing {
-  const ResultFile& result;
-  const RobotTrajectoryFile* trajectory = nullptr;
-};
 void WriteSnapshotFigure(const CheckedDrawing& drawing, const FigureOptions& options,
                          const std::string& path);
 void WritePlot(const CheckedDrawing& drawing, PlotKind kind, const PlotOptions& options,

@@ -243,4 +243,18 @@ RobotTrajectoryFile RobotTrajectoryFromText(const std::string& json_text);
 // mismatched shapes.
 ResultFile RobotTrajectoryAsResult(const RobotTrajectoryFile& trajectory);
 
+namespace internal {
+
+// What Draw (flexkin/draw.h) hands the writers once it has checked the drawing and every option,
+// once, where they entered the library (docs/architecture.md, "Checked once"): `result` is valid
+// (ValidateResult); for a robot trajectory `trajectory` is the file and `result` its
+// RobotTrajectoryAsResult, made once for every output. The internal:: writers that take it
+// (flexkin/render.h, viewer.h, gltf.h) check neither again (the path's extension they still read).
+struct CheckedDrawing {
+  const ResultFile& result;
+  const RobotTrajectoryFile* trajectory = nullptr;
+};
+
+}  // namespace internal
+
 }  // namespace flexkin

@@ -3,7 +3,6 @@
 #include <string>
 #include <vector>
 
-#include "flexkin/render.h"
 #include "flexkin/result_io.h"
 #include "flexkin/robot_scenario.h"
 

@@ -64,8 +64,7 @@ ViewerOptions ViewerWithTitle(const DrawOptions& options) {
 
 void Viewer(const Output& o) {
   const std::string path = o.options.base + ".html";
-  o.Write(path,
-          [&] { internal::WriteViewerHtml(*o.drawing, ViewerWithTitle(o.options), path); });
+  o.Write(path, [&] { internal::WriteViewerHtml(*o.drawing, ViewerWithTitle(o.options), path); });
 }
 
 void Gltf(const Output& o, OutputFormat format) {

@@ -316,8 +316,7 @@ void internal::RenderStrandsSnapshot(StrandFileReader* reader, const StrandsRend
   render::SaveCanvas(&canvas, path);
 }
 
-void internal::RenderStrandsAnimation(StrandFileReader* reader,
-                                      const StrandsRenderOptions& options,
+void internal::RenderStrandsAnimation(StrandFileReader* reader, const StrandsRenderOptions& options,
                                       const std::string& path) {
   const render::VideoFormat video = render::VideoFormatFromPath(path);
   const Drawing d = Prepare(*reader, options);

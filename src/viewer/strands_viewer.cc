@@ -195,8 +195,7 @@ void WriteStrandsViewerHtml(StrandFileReader* reader, const StrandsViewerOptions
   internal::WriteStrandsViewerHtml(reader, options, path);
 }
 
-void internal::WriteStrandsViewerHtml(StrandFileReader* reader,
-                                      const StrandsViewerOptions& options,
+void internal::WriteStrandsViewerHtml(StrandFileReader* reader, const StrandsViewerOptions& options,
                                       const std::string& path) {
   assert(reader != nullptr);
   const StrandFileHeader& h = reader->header();
