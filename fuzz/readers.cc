@@ -7,9 +7,12 @@
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <nlohmann/json.hpp>
 #include <system_error>
 
+#include "flexkin/any_scenario.h"
 #include "flexkin/error.h"
+#include "flexkin/groom.h"
 #include "flexkin/gltf.h"
 #include "flexkin/result_io.h"
 #include "flexkin/robot_scenario.h"
@@ -90,9 +93,38 @@ void ReadRobotScenario(const std::string& bytes) {
                     [&] { ParseRobotScenarioText(bytes, options); });
 }
 
+void ReadGroomScenario(const std::string& bytes) {
+  IsGroomText(bytes);
+  // A grown groom holds roots x (links + 1) points (up to kMaxGroomPoints, 4.8 GB): over the
+  // fuzzer's memory limit. Validation reads any size; growing, only up to a million points.
+  const nlohmann::json root = nlohmann::json::parse(bytes, nullptr, /*allow_exceptions=*/false);
+  if (root.is_object() && root.contains("groom") && root["groom"].is_object()) {
+    const nlohmann::json& groom = root["groom"];
+    const auto count = [&](const char* key) {
+      const auto it = groom.find(key);
+      return it != groom.end() && it->is_number() ? it->get<double>() : 0.0;
+    };
+    if (count("roots") * (count("links") + 1.0) > 1e6) {
+      ValidateGroomText(bytes);
+      return;
+    }
+  }
+  ValidateThenParse([&] { return ValidateGroomText(bytes); }, [&] { ParseGroomText(bytes); });
+  // The front door (flexkin/any_scenario.h) reads the same text, of any kind, once.
+  const AnyScenario any = ReadScenarioText(bytes);
+  if (any.valid() != (any.chain || any.groom || any.robot)) {
+    throw std::logic_error("the front door's problems and its scenario disagree");
+  }
+}
+
 void ReadResult(const std::string& bytes) {
   if (bytes.compare(0, 4, std::string("PK\x03\x04", 4)) != 0) {
-    ResultFromText(bytes);
+    // JSON: a robot trajectory (flexkin render tells it by its "format") or a chain result.
+    if (bytes.find("flexkin-robot-trajectory") != std::string::npos) {
+      RobotTrajectoryFromText(bytes);
+    } else {
+      ResultFromText(bytes);
+    }
     return;
   }
   const std::string path = WriteTemporary(bytes, "result.npz");
@@ -115,6 +147,7 @@ void ReadGltf(const std::string& bytes) {
 const std::vector<Target>& Targets() {
   static const std::vector<Target> targets = {{"scenario", ReadScenario},
                                               {"robot", ReadRobotScenario},
+                                              {"groom", ReadGroomScenario},
                                               {"result", ReadResult},
                                               {"urdf", ReadUrdf},
                                               {"gltf", ReadGltf}};

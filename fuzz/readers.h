@@ -19,10 +19,15 @@ void ReadScenario(const std::string& bytes);
 // scenario naming a URDF file ("urdf") gets a small built-in URDF arm instead of a file, so that
 // the fuzzer reaches the URDF chain options without reading the file system.
 void ReadRobotScenario(const std::string& bytes);
+// The groom scenario reader (flexkin/groom.h), the same way (a groom that would grow over a
+// million points is only validated: the fuzzer's memory limit), then the front door
+// (flexkin/any_scenario.h, ReadScenarioText) on the same text.
+void ReadGroomScenario(const std::string& bytes);
 // Result files (flexkin/result_io.h): an .npz archive (bytes starting "PK\x03\x04") through a
 // temporary file: a strand file (IsStrandFile) with the strand file reader
-// (flexkin/strand_file.h, every frame read), any other with ReadResultFile; anything else as JSON
-// with ResultFromText.
+// (flexkin/strand_file.h, every frame read), any other with ReadResultFile; anything else as JSON:
+// a robot trajectory (text naming "flexkin-robot-trajectory") with RobotTrajectoryFromText, any
+// other with ResultFromText.
 void ReadResult(const std::string& bytes);
 // URDF text through urdfdom (flexkin/urdf.h): ArmFromUrdf with the default chain.
 void ReadUrdf(const std::string& bytes);

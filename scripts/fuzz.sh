@@ -18,10 +18,10 @@ seconds=${2:?usage: scripts/fuzz.sh [--fresh] BUILD SECONDS [TARGET...]}
 shift 2
 root=$(cd "$(dirname "$0")/.." && pwd)
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(scenario robot result urdf gltf)
+[ ${#targets[@]} -gt 0 ] || targets=(scenario robot groom result urdf gltf)
 
 # The largest input each reader is given: a few times its largest seed.
-declare -A max_len=([scenario]=16384 [robot]=16384 [result]=65536 [urdf]=16384 [gltf]=65536)
+declare -A max_len=([scenario]=16384 [robot]=16384 [groom]=16384 [result]=65536 [urdf]=16384 [gltf]=65536)
 
 work="$build/fuzz-run"
 mkdir -p "$work"

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "chain/denormals.h"
+
 namespace flexkin::internal {
 
 // Arc-length weights of the trapezoid rule for eq. (6): half of each adjacent link.
@@ -117,6 +119,8 @@ void SweepPipeline::EndStep(int64_t s) {
 
 void SweepPipeline::Capture(void* context, int64_t sweep, int slot) {
   auto* self = static_cast<SweepPipeline*>(context);
+  // The sink is the caller's code: it runs in the caller's floating-point mode.
+  const CallerFloatingPointMode caller_mode;
   self->on_frame_(self->sweep_step_[sweep] + 1, slot < 0 ? self->points_ : self->slots_[slot]);
 }
 

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "chain/denormals.h"
+#include "chain/denormals.h"
 #include "chain/simd.h"
 #include "chain/substep.h"
 #include "flexkin/error.h"
@@ -100,6 +102,7 @@ namespace internal {
 void TracedSweepsScalarFrom(Method method, int dim, const double* heads, int64_t first,
                             int64_t num_sweeps, const double* lengths, const double* inv_lengths,
                             int n, double* pts, SweepTrace* trace) {
+  const SubnormalsAsZero subnormals;
   DispatchRule<kSweepsEngine>(method, [&](auto rule) {
     using Rule = decltype(rule);
     dim == 2 ? TracedSweeps<typename Rule::template Step<2>, 2>(heads, first, num_sweeps, lengths,
@@ -154,6 +157,7 @@ const WavefrontChoice& Wavefront() {
 
 void SweepsScalar(Method method, int dim, const double* heads, int64_t num_sweeps,
                   const double* lengths, const double* inv_lengths, int n, double* pts) {
+  const SubnormalsAsZero subnormals;
   DispatchRule<kSweepsEngine>(method, [&](auto rule) {
     using Rule = decltype(rule);
     dim == 2 ? Sweeps<typename Rule::template Step<2>, 2>(heads, num_sweeps, lengths, inv_lengths,
@@ -167,6 +171,7 @@ void SweepsWavefront(Method method, int dim, const double* heads, int64_t num_sw
                      const double* lengths, const double* inv_lengths, int n, double* pts) {
 #if FLEXKIN_HAVE_WAVEFRONT
   if (Wavefront().fn != nullptr) {
+    const SubnormalsAsZero subnormals;
     Wavefront().fn(method, dim, heads, num_sweeps, lengths, inv_lengths, n, pts);
     return;
   }
@@ -179,6 +184,7 @@ void TracedSweepsWavefront(Method method, int dim, const double* heads, int64_t 
                            SweepTrace* trace) {
 #if FLEXKIN_HAVE_WAVEFRONT
   if (Wavefront().traced != nullptr && trace->moved == nullptr) {
+    const SubnormalsAsZero subnormals;
     Wavefront().traced(method, dim, heads, num_sweeps, lengths, inv_lengths, n, pts, trace);
     return;
   }

@@ -124,14 +124,15 @@ constexpr bool RunsOn(Method method, unsigned engines, RuleList<Rules...>) {
 template <class... Rules>
 constexpr int OrderOf(Method method, RuleList<Rules...>) {
   int order = 0;
-  ((method == Rules::kMethod ? (order = Rules::kOrder, true) : false) || ...);
+  static_cast<void>(((method == Rules::kMethod ? (order = Rules::kOrder, true) : false) || ...));
   return order;
 }
 
 template <class... Rules>
 std::vector<std::string> NamesOn(unsigned engines, RuleList<Rules...>) {
   std::vector<std::string> names;
-  ((Rules::kEngines & engines ? names.emplace_back(NameOf(Rules::kMethod)), 0 : 0), ...);
+  static_cast<void>(
+      ((Rules::kEngines & engines ? names.emplace_back(NameOf(Rules::kMethod)), 0 : 0), ...));
   return names;
 }
 

@@ -14,6 +14,8 @@
 #include <thread>
 #include <utility>
 
+#include "chain/denormals.h"
+#include "chain/denormals.h"
 #include "chain/simd.h"
 #include "chain/substep.h"
 #include "sequential/link_rules.h"
@@ -243,6 +245,7 @@ void StrandBatchImpl::StepBlock(int b, double* scratch_heads) {
       }
     }
   }
+  const SubnormalsAsZero subnormals;  // as every sweep engine (src/chain/denormals.h)
   sweeps(options.method, dim, block.n, head, S, scratch_heads, lengths.data() + block.lengths,
          inv_lengths.data() + block.lengths, pts);
 }
