@@ -27,7 +27,7 @@ deps:
 	@bash scripts/install-deps.sh
 
 build: deps
-	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo > /dev/null
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLEXKIN_PYTHON=ON > /dev/null
 	@cmake --build $(BUILD) -j$(JOBS)
 
 demo: build

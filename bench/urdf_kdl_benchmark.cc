@@ -26,8 +26,8 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
-#include <ctime>
 #include <map>
 #include <memory>
 #include <tuple>
@@ -48,11 +48,8 @@ constexpr int kSteps = 64;
 constexpr int kRuns = 5;          // runs per KDL solver for the reference medians
 constexpr int kFlexkinRuns = 25;  // flexkin's (each run a hundred times shorter)
 
-// This thread's CPU time (s).
-double CpuSeconds() {
-  timespec t;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return t.tv_sec + 1e-9 * t.tv_nsec;
+double Seconds(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 double Median(std::vector<double> values) {
@@ -71,7 +68,7 @@ struct Scene {
   peers::KdlUrdfOptions kdl_options;
   std::vector<Eigen::Matrix3d> target_rotations;  // pointing: flexkin's reached tool rotations
   double mean_link = 0.0;
-  // Median CPU seconds per step of flexkin, KDL NR and KDL LMA.
+  // Median seconds per step of each solver's own work: flexkin, KDL NR and KDL LMA.
   double flexkin_per_step = 0.0, nr_per_step = 0.0, lma_per_step = 0.0;
 };
 
@@ -87,15 +84,13 @@ peers::KdlUrdfTrajectory RunKdl(const Scene& s, KdlUrdfSolver solver) {
 // After one run not timed (first calls: lazy symbol binding, first allocations, cold caches), the
 // median of `runs` timed runs: flexkin's runs (64 steps) last a few hundred microseconds, a hundred
 // times less than KDL's, so they take more runs for the same shelter from the machine's noise.
+// `run` returns the seconds of the solver's own work: flexkin's TrackPath call (wall time), KDL's
+// CartToJnt calls summed (its goal frames and the end effector read back are outside them).
 template <typename Run>
 double MedianPerStep(const Run& run, int runs = kRuns) {
   run();
   std::vector<double> times;
-  for (int r = 0; r < runs; ++r) {
-    const double start = CpuSeconds();
-    run();
-    times.push_back(CpuSeconds() - start);
-  }
+  for (int r = 0; r < runs; ++r) times.push_back(run());
   return Median(times) / kSteps;
 }
 
@@ -140,18 +135,15 @@ std::unique_ptr<Scene> MakeScene(int modules, int design, bool pointing) {
   }
   s->flexkin_per_step = MedianPerStep(
       [&] {
+        const auto start = std::chrono::steady_clock::now();
         const flexkin::ArmTrajectory t = RunFlexkin(*s);
+        const double seconds = Seconds(start);
         benchmark::DoNotOptimize(t.steps.back().state.points.data());
+        return seconds;
       },
       kFlexkinRuns);
-  s->nr_per_step = MedianPerStep([&] {
-    const peers::KdlUrdfTrajectory t = RunKdl(*s, KdlUrdfSolver::kNewtonPinv);
-    benchmark::DoNotOptimize(t.steps.back().angles.data());
-  });
-  s->lma_per_step = MedianPerStep([&] {
-    const peers::KdlUrdfTrajectory t = RunKdl(*s, KdlUrdfSolver::kLma);
-    benchmark::DoNotOptimize(t.steps.back().angles.data());
-  });
+  s->nr_per_step = MedianPerStep([&] { return RunKdl(*s, KdlUrdfSolver::kNewtonPinv).seconds; });
+  s->lma_per_step = MedianPerStep([&] { return RunKdl(*s, KdlUrdfSolver::kLma).seconds; });
   return s;
 }
 

@@ -56,7 +56,7 @@ Problems KdlOptions::Validate() const {
   return problems;
 }
 
-int KdlJointsPerLink(const ArmModel& model) { return model.dim == 2 ? 1 : 3; }
+int KdlJointsPerLink(const ArmModel& model) { return model.dim == 2 ? 1 : 2; }
 
 KDL::Chain KdlChain(const ArmModel& model) {
   CheckModel(model);
@@ -78,9 +78,8 @@ KDL::Chain KdlChain(const ArmModel& model) {
     if (model.dim == 2) {
       chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::RotZ), link));
     } else {
-      chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::RotX), KDL::Frame::Identity()));
       chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::RotZ), KDL::Frame::Identity()));
-      chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::RotX), link));
+      chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::RotY), link));
     }
   }
   return chain;
@@ -93,14 +92,24 @@ KDL::JntArray KdlJoints(const ArmModel& model, const JointAngles& angles) {
                      "must have one angle (and in 3D one azimuth) per link, " + std::to_string(n));
   }
   KDL::JntArray q(static_cast<unsigned>(n * KdlJointsPerLink(model)));
+  if (model.dim == 2) {
+    for (int j = 0; j < n; ++j) q(j) = angles.angle[j];
+    return q;
+  }
+  // Spatial: the universal joint that points each link where flexkin's joint points it, read from
+  // the points: link j's direction in the frame after joint j - 1 is Rz(qz) Ry(qy) x =
+  // (cos qz cos qy, sin qz cos qy, -sin qy).
+  const Points points = ForwardKinematics(model, angles);
+  const KDL::Chain chain = KdlChain(model);
+  KDL::Rotation frame = chain.getSegment(0).getFrameToTip().M;  // the base frame
   for (int j = 0; j < n; ++j) {
-    if (model.dim == 2) {
-      q(j) = angles.angle[j];
-    } else {
-      q(3 * j) = angles.azimuth[j];
-      q(3 * j + 1) = angles.angle[j];
-      q(3 * j + 2) = -angles.azimuth[j];
-    }
+    const Eigen::Vector3d link = (points.row(j + 1) - points.row(j)).transpose();
+    const KDL::Vector d = frame.Inverse(KDL::Vector(link[0], link[1], link[2]));
+    const double qz = std::atan2(d.y(), d.x());
+    const double qy = std::atan2(-d.z(), std::hypot(d.x(), d.y()));
+    q(2 * j) = qz;
+    q(2 * j + 1) = qy;
+    frame = frame * KDL::Rotation::RotZ(qz) * KDL::Rotation::RotY(qy);
   }
   return q;
 }
@@ -131,12 +140,14 @@ KdlTrajectory TrackPathWithKdl(const ArmModel& model, const Points& path, KdlSol
   const double scale = model.reach() / model.num_links();  // mean link length
   const double tolerance = options.tolerance * scale;
 
+  // The solvers made once for the path, as a controller makes them; LMA needs no velocity solver.
   CountingFk fk(chain);
-  KDL::ChainIkSolverVel_pinv pinv(chain, options.pinv_eps);
+  std::unique_ptr<KDL::ChainIkSolverVel_pinv> pinv;
   std::unique_ptr<KDL::ChainIkSolverPos> ik;
   KDL::ChainIkSolverPos_LMA* lma = nullptr;
   if (solver == KdlSolver::kNewtonPinv) {
-    ik = std::make_unique<KDL::ChainIkSolverPos_NR>(chain, fk, pinv, options.max_iterations,
+    pinv = std::make_unique<KDL::ChainIkSolverVel_pinv>(chain, options.pinv_eps);
+    ik = std::make_unique<KDL::ChainIkSolverPos_NR>(chain, fk, *pinv, options.max_iterations,
                                                     tolerance);
   } else {
     Eigen::Matrix<double, 6, 1> weights;
@@ -150,10 +161,13 @@ KdlTrajectory TrackPathWithKdl(const ArmModel& model, const Points& path, KdlSol
   KdlTrajectory result;
   KDL::JntArray q = KdlJoints(model, model.initial);
   double total_iterations = 0;
+  // Outside the timed solve: the goal's orientation (NR holds the current one; LMA ignores it,
+  // weight 0), and reading the answer back into points and flexkin's angles.
+  KDL::ChainFkSolverPos_recursive goal_fk(chain);
   for (Eigen::Index i = 0; i < path.rows(); ++i) {
     KDL::Frame current;
-    fk.JntToCart(q, current);
-    KDL::Frame goal(current.M, ToKdl(path.row(i).transpose()));  // hold the orientation (NR)
+    if (lma == nullptr) goal_fk.JntToCart(q, current);
+    KDL::Frame goal(current.M, ToKdl(path.row(i).transpose()));
     KdlStepReport step;
     step.q.resize(q.rows());
     fk.calls = 0;

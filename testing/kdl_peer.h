@@ -9,13 +9,16 @@
 //     taking the world x axis to model.base_direction, as flexkin's base frame).
 //   Planar (revolute joints): per link one segment, a joint about z then the translation of the
 //     link length along x. KDL joint j = flexkin angle[j].
-//   Spatial (spherical joints): per link three revolute joints about x, z, x (Euler X-Z-X), the
-//     last with the translation along x. flexkin's twist-free joint (bend b, azimuth a) is
-//     Rx(a) Rz(b) Rx(-a), i.e. KDL joints (a, b, -a). KDL's solvers move all three freely (the
-//     third is a twist about the link, which moves no point of the arm by itself).
+//   Spatial (spherical joints): per link a universal joint, two revolute joints about z then y,
+//     the second with the translation along x: two degrees of freedom per link, as flexkin's
+//     twist-free joint (bend and azimuth) has, so that KDL solves the same kinematic model (no
+//     twist joint, which would move no point and only enlarge KDL's Jacobian). The two point a
+//     link the same way; KdlJoints reads the KDL joints from flexkin's points.
 //
 // Tracking: each path point is one call of the position IK, started from the previous step's
-// joints (warm start, as a controller would). Two solvers:
+// joints (warm start, as a controller would), with the solvers made once for the path. Only the
+// call (CartToJnt) is timed (KdlStepReport::seconds); the goal's orientation and the points and
+// angles read back from the answer are computed outside it. Two solvers:
 //   kNewtonPinv: ChainIkSolverPos_NR with ChainIkSolverVel_pinv and ChainFkSolverPos_recursive.
 //     NR's stopping test is on the full 6D twist, so a target needs an orientation: it gets the
 //     end effector's orientation before the step (hold the orientation). This is the only
@@ -55,11 +58,12 @@ struct KdlOptions {
   Problems Validate() const;
 };
 
-// Joints per link in the KDL chain: 1 (planar) or 3 (spatial).
+// Joints per link in the KDL chain: 1 (planar) or 2 (spatial).
 int KdlJointsPerLink(const ArmModel& model);
 // The KDL chain of `model` (see above). Throws InputError on an invalid model or joint limits.
 KDL::Chain KdlChain(const ArmModel& model);
-// flexkin's joint angles as KDL joints (planar: angle; spatial: (a, b, -a) per joint).
+// flexkin's joint angles as KDL joints (planar: the angle; spatial: the universal joint's two
+// angles that point each link as flexkin's angles do).
 KDL::JntArray KdlJoints(const ArmModel& model, const JointAngles& angles);
 // The (n+1) by dim points (base first) of `chain` at `q`, by KDL's ChainFkSolverPos_recursive.
 Points KdlPoints(const ArmModel& model, const KDL::Chain& chain, const KDL::JntArray& q);

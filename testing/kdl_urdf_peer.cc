@@ -141,12 +141,14 @@ KdlUrdfTrajectory TrackUrdfPathWithKdl(const KdlUrdfChain& chain, const Eigen::V
     throw std::invalid_argument("TrackUrdfPathWithKdl: one target rotation per path row");
   }
 
+  // The solvers made once for the path, as a controller makes them; LMA needs no velocity solver.
   CountingFk fk(chain.chain);
-  KDL::ChainIkSolverVel_pinv pinv(chain.chain, options.pinv_eps);
+  std::unique_ptr<KDL::ChainIkSolverVel_pinv> pinv;
   std::unique_ptr<KDL::ChainIkSolverPos> ik;
   KDL::ChainIkSolverPos_LMA* lma = nullptr;
   if (solver == KdlUrdfSolver::kNewtonPinv) {
-    ik = std::make_unique<KDL::ChainIkSolverPos_NR>(chain.chain, fk, pinv, options.max_iterations,
+    pinv = std::make_unique<KDL::ChainIkSolverVel_pinv>(chain.chain, options.pinv_eps);
+    ik = std::make_unique<KDL::ChainIkSolverPos_NR>(chain.chain, fk, *pinv, options.max_iterations,
                                                     options.tolerance);
   } else {
     Eigen::Matrix<double, 6, 1> weights;
@@ -161,9 +163,12 @@ KdlUrdfTrajectory TrackUrdfPathWithKdl(const KdlUrdfChain& chain, const Eigen::V
   KdlUrdfTrajectory result;
   KDL::JntArray q = KdlJointArray(start);
   double total_iterations = 0.0;
+  // Outside the timed solve: the goal's orientation (NR, position only, holds the current one;
+  // LMA's weights ignore it) and the end effector read back from the answer.
+  KDL::ChainFkSolverPos_recursive check_fk(chain.chain);
   for (Eigen::Index i = 0; i < path.rows(); ++i) {
     KDL::Frame current;
-    fk.JntToCart(q, current);
+    if (!pointing && lma == nullptr) check_fk.JntToCart(q, current);
     const KDL::Vector target(path(i, 0), path(i, 1), path(i, 2));
     // Position only: hold the orientation (NR needs one; LMA's weights ignore it).
     const KDL::Frame goal(pointing ? ToKdl(target_rotations[i]) : current.M, target);
@@ -179,7 +184,7 @@ KdlUrdfTrajectory TrackUrdfPathWithKdl(const KdlUrdfChain& chain, const Eigen::V
     const bool finite = out.data.allFinite();
     if (finite) {
       KDL::Frame reached;
-      fk.JntToCart(out, reached);
+      check_fk.JntToCart(out, reached);
       step.end_effector = FromKdl(reached.p);
       step.tip_rotation = FromKdl(reached.M);
       step.ee_error = (step.end_effector - path.row(i).transpose()).norm();

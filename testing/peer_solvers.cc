@@ -10,7 +10,10 @@
 #include <cmath>
 #include <cstdio>
 #include <new>
+#include <stdexcept>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
@@ -95,6 +98,8 @@ using internal::IpoptStatusName;
 using internal::SecondsSince;
 using internal::ValidateInput;
 
+}  // namespace
+
 // The problem shared by both adapters: the unknowns x_1..x_n flattened row by row (point j's
 // coordinates at (j - 1) dim), point 0 pinned at the head.
 class StepProblem {
@@ -159,6 +164,8 @@ class StepProblem {
   int evaluations_ = 0;
 };
 
+namespace {
+
 // ---- NLopt SLSQP -------------------------------------------------------------------------------
 
 struct SlsqpData {
@@ -205,12 +212,17 @@ void SlsqpConstraints(unsigned m, double* result, unsigned n, const double* v, d
 // banded patterns (the Hessian's lower triangle: point j with points j - band .. j).
 class IpoptStep : public Ipopt::TNLP {
  public:
-  IpoptStep(StepProblem* problem, int band) : p_(*problem), band_(band) {}
+  IpoptStep(StepProblem* problem, int band) : problem_(problem), band_(band) {}
+  // The next solve's problem (ReOptimizeTNLP): the same sizes and band.
+  void set_problem(StepProblem* problem) {
+    problem_ = problem;
+    cached_ = false;
+  }
 
   bool get_nlp_info(Ipopt::Index& n, Ipopt::Index& m, Ipopt::Index& nnz_jac_g,
                     Ipopt::Index& nnz_h_lag, IndexStyleEnum& index_style) override {
-    const int links = p_.num_links(), dim = p_.dim();
-    n = p_.num_variables();
+    const int links = problem_->num_links(), dim = problem_->dim();
+    n = problem_->num_variables();
     m = links;
     nnz_jac_g = (2 * links - 1) * dim;
     nnz_h_lag = 0;
@@ -232,7 +244,7 @@ class IpoptStep : public Ipopt::TNLP {
                           Ipopt::Number* /*z_L*/, Ipopt::Number* /*z_U*/, Ipopt::Index /*m*/,
                           bool init_lambda, Ipopt::Number* /*lambda*/) override {
     if (init_z || init_lambda) return false;  // only the primal start is known
-    if (init_x) std::copy(p_.start(), p_.start() + n, x);
+    if (init_x) std::copy(problem_->start(), problem_->start() + n, x);
     return true;
   }
 
@@ -253,8 +265,8 @@ class IpoptStep : public Ipopt::TNLP {
   bool eval_g(Ipopt::Index /*n*/, const Ipopt::Number* x, bool new_x, Ipopt::Index m,
               Ipopt::Number* g) override {
     if (new_x) cached_ = false;
-    p_.Load(x);
-    for (int i = 1; i <= m; ++i) g[i - 1] = p_.Constraint(i);
+    problem_->Load(x);
+    for (int i = 1; i <= m; ++i) g[i - 1] = problem_->Constraint(i);
     return true;
   }
 
@@ -262,7 +274,7 @@ class IpoptStep : public Ipopt::TNLP {
                   Ipopt::Index /*nele_jac*/, Ipopt::Index* i_row, Ipopt::Index* j_col,
                   Ipopt::Number* values) override {
     if (new_x) cached_ = false;
-    const int dim = p_.dim();
+    const int dim = problem_->dim();
     int k = 0;
     if (values == nullptr) {
       for (int i = 1; i <= m; ++i) {
@@ -271,10 +283,10 @@ class IpoptStep : public Ipopt::TNLP {
       }
       return true;
     }
-    p_.Load(x);
+    problem_->Load(x);
     double e[3];
     for (int i = 1; i <= m; ++i) {
-      p_.ConstraintGradient(i, e);
+      problem_->ConstraintGradient(i, e);
       for (int a = 0; a < dim && i > 1; ++a) values[k++] = -e[a];
       for (int a = 0; a < dim; ++a) values[k++] = e[a];
     }
@@ -286,7 +298,7 @@ class IpoptStep : public Ipopt::TNLP {
               Ipopt::Index /*nele_hess*/, Ipopt::Index* i_row, Ipopt::Index* j_col,
               Ipopt::Number* values) override {
     if (new_x) cached_ = false;
-    const int dim = p_.dim(), links = p_.num_links();
+    const int dim = problem_->dim(), links = problem_->num_links();
     int k = 0;
     if (values == nullptr) {
       for (int r = 0; r < n; ++r) {
@@ -295,13 +307,13 @@ class IpoptStep : public Ipopt::TNLP {
       return true;
     }
     try {
-      p_.Load(x);
-      if (obj_factor != 0.0) p_.Hessian(&hessian_);
+      problem_->Load(x);
+      if (obj_factor != 0.0) problem_->Hessian(&hessian_);
     } catch (...) {
       return false;
     }
     // Constraint i's Hessian is (1/L_i) [I, -I; -I, I] on (x_{i-1}, x_i).
-    const Eigen::VectorXd& lengths = p_.lengths();
+    const Eigen::VectorXd& lengths = problem_->lengths();
     for (int r = 0; r < n; ++r) {
       const int j = r / dim + 1, a = r % dim;
       for (int c = FirstColumn(r); c <= r; ++c, ++k) {
@@ -325,21 +337,23 @@ class IpoptStep : public Ipopt::TNLP {
                          const Ipopt::Number* /*lambda*/, Ipopt::Number /*obj_value*/,
                          const Ipopt::IpoptData* /*ip_data*/,
                          Ipopt::IpoptCalculatedQuantities* /*ip_cq*/) override {
-    p_.Load(x);
+    problem_->Load(x);
   }
 
  private:
   // First column of row r in the Hessian's lower-triangle pattern.
-  int FirstColumn(int r) const { return std::max(0, r / p_.dim() - band_) * p_.dim(); }
+  int FirstColumn(int r) const {
+    return std::max(0, r / problem_->dim() - band_) * problem_->dim();
+  }
 
   // Objective and gradient at x, computed once per new point. IPOPT's new_x is false when any
   // eval_* method has seen x before, so every one of them clears the cache on a new x.
   bool Update(int n, const double* x, bool new_x) {
     if (!new_x && cached_) return true;
     try {
-      p_.Load(x);
+      problem_->Load(x);
       gradient_.resize(n);
-      value_ = p_.Objective(gradient_.data());
+      value_ = problem_->Objective(gradient_.data());
       cached_ = true;
     } catch (...) {
       cached_ = false;
@@ -348,7 +362,7 @@ class IpoptStep : public Ipopt::TNLP {
     return std::isfinite(value_);
   }
 
-  StepProblem& p_;
+  StepProblem* problem_;
   int band_;
   bool cached_ = false;
   double value_ = 0.0;
@@ -385,75 +399,136 @@ std::string PeerReport::BriefReport() const {
   return buf;
 }
 
-PeerReport SolveWithSlsqp(const Eigen::VectorXd& lengths,
-                          const Eigen::Ref<const Eigen::VectorXd>& head, const PeerOptions& options,
-                          const Points& old_points) {
-  const Clock::time_point started = Clock::now();
-  ValidateInput(lengths, head, options, old_points);
-  StepProblem problem(lengths, head, options.weights, old_points);
+struct SlsqpPeer::State {
+  nlopt_opt opt = nullptr;
+  SlsqpData data{nullptr, nullptr};
+  std::vector<double> x;
+};
+
+SlsqpPeer::SlsqpPeer(const Eigen::VectorXd& lengths, int dim, const PeerOptions& options)
+    : lengths_(lengths), options_(options), state_(new State) {
+  const unsigned n = static_cast<unsigned>(lengths.size() * dim);
+  const unsigned m = static_cast<unsigned>(lengths.size());
+  nlopt_opt opt = nlopt_create(NLOPT_LD_SLSQP, n);
+  if (opt == nullptr) {
+    delete state_;
+    throw std::bad_alloc();
+  }
+  state_->opt = opt;
+  state_->data.opt = opt;
+  std::vector<double> tolerances(m);
+  for (unsigned i = 0; i < m; ++i) tolerances[i] = options.constraint_tolerance * lengths[i];
+  nlopt_set_min_objective(opt, SlsqpObjective, &state_->data);
+  nlopt_add_equality_mconstraint(opt, m, SlsqpConstraints, &state_->data, tolerances.data());
+  nlopt_set_xtol_rel(opt, options.xtol_rel);
+  nlopt_set_ftol_rel(opt, options.ftol_rel);
+  nlopt_set_maxeval(opt, options.max_evaluations);
+  if (options.max_seconds > 0.0) nlopt_set_maxtime(opt, options.max_seconds);
+  state_->x.resize(n);
+}
+
+SlsqpPeer::~SlsqpPeer() {
+  nlopt_destroy(state_->opt);
+  delete state_;
+}
+
+PeerReport SlsqpPeer::Solve(const Eigen::Ref<const Eigen::VectorXd>& head,
+                            const Points& old_points) {
+  ValidateInput(lengths_, head, options_, old_points);
+  StepProblem problem(lengths_, head, options_.weights, old_points);
+  if (problem.num_variables() != static_cast<int>(state_->x.size())) {
+    throw InputError("points", "do not match the chain this SLSQP peer was made for");
+  }
   PeerReport report;
   report.solver = "slsqp";
-  const unsigned n = static_cast<unsigned>(problem.num_variables());
-  const unsigned m = static_cast<unsigned>(problem.num_links());
-  nlopt_opt opt = nlopt_create(NLOPT_LD_SLSQP, n);
-  nlopt_result result = NLOPT_OUT_OF_MEMORY;
-  if (opt != nullptr) {
-    SlsqpData data{&problem, opt};
-    std::vector<double> tolerances(m), x(problem.start(), problem.start() + n);
-    for (unsigned i = 0; i < m; ++i) tolerances[i] = options.constraint_tolerance * lengths[i];
-    nlopt_set_min_objective(opt, SlsqpObjective, &data);
-    nlopt_add_equality_mconstraint(opt, m, SlsqpConstraints, &data, tolerances.data());
-    nlopt_set_xtol_rel(opt, options.xtol_rel);
-    nlopt_set_ftol_rel(opt, options.ftol_rel);
-    nlopt_set_maxeval(opt, options.max_evaluations);
-    if (options.max_seconds > 0.0) nlopt_set_maxtime(opt, options.max_seconds);
-    double minimum = 0.0;
-    result = nlopt_optimize(opt, x.data(), &minimum);
-    problem.Load(x.data());  // NLopt returns its best feasible point, not the last one
-    nlopt_destroy(opt);
-  }
+  state_->data.problem = &problem;
+  std::copy(problem.start(), problem.start() + problem.num_variables(), state_->x.begin());
+  double minimum = 0.0;
+  const Clock::time_point started = Clock::now();
+  const nlopt_result result = nlopt_optimize(state_->opt, state_->x.data(), &minimum);
+  report.seconds = SecondsSince(started);
+  problem.Load(state_->x.data());  // NLopt returns its best feasible point, not the last one
   problem.Finish(&report);
   report.status_code = result;
   report.status = nlopt_result_to_string(result);
   report.converged =
       result == NLOPT_SUCCESS || result == NLOPT_FTOL_REACHED || result == NLOPT_XTOL_REACHED;
-  report.seconds = SecondsSince(started);
   return report;
+}
+
+struct IpoptPeer::State {
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app;
+  Ipopt::SmartPtr<IpoptStep> nlp;  // made by the first solve, reused by the next ones
+  int band = 1;
+  int variables = 0;
+};
+
+IpoptPeer::IpoptPeer(const Eigen::VectorXd& lengths, int dim, const PeerOptions& options)
+    : lengths_(lengths), options_(options), state_(new State) {
+  state_->band = HessianBand(options.weights, dim);
+  state_->variables = static_cast<int>(lengths.size()) * dim;
+  // No console journal at all, and no banner: IPOPT must stay silent in the tests.
+  state_->app = new Ipopt::IpoptApplication(false);
+  Ipopt::SmartPtr<Ipopt::OptionsList> o = state_->app->Options();
+  internal::SetCommonIpoptOptions(options, GetRawPtr(o));
+  if (options.ipopt_mehrotra) o->SetStringValue("mehrotra_algorithm", "yes");
+  const Ipopt::ApplicationReturnStatus status = state_->app->Initialize("");  // no ipopt.opt
+  if (status != Ipopt::Solve_Succeeded) {
+    delete state_;
+    throw std::runtime_error(std::string("IPOPT did not initialize: ") + IpoptStatusName(status));
+  }
+}
+
+IpoptPeer::~IpoptPeer() { delete state_; }
+
+PeerReport IpoptPeer::Solve(const Eigen::Ref<const Eigen::VectorXd>& head,
+                            const Points& old_points) {
+  ValidateInput(lengths_, head, options_, old_points);
+  StepProblem problem(lengths_, head, options_.weights, old_points);
+  if (problem.num_variables() != state_->variables) {
+    throw InputError("points", "do not match the chain this IPOPT peer was made for");
+  }
+  PeerReport report;
+  report.solver = "ipopt";
+  Ipopt::ApplicationReturnStatus status = Ipopt::Internal_Error;
+  const bool first = Ipopt::IsNull(state_->nlp);
+  if (first) {
+    state_->nlp = new IpoptStep(&problem, state_->band);
+  } else {
+    state_->nlp->set_problem(&problem);
+  }
+  const Ipopt::SmartPtr<Ipopt::TNLP> nlp = GetRawPtr(state_->nlp);
+  const Clock::time_point started = Clock::now();
+  try {
+    status = first ? state_->app->OptimizeTNLP(nlp) : state_->app->ReOptimizeTNLP(nlp);
+  } catch (const std::bad_alloc&) {
+    status = Ipopt::Insufficient_Memory;
+  }
+  report.seconds = SecondsSince(started);
+  if (Ipopt::SmartPtr<Ipopt::SolveStatistics> stats = state_->app->Statistics();
+      Ipopt::IsValid(stats)) {
+    report.iterations = stats->IterationCount();
+  }
+  state_->nlp->set_problem(nullptr);
+  problem.Finish(&report);
+  report.status_code = status;
+  report.status = IpoptStatusName(status);
+  report.converged = status == Ipopt::Solve_Succeeded;
+  return report;
+}
+
+PeerReport SolveWithSlsqp(const Eigen::VectorXd& lengths,
+                          const Eigen::Ref<const Eigen::VectorXd>& head, const PeerOptions& options,
+                          const Points& old_points) {
+  ValidateInput(lengths, head, options, old_points);
+  return SlsqpPeer(lengths, static_cast<int>(old_points.cols()), options).Solve(head, old_points);
 }
 
 PeerReport SolveWithIpopt(const Eigen::VectorXd& lengths,
                           const Eigen::Ref<const Eigen::VectorXd>& head, const PeerOptions& options,
                           const Points& old_points) {
-  const Clock::time_point started = Clock::now();
   ValidateInput(lengths, head, options, old_points);
-  StepProblem problem(lengths, head, options.weights, old_points);
-  PeerReport report;
-  report.solver = "ipopt";
-  Ipopt::ApplicationReturnStatus status = Ipopt::Internal_Error;
-  try {
-    // No console journal at all, and no banner: IPOPT must stay silent in the tests.
-    Ipopt::SmartPtr<Ipopt::IpoptApplication> app = new Ipopt::IpoptApplication(false);
-    Ipopt::SmartPtr<Ipopt::OptionsList> o = app->Options();
-    internal::SetCommonIpoptOptions(options, GetRawPtr(o));
-    status = app->Initialize("");  // "": no ipopt.opt file from the working directory
-    if (status == Ipopt::Solve_Succeeded) {
-      Ipopt::SmartPtr<Ipopt::TNLP> nlp =
-          new IpoptStep(&problem, HessianBand(options.weights, problem.dim()));
-      status = app->OptimizeTNLP(nlp);
-      if (Ipopt::SmartPtr<Ipopt::SolveStatistics> stats = app->Statistics();
-          Ipopt::IsValid(stats)) {
-        report.iterations = stats->IterationCount();
-      }
-    }
-  } catch (const std::bad_alloc&) {
-    status = Ipopt::Insufficient_Memory;
-  }
-  problem.Finish(&report);
-  report.status_code = status;
-  report.status = IpoptStatusName(status);
-  report.converged = status == Ipopt::Solve_Succeeded;
-  report.seconds = SecondsSince(started);
-  return report;
+  return IpoptPeer(lengths, static_cast<int>(old_points.cols()), options).Solve(head, old_points);
 }
 
 int HessianBand(const ObjectiveWeights& weights, int dim) {

@@ -39,6 +39,9 @@ struct PeerOptions {
   // IPOPT: true, the exact Hessian of the Lagrangian (banded, from OverallObjective's Hessian);
   // false, its limited-memory quasi-Newton approximation.
   bool exact_hessian = true;
+  // IPOPT: Mehrotra's predictor-corrector ("mehrotra_algorithm yes"), IPOPT's documented faster
+  // mode for convex problems; off by default (these problems are not convex).
+  bool ipopt_mehrotra = false;
   // Both: time limit in seconds (SLSQP: wall clock; IPOPT: CPU time); 0 for none.
   double max_seconds = 0.0;
 
@@ -60,21 +63,62 @@ struct PeerReport {
   // is >= `objective` (t_j >= |x_j - a_j|) and shows how tightly the cones close.
   double solver_objective = 0.0;
   double constraint_violation = 0.0;  // largest |(|D_i|^2 - L_i^2)| / (2 L_i^2) at `points`
-  int iterations = -1;   // IPOPT's iterations; -1 for SLSQP (NLopt does not report them)
-  int evaluations = 0;   // objective evaluations
-  double seconds = 0.0;  // wall time of the whole call, the starting point included
+  int iterations = -1;  // IPOPT's iterations; -1 for SLSQP (NLopt does not report them)
+  int evaluations = 0;  // objective evaluations
+  // Wall time of the solver's own work: nlopt_optimize, or IPOPT's OptimizeTNLP (its first solve)
+  // and ReOptimizeTNLP (later ones). Not in it: the starting point (the tractrix step, flexkin's
+  // work given to the peer), the checks of the input, and the solver's set-up (SlsqpPeer,
+  // IpoptPeer, made once).
+  double seconds = 0.0;
 
   std::string BriefReport() const;
 };
 
+// A peer set up as its users set it up: once for a chain's links and dimension, then reused for
+// every step. SlsqpPeer holds NLopt's object with its n equality constraints and stopping rules;
+// IpoptPeer holds an IpoptApplication, initialized once, and its problem object, which later
+// solves hand to ReOptimizeTNLP (same sizes and sparsity, IPOPT's documented way to solve a
+// sequence of problems). Solve() is one step from `old_points` (the chain's shape given at
+// construction) to `head`, from the same start as OverallStep (the sequential tractrix step).
+class SlsqpPeer {
+ public:
+  SlsqpPeer(const Eigen::VectorXd& lengths, int dim, const PeerOptions& options);
+  ~SlsqpPeer();
+  SlsqpPeer(const SlsqpPeer&) = delete;
+  SlsqpPeer& operator=(const SlsqpPeer&) = delete;
+  PeerReport Solve(const Eigen::Ref<const Eigen::VectorXd>& head, const Points& old_points);
+
+ private:
+  struct State;
+  Eigen::VectorXd lengths_;
+  PeerOptions options_;
+  State* state_;
+};
+
+class IpoptPeer {
+ public:
+  IpoptPeer(const Eigen::VectorXd& lengths, int dim, const PeerOptions& options);
+  ~IpoptPeer();
+  IpoptPeer(const IpoptPeer&) = delete;
+  IpoptPeer& operator=(const IpoptPeer&) = delete;
+  PeerReport Solve(const Eigen::Ref<const Eigen::VectorXd>& head, const Points& old_points);
+
+ private:
+  struct State;
+  Eigen::VectorXd lengths_;
+  PeerOptions options_;
+  State* state_;
+};
+
 // One step, as OverallStep(lengths, head, {weights}, &old_points) but by SLSQP (NLopt's
-// NLOPT_LD_SLSQP: dense, memory and time grow as the square and the cube of n). Throws
-// InputError on invalid input, as OverallStep does.
+// NLOPT_LD_SLSQP: dense, memory and time grow as the square and the cube of n): a SlsqpPeer made
+// for this one solve. Throws InputError on invalid input, as OverallStep does.
 PeerReport SolveWithSlsqp(const Eigen::VectorXd& lengths,
                           const Eigen::Ref<const Eigen::VectorXd>& head, const PeerOptions& options,
                           const Points& old_points);
 
-// The same by IPOPT (sparse: banded Hessian and Jacobian, MUMPS). Prints nothing.
+// The same by IPOPT (sparse: banded Hessian and Jacobian, MUMPS), an IpoptPeer made for this one
+// solve. Prints nothing.
 PeerReport SolveWithIpopt(const Eigen::VectorXd& lengths,
                           const Eigen::Ref<const Eigen::VectorXd>& head, const PeerOptions& options,
                           const Points& old_points);

@@ -435,6 +435,48 @@ TYPED_TEST(TractrixStepTest, ExtremeRatiosOutsideTheFastRangeAreHandled) {
   }
 }
 
+// Where the motion dies out along a chain, moves fall to 1e-50 of a link and below, down to
+// subnormal sizes: the rule computes them in its vector form, scaled, without flagging the lane
+// for the scalar reference form (which made a long chain moved off its axis several times slower),
+// and agrees with the reference to rounding. So do moves of 1e60 links.
+TYPED_TEST(TractrixStepTest, TinyAndHugeMovesStayInTheVectorForm) {
+  constexpr int kDim = TypeParam::value;
+  Random random(17);
+  int checked = 0;
+  for (const double length : {1e-3, 1.0, 1e3}) {
+    for (const double ratio : {1e-45, 1e-60, 1e-120, 1e-200, 1e-300, 1e-310, 1e60}) {
+      for (const MoveKind kind : {MoveKind::kPull, MoveKind::kSideways, MoveKind::kPush}) {
+        // Head at the origin, so that a move of 1e-310 L is a move and not rounded away.
+        const double p = ratio * length;
+        LinkMove<kDim> m = RandomMove<kDim>(random, kind, length, 1.0);
+        const Vec<kDim> u = m.head_new - m.head_old;  // unit, to rounding
+        m.tail -= m.head_old;
+        m.head_old.setZero();
+        m.head_new = p * u;
+        if (!(m.head_new.cwiseAbs().maxCoeff() > 0.0)) continue;
+        Vec<kDim> tail = m.tail;
+        const bool flagged = internal::TractrixRule<kDim>::Apply(
+            m.head_old.data(), m.head_new.data(), tail.data(), length, -1.0 / length);
+        const Vec<kDim> ref = Reference<kDim>(m.head_old, m.head_new, m.tail, length);
+        SCOPED_TRACE("L = " + Str(length) + ", p/L = " + Str(ratio) + ", " + KindName(kind));
+        EXPECT_FALSE(flagged);
+        ASSERT_TRUE(tail.allFinite());
+        const double rounding = 8 * kEps * (m.head_new.cwiseAbs().maxCoeff() + length);
+        EXPECT_LE(std::fabs((tail - m.head_new).norm() - length), rounding);
+        if (ratio < 1.0) {
+          // The tail moves by at most p: below the rounding of its coordinates.
+          EXPECT_LE((tail - m.tail).norm(), p + rounding);
+        }
+        // The reference form agrees, except for a subnormal move (1e-310 L here), whose direction
+        // the reference's asinh, tanh and cosh of large arguments resolve only to a few ulps.
+        if (ratio >= 1e-300) EXPECT_LE((tail - ref).norm(), rounding);
+        ++checked;
+      }
+    }
+  }
+  EXPECT_EQ(checked, 63);
+}
+
 // Invariants over many random inputs, manif style: identity (no move), tiny (1e-8 L) and
 // random moves (1e-3 to 30 L, pulling, sideways and pushing).
 enum class InputKind { kIdentity, kTiny, kRandom };

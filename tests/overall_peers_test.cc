@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <random>
 #include <string>
 #include <vector>
@@ -123,16 +125,81 @@ TEST_P(OverallPeersTest, SameMinimumAsSlsqpAndIpopt) {
               OverallObjective(c.weights, c.chain.lengths, c.chain.points, overall),
               1e-12 * (1.0 + std::fabs(report.objective)));
 
+  int compared = 0;
   for (const PeerReport& peer : peers) {
     if (!peer.converged) continue;  // recorded above; the peer's failure is not OverallStep's
+    ++compared;
     ExpectSameObjective(report.objective, peer.objective, peer.BriefReport());
     EXPECT_LT(peer.constraint_violation, 1e-10) << peer.BriefReport();
     EXPECT_LT((overall - peer.points).cwiseAbs().maxCoeff(), 1e-6) << peer.BriefReport();
   }
+  // A problem no peer solved compares nothing: at least one must have.
+  EXPECT_GE(compared, 1) << "no peer converged on " << c.name << peer_results;
+}
+
+// The whole list, counted: every one of its 50 problems (5 objectives on the paper's parabola, 4
+// or 5 on each of 10 random chains) is solved by both peers and matched by OverallStep (measured:
+// 50 of 50 for each), so a peer that stops converging, or a list that shrinks, fails here.
+TEST(OverallPeers, EnoughProblemsAreCompared) {
+  const std::vector<Case> cases = Cases();
+  ASSERT_EQ(cases.size(), 50u);
+  int slsqp = 0, ipopt = 0;
+  for (const Case& c : cases) {
+    PeerOptions peer_options;
+    peer_options.weights = c.weights;
+    OverallOptions options;
+    options.weights = c.weights;
+    Chain moved = c.chain;
+    const OverallReport report = OverallStep(c.head, options, &moved);
+    if (!report.converged()) continue;
+    const auto same = [&](const PeerReport& peer) {
+      return peer.converged &&
+             std::fabs(report.objective - peer.objective) <=
+                 1e-8 * std::fmax(std::fabs(report.objective), std::fabs(peer.objective)) + 1e-14 &&
+             (moved.points - peer.points).cwiseAbs().maxCoeff() < 1e-6;
+    };
+    slsqp += same(peers::SolveWithSlsqp(c.chain.lengths, c.head, peer_options, c.chain.points));
+    ipopt += same(peers::SolveWithIpopt(c.chain.lengths, c.head, peer_options, c.chain.points));
+  }
+  RecordProperty("slsqp_compared", slsqp);
+  RecordProperty("ipopt_compared", ipopt);
+  std::printf("compared with SLSQP: %d of %zu; with IPOPT: %d of %zu\n", slsqp, cases.size(), ipopt,
+              cases.size());
+  EXPECT_EQ(slsqp, 50);
+  EXPECT_EQ(ipopt, 50);
 }
 
 INSTANTIATE_TEST_SUITE_P(Problems, OverallPeersTest, testing::ValuesIn(Cases()),
                          [](const testing::TestParamInfo<Case>& info) { return info.param.name; });
+
+// A peer made once and reused for a sequence of steps (as the benchmark uses it, and as its users
+// would) gives each step the answer a peer made for that step alone gives.
+TEST(OverallPeers, PeersMadeOnceSolveEveryStepAsFreshOnes) {
+  const Chain chain = scenes::PaperParabola();
+  PeerOptions options;
+  peers::SlsqpPeer slsqp(chain.lengths, 2, options);
+  peers::IpoptPeer ipopt(chain.lengths, 2, options);
+  int compared = 0;
+  for (const Eigen::Vector2d& move :
+       {Eigen::Vector2d(0.49, 0.49), Eigen::Vector2d(-0.3, 0.2), Eigen::Vector2d(0.1, -0.6)}) {
+    const Eigen::Vector2d head = chain.points.row(0).transpose() + move;
+    const PeerReport reused[] = {slsqp.Solve(head, chain.points), ipopt.Solve(head, chain.points)};
+    const PeerReport fresh[] = {peers::SolveWithSlsqp(chain.lengths, head, options, chain.points),
+                                peers::SolveWithIpopt(chain.lengths, head, options, chain.points)};
+    for (int k = 0; k < 2; ++k) {
+      ASSERT_TRUE(reused[k].converged) << reused[k].BriefReport();
+      ASSERT_TRUE(fresh[k].converged) << fresh[k].BriefReport();
+      EXPECT_NEAR(reused[k].objective, fresh[k].objective, 1e-12 * fresh[k].objective);
+      EXPECT_LT((reused[k].points - fresh[k].points).cwiseAbs().maxCoeff(), 1e-12);
+      EXPECT_GT(reused[k].seconds, 0.0);
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, 6);
+  // A peer refuses a chain of another shape.
+  const Chain other = scenes::Helix(5);
+  EXPECT_THROW(slsqp.Solve(other.points.row(0).transpose(), other.points), InputError);
+}
 
 // IPOPT with its quasi-Newton Hessian instead of the exact one reaches the same minimum.
 TEST(OverallPeers, IpoptLimitedMemoryAgrees) {

@@ -50,9 +50,12 @@ def test_run_scenario_equals_cli(path, cli, tmp_path):
 @pytest.mark.parametrize("path", ROBOT_SCENARIOS, ids=lambda p: p.stem)
 def test_run_robot_equals_cli(path, cli, tmp_path):
     out = tmp_path / "trajectory.json"
-    subprocess.run([cli, "robot", str(path), "-o", str(out), "-q"], check=False)
+    done = subprocess.run([cli, "robot", str(path), "-o", str(out), "-q"], check=False,
+                          capture_output=True, text=True)
     with open(out) as f:
         cli_result = json.load(f)
+    # The exit status: 0, or 3 when a target was not reached (the file is written either way).
+    assert done.returncode == (3 if cli_result["summary"]["unreached"] else 0), done.stderr
     traj = flexkin.run_robot(path)
     steps = cli_result["steps"]
     assert traj.num_steps == len(steps) == traj.angles.shape[0]
@@ -95,9 +98,12 @@ def without_seconds(value):
 
 @pytest.mark.parametrize("path", ROBOT_SCENARIOS, ids=lambda p: p.stem)
 def test_run_robot_files_equal_cli(path, cli, tmp_path):
-    subprocess.run([cli, "robot", str(path), "-o", str(tmp_path / "cli.json"), "--csv",
-                    str(tmp_path / "cli.csv"), "-q"], check=False)
-    flexkin.run_robot(path, output=tmp_path / "py.json", csv=tmp_path / "py.csv")
+    # `flexkin run` of a robot scenario is `flexkin robot` (the same files, the same status).
+    done = subprocess.run([cli, "run", str(path), "-o", str(tmp_path / "cli.json"), "--csv",
+                           str(tmp_path / "cli.csv"), "-q"], check=False, capture_output=True,
+                          text=True)
+    traj = flexkin.run_robot(path, output=tmp_path / "py.json", csv=tmp_path / "py.csv")
+    assert done.returncode == (3 if traj.unreached else 0), done.stderr
     assert (tmp_path / "py.csv").read_bytes() == (tmp_path / "cli.csv").read_bytes()
     with open(tmp_path / "cli.json") as a, open(tmp_path / "py.json") as b:
         assert without_seconds(json.load(a)) == without_seconds(json.load(b))

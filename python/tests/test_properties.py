@@ -79,3 +79,49 @@ def test_link_steps_and_overall_step():
     res = flexkin.run(pts, [[0.1, 0.1]], method="overall", overall=flexkin.ObjectiveWeights(l2=1))
     assert res.overall.solves >= 1 and res.overall.failures == 0
     assert res.weights.l2 == 1 and res.weights.squared == 0
+
+
+METHODS = ("tractrix", "ftl", "min_rotation", "min_joint_angle", "overall")
+
+
+def joint_cosines(points):
+    """The cosine of the angle between each link and the next."""
+    links = np.diff(points, axis=0)
+    links /= np.linalg.norm(links, axis=1, keepdims=True)
+    return np.sum(links[:-1] * links[1:], axis=1)
+
+
+@pytest.mark.parametrize("seed, dim, method",
+                         [(s, d, m) for s in range(3) for d in (2, 3) for m in METHODS])
+def test_every_method_keeps_the_lengths_and_its_own_property(seed, dim, method):
+    """Each method's defining property, on random chains and random paths, step by step."""
+    rng = np.random.default_rng(200 + seed)
+    points = random_chain(rng, links=int(rng.integers(3, 25)), dim=dim)
+    chain = flexkin.Chain(points)
+    path = points[0] + np.cumsum(rng.normal(scale=0.2, size=(12, dim)), axis=0)
+    res = flexkin.run(chain, path, method=method)
+    frames = res.frames
+    assert np.all(np.isfinite(frames))
+    # Every method: the leading end on its path, every length kept.
+    assert np.array_equal(frames[1:, 0], path)
+    links = np.linalg.norm(np.diff(frames, axis=1), axis=2)
+    assert np.max(np.abs(links / chain.lengths - 1)) <= 1e-12
+    moves = np.linalg.norm(np.diff(frames, axis=0), axis=2)
+    if method in ("tractrix", "ftl"):
+        # No point moves farther than the point ahead of it.
+        assert np.all(moves[:, 1:] <= moves[:, :-1] * (1 + 1e-12) + 1e-12)
+    elif method == "min_rotation":
+        # No link turns: the whole chain translates with its leading end.
+        shift = frames - frames[:, :1]
+        assert np.max(np.abs(shift - shift[0])) <= 1e-12 * (1 + np.abs(frames).max())
+    elif method == "min_joint_angle":
+        # Every joint angle kept: the chain behind the first link moves rigidly with it.
+        for frame in frames[1:]:
+            assert np.max(np.abs(joint_cosines(frame) - joint_cosines(points))) <= 1e-12
+    else:
+        # The overall step moves the chain no more (sum of squared moves, its objective) than the
+        # tractrix step from the same configuration, which is feasible: it is the minimizer.
+        for before, after, head in zip(frames[:-1], frames[1:], path):
+            tractrix = flexkin.move_leader(flexkin.Chain(before, lengths=chain.lengths), head)
+            assert np.sum((after - before) ** 2) <= np.sum((tractrix - before) ** 2) * (1 + 1e-12)
+        assert res.overall.failures == 0

@@ -123,30 +123,77 @@ inline void TractrixStepReference(const double* head_old, const double* head_new
 //   r_new = L ((s1 - s2) d + c V) / (p (s1 + s2)).
 // Each branch's denominator is a sum of non-negative terms: no cancellation. |r_new| = L holds
 // algebraically (c^2 |V|^2 = 4 s1 s2 dd), so the length is kept to rounding and rounding never
-// accumulates from step to step. Lanes whose denominator leaves the safe range (moves or offsets
-// beyond ~1e+-50 link lengths) are flagged for the reference form.
+// accumulates from step to step.
+// Apart from E, r_new is homogeneous of degree 0 in d: the same r_new comes from d scaled by any
+// factor, E kept. Where the motion dies out along a chain a link's move falls below about 1e-50
+// of its length and the denominator (about L^2 p^5) under 1e-250; such lanes, and moves over
+// about 1e50 links, are computed again in the same form with d scaled to the link's length, in
+// the vector lanes (the other lanes keep their bits). Only lanes still out of range (a non-finite
+// input, a link of extreme length) are flagged for the reference form.
 template <int Dim, class Exp = StdExp>
 struct TractrixRule {
   template <class T>
   static auto Apply(const T* head_old, const T* head_new, T* tail, T length, T neg_inv_length) {
-    T d[Dim], r[Dim], v[Dim];
+    T d[Dim], r[Dim];
     for (int k = 0; k < Dim; ++k) {
       d[k] = head_new[k] - head_old[k];
       r[k] = tail[k] - head_old[k];
     }
     const T dd = Dot<Dim>(d, d);
     // Where the motion has died out the head does not move and neither does the tail. Lanes
-    // that did not move among lanes that did get den = 0 below and go to the reference form.
+    // that did not move among lanes that did keep their tail below.
     if (none(dd > T(0.0))) return Mask<T>(dd != dd);
+    const T p = sqrt(dd);
+    T out[Dim];
+    const T den = Rational(d, r, dd, p, Exp()(p * neg_inv_length), head_new, length, out);
+    const auto out_of_range = (den <= T(1e-250)) | (den >= T(1e250));
+    if (none(out_of_range)) {
+      for (int k = 0; k < Dim; ++k) tail[k] = out[k];
+      return Mask<T>(den != den);
+    }
+    {
+      // The move scaled to the link's length (its largest coordinate to L): the same r_new, the
+      // terms in range. A lane that did not move keeps its tail.
+      T a = abs(d[0]);
+      for (int k = 1; k < Dim; ++k) a = select(abs(d[k]) > a, abs(d[k]), a);
+      const auto moved = a > T(0.0);
+      T scale = select(moved, length / a, T(1.0));
+      scale = select(scale > T(1e300), T(1e300), scale);
+      T ds[Dim], scaled[Dim];
+      for (int k = 0; k < Dim; ++k) ds[k] = d[k] * scale;
+      const T dds = Dot<Dim>(ds, ds);
+      const T ps = sqrt(dds);
+      const T den_scaled =
+          Rational(ds, r, dds, ps, Exp()((ps / scale) * neg_inv_length), head_new, length, scaled);
+      for (int k = 0; k < Dim; ++k) {
+        out[k] = select(out_of_range, select(moved, scaled[k], tail[k]), out[k]);
+      }
+      const auto scaled_bad =
+          (den_scaled <= T(1e-250)) | (den_scaled >= T(1e250)) | (den_scaled != den_scaled);
+      for (int k = 0; k < Dim; ++k) tail[k] = out[k];
+      // NaN is in no range: a lane is flagged if its denominator is NaN, or if it moved out of
+      // range and the scaled form is out of range too.
+      return Mask<T>((den != den) | (out_of_range & moved & scaled_bad));
+    }
+  }
+  static void Reference(const double* head_old, const double* head_new, double* tail,
+                        double length) {
+    TractrixStepReference<Dim>(head_old, head_new, tail, length);
+  }
+
+ private:
+  // The rational form for a move d (dd = d.d, p = |d|) with E = e: the new tail into `out`;
+  // returns the denominator p (s1 + s2), whose range says whether `out` can be trusted.
+  template <class T>
+  static T Rational(const T* d, const T* r, T dd, T p, T e, const T* head_new, T length, T* out) {
+    T v[Dim];
     const T rd = Dot<Dim>(r, d);
     const auto pulling = rd <= T(0.0);
-    const T p = sqrt(dd);
-    T e, m, s1, s2;
+    T m, s1, s2;
     if (all(pulling)) {
       // Pulling: v enters only beside the dominant (L p - rd)^2 dd term, so the plain form
       // (whose error is eps L p^2 absolute) moves the tail by rounding only.
       for (int k = 0; k < Dim; ++k) v[k] = dd * r[k] - rd * d[k];
-      e = Exp()(p * neg_inv_length);
       m = length * p - rd;
       s1 = (e * e) * Dot<Dim>(v, v);
       s2 = (m * m) * dd;
@@ -154,7 +201,6 @@ struct TractrixRule {
       // Pushing: with the tail nearly ahead of the head, v is small and decides which way the
       // link swings; it needs full relative accuracy (and v.d = 0 keeps the length).
       const T vv = RejectAccurately<Dim>(r, d, dd, v);
-      e = Exp()(p * neg_inv_length);
       // m = L p - rd when pulling, L p + rd when pushing: L p + |rd|, no cancellation.
       m = length * p + abs(rd);
       const T mmdd = (m * m) * dd;
@@ -166,12 +212,8 @@ struct TractrixRule {
     const T f = length / den;
     const T g = f * (s1 - s2);
     const T h = f * c;
-    for (int k = 0; k < Dim; ++k) tail[k] = g * d[k] + (h * v[k] + head_new[k]);
-    return Mask<T>((den <= T(1e-250)) | (den >= T(1e250)) | (den != den));
-  }
-  static void Reference(const double* head_old, const double* head_new, double* tail,
-                        double length) {
-    TractrixStepReference<Dim>(head_old, head_new, tail, length);
+    for (int k = 0; k < Dim; ++k) out[k] = g * d[k] + (h * v[k] + head_new[k]);
+    return den;
   }
 };
 
