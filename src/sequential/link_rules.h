@@ -151,12 +151,19 @@ struct TractrixRule {
       for (int k = 0; k < Dim; ++k) tail[k] = out[k];
       return Mask<T>(den != den);
     }
+    // A lane whose head did not move (dd = 0: every coordinate of the move below 1e-162, below
+    // the rounding of any coordinate over 1e-146) keeps its tail, as the reference form does.
+    const auto moved_out_of_range = out_of_range & (dd > T(0.0));
+    if (none(moved_out_of_range)) {
+      for (int k = 0; k < Dim; ++k) tail[k] = select(out_of_range, tail[k], out[k]);
+      return Mask<T>(den != den);
+    }
     {
       // The move scaled to the link's length (its largest coordinate to L): the same r_new, the
-      // terms in range. A lane that did not move keeps its tail.
+      // terms in range. A lane that did not move keeps its tail, as above.
       T a = abs(d[0]);
       for (int k = 1; k < Dim; ++k) a = select(abs(d[k]) > a, abs(d[k]), a);
-      const auto moved = a > T(0.0);
+      const auto moved = dd > T(0.0);
       T scale = select(moved, length / a, T(1.0));
       scale = select(scale > T(1e300), T(1e300), scale);
       T ds[Dim], scaled[Dim];
