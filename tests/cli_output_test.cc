@@ -113,6 +113,21 @@ TEST_F(CliOutputTest, OutputOverTheLimitIsRefusedBeforeTheRun) {
   EXPECT_CONTAINS(csv.err, "the frames CSV r.csv");
 }
 
+// Without --max-output-size the limit is 4 GiB (docs/result-format.md): a result of 11 GiB is
+// refused before the run, the estimate and the default limit named, nothing written.
+TEST_F(CliOutputTest, TheDefaultLimitIsFourGiB) {
+  std::ofstream(Path("big.json"))
+      << R"({"curve": {"shape": "line", "start": [0, 0], "direction": [-1, 0],
+                                  "links": 100000, "link_length": 0.01},
+                        "leader": {"pull": [1, 0], "steps": 5000}})";
+  const CliResult r = Cli("run big.json -o big.npz");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_CONTAINS(r.err, "--max-output-size: the result big.npz would be about 11 GiB");
+  EXPECT_CONTAINS(r.err, "over the limit of 4.0 GiB");
+  EXPECT_CONTAINS(r.err, "--record-every 3");
+  EXPECT_EQ(Files(), std::vector<std::string>{"big.json"});
+}
+
 TEST_F(CliOutputTest, RobotOutputOverTheLimitIsRefused) {
   const std::string scenario = Example("robot_planar_8link.json");
   const CliResult r = Cli("robot '" + scenario + "' -o t.json --max-output-size 1K");
