@@ -6,14 +6,14 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <stdexcept>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <system_error>
 
 #include "flexkin/any_scenario.h"
 #include "flexkin/error.h"
-#include "flexkin/groom.h"
 #include "flexkin/gltf.h"
+#include "flexkin/groom.h"
 #include "flexkin/result_io.h"
 #include "flexkin/robot_scenario.h"
 #include "flexkin/scenario.h"
@@ -145,12 +145,9 @@ void ReadGltf(const std::string& bytes) {
 }
 
 const std::vector<Target>& Targets() {
-  static const std::vector<Target> targets = {{"scenario", ReadScenario},
-                                              {"robot", ReadRobotScenario},
-                                              {"groom", ReadGroomScenario},
-                                              {"result", ReadResult},
-                                              {"urdf", ReadUrdf},
-                                              {"gltf", ReadGltf}};
+  static const std::vector<Target> targets = {
+      {"scenario", ReadScenario}, {"robot", ReadRobotScenario}, {"groom", ReadGroomScenario},
+      {"result", ReadResult},     {"urdf", ReadUrdf},           {"gltf", ReadGltf}};
   return targets;
 }
 

@@ -7,7 +7,6 @@
 #include <vector>
 
 #include "chain/denormals.h"
-#include "chain/denormals.h"
 #include "chain/simd.h"
 #include "chain/substep.h"
 #include "flexkin/error.h"

@@ -15,7 +15,6 @@
 #include <utility>
 
 #include "chain/denormals.h"
-#include "chain/denormals.h"
 #include "chain/simd.h"
 #include "chain/substep.h"
 #include "sequential/link_rules.h"
