@@ -164,7 +164,7 @@ struct TractrixRule {
       T a = abs(d[0]);
       for (int k = 1; k < Dim; ++k) a = select(abs(d[k]) > a, abs(d[k]), a);
       const auto moved = dd > T(0.0);
-      T scale = select(moved, length / a, T(1.0));
+      T scale = select(moved, length / select(a > T(0.0), a, length), T(1.0));
       scale = select(scale > T(1e300), T(1e300), scale);
       T ds[Dim], scaled[Dim];
       for (int k = 0; k < Dim; ++k) ds[k] = d[k] * scale;
