@@ -565,7 +565,7 @@ class NpyDictParser {
 
 NpyArray ReadNpyHeader(ZipReader::Member* member, const std::string& name,
                        const std::string& descr) {
-  unsigned char start[10];
+  unsigned char start[12];  // magic (6), version (2), header length (2 in 1.0, 4 in 2.0 and 3.0)
   member->Read(start, 8);
   if (std::memcmp(start, kNpyMagic, 6) != 0) Malformed(name, "is not an .npy array (bad magic)");
   const int major = start[6], minor = start[7];
