@@ -168,6 +168,23 @@ TEST(Urdf, BadUrdfsNameTheElement) {
                                      "joints above it form a cycle"),
             std::string::npos)
       << InputErrorOf(cycle);
+  // Text that is not UTF-8 is refused before any XML parse: a multi-byte sequence cut off by the
+  // end of the text made TinyXML read past it (the urdf fuzzer's find); also a stray continuation
+  // byte, an overlong form and a surrogate. UTF-8 names are read.
+  EXPECT_NE(InputErrorOf(good + "\xDC")
+                .find("urdf: byte " + std::to_string(good.size()) + " (0xDC) is not valid UTF-8"),
+            std::string::npos)
+      << InputErrorOf(good + "\xDC");
+  for (const char* bad : {"\x80", "\xC0\xAF", "\xED\xA0\x80", "\xF4\x90\x80\x80"}) {
+    EXPECT_NE(InputErrorOf(Replace(good, "</robot>", std::string("<!--") + bad + "--></robot>"))
+                  .find("is not valid UTF-8"),
+              std::string::npos)
+        << bad;
+  }
+  EXPECT_EQ(
+      ArmFromUrdf(Replace(good, "</robot>", "<!-- \xC3\xA9l\xC3\xA8ve \xE2\x86\x92 --></robot>"))
+          .num_links(),
+      ArmFromUrdf(good).num_links());
   EXPECT_NE(InputErrorOf(good, {"", "elbowx"}).find("\"elbowx\" is not in the URDF"),
             std::string::npos);
   EXPECT_NE(InputErrorOf(good, {"nowhere", ""}).find("base_link"), std::string::npos);

@@ -6,6 +6,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -122,7 +124,45 @@ void RefuseJointCycles(const std::string& text) {
   }
 }
 
+// Refuses text that is not UTF-8 (XML's encoding here), naming the first bad byte. TinyXML, which
+// urdfdom and RefuseJointCycles parse with, trusts a lead byte's length: a multi-byte sequence cut
+// off by the end of the text makes it read past the end (found by the urdf fuzzer).
+void RefuseInvalidUtf8(const std::string& text) {
+  const auto* p = reinterpret_cast<const unsigned char*>(text.data());
+  const size_t n = text.size();
+  for (size_t i = 0; i < n;) {
+    const unsigned char c = p[i];
+    size_t len = 0;
+    uint32_t min = 0, code = 0;
+    if (c < 0x80) {
+      ++i;
+      continue;
+    } else if ((c & 0xE0) == 0xC0) {
+      len = 2, min = 0x80, code = c & 0x1F;
+    } else if ((c & 0xF0) == 0xE0) {
+      len = 3, min = 0x800, code = c & 0x0F;
+    } else if ((c & 0xF8) == 0xF0) {
+      len = 4, min = 0x10000, code = c & 0x07;
+    }
+    bool valid = len > 0 && i + len <= n;
+    for (size_t k = 1; valid && k < len; ++k) {
+      valid = (p[i + k] & 0xC0) == 0x80;
+      code = (code << 6) | (p[i + k] & 0x3F);
+    }
+    // No overlong forms, no surrogates, nothing past U+10FFFF.
+    valid = valid && code >= min && code <= 0x10FFFF && !(code >= 0xD800 && code <= 0xDFFF);
+    if (!valid) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02X", c);
+      throw InputError("urdf", std::string("byte ") + std::to_string(i) + " (" + hex +
+                                   ") is not valid UTF-8; expected UTF-8 text (XML)");
+    }
+    i += len;
+  }
+}
+
 urdf::ModelInterfaceSharedPtr Parse(const std::string& text) {
+  RefuseInvalidUtf8(text);
   RefuseJointCycles(text);
   // console_bridge's handler is global: one parse at a time.
   static std::mutex mutex;
