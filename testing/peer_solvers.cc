@@ -406,14 +406,11 @@ struct SlsqpPeer::State {
 };
 
 SlsqpPeer::SlsqpPeer(const Eigen::VectorXd& lengths, int dim, const PeerOptions& options)
-    : lengths_(lengths), options_(options), state_(new State) {
+    : lengths_(lengths), options_(options), state_(std::make_unique<State>()) {
   const unsigned n = static_cast<unsigned>(lengths.size() * dim);
   const unsigned m = static_cast<unsigned>(lengths.size());
   nlopt_opt opt = nlopt_create(NLOPT_LD_SLSQP, n);
-  if (opt == nullptr) {
-    delete state_;
-    throw std::bad_alloc();
-  }
+  if (opt == nullptr) throw std::bad_alloc();
   state_->opt = opt;
   state_->data.opt = opt;
   std::vector<double> tolerances(m);
@@ -427,10 +424,7 @@ SlsqpPeer::SlsqpPeer(const Eigen::VectorXd& lengths, int dim, const PeerOptions&
   state_->x.resize(n);
 }
 
-SlsqpPeer::~SlsqpPeer() {
-  nlopt_destroy(state_->opt);
-  delete state_;
-}
+SlsqpPeer::~SlsqpPeer() { nlopt_destroy(state_->opt); }
 
 PeerReport SlsqpPeer::Solve(const Eigen::Ref<const Eigen::VectorXd>& head,
                             const Points& old_points) {
@@ -464,7 +458,7 @@ struct IpoptPeer::State {
 };
 
 IpoptPeer::IpoptPeer(const Eigen::VectorXd& lengths, int dim, const PeerOptions& options)
-    : lengths_(lengths), options_(options), state_(new State) {
+    : lengths_(lengths), options_(options), state_(std::make_unique<State>()) {
   state_->band = HessianBand(options.weights, dim);
   state_->variables = static_cast<int>(lengths.size()) * dim;
   // No console journal at all, and no banner: IPOPT must stay silent in the tests.
@@ -474,12 +468,11 @@ IpoptPeer::IpoptPeer(const Eigen::VectorXd& lengths, int dim, const PeerOptions&
   if (options.ipopt_mehrotra) o->SetStringValue("mehrotra_algorithm", "yes");
   const Ipopt::ApplicationReturnStatus status = state_->app->Initialize("");  // no ipopt.opt
   if (status != Ipopt::Solve_Succeeded) {
-    delete state_;
     throw std::runtime_error(std::string("IPOPT did not initialize: ") + IpoptStatusName(status));
   }
 }
 
-IpoptPeer::~IpoptPeer() { delete state_; }
+IpoptPeer::~IpoptPeer() = default;
 
 PeerReport IpoptPeer::Solve(const Eigen::Ref<const Eigen::VectorXd>& head,
                             const Points& old_points) {

@@ -11,6 +11,7 @@
 // only to build the tests and the benchmarks.
 
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -92,7 +93,7 @@ class SlsqpPeer {
   struct State;
   Eigen::VectorXd lengths_;
   PeerOptions options_;
-  State* state_;
+  std::unique_ptr<State> state_;
 };
 
 class IpoptPeer {
@@ -107,7 +108,7 @@ class IpoptPeer {
   struct State;
   Eigen::VectorXd lengths_;
   PeerOptions options_;
-  State* state_;
+  std::unique_ptr<State> state_;
 };
 
 // One step, as OverallStep(lengths, head, {weights}, &old_points) but by SLSQP (NLopt's

@@ -158,30 +158,27 @@ struct TractrixRule {
       for (int k = 0; k < Dim; ++k) tail[k] = select(out_of_range, tail[k], out[k]);
       return Mask<T>(den != den);
     }
-    {
-      // The move scaled to the link's length (its largest coordinate to L): the same r_new, the
-      // terms in range. A lane that did not move keeps its tail, as above.
-      T a = abs(d[0]);
-      for (int k = 1; k < Dim; ++k) a = select(abs(d[k]) > a, abs(d[k]), a);
-      const auto moved = dd > T(0.0);
-      T scale = select(moved, length / select(a > T(0.0), a, length), T(1.0));
-      scale = select(scale > T(1e300), T(1e300), scale);
-      T ds[Dim], scaled[Dim];
-      for (int k = 0; k < Dim; ++k) ds[k] = d[k] * scale;
-      const T dds = Dot<Dim>(ds, ds);
-      const T ps = sqrt(dds);
-      const T den_scaled =
-          Rational(ds, r, dds, ps, Exp()((ps / scale) * neg_inv_length), head_new, length, scaled);
-      for (int k = 0; k < Dim; ++k) {
-        out[k] = select(out_of_range, select(moved, scaled[k], tail[k]), out[k]);
-      }
-      const auto scaled_bad =
-          (den_scaled <= T(1e-250)) | (den_scaled >= T(1e250)) | (den_scaled != den_scaled);
-      for (int k = 0; k < Dim; ++k) tail[k] = out[k];
-      // NaN is in no range: a lane is flagged if its denominator is NaN, or if it moved out of
-      // range and the scaled form is out of range too.
-      return Mask<T>((den != den) | (out_of_range & moved & scaled_bad));
+    // The move scaled to the link's length (its largest coordinate to L): the same r_new, the
+    // terms in range. A lane that did not move keeps its tail, as above.
+    T a = abs(d[0]);
+    for (int k = 1; k < Dim; ++k) a = select(abs(d[k]) > a, abs(d[k]), a);
+    const auto moved = dd > T(0.0);
+    T scale = select(moved, length / select(a > T(0.0), a, length), T(1.0));
+    scale = select(scale > T(1e300), T(1e300), scale);
+    T ds[Dim], scaled[Dim];
+    for (int k = 0; k < Dim; ++k) ds[k] = d[k] * scale;
+    const T dds = Dot<Dim>(ds, ds);
+    const T ps = sqrt(dds);
+    const T den_scaled =
+        Rational(ds, r, dds, ps, Exp()((ps / scale) * neg_inv_length), head_new, length, scaled);
+    for (int k = 0; k < Dim; ++k) {
+      tail[k] = select(out_of_range, select(moved, scaled[k], tail[k]), out[k]);
     }
+    const auto scaled_bad =
+        (den_scaled <= T(1e-250)) | (den_scaled >= T(1e250)) | (den_scaled != den_scaled);
+    // NaN is in no range: a lane is flagged if its denominator is NaN, or if it moved out of
+    // range and the scaled form is out of range too.
+    return Mask<T>((den != den) | (out_of_range & moved & scaled_bad));
   }
   static void Reference(const double* head_old, const double* head_new, double* tail,
                         double length) {
