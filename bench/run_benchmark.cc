@@ -9,6 +9,10 @@
 //   run_*         Run with the frames copied into one buffer by the sink: recording every step
 //                 (with and without link angles), every 100th step, and first and last (also
 //                 with a progress callback, whose hidden cost is the difference)
+//   whole_chain   min_rotation and min_joint_angle through Run (on the SIMD engine where the CPU
+//                 has one) against the sub-step by sub-step loop they took before
+//                 (internal::RunSubstepBySubstep), first and last frames recorded, the leading
+//                 end pulled obliquely, (1, 0.5, 0.25) / |.|, so the joint-angle rule turns
 //   cli_json, cli_npz  `flexkin run -q` end to end (reading the scenario, the run, the file
 //                 written), one sub-process per iteration
 // Run: build/bench/run_benchmark --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
@@ -28,6 +32,7 @@
 #include "flexkin/curves.h"
 #include "flexkin/propagate.h"
 #include "flexkin/run.h"
+#include "run/sweep_pipeline.h"
 #include "sequential/sweep.h"
 
 namespace flexkin {
@@ -119,6 +124,30 @@ void BM_Run(benchmark::State& state, int record_every, bool link_angles, bool pr
   state.counters["length_error"] = length_error;
 }
 
+void BM_WholeChain(benchmark::State& state, Method method, bool engine) {
+  const int n = static_cast<int>(state.range(0));
+  const Chain chain = StraightLine(n);
+  const int64_t steps = StepsFor(n) / 4;
+  const Eigen::RowVector3d direction = Eigen::RowVector3d(1.0, 0.5, 0.25).normalized();
+  Points targets(steps, 3);
+  for (int64_t s = 0; s < steps; ++s) {
+    targets.row(s) = chain.points.row(0) + kStep * static_cast<double>(s + 1) * direction;
+  }
+  RunOptions options;
+  options.method = method;
+  options.record_every = 1 << 30;
+  CopySink sink;
+  double length_error = 0.0;
+  for (auto _ : state) {
+    const RunResult result = engine ? Run(chain, targets, options, &sink)
+                                    : internal::RunSubstepBySubstep(chain, targets, options, &sink);
+    length_error = result.metrics.max_relative_length_error;
+    benchmark::DoNotOptimize(result.metrics.l2_total);
+  }
+  SetRate(state, static_cast<double>(n) * steps);
+  state.counters["length_error"] = length_error;
+}
+
 // `flexkin run` end to end on the same scene, written as a scenario file.
 void BM_Cli(benchmark::State& state, const char* extension) {
   const int n = static_cast<int>(state.range(0));
@@ -170,6 +199,11 @@ BENCHMARK_CAPTURE(BM_Run, every_step_no_angles, 1, false)->Apply(Sizes);
 BENCHMARK_CAPTURE(BM_Run, every_100, 100, true)->Apply(Sizes);
 BENCHMARK_CAPTURE(BM_Run, first_last, 1 << 30, true)->Apply(Sizes);
 BENCHMARK_CAPTURE(BM_Run, first_last_with_progress, 1 << 30, true, true)->Apply(Sizes);
+BENCHMARK_CAPTURE(BM_WholeChain, min_rotation_engine, Method::kMinRotation, true)->Apply(Sizes);
+BENCHMARK_CAPTURE(BM_WholeChain, min_rotation_loop, Method::kMinRotation, false)->Apply(Sizes);
+BENCHMARK_CAPTURE(BM_WholeChain, min_joint_angle_engine, Method::kMinJointAngle, true)
+    ->Apply(Sizes);
+BENCHMARK_CAPTURE(BM_WholeChain, min_joint_angle_loop, Method::kMinJointAngle, false)->Apply(Sizes);
 BENCHMARK_CAPTURE(BM_Cli, json, "json")->Apply(CliSizes);
 BENCHMARK_CAPTURE(BM_Cli, npz, "npz")->Apply(CliSizes);
 

@@ -18,7 +18,9 @@
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
 #include "reference_ode.h"
+#include "run/sweep_pipeline.h"
 #include "scenes/scenes.h"
+#include "sequential/whole_chain.h"
 #include "test_util.h"
 
 namespace flexkin {
@@ -398,6 +400,69 @@ TEST(RunTest, ProgressThatThrowsStopsTheRun) {
     if (accuracy) EXPECT_EQ(first_done, 0);
     if (!accuracy) EXPECT_LT(first_done, 2000);
   }
+}
+
+// The whole-chain rules on the SIMD engine (sequential/whole_chain.h) give the run of the
+// sub-step by sub-step loop to rounding: every frame's points and link angles, every metric, on
+// chains of 1 to 203 links (the kernel's batches full, partial and empty), in 2D and 3D, with
+// sub-steps and sparse recording.
+TEST(RunTest, WholeChainRulesOnTheSimdEngineGiveTheSubstepBySubstepRun) {
+  if (!internal::WholeChainOnSimd()) {
+    GTEST_SKIP() << "this CPU (or FLEXKIN_SIMD) gives no SIMD engine: Run takes the loop itself";
+  }
+  const auto near = [](double a, double b) {
+    return std::fabs(a - b) <= 1e-14 * std::fmax(1.0, std::fmax(std::fabs(a), std::fabs(b)));
+  };
+  int compared = 0;
+  for (const Method method : {Method::kMinRotation, Method::kMinJointAngle}) {
+    ASSERT_TRUE(internal::Pipelined(method));
+    for (int dim : {2, 3}) {
+      for (int n : {1, 2, 3, 7, 8, 9, 20, 203}) {
+        for (int substeps : {1, 3}) {
+          for (int every : {1, 5}) {
+            SCOPED_TRACE(std::string(NameOf(method)) + " dim " + std::to_string(dim) + " links " +
+                         std::to_string(n) + " substeps " + std::to_string(substeps) + " every " +
+                         std::to_string(every));
+            const Chain chain = CurvedChain(dim, n, 2.0, 1.5);
+            const Points path = CurvedLeaderPath(chain, 23, 0.07);
+            RunOptions options;
+            options.method = method;
+            options.substeps = substeps;
+            options.record_every = every;
+            const RunResult simd = flexkin::Run(chain, path, options);
+            FrameRecorder recorder;
+            const RunResult loop = internal::RunSubstepBySubstep(chain, path, options, &recorder);
+            ASSERT_EQ(simd.frames.size(), recorder.frames.size());
+            for (size_t f = 0; f < simd.frames.size(); ++f) {
+              const Frame a = simd.frames[f], b = recorder.frames[f];
+              ASSERT_EQ(a.step, b.step);
+              for (Eigen::Index i = 0; i < a.points.size(); ++i) {
+                ASSERT_PRED2(near, a.points.data()[i], b.points.data()[i]) << "frame " << f;
+              }
+              for (Eigen::Index i = 0; i < a.link_angles.size(); ++i) {
+                ASSERT_NEAR(a.link_angles[i], b.link_angles[i], 1e-12) << "frame " << f;
+              }
+            }
+            const Metrics &m = simd.metrics, &r = loop.metrics;
+            for (Eigen::Index s = 0; s < path.rows(); ++s) {
+              ASSERT_PRED2(near, m.l2_per_step[s], r.l2_per_step[s]) << "step " << s;
+              ASSERT_PRED2(near, m.l2_weighted_per_step[s], r.l2_weighted_per_step[s]);
+            }
+            for (Eigen::Index i = 0; i <= n; ++i) {
+              ASSERT_PRED2(near, m.path_length[i], r.path_length[i]) << "point " << i;
+            }
+            ASSERT_PRED2(near, m.l2_total, r.l2_total);
+            ASSERT_PRED2(near, m.l2_weighted_total, r.l2_weighted_total);
+            // Rigid motions keep the lengths to rounding in both; the error is measured the same.
+            EXPECT_LE(m.max_relative_length_error, 1e-13);
+            EXPECT_NEAR(m.max_relative_length_error, r.max_relative_length_error, 1e-14);
+            ++compared;
+          }
+        }
+      }
+    }
+  }
+  EXPECT_EQ(compared, 2 * 2 * 8 * 2 * 2);
 }
 
 }  // namespace

@@ -174,13 +174,9 @@ void StepDirection(const Points& start, const Points& leader_steps, int64_t s,
   *direction = fallback;
 }
 
-// Per-link rules go through the sweep pipeline (sweeps engine, wavefront).
-bool Pipelined(Method method) { return internal::RuleRunsOn(method, internal::kSweepsEngine); }
-
-}  // namespace
-
-RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& options,
-              FrameSink* sink) {
+// Run, through the sweep pipeline where `pipeline` and the method has one.
+RunResult RunOn(const Chain& chain, const Points& leader_steps, const RunOptions& options,
+                FrameSink* sink, bool pipeline) {
   ValidateChain(chain);
   ValidateLeaderSteps(leader_steps, chain.dim());
   ThrowIfAny(options.Validate());
@@ -218,7 +214,7 @@ RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& 
     }
   };
 
-  if (Pipelined(options.method)) {
+  if (pipeline && internal::Pipelined(options.method)) {
     const Stepper stepper = internal::MakeStepperUnchecked(options.method, chain);
     internal::SweepPipeline pipeline(stepper, chain.points, leader_steps, substeps,
                                      &result.metrics);
@@ -263,6 +259,29 @@ RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& 
   result.metrics.l2_weighted_total = result.metrics.l2_weighted_per_step.sum();
   result.seconds = std::chrono::duration<double>(Clock::now() - start_time).count();
   return result;
+}
+
+}  // namespace
+
+namespace internal {
+
+// Per-link rules go through the sweep pipeline (sweeps engine, wavefront), and the whole-chain
+// rules where their kernel runs.
+bool Pipelined(Method method) {
+  return RuleRunsOn(method, kSweepsEngine) ||
+         (RuleRunsOn(method, kWholeChainEngine) && WholeChainOnSimd());
+}
+
+RunResult RunSubstepBySubstep(const Chain& chain, const Points& leader_steps,
+                              const RunOptions& options, FrameSink* sink) {
+  return RunOn(chain, leader_steps, options, sink, false);
+}
+
+}  // namespace internal
+
+RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& options,
+              FrameSink* sink) {
+  return RunOn(chain, leader_steps, options, sink, true);
 }
 
 RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& options) {

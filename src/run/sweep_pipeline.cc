@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "chain/denormals.h"
+#include "sequential/rule_table.h"
 
 namespace flexkin::internal {
 
@@ -24,7 +25,8 @@ SweepPipeline::SweepPipeline(const Stepper& stepper, const Points& start,
       substeps_(substeps),
       n_(static_cast<int>(stepper.lengths.size())),
       dim_(stepper.dim),
-      exact_(WavefrontLanes() == 1 || n_ < 8),
+      whole_chain_(RuleRunsOn(stepper.method, kWholeChainEngine)),
+      exact_(!whole_chain_ && (WavefrontLanes() == 1 || n_ < 8)),
       points_(start),
       metrics_(metrics),
       start_head_(start.row(0).transpose()) {
@@ -67,6 +69,10 @@ SweepPipeline::SweepPipeline(const Stepper& stepper, const Points& start,
   trace_.context = this;
   trace_.capture = &SweepPipeline::Capture;
   trace_.slots = slot_ptrs_.data();
+  if (whole_chain_) {
+    whole_chain_work_.Prepare(stepper.method, dim_, stepper.lengths.data(), weights_.data(), n_,
+                              chunk_);
+  }
 }
 
 void SweepPipeline::AddSlots(int count) {
@@ -92,8 +98,13 @@ void SweepPipeline::Sweep(int count) {
   trace_.sweep_l2 = metrics_ != nullptr ? sweep_l2_.data() : scratch_l2_.data();
   trace_.sweep_l2w = metrics_ != nullptr ? sweep_l2w_.data() : scratch_l2w_.data();
   trace_.path_length = metrics_ != nullptr ? metrics_->path_length.data() : scratch_path_.data();
-  TracedSweepsWavefront(stepper_.method, dim_, heads_.data(), count, lengths, inv_lengths, n_,
-                        points_.data(), &trace_);
+  if (whole_chain_) {
+    TracedWholeChainSweeps(heads_.data(), count, lengths, inv_lengths, points_.data(),
+                           &whole_chain_work_, &trace_);
+  } else {
+    TracedSweepsWavefront(stepper_.method, dim_, heads_.data(), count, lengths, inv_lengths, n_,
+                          points_.data(), &trace_);
+  }
   if (metrics_ != nullptr) {
     for (int i = 0; i < count; ++i) {
       metrics_->l2_per_step[sweep_step_[i]] += sweep_l2_[i];

@@ -10,6 +10,7 @@
 #include "chain/substep.h"
 #include "flexkin/run.h"
 #include "sequential/sweep.h"
+#include "sequential/whole_chain.h"
 
 namespace flexkin::internal {
 
@@ -22,7 +23,9 @@ Eigen::VectorXd ArcLengthWeights(const Eigen::VectorXd& lengths);
 //    successive sub-steps and leader steps in flight together, the metrics measured in the lanes;
 //  - else the one-pass loop, sub-step by sub-step, with the metrics of each leader step summed as
 //    the reference order does (bit for bit the results of the sub-step by sub-step run).
-// Tractrix and follow-the-leader (the rules the engines have).
+// Tractrix and follow-the-leader (the rules the engines have); and min_rotation and
+// min_joint_angle where the CPU has the whole-chain engine's kernel (WholeChainOnSimd,
+// sequential/whole_chain.h), which measures the metrics as the wavefront does.
 class SweepPipeline {
  public:
   // `start` is the chain's initial configuration; `metrics` (may be null) receives the metrics.
@@ -59,7 +62,9 @@ class SweepPipeline {
         flags_[count++] = flag;
         if ((exact_ && j == substeps_) || captures == max_slots_) break;
       }
-      if (!exact_ && captures > static_cast<int>(slots_.size())) AddSlots(captures);
+      if (!exact_ && !whole_chain_ && captures > static_cast<int>(slots_.size())) {
+        AddSlots(captures);
+      }
       Sweep(count);
       if (after_chunk) after_chunk(step_);
     }
@@ -84,6 +89,7 @@ class SweepPipeline {
   const Stepper& stepper_;
   const Points& leader_steps_;
   const int substeps_, n_, dim_;
+  const bool whole_chain_;  // a whole-chain rule (its kernel captures from the chain itself)
   const bool exact_;
   Points points_;
   Metrics* metrics_;
@@ -100,6 +106,7 @@ class SweepPipeline {
   std::vector<Points> slots_;
   std::array<double*, SweepTrace::kMaxSlots> slot_ptrs_;
   SweepTrace trace_;
+  WholeChainWork whole_chain_work_;
   std::function<void(int64_t, const Points&)> on_frame_;
 };
 
@@ -111,5 +118,14 @@ class SweepPipeline {
 // configurations after each step of the block are kept and compared with the fine run's.
 AccuracyReport ChooseSubsteps(const Chain& chain, const Points& leader_steps,
                               const RunOptions& options);
+
+// Whether Run takes `method` through the sweep pipeline on this CPU.
+bool Pipelined(Method method);
+
+// Run without the pipeline: every method one sub-step at a time (MoveLeader or the overall
+// step), the metrics measured after each sub-step. Run's own path for the methods the pipeline
+// does not take, and the reference the pipeline is tested and benchmarked against.
+RunResult RunSubstepBySubstep(const Chain& chain, const Points& leader_steps,
+                              const RunOptions& options, FrameSink* sink);
 
 }  // namespace flexkin::internal

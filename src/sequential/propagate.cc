@@ -13,6 +13,7 @@
 #include "sequential/link_rules.h"
 #include "sequential/rule_table.h"
 #include "sequential/sweep.h"
+#include "sequential/whole_chain.h"
 
 namespace flexkin {
 namespace {
@@ -128,24 +129,29 @@ void TracedSweepsWavefrontAvx2(Method, int, const double*, int64_t, const double
                                int, double*, SweepTrace*);
 void TracedSweepsWavefrontAvx512(Method, int, const double*, int64_t, const double*, const double*,
                                  int, double*, SweepTrace*);
+void WholeChainSweepsAvx2(int64_t, WholeChainWork*, double*, SweepTrace*);
+void WholeChainSweepsAvx512(int64_t, WholeChainWork*, double*, SweepTrace*);
 
 namespace {
 struct WavefrontChoice {
   SweepsFn fn;
   TracedSweepsFn traced;
   void (*atan2_of_sqrt)(const double*, const double*, int64_t, double*);
+  WholeChainKernelFn whole_chain;
   int lanes;
 };
 // The widest engine AllowedSimd() permits (src/chain/simd.h). Without AVX2 and FMA there is no
 // wavefront (lanes = 1) and every move takes the one-pass loop.
 WavefrontChoice ChooseWavefront() {
   if (AllowedSimd().avx512) {
-    return {SweepsWavefrontAvx512, TracedSweepsWavefrontAvx512, Atan2OfSqrtAvx512, 8};
+    return {SweepsWavefrontAvx512, TracedSweepsWavefrontAvx512, Atan2OfSqrtAvx512,
+            WholeChainSweepsAvx512, 8};
   }
   if (AllowedSimd().avx2_fma) {
-    return {SweepsWavefrontAvx2, TracedSweepsWavefrontAvx2, Atan2OfSqrtAvx2, 4};
+    return {SweepsWavefrontAvx2, TracedSweepsWavefrontAvx2, Atan2OfSqrtAvx2, WholeChainSweepsAvx2,
+            4};
   }
-  return {nullptr, nullptr, nullptr, 1};
+  return {nullptr, nullptr, nullptr, nullptr, 1};
 }
 const WavefrontChoice& Wavefront() {
   static const WavefrontChoice choice = ChooseWavefront();
@@ -211,6 +217,16 @@ std::vector<WavefrontEngine> AvailableWavefronts() {
 #endif
   return engines;
 }
+
+WholeChainKernelFn WholeChainKernel() {
+#if FLEXKIN_HAVE_WAVEFRONT
+  return Wavefront().whole_chain;
+#else
+  return nullptr;
+#endif
+}
+
+bool WholeChainOnSimd() { return WholeChainKernel() != nullptr; }
 
 int WavefrontLanes() {
 #if FLEXKIN_HAVE_WAVEFRONT

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "sequential/wavefront.h"
+#include "sequential/whole_chain_kernel.h"
 
 namespace flexkin::internal {
 
@@ -11,11 +12,13 @@ namespace flexkin::internal {
 #define FLEXKIN_ENTRY SweepsWavefrontAvx2
 #define FLEXKIN_TRACED_ENTRY TracedSweepsWavefrontAvx2
 #define FLEXKIN_ATAN2_ENTRY Atan2OfSqrtAvx2
+#define FLEXKIN_WHOLE_CHAIN_ENTRY WholeChainSweepsAvx2
 using Arch = xsimd::fma3<xsimd::avx2>;
 #elif FLEXKIN_ISA == 3
 #define FLEXKIN_ENTRY SweepsWavefrontAvx512
 #define FLEXKIN_TRACED_ENTRY TracedSweepsWavefrontAvx512
 #define FLEXKIN_ATAN2_ENTRY Atan2OfSqrtAvx512
+#define FLEXKIN_WHOLE_CHAIN_ENTRY WholeChainSweepsAvx512
 using Arch = xsimd::avx512f;
 #else
 #error "FLEXKIN_ISA must be 2 or 3"
@@ -32,6 +35,11 @@ void FLEXKIN_TRACED_ENTRY(Method method, int dim, const double* heads, int64_t n
                           SweepTrace* trace) {
   WavefrontDispatch<Arch, true>(method, dim, heads, num_sweeps, lengths, inv_lengths, n, points,
                                 trace);
+}
+
+void FLEXKIN_WHOLE_CHAIN_ENTRY(int64_t num_sweeps, WholeChainWork* work, double* points,
+                               SweepTrace* trace) {
+  WholeChainSweepsOn<Arch>(num_sweeps, work, points, trace);
 }
 
 void FLEXKIN_ATAN2_ENTRY(const double* across2, const double* along, int64_t count, double* out) {
