@@ -12,6 +12,7 @@ packages+=(liborocos-kdl-dev)  # the pseudo-inverse peer of the arm comparison (
 packages+=(libkdl-parser-dev)  # KDL chains from URDF text, the URDF snakes' peer (testing/kdl_urdf_peer.h)
 packages+=(chromium)         # the viewer's browser test (headless)
 packages+=(liburdfdom-dev libtinyxml-dev)  # URDF arms (src/urdf); TinyXML, the parser urdfdom uses
+packages+=(libfcl-dev)        # the colliders' reference distances (tests/colliders_test.cc)
 packages+=(zlib1g-dev)       # CRC-32 of the .npz result files (src/io/npz.cc)
 packages+=(python3-numpy)    # the tests read .npz results with numpy.load (tests/result_npz_test)
 packages+=(python3-dev pybind11-dev python3-pytest)  # the Python module (python/, docs/python.md)

@@ -1,0 +1,330 @@
+// The colliders' geometry (flexkin/colliders.h): every query is done in the collider's own frame,
+// where each shape is symmetric about its axes, and brought back to the world by its pose.
+#include "flexkin/colliders.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <sstream>
+
+namespace flexkin {
+namespace {
+
+using Eigen::Vector3d;
+
+std::string Num(double x) {
+  std::ostringstream out;
+  out.precision(17);
+  out << x;
+  return out.str();
+}
+
+// A query in the collider's frame: the point p and the result, all local.
+SurfaceQuery Sphere(double radius, const Vector3d& p) {
+  SurfaceQuery q;
+  const double r = p.norm();
+  q.normal = r > 0.0 ? Vector3d(p / r) : Vector3d::UnitZ();
+  q.nearest = radius * q.normal;
+  q.distance = r - radius;
+  return q;
+}
+
+SurfaceQuery HalfSpace(const Vector3d& p) {
+  SurfaceQuery q;
+  q.nearest = Vector3d(p.x(), p.y(), 0.0);
+  q.normal = Vector3d::UnitZ();
+  q.distance = p.z();
+  return q;
+}
+
+SurfaceQuery Capsule(double radius, double half_length, const Vector3d& p) {
+  const Vector3d axis_point(0.0, 0.0, std::clamp(p.z(), -half_length, half_length));
+  SurfaceQuery q = Sphere(radius, p - axis_point);
+  if (p == axis_point) q.normal = Vector3d::UnitX();  // on the axis: any radial direction
+  q.nearest = axis_point + radius * q.normal;
+  return q;
+}
+
+SurfaceQuery Cylinder(double radius, double half_length, const Vector3d& p) {
+  SurfaceQuery q;
+  const double rho = std::hypot(p.x(), p.y());
+  const Vector3d radial = rho > 0.0 ? Vector3d(p.x() / rho, p.y() / rho, 0.0) : Vector3d::UnitX();
+  const double side = rho - radius;                   // > 0 beyond the side
+  const double cap = std::fabs(p.z()) - half_length;  // > 0 beyond a cap
+  const double up = p.z() >= 0.0 ? 1.0 : -1.0;
+  if (side <= 0.0 && cap <= 0.0) {
+    // Inside: the nearer of the side and the cap.
+    if (side >= cap) {
+      q.distance = side;
+      q.normal = radial;
+      q.nearest = Vector3d(radius * radial.x(), radius * radial.y(), p.z());
+    } else {
+      q.distance = cap;
+      q.normal = Vector3d(0.0, 0.0, up);
+      q.nearest = Vector3d(p.x(), p.y(), up * half_length);
+    }
+    return q;
+  }
+  if (cap <= 0.0) {  // beside the side
+    q.distance = side;
+    q.normal = radial;
+    q.nearest = Vector3d(radius * radial.x(), radius * radial.y(), p.z());
+  } else if (side <= 0.0) {  // above or below a cap
+    q.distance = cap;
+    q.normal = Vector3d(0.0, 0.0, up);
+    q.nearest = Vector3d(p.x(), p.y(), up * half_length);
+  } else {  // beyond the rim
+    q.nearest = Vector3d(radius * radial.x(), radius * radial.y(), up * half_length);
+    q.distance = std::hypot(side, cap);
+    q.normal = (p - q.nearest) / q.distance;
+  }
+  return q;
+}
+
+SurfaceQuery Box(const Vector3d& half, const Vector3d& p) {
+  SurfaceQuery q;
+  const Vector3d beyond = p.cwiseAbs() - half;  // > 0 beyond a face
+  if ((beyond.array() <= 0.0).all()) {
+    // Inside: the nearest face.
+    int axis = 0;
+    for (int k = 1; k < 3; ++k) axis = beyond[k] > beyond[axis] ? k : axis;
+    const double sign = p[axis] >= 0.0 ? 1.0 : -1.0;
+    q.distance = beyond[axis];
+    q.nearest = p;
+    q.nearest[axis] = sign * half[axis];
+    q.normal = sign * Vector3d::Unit(axis);
+    return q;
+  }
+  q.nearest = p.cwiseMax(-half).cwiseMin(half);
+  q.distance = (p - q.nearest).norm();
+  q.normal = (p - q.nearest) / q.distance;
+  return q;
+}
+
+// Ellipse and ellipsoid: the nearest point of the surface to y, for semi-axes e sorted e0 >= e1
+// (>= e2) and y in the first quadrant (octant), after D. Eberly, "Distance from a point to an
+// ellipse, an ellipsoid, or a hyperellipsoid" (Geometric Tools, 2013). The nearest point is
+// x_i = r_i y_i / (s + r_i) with r_i = (e_i / e_last)^2, s the root of the monotone function
+// sum_i (r_i z_i / (s + r_i))^2 - 1 (z_i = y_i / e_i), bracketed and bisected until the bracket
+// cannot shrink (the last bit of a double). Zero components of y are the cases where the root
+// lies on a boundary of the bracket and the problem drops a dimension.
+template <size_t N>
+double EllipseRoot(const std::array<double, N>& r, const std::array<double, N>& z, double g) {
+  std::array<double, N> n;
+  for (size_t i = 0; i < N; ++i) n[i] = r[i] * z[i];
+  double s0 = z[N - 1] - 1.0, s1 = 0.0;
+  if (g >= 0.0) {
+    double scale = 0.0, sum = 0.0;
+    for (size_t i = 0; i < N; ++i) scale = std::fmax(scale, std::fabs(n[i]));
+    for (size_t i = 0; i < N; ++i) sum += (n[i] / scale) * (n[i] / scale);
+    s1 = scale * std::sqrt(sum) - 1.0;
+  }
+  double s = 0.0;
+  for (int iteration = 0; iteration < 2200; ++iteration) {
+    s = 0.5 * (s0 + s1);
+    if (s == s0 || s == s1) break;
+    double f = -1.0;
+    for (size_t i = 0; i < N; ++i) {
+      const double ratio = n[i] / (s + r[i]);
+      f += ratio * ratio;
+    }
+    if (f > 0.0) {
+      s0 = s;
+    } else if (f < 0.0) {
+      s1 = s;
+    } else {
+      break;
+    }
+  }
+  return s;
+}
+
+void NearestOnEllipse(double e0, double e1, double y0, double y1, double* x0, double* x1) {
+  if (y1 > 0.0) {
+    if (y0 > 0.0) {
+      const double z0 = y0 / e0, z1 = y1 / e1, g = z0 * z0 + z1 * z1 - 1.0;
+      if (g != 0.0) {
+        const double r0 = (e0 / e1) * (e0 / e1);
+        const double s = EllipseRoot<2>({r0, 1.0}, {z0, z1}, g);
+        *x0 = r0 * y0 / (s + r0);
+        *x1 = y1 / (s + 1.0);
+      } else {
+        *x0 = y0;
+        *x1 = y1;
+      }
+    } else {
+      *x0 = 0.0;
+      *x1 = e1;
+    }
+    return;
+  }
+  const double numer0 = e0 * y0, denom0 = e0 * e0 - e1 * e1;
+  if (numer0 < denom0) {
+    const double xde0 = numer0 / denom0;
+    *x0 = e0 * xde0;
+    *x1 = e1 * std::sqrt(1.0 - xde0 * xde0);
+  } else {
+    *x0 = e0;
+    *x1 = 0.0;
+  }
+}
+
+void NearestOnEllipsoid(const std::array<double, 3>& e, const std::array<double, 3>& y,
+                        std::array<double, 3>* x) {
+  if (y[2] > 0.0) {
+    if (y[1] > 0.0) {
+      if (y[0] > 0.0) {
+        const std::array<double, 3> z = {y[0] / e[0], y[1] / e[1], y[2] / e[2]};
+        const double g = z[0] * z[0] + z[1] * z[1] + z[2] * z[2] - 1.0;
+        if (g != 0.0) {
+          const std::array<double, 3> r = {(e[0] / e[2]) * (e[0] / e[2]),
+                                           (e[1] / e[2]) * (e[1] / e[2]), 1.0};
+          const double s = EllipseRoot<3>(r, z, g);
+          for (int i = 0; i < 3; ++i) (*x)[i] = r[i] * y[i] / (s + r[i]);
+        } else {
+          *x = y;
+        }
+      } else {
+        (*x)[0] = 0.0;
+        NearestOnEllipse(e[1], e[2], y[1], y[2], &(*x)[1], &(*x)[2]);
+      }
+    } else if (y[0] > 0.0) {
+      (*x)[1] = 0.0;
+      NearestOnEllipse(e[0], e[2], y[0], y[2], &(*x)[0], &(*x)[2]);
+    } else {
+      *x = {0.0, 0.0, e[2]};
+    }
+    return;
+  }
+  // y on the plane of the two longer axes: the nearest point may leave it (a point inside, near
+  // the long axes), else the problem is the ellipse of those axes.
+  const double denom0 = e[0] * e[0] - e[2] * e[2], denom1 = e[1] * e[1] - e[2] * e[2];
+  const double numer0 = e[0] * y[0], numer1 = e[1] * y[1];
+  if (numer0 < denom0 && numer1 < denom1) {
+    const double xde0 = numer0 / denom0, xde1 = numer1 / denom1;
+    const double discr = 1.0 - xde0 * xde0 - xde1 * xde1;
+    if (discr > 0.0) {
+      *x = {e[0] * xde0, e[1] * xde1, e[2] * std::sqrt(discr)};
+      return;
+    }
+  }
+  (*x)[2] = 0.0;
+  NearestOnEllipse(e[0], e[1], y[0], y[1], &(*x)[0], &(*x)[1]);
+}
+
+SurfaceQuery Ellipsoid(const Vector3d& semi_axes, const Vector3d& p) {
+  // Axes sorted longest first, the point reflected into the first octant.
+  std::array<int, 3> order = {0, 1, 2};
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return semi_axes[a] > semi_axes[b]; });
+  std::array<double, 3> e, y, x;
+  for (int i = 0; i < 3; ++i) {
+    e[i] = semi_axes[order[i]];
+    y[i] = std::fabs(p[order[i]]);
+  }
+  NearestOnEllipsoid(e, y, &x);
+  SurfaceQuery q;
+  Vector3d gradient;
+  for (int i = 0; i < 3; ++i) {
+    const int axis = order[i];
+    const double sign = p[axis] >= 0.0 ? 1.0 : -1.0;
+    q.nearest[axis] = sign * x[i];
+    gradient[axis] = q.nearest[axis] / (e[i] * e[i]);
+  }
+  q.normal = gradient.normalized();
+  double inside = 0.0;
+  for (int k = 0; k < 3; ++k) inside += (p[k] / semi_axes[k]) * (p[k] / semi_axes[k]);
+  q.distance = (p - q.nearest).norm() * (inside < 1.0 ? -1.0 : 1.0);
+  return q;
+}
+
+}  // namespace
+
+const char* ColliderShapeName(ColliderShape shape) {
+  switch (shape) {
+    case ColliderShape::kSphere:
+      return "sphere";
+    case ColliderShape::kEllipsoid:
+      return "ellipsoid";
+    case ColliderShape::kCapsule:
+      return "capsule";
+    case ColliderShape::kCylinder:
+      return "cylinder";
+    case ColliderShape::kBox:
+      return "box";
+    case ColliderShape::kHalfSpace:
+      return "half_space";
+  }
+  return "?";
+}
+
+SurfaceQuery QuerySurface(const Collider& c, const Vector3d& x) {
+  const Vector3d p = c.pose.inverse(Eigen::Isometry) * x;
+  SurfaceQuery q;
+  switch (c.shape) {
+    case ColliderShape::kSphere:
+      q = Sphere(c.radius, p);
+      break;
+    case ColliderShape::kEllipsoid:
+      q = Ellipsoid(c.extents, p);
+      break;
+    case ColliderShape::kCapsule:
+      q = Capsule(c.radius, c.half_length, p);
+      break;
+    case ColliderShape::kCylinder:
+      q = Cylinder(c.radius, c.half_length, p);
+      break;
+    case ColliderShape::kBox:
+      q = Box(c.extents, p);
+      break;
+    case ColliderShape::kHalfSpace:
+      q = HalfSpace(p);
+      break;
+  }
+  q.nearest = c.pose * q.nearest;
+  q.normal = c.pose.linear() * q.normal;
+  return q;
+}
+
+std::vector<Problem> CheckCollider(const Collider& c, const std::string& field) {
+  std::vector<Problem> problems;
+  const auto positive = [&](const std::string& name, double value) {
+    if (!(std::isfinite(value) && value > 0.0)) {
+      problems.push_back(Problem::Invalid(field + "/" + name, Num(value), "a finite number > 0"));
+    }
+  };
+  const auto non_negative = [&](const std::string& name, double value) {
+    if (!(std::isfinite(value) && value >= 0.0)) {
+      problems.push_back(Problem::Invalid(field + "/" + name, Num(value), "a finite number >= 0"));
+    }
+  };
+  switch (c.shape) {
+    case ColliderShape::kSphere:
+      positive("radius", c.radius);
+      break;
+    case ColliderShape::kCapsule:
+      positive("radius", c.radius);
+      non_negative("half_length", c.half_length);
+      break;
+    case ColliderShape::kCylinder:
+      positive("radius", c.radius);
+      positive("half_length", c.half_length);
+      break;
+    case ColliderShape::kEllipsoid:
+    case ColliderShape::kBox:
+      for (int k = 0; k < 3; ++k) positive("extents/" + std::to_string(k), c.extents[k]);
+      break;
+    case ColliderShape::kHalfSpace:
+      break;
+  }
+  const Eigen::Matrix3d r = c.pose.linear();
+  if (!r.allFinite() || !c.pose.translation().allFinite()) {
+    problems.emplace_back(field + "/pose", "has a value that is not a finite number");
+  } else if ((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-12 ||
+             r.determinant() < 0.0) {
+    problems.emplace_back(field + "/pose",
+                          "is not a rotation (orthonormal, determinant +1) and a translation");
+  }
+  return problems;
+}
+
+}  // namespace flexkin
