@@ -254,6 +254,43 @@ TEST(OverallStepTest, WeightedMetricMovesContinuouslyBetweenItsLimits) {
   EXPECT_LE((solve(1, 1e8) - rod).cwiseAbs().maxCoeff(), 1e-6);
 }
 
+// A workspace kept from step to step holds what a solve may keep (the KKT storage, the metric's
+// Hessian terms summed once per solve where they are constant): steps under other weights, on
+// other chains, in between change nothing, to the last bit, against a fresh workspace.
+TEST(OverallStepTest, AKeptWorkspaceGivesTheResultOfAFreshOne) {
+  OverallWorkspace kept;
+  for (const int dim : {2, 3}) {
+    for (const int links : {20, 3, 9}) {
+      const Points old_points = CurvedPoints(dim, links, 1.0, 0.5);
+      const Eigen::VectorXd lengths = LengthsOf(old_points);
+      std::vector<ObjectiveWeights> mixes = Mixes(dim);
+      mixes.push_back({0, 0, 0, 0, 1, 0});        // L2: the active set's solver
+      mixes.push_back({0.5, 0, 0.2, 0, 0, 0.5});  // L2 weighted, with smooth terms
+      for (const ObjectiveWeights& w : mixes) {
+        for (const double move : {0.05, 0.9}) {  // one sub-step, and several
+          SCOPED_TRACE(std::to_string(dim) + "D, " + std::to_string(links) + " links, move " +
+                       std::to_string(move));
+          OverallOptions options;
+          options.weights = w;
+          Eigen::VectorXd head = old_points.row(0).transpose();
+          head[0] -= move;
+          head[1] += 0.5 * move;
+          Chain with_kept{old_points, lengths}, with_fresh{old_points, lengths};
+          const OverallReport a = OverallStep(head, options, &with_kept, &kept);
+          OverallWorkspace fresh;
+          const OverallReport b = OverallStep(head, options, &with_fresh, &fresh);
+          ASSERT_TRUE(a.converged()) << a.BriefReport();
+          EXPECT_EQ(a.iterations, b.iterations);
+          EXPECT_EQ(a.start, b.start);
+          EXPECT_EQ(a.objective, b.objective);
+          EXPECT_EQ(a.optimality, b.optimality);
+          EXPECT_TRUE(with_kept.points == with_fresh.points);
+        }
+      }
+    }
+  }
+}
+
 TEST(OverallStepTest, ReportsInsteadOfFailingSilently) {
   const Points old_points = CurvedPoints(2, 30, 1.0, 0.4);
   const Eigen::VectorXd lengths = LengthsOf(old_points);

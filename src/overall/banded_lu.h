@@ -62,6 +62,13 @@ class BandMatrix {
     if (lower_ && i < j) return;
     ab_[Index(i, j)] += v;
   }
+  // Adds v to A(i, j), i >= j, and to A(j, i) where the layout stores it: for symmetric
+  // assemblers that write each entry's pair once, their pattern's bounds checked by the caller
+  // (no check per entry).
+  void AddSymmetric(int i, int j, double v) {
+    ab_[Index(i, j)] += v;
+    if (!lower_ && i != j) ab_[Index(j, i)] += v;
+  }
   double operator()(int i, int j) const {
     if (lower_ && i < j) std::swap(i, j);
     return std::abs(i - j) <= band_ ? ab_[Index(i, j)] : 0.0;
@@ -312,32 +319,61 @@ class BandedLdlt {
  private:
   // The factorization proper, for half-bandwidth B (0: the run-time band_). Column j of the
   // storage: D(j) at [0], then L(j + r, j) at [r].
+  //
+  // Its speed is the chain from one pivot to the next, D(j + 1) = A(j + 1, j + 1) - (A(j + 1, j)
+  // / D(j)) A(j + 1, j): a division, two multiplications and a subtraction per column. The next
+  // pivot is therefore computed first and carried in a register (not stored and loaded back),
+  // the other updates, off that chain, overlap with it; for the fixed bands the loops are
+  // unrolled (straight-line code, no loop control). Every entry gets the same operations in the
+  // same order as in the plain loop (each entry of the trailing block is updated once per
+  // column), so the factors are the same to the last bit.
   template <int B>
   bool Run(double smallest) {
     const int n = size_, band = B > 0 ? B : band_, width = band + 1;
-    negative_ = 0;
-    growth_ = 0.0;
+    double* const ab = a_.ab_.data();
+    int negative = 0;
+    double growth = 0.0;
+    bool ok = true;
+    double pivot = n > 0 ? ab[0] : 0.0;  // D(j), carried from column j - 1's update
     for (int j = 0; j < n; ++j) {
-      double* column = &a_.ab_[static_cast<size_t>(j) * width];
-      const double pivot = column[0];
-      if (!(std::fabs(pivot) > smallest)) return false;
-      if (pivot < 0.0) ++negative_;
+      double* const column = ab + static_cast<size_t>(j) * width;
+      if (!(std::fabs(pivot) > smallest)) {
+        ok = false;
+        break;
+      }
+      if (pivot < 0.0) ++negative;
       // A(j + i, j + k) -= A(j + i, j) A(j + k, j) / pivot for 1 <= k <= i <= band (column
-      // j + k of the factor), then L(j + r, j) = A(j + r, j) / pivot.
+      // j + k of the factor), then L(j + r, j) = A(j + r, j) / pivot. (The columns after the
+      // last are the identity, and the entries below the matrix 0: no bounds needed.)
       const double inverse = 1.0 / pivot;
-      for (int k = 1; k <= band; ++k) {
+      double next_pivot = column[width];  // A(j + 1, j + 1) (band 0: nothing to update)
+      if (band >= 1) {
+        const double f = column[1] * inverse;
+        next_pivot -= f * column[1];
+        column[width] = next_pivot;
+        double* const target = column + width;
+#pragma GCC unroll 8
+        for (int i = 2; i <= band; ++i) target[i - 1] -= f * column[i];
+      }
+#pragma GCC unroll 8
+      for (int k = 2; k <= band; ++k) {
         const double f = column[k] * inverse;
-        double* target = column + static_cast<size_t>(k) * width;
+        double* const target = column + static_cast<size_t>(k) * width;
+#pragma GCC unroll 8
         for (int i = k; i <= band; ++i) target[i - k] -= f * column[i];
       }
       // |D(j)| max(1, max_r |L(j + r, j)|)^2 = max(|pivot|, m^2 / |pivot|), m the largest
       // entry below the pivot before scaling.
       const double m = MaxBelowPivot<B>(column, band);
-      growth_ = std::max(growth_, std::max(std::fabs(pivot), m * m * std::fabs(inverse)));
+      growth = std::max(growth, std::max(std::fabs(pivot), m * m * std::fabs(inverse)));
+#pragma GCC unroll 8
       for (int r = 1; r <= band; ++r) column[r] *= inverse;
       inverse_pivot_[j] = inverse;
+      pivot = next_pivot;
     }
-    return std::isfinite(growth_);
+    negative_ = negative;
+    growth_ = growth;
+    return ok && std::isfinite(growth);
   }
 
   // max_{1 <= r <= band} |column[r]|, as a tree of independent comparisons for the fixed bands
@@ -365,30 +401,35 @@ class BandedLdlt {
   void SolveFixed(const Eigen::Ref<const Eigen::VectorXd>& rhs,
                   Eigen::Ref<Eigen::VectorXd> solution) const {
     const int n = size_, band = B > 0 ? B : band_, width = band + 1;
+    assert(rhs.size() == n && solution.size() == n);
     const double* l = a_.ab_.data();
+    const double* const in = rhs.data();
+    const double* const inverse_pivot = inverse_pivot_.data();
     double* y = work_.data();
-    for (int i = 0; i < n; ++i) y[i] = rhs[i];
+    for (int i = 0; i < n; ++i) y[i] = in[i];
     for (int i = n; i < n + band; ++i) y[i] = 0.0;
     // L y = rhs by columns: y_{j+r} -= L(j + r, j) y_j. On the critical path is only y_{j+1}'s
-    // update, one multiply-add per row.
+    // update, one multiply-add per row. y_j is final once used: D^-1 is applied then.
     for (int j = 0; j < n; ++j) {
       const double* column = l + static_cast<size_t>(j) * width;
       const double yj = y[j];
+#pragma GCC unroll 8
       for (int r = 1; r <= band; ++r) y[j + r] -= column[r] * yj;
+      y[j] = yj * inverse_pivot[j];
     }
-    for (int j = 0; j < n; ++j) y[j] *= inverse_pivot_[j];
     // L^T x = y by rows, the term of x_{j+1} (just computed) last: again one multiply-add per row
     // on the critical path.
     if (band >= 1) {
       for (int j = n - 1; j >= 0; --j) {
         const double* column = l + static_cast<size_t>(j) * width;
         double others = 0.0;
+#pragma GCC unroll 8
         for (int r = band; r >= 2; --r) others += column[r] * y[j + r];
         y[j] = (y[j] - others) - column[1] * y[j + 1];
       }
     }
-    assert(solution.size() == n);
-    for (int i = 0; i < n; ++i) solution[i] = y[i];
+    double* const out = solution.data();
+    for (int i = 0; i < n; ++i) out[i] = y[i];
   }
 
   int size_ = 0, band_ = 0;

@@ -8,19 +8,13 @@
 // lambda_i.
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 
 #include "overall/newton.h"
 
 namespace flexkin::internal {
-namespace {
-
-// A vector of a point's coordinates (2 or 3) without heap allocation: the loops over links below
-// run in every Newton iteration.
-using PointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 3, 1>;
-
-}  // namespace
 
 // The metric at `p` and its gradient (into `*gradient`, indexed like the unknowns).
 double NewtonSolver::EvaluateMetric(const Points& p, VectorView* gradient) {
@@ -31,31 +25,53 @@ double NewtonSolver::EvaluateMetric(const Points& p, VectorView* gradient) {
   return Evaluate(options_.weights, lengths_, old_points_, p, sink_, last_, smoothing_);
 }
 
-// c_i = (|D_i|^2 - L_i^2) / (2 L_i) at `p`, into c_.
+// c_i = (|D_i|^2 - L_i^2) / (2 L_i) at `p`, into c_. (Plain loops; |D_i|^2 summed by coordinate
+// in order, as Eigen's squaredNorm of a row sums 2 or 3 entries.)
 void NewtonSolver::EvaluateConstraints(const Points& p) {
+  const double* const points = p.data();
+  const double* const length = lengths_.data();
+  double* const c = c_.data();
   for (int i = 1; i <= nc_; ++i) {
-    c_[i - 1] = ((p.row(i) - p.row(i - 1)).squaredNorm() - lengths_[i - 1] * lengths_[i - 1]) /
-                (2.0 * lengths_[i - 1]);
+    const double* const a = points + (i - 1) * dim_;  // x_{i-1}, then x_i
+    double sq = 0.0;
+    for (int q = 0; q < dim_; ++q) sq += (a[dim_ + q] - a[q]) * (a[dim_ + q] - a[q]);
+    const double l = length[i - 1];
+    c[i - 1] = (sq - l * l) / (2.0 * l);
   }
 }
 
-// Gradient of the Lagrangian g + J^T lambda (x rows only; the multiplier rows 0), into `out`.
+// Gradient of the Lagrangian g + J^T lambda (x rows only; the multiplier rows 0), into `out`,
+// point by point in one pass: point j's rows are g_j + lambda_j e_j - lambda_j+1 e_j+1, summed in
+// that order (link j + 1's force is carried over to the next point). `out` may be `gradient`.
 void NewtonSolver::LagrangianGradient(const Points& p, const VectorView& gradient,
                                       const VectorView& lambda, VectorView* out) const {
-  VectorView& result = *out;
-  result = gradient;
-  double* r = result.data();
-  const double* points = p.data();
-  for (int i = 1; i <= nc_; ++i) {
-    const double f = lambda[i - 1] / lengths_[i - 1];
+  assert(gradient.size() == size_ && out->size() == size_);
+  const double* const g = gradient.data();
+  double* const r = out->data();
+  const double* const points = p.data();
+  const double* const multiplier = lambda.data();
+  const double* const length = lengths_.data();
+  // lambda_i e_i = (lambda_i / L_i) D_i, link i's force on x_i (and minus it on x_{i-1}).
+  auto force_of_link = [&](int i, double* force) {
+    const double f = multiplier[i - 1] / length[i - 1];
     const double* a = points + (i - 1) * dim_;
+    for (int c = 0; c < dim_; ++c) force[c] = f * (a[dim_ + c] - a[c]);
+  };
+  double force[3], next[3] = {0.0, 0.0, 0.0};
+  force_of_link(1, force);
+  for (int j = 1; j <= k_; ++j) {
+    const bool pulled_back = j < nc_;  // link j + 1 is a constraint
+    if (pulled_back) force_of_link(j + 1, next);
+    const int row = PointRow(j);
     for (int c = 0; c < dim_; ++c) {
-      const double force = f * (a[dim_ + c] - a[c]);  // lambda_i e_i
-      if (i <= k_) r[PointRow(i) + c] += force;
-      if (i > 1) r[PointRow(i - 1) + c] -= force;
+      double v = g[row + c] + force[c];
+      if (pulled_back) v -= next[c];
+      r[row + c] = v;
+      force[c] = next[c];
     }
+    r[MultiplierRow(j)] = 0.0;
   }
-  for (int i = 1; i <= nc_; ++i) r[MultiplierRow(i)] = 0.0;
+  if (nc_ > k_) r[MultiplierRow(nc_)] = 0.0;
 }
 
 // First-order optimality: the Lagrangian's gradient relative to the objective's gradient (now
@@ -140,48 +156,70 @@ double NewtonSolver::CurvatureAlong(const Points& p, const VectorView& lambda,
   return form;
 }
 
-// The KKT matrix [H + delta I, J^T; J, 0] at (p, lambda), into `kkt`. The terms that are
-// multiples of the identity per pair of neighbouring points are summed by point first (see
-// Sink) and written in one pass.
-void NewtonSolver::AssembleKkt(const Points& p, const VectorView& lambda, double delta,
-                               BandMatrix* kkt) {
-  std::vector<double>& identity_diagonal = buffers_.identity_diagonal;
-  std::vector<double>& identity_below = buffers_.identity_below;
-  kkt->SetZero();
-  std::fill(identity_diagonal.begin(), identity_diagonal.end(), 0.0);
-  std::fill(identity_below.begin(), identity_below.end(), 0.0);
+// The metric's part of H at `p`: its terms that are multiples of the identity per pair of
+// neighbouring points summed by point into the identity buffers (see Sink), its other blocks
+// added into `kkt`. Without the L2 and joint-angle terms the metric's Hessian is made of the
+// former only, and they do not depend on `p` (the squared and rotation metrics are quadratic):
+// they are then summed once per solve, by the same calls in the same order, and kept.
+void NewtonSolver::MetricHessianTerms(const Points& p, BandMatrix* kkt) {
+  if (metric_terms_kept_) return;
+  std::fill(buffers_.identity_diagonal.begin(), buffers_.identity_diagonal.end(), 0.0);
+  std::fill(buffers_.identity_below.begin(), buffers_.identity_below.end(), 0.0);
+  sink_.gradient = nullptr;
   sink_.band = kkt;
   sink_.form = nullptr;
-  sink_.identity_diagonal = identity_diagonal.data();
-  sink_.identity_below = identity_below.data();
-  LagrangianHessianTerms(p, lambda);
+  sink_.identity_diagonal = buffers_.identity_diagonal.data();
+  sink_.identity_below = buffers_.identity_below.data();
+  Evaluate(options_.weights, lengths_, old_points_, p, sink_, last_, smoothing_);
   sink_.identity_diagonal = nullptr;
   sink_.identity_below = nullptr;
+  metric_terms_kept_ = constant_metric_hessian_;
+}
+
+// The KKT matrix [H + delta I, J^T; J, 0] at (p, lambda), into `kkt`: the metric's terms
+// (MetricHessianTerms), then, in one pass over the points, the constraints' terms and J. Point
+// j's identity terms are summed in the order LagrangianHessianTerms adds them (the metric's,
+// then lambda_j / L_j, then lambda_j+1 / L_j+1 on the diagonal; the metric's, then
+// -lambda_j / L_j below it: a + (-s) is a - s) and written once; each entry is written once, onto
+// the metric's blocks, through BandMatrix::AddSymmetric (the pattern's bounds asserted here, once).
+void NewtonSolver::AssembleKkt(const Points& p, const VectorView& lambda, double delta,
+                               BandMatrix* kkt) {
+  assert(kkt->size() == size_ && kkt->band() >= std::min(2 * dim_ + 1, size_ - 1));
+  kkt->SetZero();
+  MetricHessianTerms(p, kkt);
+  const double* const metric_diagonal = buffers_.identity_diagonal.data();
+  const double* const metric_below = buffers_.identity_below.data();
+  // J's row of constraint i: +e_i at x_i (i <= k), -e_i at x_{i-1} (i >= 2).
+  // (Plain loops on the storage, as in LagrangianGradient: this runs in every Newton iteration.)
+  const double* const points = p.data();
+  const double* const length = lengths_.data();
+  const double* const multiplier = lambda.data();
+  auto link = [&](int i) {
+    const double* const a = points + (i - 1) * dim_;  // x_{i-1}, then x_i
+    const int row = MultiplierRow(i);
+    for (int q = 0; q < dim_; ++q) {
+      const double e = (a[dim_ + q] - a[q]) / length[i - 1];  // e_i = D_i / L_i
+      if (i <= k_) kkt->AddSymmetric(row, PointRow(i) + q, e);
+      if (i > 1) kkt->AddSymmetric(row, PointRow(i - 1) + q, -e);
+    }
+  };
+  double s = multiplier[0] / length[0];  // lambda_j / L_j, the constraints' curvature
   for (int j = 1; j <= k_; ++j) {
+    const double s_next = j < nc_ ? multiplier[j] / length[j] : 0.0;
+    double sum = metric_diagonal[j] + s;
+    if (j < nc_) sum += s_next;
     const int row = PointRow(j);
-    const double diagonal = identity_diagonal[j] + delta;
-    for (int q = 0; q < dim_; ++q) kkt->Add(row + q, row + q, diagonal);
-    if (j == 1) continue;  // point 0 is fixed
-    const int column = PointRow(j - 1);
-    const double below = identity_below[j];
-    for (int q = 0; q < dim_; ++q) {
-      kkt->Add(row + q, column + q, below);
-      kkt->Add(column + q, row + q, below);
+    const double diagonal = sum + delta;
+    for (int q = 0; q < dim_; ++q) kkt->AddSymmetric(row + q, row + q, diagonal);
+    if (j > 1) {  // point 0 is fixed
+      const int column = PointRow(j - 1);
+      const double below = metric_below[j] - s;
+      for (int q = 0; q < dim_; ++q) kkt->AddSymmetric(row + q, column + q, below);
     }
+    link(j);
+    s = s_next;
   }
-  for (int i = 1; i <= nc_; ++i) {
-    const PointVector e = (p.row(i) - p.row(i - 1)).transpose() / lengths_[i - 1];
-    for (int q = 0; q < dim_; ++q) {
-      if (i <= k_) {
-        kkt->Add(MultiplierRow(i), PointRow(i) + q, e[q]);
-        kkt->Add(PointRow(i) + q, MultiplierRow(i), e[q]);
-      }
-      if (i > 1) {
-        kkt->Add(MultiplierRow(i), PointRow(i - 1) + q, -e[q]);
-        kkt->Add(PointRow(i - 1) + q, MultiplierRow(i), -e[q]);
-      }
-    }
-  }
+  if (nc_ > k_) link(nc_);  // the link to the fixed point k + 1
 }
 
 }  // namespace flexkin::internal

@@ -59,6 +59,7 @@ NewtonSolver::NewtonSolver(const Eigen::VectorXd& lengths, const Points& old_poi
       smoothing_(smoothing),
       l2_(options.weights.l2 > 0.0 || options.weights.l2_weighted > 0.0),
       weight_sum_(WeightSum(options.weights, lengths)),
+      constant_metric_hessian_(!l2_ && !(options.weights.joint_angle > 0.0)),
       buffers_(*buffers),
       sink_(buffers->sink),
       x_(buffers->x),
@@ -135,7 +136,9 @@ OverallReport NewtonSolver::Solve(Points* x) {
 }
 
 // A strict local minimizer (second-order sufficient conditions) has a KKT matrix with exactly as
-// many negative eigenvalues as constraints and none zero.
+// many negative eigenvalues as constraints and none zero. (Its own assembly and factorization:
+// the last iteration's factors are of another matrix, at the iterate before and possibly
+// regularized.)
 bool NewtonSolver::IsStrictMinimizer(const OverallReport& report) {
   if (!report.converged()) return false;
   AssembleKkt(x_, lambda_, 0.0, &buffers_.ldlt.matrix());
@@ -174,10 +177,13 @@ NewtonSolver::StepOutcome NewtonSolver::ComputeNewtonStep() {
   }
   factorized_ = true;
   if (!sol_.allFinite()) return StepOutcome::kNotFinite;
+  const double* const solution = sol_.data();
+  double* const step = dx_.data();  // row-major: point j's coordinates at j dim
   for (int j = 1; j <= k_; ++j) {
-    for (int q = 0; q < dim_; ++q) dx_(j, q) = sol_[PointRow(j) + q];
+    for (int q = 0; q < dim_; ++q) step[j * dim_ + q] = solution[PointRow(j) + q];
   }
-  for (int i = 1; i <= nc_; ++i) lambda_new_[i - 1] = sol_[MultiplierRow(i)];
+  double* const multipliers = lambda_new_.data();
+  for (int i = 1; i <= nc_; ++i) multipliers[i - 1] = solution[MultiplierRow(i)];
   if (!inertia_ok && !HasPositiveCurvature()) {
     Regularize(1e-4 * std::fmax(1.0, weight_sum_));
     return StepOutcome::kRegularized;
@@ -195,10 +201,13 @@ NewtonSolver::StepOutcome NewtonSolver::ComputeNewtonStep() {
 bool NewtonSolver::FactorAndSolveKkt(bool* inertia_ok) {
   BandedLdlt& ldlt = buffers_.ldlt;
   AssembleKkt(x_, lambda_, regularization_, &ldlt.matrix());
+  double* const rhs = rhs_.data();
+  const double* const gradient = g_.data();
+  const double* const constraints = c_.data();
   for (int j = 1; j <= k_; ++j) {
-    for (int q = 0; q < dim_; ++q) rhs_[PointRow(j) + q] = -g_[PointRow(j) + q];
+    for (int q = 0; q < dim_; ++q) rhs[PointRow(j) + q] = -gradient[PointRow(j) + q];
   }
-  for (int i = 1; i <= nc_; ++i) rhs_[MultiplierRow(i)] = -c_[i - 1];
+  for (int i = 1; i <= nc_; ++i) rhs[MultiplierRow(i)] = -constraints[i - 1];
   if (ldlt.Factorize(1e-10)) {
     ldlt.SolveInto(rhs_, sol_);
     *inertia_ok = ldlt.negative() == nc_;

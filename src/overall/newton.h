@@ -29,7 +29,8 @@ struct NewtonBuffers {
   Eigen::VectorXd inverse_lengths;  // 1 / L_i, n
   Points x, step, trial;            // (n + 1) by dim: the iterate, the step, a trial point
   Sink sink;                        // where the metric's derivatives go (its offsets kept)
-  std::vector<double> identity_diagonal, identity_below;  // n + 1: see Sink
+  // n + 1: the metric's identity terms summed by point (see Sink, MetricHessianTerms).
+  std::vector<double> identity_diagonal, identity_below;
   BandedLdlt ldlt;           // the KKT matrix, assembled and factored in place
   BandMatrix kkt_general;    // the LU fallback's copy of it (general layout) ...
   BandedLu lu;               // ... and its factors
@@ -80,6 +81,7 @@ class NewtonSolver {
 
   // Second derivatives and the KKT matrix (kkt.cc).
   void LagrangianHessianTerms(const Points& p, const VectorView& lambda);
+  void MetricHessianTerms(const Points& p, BandMatrix* kkt);
   double CurvatureAlong(const Points& p, const VectorView& lambda, const VectorView& v);
   void AssembleKkt(const Points& p, const VectorView& lambda, double delta, BandMatrix* kkt);
 
@@ -108,6 +110,9 @@ class NewtonSolver {
   // Constants of the optimality measure (see Optimality).
   const bool l2_;
   const double weight_sum_;
+  // The metric's Hessian does not depend on the configuration (no L2 or joint-angle term): its
+  // identity terms are summed once per solve (MetricHessianTerms).
+  const bool constant_metric_hessian_;
   double max_inverse_length_ = 0.0;
   double start_gradient_ = 0.0;
 
@@ -119,11 +124,12 @@ class NewtonSolver {
   VectorView lambda_, lambda_new_, c_;                                        // nc_
   VectorView inverse_length_;                                                 // n_
 
-  double value_ = 0.0;           // the metric at x_
-  double regularization_ = 0.0;  // delta of the Hessian block H + delta I
-  bool factorized_ = false;      // the last attempt's matrix was not singular
-  bool lag_current_ = false;     // lag_ already holds the Lagrangian's gradient at (x_, lambda_)
-  bool general_ready_ = false;   // kkt_general and lu have this problem's shape
+  double value_ = 0.0;              // the metric at x_
+  double regularization_ = 0.0;     // delta of the Hessian block H + delta I
+  bool factorized_ = false;         // the last attempt's matrix was not singular
+  bool lag_current_ = false;        // lag_ already holds the Lagrangian's gradient at (x_, lambda_)
+  bool general_ready_ = false;      // kkt_general and lu have this problem's shape
+  bool metric_terms_kept_ = false;  // the identity buffers hold this solve's metric terms
 };
 
 }  // namespace flexkin::internal

@@ -30,6 +30,8 @@ double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const
                 const Points& x, const Sink& sink, int last, double smoothing) {
   const int n = last < 0 ? static_cast<int>(lengths.size()) : last;
   const int dim = static_cast<int>(x.cols());
+  assert(old_points.rows() == x.rows() && old_points.cols() == x.cols() && x.rows() > n &&
+         lengths.size() >= n);
   double value = 0.0;
 
   // The paper's L2 metric, sum of w_j |x_j - a_j|: gradient w u, Hessian w (I - u u^T) / r with
@@ -57,15 +59,19 @@ double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const
     }
   }
 
-  // Squared displacement, plain and arc-length weighted. (Plain loops: no temporaries per point.)
+  // Squared displacement, plain and arc-length weighted. (Plain loops on the row-major storage:
+  // no temporaries or index checks per point.)
+  const double* const xs = x.data();
+  const double* const olds = old_points.data();
+  const double* const length = lengths.data();
   double d[3], grad[3];
   if (w.squared > 0.0 || w.squared_weighted > 0.0) {
     for (int j = 1; j <= n; ++j) {
-      const double arc = 0.5 * (lengths[j - 1] + (j < n ? lengths[j] : 0.0));
+      const double arc = 0.5 * (length[j - 1] + (j < n ? length[j] : 0.0));
       const double s = w.squared + w.squared_weighted * arc;
       double sq = 0.0;
       for (int k = 0; k < dim; ++k) {
-        d[k] = x(j, k) - old_points(j, k);
+        d[k] = xs[j * dim + k] - olds[j * dim + k];
         sq += d[k] * d[k];
         grad[k] = 2.0 * s * d[k];
       }
@@ -78,10 +84,11 @@ double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const
   // Body rotation: sum of |D_i - D_i_old|^2 / L_i over the links.
   if (w.rotation > 0.0) {
     for (int i = 1; i <= n; ++i) {
-      const double s = w.rotation / lengths[i - 1];
+      const double s = w.rotation / length[i - 1];
       double sq = 0.0;
       for (int k = 0; k < dim; ++k) {
-        d[k] = (x(i, k) - x(i - 1, k)) - (old_points(i, k) - old_points(i - 1, k));
+        const int at = i * dim + k;
+        d[k] = (xs[at] - xs[at - dim]) - (olds[at] - olds[at - dim]);
         sq += d[k] * d[k];
         grad[k] = 2.0 * s * d[k];
       }

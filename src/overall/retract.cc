@@ -1,5 +1,6 @@
 #include "overall/retract.h"
 
+#include <cassert>
 #include <cmath>
 #include <limits>
 
@@ -7,19 +8,22 @@ namespace flexkin::internal {
 namespace {
 
 // The follow-the-leader projection from the (fixed) head down: exact lengths in one pass.
-// (Plain loops on the row-major storage: this runs for every trial point of the line search.)
+// (Plain loops on the row-major storage, of the dimension `Dim` known at compile time: this runs
+// for every trial point of the line search, a chain of a square root and a division per link.)
+template <int Dim>
 void RetractFollowTheLeader(const Eigen::VectorXd& lengths, Points* x) {
-  const int dim = static_cast<int>(x->cols());
+  assert(x->cols() == Dim && lengths.size() == x->rows() - 1);
   double* p = x->data();
+  const double* const length = lengths.data();
   for (Eigen::Index i = 1; i < x->rows(); ++i) {
-    double* point = p + i * dim;
-    const double* previous = point - dim;
+    double* point = p + i * Dim;
+    const double* previous = point - Dim;
     double sq = 0.0;
-    for (int k = 0; k < dim; ++k) sq += (point[k] - previous[k]) * (point[k] - previous[k]);
+    for (int k = 0; k < Dim; ++k) sq += (point[k] - previous[k]) * (point[k] - previous[k]);
     const double norm = std::sqrt(sq);
     if (!(norm > 0.0)) continue;
-    const double f = lengths[i - 1] / norm;
-    for (int k = 0; k < dim; ++k) point[k] = previous[k] + f * (point[k] - previous[k]);
+    const double f = length[i - 1] / norm;
+    for (int k = 0; k < Dim; ++k) point[k] = previous[k] + f * (point[k] - previous[k]);
   }
 }
 
@@ -88,19 +92,33 @@ bool SolveChainNormalEquations(const MatrixView& e, int moving, double tiny, Cha
   return y.allFinite();
 }
 
+// (Plain loops: |D_i|^2 summed by coordinate in order, as Eigen's squaredNorm of a row sums 2 or 3
+// entries; `worst` only grows where |c| is larger, as with std::fmax: worst is never NaN, and a
+// NaN |c| is passed over.)
 double ConstraintViolation(const Eigen::VectorXd& lengths, const Points& x) {
+  assert(lengths.size() == x.rows() - 1);
+  const int dim = static_cast<int>(x.cols());
+  const double* const points = x.data();
+  const double* const length = lengths.data();
   double worst = 0.0;
   for (Eigen::Index i = 1; i < x.rows(); ++i) {
-    const double l = lengths[i - 1];
-    const double c = ((x.row(i) - x.row(i - 1)).squaredNorm() - l * l) / (2.0 * l * l);
-    worst = std::fmax(worst, std::fabs(c));
+    const double* const a = points + (i - 1) * dim;  // x_{i-1}, then x_i
+    double sq = 0.0;
+    for (int q = 0; q < dim; ++q) sq += (a[dim + q] - a[q]) * (a[dim + q] - a[q]);
+    const double l = length[i - 1];
+    const double c = std::fabs((sq - l * l) / (2.0 * l * l));
+    if (c > worst) worst = c;
   }
   return worst;
 }
 
 bool Retract(const Eigen::VectorXd& lengths, int moving, ChainSystem* system, Points* x) {
   if (moving == lengths.size()) {
-    RetractFollowTheLeader(lengths, x);
+    if (x->cols() == 2) {
+      RetractFollowTheLeader<2>(lengths, x);
+    } else {
+      RetractFollowTheLeader<3>(lengths, x);
+    }
     return true;
   }
   return RetractBetweenEnds(lengths, moving, system, x);
