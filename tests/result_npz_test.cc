@@ -1,20 +1,25 @@
 // Tests of the streaming result writers and the .npz result format: the npz reads back bit for
 // bit (and numpy.load reads it as the JSON of the same run says), the streamed JSON parses to
 // WriteResultJson's document, a failed or abandoned write leaves nothing behind and an existing
-// file untouched, a corrupted npz is an InputError (never a crash), and the size estimate is
-// within a factor of the files written.
+// file untouched, a corrupted npz is an InputError (never a crash), every member of an archive,
+// known to the reader or not, is checked (its local header against the central directory, its
+// bytes against the other members' and the central directory's, its CRC-32), and the size
+// estimate is within a factor of the files written.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -27,6 +32,7 @@
 #include "flexkin/run.h"
 #include "flexkin/scenario.h"
 #include "flexkin/strand_file.h"
+#include "io/npz.h"
 #include "test_util.h"
 
 namespace flexkin {
@@ -496,6 +502,395 @@ TEST_F(ResultNpzFileTest, StrandFileIsNamedWithItsReader) {
     EXPECT_NE(what.find("StrandFileReader"), std::string::npos) << what;
     EXPECT_NE(what.find("numpy.load"), std::string::npos) << what;
     EXPECT_EQ(what.find("result.json"), std::string::npos) << what;
+  }
+}
+
+// ZIP archives built byte by byte, for the reader's checks of every member: stored members with
+// plain (not ZIP64) headers, where a local header may differ from its central directory entry.
+namespace zip {
+
+void Put(std::string* out, uint64_t v, int bytes) {
+  for (int i = 0; i < bytes; ++i) out->push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+}
+
+// CRC-32 (ISO 3309, as ZIP uses it), bit by bit: independent of the reader's zlib.
+uint32_t Crc32(const std::string& data) {
+  uint32_t crc = 0xffffffffu;
+  for (const char c : data) {
+    crc ^= static_cast<unsigned char>(c);
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+  }
+  return ~crc;
+}
+
+std::string Hex(uint64_t v, int digits) {
+  char text[32];
+  std::snprintf(text, sizeof text, "0x%0*llx", digits, static_cast<unsigned long long>(v));
+  return text;
+}
+
+// The fields that a local header and a central directory entry both hold.
+struct Fields {
+  std::string name;
+  uint64_t flags = 0, method = 0, crc = 0, compressed = 0, size = 0;
+};
+
+std::string LocalHeader(const Fields& f) {
+  std::string h;
+  Put(&h, 0x04034b50, 4);
+  Put(&h, 20, 2);  // version needed
+  Put(&h, f.flags, 2);
+  Put(&h, f.method, 2);
+  Put(&h, 0, 2);     // time
+  Put(&h, 0x21, 2);  // date: 1980-01-01
+  Put(&h, f.crc, 4);
+  Put(&h, f.compressed, 4);
+  Put(&h, f.size, 4);
+  Put(&h, f.name.size(), 2);
+  Put(&h, 0, 2);  // extra field
+  return h + f.name;
+}
+
+std::string CentralEntry(const Fields& f, uint64_t local_offset) {
+  std::string h;
+  Put(&h, 0x02014b50, 4);
+  Put(&h, 20, 2);  // made by
+  Put(&h, 20, 2);  // needed
+  Put(&h, f.flags, 2);
+  Put(&h, f.method, 2);
+  Put(&h, 0, 2);
+  Put(&h, 0x21, 2);
+  Put(&h, f.crc, 4);
+  Put(&h, f.compressed, 4);
+  Put(&h, f.size, 4);
+  Put(&h, f.name.size(), 2);
+  Put(&h, 0, 2);  // extra field
+  Put(&h, 0, 2);  // comment
+  Put(&h, 0, 2);  // disk
+  Put(&h, 0, 2);  // internal attributes
+  Put(&h, 0, 4);  // external attributes
+  Put(&h, local_offset, 4);
+  return h + f.name;
+}
+
+std::string EndRecord(uint64_t entries, uint64_t cd_size, uint64_t cd_offset) {
+  std::string h;
+  Put(&h, 0x06054b50, 4);
+  Put(&h, 0, 2);
+  Put(&h, 0, 2);
+  Put(&h, entries, 2);
+  Put(&h, entries, 2);
+  Put(&h, cd_size, 4);
+  Put(&h, cd_offset, 4);
+  Put(&h, 0, 2);
+  return h;
+}
+
+struct Member {
+  std::string name, data;
+  // Edits the local header's fields (which start as the central directory entry's).
+  std::function<void(Fields*)> local;
+  uint64_t flags = 0;
+  std::optional<uint32_t> crc;  // in both headers; the data's CRC-32 if not given
+  std::string after;            // bytes after the data: a data descriptor
+};
+
+Fields FieldsOf(const Member& m) {
+  Fields f;
+  f.name = m.name;
+  f.flags = m.flags;
+  f.crc = m.crc ? *m.crc : Crc32(m.data);
+  f.compressed = f.size = m.data.size();
+  return f;
+}
+
+// The members one after another, then their central directory in the same order.
+std::string Archive(const std::vector<Member>& members) {
+  std::string bytes, cd;
+  for (const Member& m : members) {
+    const Fields f = FieldsOf(m);
+    Fields local = f;
+    if (m.local) m.local(&local);
+    cd += CentralEntry(f, bytes.size());
+    bytes += LocalHeader(local) + m.data + m.after;
+  }
+  const uint64_t cd_offset = bytes.size();
+  return bytes + cd + EndRecord(members.size(), cd.size(), cd_offset);
+}
+
+}  // namespace zip
+
+// The archives of these tests hold the members of a small result that flexkin wrote, rebuilt
+// byte by byte, with an unknown member ("extra.bin") or a fault.
+class ZipMemberChecksTest : public test_util::TempDirTest {
+ protected:
+  void SetUp() override {
+    test_util::TempDirTest::SetUp();
+    const Scenario s = Example("fig06_parabola_multi_step.json");
+    RunResult r = flexkin::Run(s.chain, s.leader_steps, s.options);
+    r.frames.Truncate(3);
+    frames_ = r.frames;
+    WriteResultFile(r, Path("good.npz"), ResultFileFormat::kNpz, s.name);
+    ZipReader reader(Path("good.npz"));
+    for (const char* name :
+         {"link_lengths.npy", "frames.npy", "steps.npy", "link_angles.npy", "l2_per_step.npy",
+          "l2_weighted_per_step.npy", "path_length.npy", "result.json"}) {
+      members_.push_back({name, reader.ReadWhole(name, 1 << 20)});
+    }
+  }
+  // The result's members with `extra` inserted before member `at` (at the end if past it).
+  std::vector<zip::Member> With(const zip::Member& extra, size_t at = 100) const {
+    std::vector<zip::Member> m = members_;
+    m.insert(m.begin() + static_cast<std::ptrdiff_t>(std::min(at, m.size())), extra);
+    return m;
+  }
+  zip::Member& Named(std::vector<zip::Member>* members, const std::string& name) const {
+    for (zip::Member& m : *members) {
+      if (m.name == name) return m;
+    }
+    throw std::logic_error("no member " + name);
+  }
+  // Reads `bytes` as a result file: the frames must be those written.
+  void ExpectRead(const std::string& bytes, const std::string& what) {
+    SCOPED_TRACE(what);
+    WriteText(Path("r.npz"), bytes);
+    try {
+      RunResult expected;
+      expected.frames = frames_;
+      ExpectSameFrames(ReadResultFile(Path("r.npz")).result, expected);
+    } catch (const InputError& e) {
+      ADD_FAILURE() << "refused: " << e.what();
+    }
+  }
+  // Reads `bytes` as a result file: refused with an InputError naming `field` whose message is
+  // `message` followed by "; not a valid .npz result file".
+  void ExpectRefused(const std::string& bytes, const std::string& field,
+                     const std::string& message) {
+    SCOPED_TRACE(message);
+    WriteText(Path("r.npz"), bytes);
+    try {
+      ReadResultFile(Path("r.npz"));
+      ADD_FAILURE() << "read; expected " << field << ": " << message;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.field(), field) << e.what();
+      EXPECT_EQ(e.message(), message + "; not a valid .npz result file");
+    }
+  }
+
+  std::vector<zip::Member> members_;
+  Frames frames_;
+};
+
+TEST_F(ZipMemberChecksTest, ArchiveOfTheSameMembersIsRead) {
+  ExpectRead(zip::Archive(members_), "rebuilt");
+  // An unknown member anywhere: read and CRC-checked, its content ignored.
+  const zip::Member extra{"extra.bin", std::string(1000, 'x') + "end"};
+  for (size_t at : {0, 3, 100}) {
+    ExpectRead(zip::Archive(With(extra, at)), "extra.bin at " + std::to_string(at));
+  }
+  ExpectRead(zip::Archive(With({"empty", ""}, 2)), "an empty unknown member");
+  // Data descriptors (flag bit 3): the local header may hold 0 for the CRC-32 and the sizes,
+  // which follow the data. Accepted as before, for unknown and known members.
+  std::vector<zip::Member> described = With(extra, 1);
+  for (zip::Member& m : described) {
+    m.flags = 8;
+    if (m.name == "extra.bin" || m.name == "frames.npy") {
+      const zip::Fields real = zip::FieldsOf(m);
+      m.local = [](zip::Fields* f) { f->crc = f->compressed = f->size = 0; };
+      zip::Put(&m.after, 0x08074b50, 4);
+      zip::Put(&m.after, real.crc, 4);
+      zip::Put(&m.after, real.compressed, 4);
+      zip::Put(&m.after, real.size, 4);
+    }
+  }
+  ExpectRead(zip::Archive(described), "data descriptors");
+}
+
+TEST_F(ZipMemberChecksTest, UnknownMemberWithABadCrcIsRefused) {
+  zip::Member extra{"extra.bin", std::string(3000, 'x')};
+  const uint32_t crc = zip::Crc32(extra.data);
+  extra.data[1234] = 'y';  // after the CRC-32 was taken: both headers hold the old one
+  extra.crc = crc;
+  const std::string message = "CRC-32 of its data is " + zip::Hex(zip::Crc32(extra.data), 8) +
+                              "; expected " + zip::Hex(crc, 8) +
+                              " as in the central directory (the member is corrupted)";
+  for (size_t at : {0, 5, 100}) ExpectRefused(zip::Archive(With(extra, at)), "extra.bin", message);
+  // A known member says the same when it is read.
+  std::vector<zip::Member> members = members_;
+  zip::Member& frames = Named(&members, "frames.npy");
+  frames.crc = zip::Crc32(frames.data) ^ 1;
+  ExpectRefused(zip::Archive(members), "frames.npy",
+                "CRC-32 of its data is " + zip::Hex(zip::Crc32(frames.data), 8) + "; expected " +
+                    zip::Hex(*frames.crc, 8) +
+                    " as in the central directory (the member is corrupted)");
+}
+
+TEST_F(ZipMemberChecksTest, LocalHeaderThatDiffersFromTheCentralDirectoryIsRefused) {
+  struct Case {
+    const char* what;
+    std::function<void(zip::Fields*)> edit;
+    // The message, given the central directory entry's fields.
+    std::function<std::string(const zip::Fields&)> message;
+  };
+  const std::string cd = " as in the central directory";
+  const Case cases[] = {
+      {"name", [](zip::Fields* f) { f->name.back() = 'Z'; },
+       [&](const zip::Fields& f) {
+         std::string other = f.name;
+         other.back() = 'Z';
+         return "local header names \"" + other + "\"; expected \"" + f.name + "\"" + cd;
+       }},
+      {"longer name", [](zip::Fields* f) { f->name += ".old"; },
+       [&](const zip::Fields& f) {
+         return "local header names \"" + f.name + ".old\"; expected \"" + f.name + "\"" + cd;
+       }},
+      {"method", [](zip::Fields* f) { f->method = 8; },
+       [&](const zip::Fields&) { return "local header compression method 8; expected 0" + cd; }},
+      {"crc", [](zip::Fields* f) { f->crc ^= 0x80; },
+       [&](const zip::Fields& f) {
+         return "local header CRC-32 " + zip::Hex(f.crc ^ 0x80, 8) + "; expected " +
+                zip::Hex(f.crc, 8) + cd;
+       }},
+      {"uncompressed size", [](zip::Fields* f) { f->size -= 1; },
+       [&](const zip::Fields& f) {
+         return "local header uncompressed size " + std::to_string(f.size - 1) + "; expected " +
+                std::to_string(f.size) + cd;
+       }},
+      {"compressed size", [](zip::Fields* f) { f->compressed += 1; },
+       [&](const zip::Fields& f) {
+         return "local header compressed size " + std::to_string(f.size + 1) + "; expected " +
+                std::to_string(f.size) + cd;
+       }},
+      {"data descriptor flag", [](zip::Fields* f) { f->flags = 8; },
+       [&](const zip::Fields&) {
+         return "local header flags 0x0008 (bits 0, encrypted, and 3, data descriptor); expected "
+                "0x0000 in those bits" +
+                cd;
+       }},
+      {"encrypted flag", [](zip::Fields* f) { f->flags = 0x0801; },
+       [&](const zip::Fields&) {
+         return "local header flags 0x0801 (bits 0, encrypted, and 3, data descriptor); expected "
+                "0x0000 in those bits" +
+                cd;
+       }},
+  };
+  for (const Case& c : cases) {
+    for (const std::string& name : {"extra.bin", "frames.npy", "result.json"}) {
+      SCOPED_TRACE(std::string(c.what) + " of " + name);
+      std::vector<zip::Member> members = With({"extra.bin", "unknown to the reader"}, 4);
+      zip::Member& m = Named(&members, name);
+      m.local = c.edit;
+      ExpectRefused(zip::Archive(members), name, c.message(zip::FieldsOf(m)));
+    }
+  }
+  // Other flags than bits 0 and 3 (here bit 11, UTF-8 names) are not compared.
+  std::vector<zip::Member> members = With({"extra.bin", "unknown"}, 4);
+  Named(&members, "extra.bin").local = [](zip::Fields* f) { f->flags = 0x0800; };
+  ExpectRead(zip::Archive(members), "bit 11 in a local header only");
+  // The sizes in a ZIP64 extra field, as flexkin writes them: frames.npy's local header holds
+  // 0xffffffff in its size fields and the sizes (uncompressed, compressed) in its extra field.
+  const std::string good = ReadFile(Path("good.npz"));
+  const std::string signature("PK\x03\x04", 4);
+  size_t at = 0;
+  while ((at = good.find(signature, at + 1)) != std::string::npos &&
+         good.compare(at + 30, 10, "frames.npy") != 0) {
+  }
+  ASSERT_NE(at, std::string::npos);
+  const size_t extra = at + 30 + 10;
+  ASSERT_EQ(good.substr(extra, 4), std::string("\x01\x00\x10\x00", 4));  // ZIP64, 16 bytes
+  uint64_t size = 0;
+  for (int i = 7; i >= 0; --i) size = (size << 8) | static_cast<unsigned char>(good[extra + 4 + i]);
+  ASSERT_EQ(size, Named(&members_, "frames.npy").data.size());
+  for (const auto& [offset, what] : {std::pair{4, "uncompressed"}, {12, "compressed"}}) {
+    std::string bytes = good, patched;
+    zip::Put(&patched, size + 1, 8);
+    bytes.replace(extra + offset, 8, patched);
+    ExpectRefused(bytes, "frames.npy",
+                  std::string("local header ") + what + " size " + std::to_string(size + 1) +
+                      "; expected " + std::to_string(size) + " as in the central directory");
+  }
+}
+
+TEST_F(ZipMemberChecksTest, OverlappingMembersAreRefused) {
+  // "extra.bin" holds the whole of the next member, "steps.npy" (its local header and data),
+  // or the first 10 bytes of its local header: each member's headers and CRC-32 are right.
+  for (const size_t shared : {size_t{0}, size_t{10}}) {
+    SCOPED_TRACE("shared " + std::to_string(shared));
+    std::string bytes, cd;
+    std::vector<std::pair<zip::Fields, uint64_t>> entries;  // central directory, offsets
+    const zip::Member* steps = nullptr;
+    for (const zip::Member& m : members_) {
+      if (m.name == "steps.npy") steps = &m;
+    }
+    const zip::Fields steps_fields = zip::FieldsOf(*steps);
+    const std::string steps_record = zip::LocalHeader(steps_fields) + steps->data;
+    uint64_t extra_start = 0, steps_start = 0;
+    for (const zip::Member& m : members_) {
+      if (&m == steps) {
+        // extra.bin: its own bytes, then all or part of steps.npy's record, counted as its data.
+        zip::Member extra{"extra.bin", "extra bytes before steps.npy"};
+        extra.data += shared == 0 ? steps_record : steps_record.substr(0, shared);
+        extra_start = bytes.size();
+        entries.push_back({zip::FieldsOf(extra), extra_start});
+        bytes += zip::LocalHeader(zip::FieldsOf(extra)) + extra.data;
+        steps_start = bytes.size() - (shared == 0 ? steps_record.size() : shared);
+        entries.push_back({steps_fields, steps_start});
+        if (shared != 0) bytes += steps_record.substr(shared);
+        continue;
+      }
+      entries.push_back({zip::FieldsOf(m), bytes.size()});
+      bytes += zip::LocalHeader(zip::FieldsOf(m)) + m.data;
+    }
+    for (const auto& [fields, offset] : entries) cd += zip::CentralEntry(fields, offset);
+    const uint64_t cd_offset = bytes.size();
+    bytes += cd + zip::EndRecord(entries.size(), cd.size(), cd_offset);
+    const uint64_t extra_end = steps_start + (shared == 0 ? steps_record.size() : shared);
+    const uint64_t steps_end = steps_start + steps_record.size();
+    ExpectRefused(bytes, "steps.npy",
+                  "local header and data (" + std::to_string(steps_record.size()) +
+                      " bytes at offsets " + std::to_string(steps_start) + " to " +
+                      std::to_string(steps_end) + ") overlap those of \"extra.bin\" (" +
+                      std::to_string(extra_end - extra_start) + " bytes at offsets " +
+                      std::to_string(extra_start) + " to " + std::to_string(extra_end) +
+                      "); expected members apart");
+  }
+}
+
+TEST_F(ZipMemberChecksTest, MemberOverlappingTheCentralDirectoryIsRefused) {
+  // The last member's data runs 16 bytes into the central directory: into the start of the
+  // first entry (not its own, so that its CRC-32 can be right).
+  for (const std::string& name : {"extra.bin", "result.json"}) {
+    SCOPED_TRACE(name);
+    std::vector<zip::Member> members = members_;
+    if (name == "extra.bin") members.push_back({"extra.bin", "the last member"});
+    std::rotate(members.begin(), members.end() - 1, members.end());  // last, first in the file
+    std::string bytes;
+    std::vector<uint64_t> offsets;
+    for (size_t k = 1; k < members.size(); ++k) {
+      offsets.push_back(bytes.size());
+      bytes += zip::LocalHeader(zip::FieldsOf(members[k])) + members[k].data;
+    }
+    // The central directory lists the members in the file's order, the last one last.
+    std::string cd;
+    for (size_t k = 1; k < members.size(); ++k) {
+      cd += zip::CentralEntry(zip::FieldsOf(members[k]), offsets[k - 1]);
+    }
+    zip::Member last = members[0];
+    const uint64_t last_start = bytes.size();
+    const std::string own_data = last.data;
+    bytes += zip::LocalHeader(zip::FieldsOf({last.name, own_data + cd.substr(0, 16)})) + own_data;
+    last.data = own_data + cd.substr(0, 16);
+    cd += zip::CentralEntry(zip::FieldsOf(last), last_start);
+    const uint64_t cd_offset = bytes.size();
+    bytes += cd + zip::EndRecord(members.size(), cd.size(), cd_offset);
+    const uint64_t data_start = last_start + 30 + last.name.size();
+    ExpectRefused(bytes, name,
+                  "data (" + std::to_string(last.data.size()) + " bytes at offsets " +
+                      std::to_string(data_start) + " to " +
+                      std::to_string(data_start + last.data.size()) +
+                      ") overlaps the central directory (" + std::to_string(cd.size()) +
+                      " bytes at offsets " + std::to_string(cd_offset) + " to " +
+                      std::to_string(cd_offset + cd.size()) + ")");
   }
 }
 

@@ -107,6 +107,23 @@ std::string PrintableName(const std::string& name) {
   return out;
 }
 
+std::string Hex(uint64_t v, int digits) {
+  static const char kHex[] = "0123456789abcdef";
+  std::string out = "0x";
+  for (int i = digits - 1; i >= 0; --i) out += kHex[(v >> (4 * i)) & 15];
+  return out;
+}
+
+// "N bytes at offsets A to B": the half-open range [A, B) of a message.
+std::string Range(uint64_t start, uint64_t end) {
+  return std::to_string(end - start) + " bytes at offsets " + std::to_string(start) + " to " +
+         std::to_string(end);
+}
+
+// The flags that a local header and its central directory entry must agree on: bit 0 (encrypted)
+// and bit 3 (sizes and CRC-32 in a data descriptor after the data).
+constexpr uint64_t kComparedFlags = 0x0009;
+
 }  // namespace
 
 std::string NpyHeader(const std::string& descr, const std::vector<uint64_t>& shape, size_t length) {
@@ -231,7 +248,19 @@ void ZipWriter::Finish() {
   file_->Check();
 }
 
-ZipReader::ZipReader(const std::string& path) : path_(path) {
+const std::set<std::string>& ZipReader::LibraryMembers() {
+  static const std::set<std::string> names = {
+      // a result (io/result_npz.cc)
+      "result.json", "link_lengths.npy", "path_length.npy", "l2_per_step.npy",
+      "l2_weighted_per_step.npy", "frames.npy", "steps.npy", "link_angles.npy",
+      // a strand file (io/strand_file.cc)
+      "groom.json", "offsets.npy", "times.npy", "body_rotation.npy", "body_translation.npy",
+      "points.npy"};
+  return names;
+}
+
+ZipReader::ZipReader(const std::string& path, const std::set<std::string>& read_later)
+    : path_(path) {
   fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd_ < 0) {
     throw std::system_error(errno, std::generic_category(), "cannot read '" + path + "'");
@@ -312,6 +341,8 @@ ZipReader::ZipReader(const std::string& path) : path_(path) {
   std::vector<unsigned char> cd(cd_size);
   ReadAt(cd_offset, cd.data(), cd.size(), cd_field);
   members_end_ = cd_offset;
+  cd_size_ = cd_size;
+  std::vector<Named> order;  // the members in central directory order
   size_t pos = 0;
   for (uint64_t k = 0; k < entries; ++k) {
     const std::string field = cd_field + " entry " + std::to_string(k);
@@ -361,10 +392,141 @@ ZipReader::ZipReader(const std::string& path) : path_(path) {
       Malformed(member_field, "local header offset " + std::to_string(e.local_offset) +
                                   " lies outside the members");
     }
-    if (!members_.emplace(name, e).second) Malformed(member_field, "appears twice");
+    if (members_.count(name) > 0) Malformed(member_field, "appears twice");
+    PlaceMember(member_field, &e);
+    members_.emplace(name, e);
+    order.push_back({name, member_field, flags, method});
     pos += kCentralHeaderSize + name_len + extra_len + comment_len;
   }
+  // Before the local headers' names and extra fields are read: with no two members sharing
+  // bytes, what is read below is at most the file.
+  CheckNoOverlap(order);
+  for (const Named& m : order) CheckLocalHeader(m, members_.at(m.name));
+  for (const Named& m : order) {
+    if (read_later.count(m.name) == 0) CheckCrc(m.field, members_.at(m.name));
+  }
   closer.keep = true;
+}
+
+void ZipReader::PlaceMember(const std::string& field, Entry* e) const {
+  unsigned char h[kLocalHeaderSize];
+  ReadAt(e->local_offset, h, sizeof h, field + " local header");
+  if (Get(h, 4) != kLocalHeaderSignature) {
+    Malformed(field, "local header at offset " + std::to_string(e->local_offset) +
+                         " has signature " + Hex(Get(h, 4), 8) + "; expected " +
+                         Hex(kLocalHeaderSignature, 8));
+  }
+  const uint64_t variable = Get(h + 26, 2) + Get(h + 28, 2);  // name and extra field
+  const std::string cd_range = Range(members_end_, members_end_ + cd_size_);
+  // The central directory entry's check leaves at least the fixed part before members_end_.
+  if (variable > members_end_ - e->local_offset - kLocalHeaderSize) {
+    Malformed(field, "local header (" +
+                         Range(e->local_offset, e->local_offset + kLocalHeaderSize + variable) +
+                         ") overlaps the central directory (" + cd_range + ")");
+  }
+  e->data_offset = e->local_offset + kLocalHeaderSize + variable;
+  if (e->size > members_end_ - e->data_offset) {
+    Malformed(field, "data (" + Range(e->data_offset, e->data_offset + e->size) +
+                         ") overlaps the central directory (" + cd_range + ")");
+  }
+}
+
+void ZipReader::CheckLocalHeader(const Named& m, const Entry& e) const {
+  const std::string& field = m.field;
+  const std::string cd = " as in the central directory";
+  std::vector<unsigned char> h(e.data_offset - e.local_offset);
+  ReadAt(e.local_offset, h.data(), h.size(), field + " local header");
+  const uint64_t name_len = Get(h.data() + 26, 2), extra_len = Get(h.data() + 28, 2);
+  const std::string local_name(reinterpret_cast<const char*>(h.data()) + kLocalHeaderSize,
+                               name_len);
+  if (local_name != m.name) {
+    Malformed(field, "local header names \"" + PrintableName(local_name) + "\"; expected \"" +
+                         PrintableName(m.name) + "\"" + cd);
+  }
+  const uint64_t flags = Get(h.data() + 6, 2), method = Get(h.data() + 8, 2);
+  if ((flags & kComparedFlags) != (m.flags & kComparedFlags)) {
+    Malformed(field, "local header flags " + Hex(flags, 4) + " (bits 0, encrypted, and 3, " +
+                         "data descriptor); expected " + Hex(m.flags & kComparedFlags, 4) +
+                         " in those bits" + cd);
+  }
+  if (method != m.method) {
+    Malformed(field, "local header compression method " + std::to_string(method) + "; expected " +
+                         std::to_string(m.method) + cd);
+  }
+  // Sizes: the fixed fields, or where they are 0xffffffff the ZIP64 extra field's values, in
+  // the order uncompressed, compressed.
+  uint64_t size = Get(h.data() + 22, 4), compressed = Get(h.data() + 18, 4);
+  const unsigned char* x = h.data() + kLocalHeaderSize + name_len;
+  uint64_t x_left = extra_len;
+  while (x_left >= 4) {
+    const uint64_t id = Get(x, 2), len = Get(x + 2, 2);
+    if (len > x_left - 4) Malformed(field, "local header's ZIP extra field is truncated");
+    if (id == kZip64ExtraId) {
+      const unsigned char* value = x + 4;
+      uint64_t value_left = len;
+      for (uint64_t* field_value : {&size, &compressed}) {
+        if (*field_value != 0xffffffffu) continue;
+        if (value_left < 8) Malformed(field, "local header's ZIP64 extra field is truncated");
+        *field_value = Get(value, 8);
+        value += 8;
+        value_left -= 8;
+      }
+    }
+    x += 4 + len;
+    x_left -= 4 + len;
+  }
+  // With a data descriptor (flag bit 3) the local header may hold 0 for the CRC-32 and sizes.
+  const bool descriptor = (flags & 8) != 0;
+  const uint64_t crc = Get(h.data() + 14, 4);
+  if (crc != e.crc && !(descriptor && crc == 0)) {
+    Malformed(field, "local header CRC-32 " + Hex(crc, 8) + "; expected " + Hex(e.crc, 8) + cd);
+  }
+  for (const auto& [value, what] : {std::pair{size, "uncompressed"}, {compressed, "compressed"}}) {
+    if (value != e.size && !(descriptor && value == 0)) {
+      Malformed(field, std::string("local header ") + what + " size " + std::to_string(value) +
+                           "; expected " + std::to_string(e.size) + cd);
+    }
+  }
+}
+
+void ZipReader::CheckNoOverlap(const std::vector<Named>& order) const {
+  struct Span {
+    uint64_t start, end;
+    const std::string* field;
+  };
+  std::vector<Span> spans;
+  spans.reserve(order.size());
+  for (const Named& m : order) {
+    const Entry& e = members_.at(m.name);
+    spans.push_back({e.local_offset, e.data_offset + e.size, &m.field});
+  }
+  // By start, then central directory order; each span against the one reaching furthest so far.
+  std::stable_sort(spans.begin(), spans.end(),
+                   [](const Span& a, const Span& b) { return a.start < b.start; });
+  const Span* furthest = nullptr;
+  for (const Span& s : spans) {
+    if (furthest != nullptr && s.start < furthest->end) {
+      Malformed(*s.field, "local header and data (" + Range(s.start, s.end) +
+                              ") overlap those of \"" + *furthest->field + "\" (" +
+                              Range(furthest->start, furthest->end) + "); expected members apart");
+    }
+    if (furthest == nullptr || s.end > furthest->end) furthest = &s;
+  }
+}
+
+void ZipReader::CheckCrc(const std::string& field, const Entry& e) const {
+  std::vector<char> chunk(static_cast<size_t>(std::min<uint64_t>(e.size, 1u << 20)));
+  unsigned long crc = ::crc32(0L, Z_NULL, 0);
+  for (uint64_t done = 0; done < e.size;) {
+    const size_t n = static_cast<size_t>(std::min<uint64_t>(e.size - done, chunk.size()));
+    ReadAt(e.data_offset + done, chunk.data(), n, field);
+    crc = Crc(crc, chunk.data(), n);
+    done += n;
+  }
+  if (static_cast<uint32_t>(crc) != e.crc) {
+    Malformed(field, "CRC-32 of its data is " + Hex(static_cast<uint32_t>(crc), 8) + "; expected " +
+                         Hex(e.crc, 8) + " as in the central directory (the member is corrupted)");
+  }
 }
 
 ZipReader::~ZipReader() {
@@ -391,20 +553,9 @@ void ZipReader::ReadAt(uint64_t offset, void* out, size_t size, const std::strin
 ZipReader::Member::Member(const ZipReader* zip, const std::string& name) : zip_(zip), name_(name) {
   const auto it = zip->members_.find(name);
   if (it == zip->members_.end()) Malformed(name, "is missing from the archive");
+  // The local header and the data's place were checked when the archive was opened.
   const Entry& e = it->second;
-  unsigned char h[kLocalHeaderSize];
-  zip->ReadAt(e.local_offset, h, sizeof h, name + " local header");
-  if (Get(h, 4) != kLocalHeaderSignature) Malformed(name, "local header has a bad signature");
-  const uint64_t name_len = Get(h + 26, 2), extra_len = Get(h + 28, 2);
-  const uint64_t start = e.local_offset + kLocalHeaderSize + name_len + extra_len;
-  if (start > zip->members_end_ || e.size > zip->members_end_ - start) {
-    Malformed(name, "data (" + std::to_string(e.size) + " bytes at offset " +
-                        std::to_string(start) + ") lies outside the members");
-  }
-  std::string local_name(name_len, '\0');
-  zip->ReadAt(e.local_offset + kLocalHeaderSize, local_name.data(), local_name.size(), name);
-  if (local_name != name) Malformed(name, "local header names another member");
-  start_ = start;
+  start_ = e.data_offset;
   size_ = e.size;
   expected_crc_ = e.crc;
   crc_ = ::crc32(0L, Z_NULL, 0);
@@ -439,7 +590,9 @@ void ZipReader::Member::Finish() {
     Malformed(name_, "has " + std::to_string(left()) + " bytes more than its header says");
   }
   if (static_cast<uint32_t>(crc_) != expected_crc_) {
-    Malformed(name_, "CRC-32 does not match (the member is corrupted)");
+    Malformed(name_, "CRC-32 of its data is " + Hex(static_cast<uint32_t>(crc_), 8) +
+                         "; expected " + Hex(expected_crc_, 8) +
+                         " as in the central directory (the member is corrupted)");
   }
 }
 

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -56,10 +57,20 @@ class ZipWriter {
 // A ZIP archive read member by member (stored members only). Every structure is checked against
 // the file's size before it is used: a malformed archive throws InputError naming the structure
 // ("zip: end of central directory") or the member ("frames.npy"), never reads out of bounds.
+// Opening the archive checks every member that the central directory lists: its local header
+// against its central directory entry, its bytes (local header and data) against every other
+// member's and the central directory's, and, for a member the caller does not read itself, its
+// data against its CRC-32 (the other members' data is checked by Member::Finish when read).
 class ZipReader {
  public:
+  // The members that flexkin's readers of .npz files (ReadResultFile, StrandFileReader) read
+  // through Member or ReadWhole: the default of `read_later`.
+  static const std::set<std::string>& LibraryMembers();
+
   // Throws std::system_error if the file cannot be read, InputError if it is not a valid archive.
-  explicit ZipReader(const std::string& path);
+  // The data of every member not named in `read_later` is read and its CRC-32 checked here.
+  explicit ZipReader(const std::string& path,
+                     const std::set<std::string>& read_later = LibraryMembers());
   ~ZipReader();
   ZipReader(const ZipReader&) = delete;
   ZipReader& operator=(const ZipReader&) = delete;
@@ -91,13 +102,31 @@ class ZipReader {
 
  private:
   struct Entry {
-    uint64_t local_offset = 0, size = 0;
+    uint64_t local_offset = 0, data_offset = 0, size = 0;
     uint32_t crc = 0;
   };
+  // A member's name and the field that names it in messages (printable, or the central
+  // directory entry of an empty name).
+  struct Named {
+    std::string name, field;
+    uint64_t flags = 0, method = 0;  // of its central directory entry
+  };
   void ReadAt(uint64_t offset, void* out, size_t size, const std::string& what) const;
+  // Reads the fixed part of a member's local header (its signature, the lengths of its name and
+  // extra field), sets e->data_offset and checks that the header and the data end before the
+  // central directory.
+  void PlaceMember(const std::string& field, Entry* e) const;
+  // Reads the whole local header and checks it against the central directory entry: name,
+  // flags (bits 0 and 3), compression method, CRC-32 and sizes.
+  void CheckLocalHeader(const Named& m, const Entry& e) const;
+  // Refuses members whose bytes overlap; `order`: the members in central directory order.
+  void CheckNoOverlap(const std::vector<Named>& order) const;
+  // Reads a member's whole data and checks its CRC-32.
+  void CheckCrc(const std::string& field, const Entry& e) const;
   int fd_ = -1;
   std::string path_;
   uint64_t file_size_ = 0, members_end_ = 0;  // members lie in [0, members_end_)
+  uint64_t cd_size_ = 0;                      // the central directory follows, at members_end_
   std::map<std::string, Entry> members_;
 };
 
