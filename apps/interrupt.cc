@@ -5,6 +5,8 @@
 #include <csignal>
 #include <string>
 
+#include "flexkin/result_io.h"
+
 namespace flexkin::cli {
 namespace {
 
@@ -23,6 +25,8 @@ void InstallInterruptHandlers() {
   // write fails half way for it. Reset after the first: a second signal ends the process.
   action.sa_flags = SA_RESTART | SA_RESETHAND;
   for (int signal : {SIGINT, SIGTERM}) ::sigaction(signal, &action, nullptr);
+  // Up to the rename that puts a finished output in place.
+  SetBeforeOutputCommit(&ThrowIfInterrupted);
 }
 
 int InterruptSignal() { return g_signal; }

@@ -201,4 +201,11 @@ ResultSizeEstimate EstimateResultSize(int num_links, int dim, int64_t num_steps,
 uint64_t EstimateResultBytes(int num_links, int dim, int64_t num_steps, const RunOptions& options,
                              ResultFileFormat format);
 
+// A process-wide check made by every writer of flexkin just before it puts a finished output in
+// place (its data on disk, before the rename over an earlier file): a check that throws leaves the
+// earlier file as it was and removes the new one, and the exception propagates. The command line
+// sets it so that SIGINT and SIGTERM stop a command up to that moment. Null (the default): none.
+// Set it before any writing starts.
+void SetBeforeOutputCommit(void (*check)());
+
 }  // namespace flexkin

@@ -2,10 +2,13 @@
 // flexkin's files shares.
 #include "io/atomic_file.h"
 
+#include "flexkin/result_io.h"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <fstream>
@@ -171,6 +174,12 @@ void AtomicFile::WriteAt(uint64_t offset, const void* data, size_t size) {
   }
 }
 
+namespace {
+std::atomic<void (*)()> g_before_commit{nullptr};
+}  // namespace
+
+void SetBeforeOutputCommit(void (*check)()) { g_before_commit.store(check); }
+
 void AtomicFile::Commit() {
   State& s = *state_;
   s.out->flush();
@@ -180,6 +189,7 @@ void AtomicFile::Commit() {
   if (::fsync(s.temp.fd) != 0 && errno != EINVAL && errno != EROFS) {
     throw SystemError(errno, s.what);
   }
+  if (void (*check)() = g_before_commit.load()) check();
   const int fd = s.temp.fd;
   s.temp.fd = -1;
   if (::close(fd) != 0) throw SystemError(errno, s.what);
