@@ -18,6 +18,7 @@
 #include "flexkin/any_scenario.h"    // the front door: a scenario file of any kind, read once
 #include "flexkin/arm.h"             // fixed-base arms: models, forward kinematics, TrackPath
 #include "flexkin/chain.h"           // Chain, Points, MakeChain
+#include "flexkin/colliders.h"       // colliders: spheres, capsules, boxes, ... and their geometry
 #include "flexkin/curves.h"          // generated initial curves: line, parabola, arc, helix
 #include "flexkin/error.h"           // Problem, Problems, InputError
 #include "flexkin/groom.h"           // groom scenarios (strands on a moving body) and their runs

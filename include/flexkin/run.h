@@ -3,10 +3,12 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include "flexkin/chain.h"
+#include "flexkin/colliders.h"
 #include "flexkin/error.h"
 #include "flexkin/frames.h"
 #include "flexkin/overall.h"
@@ -41,10 +43,27 @@ struct RunOptions {
   // control chooses the sub-steps); may be empty. It may throw to stop the run: the exception
   // propagates out of Run.
   std::function<void(int64_t done, int64_t total)> progress;
+  // Things in the world the chain stays outside of (flexkin/colliders.h, docs/colliders.md): each
+  // link's rule step is kept where the link stays outside every collider, else replaced by the
+  // least-motion position of its trailing end that keeps it outside. Tractrix and ftl; no
+  // accuracy control. A 2D chain lies in the plane z = 0. Empty: the run is exactly the one
+  // without colliders.
+  std::vector<Collider> colliders;
 
   // Every problem with the options (empty if valid), each naming its member ("substeps",
   // "overall.weights.l2").
   Problems Validate() const;
+};
+
+// What the colliders did to a run.
+struct ContactReport {
+  int num_colliders = 0;
+  // Link steps (a link's move in one sub-step) whose rule step would have entered a collider and
+  // that slid along it instead.
+  int64_t contact_link_steps = 0;
+  // The least clearance of any link from any collider after any sub-step, relative to the link's
+  // length (+inf without colliders); never below -1e-13 (the rounding of points on a surface).
+  double least_clearance = std::numeric_limits<double>::infinity();
 };
 
 // Metrics of a run (paper eq. 6 and Sec. 3.2).
@@ -99,6 +118,7 @@ struct RunResult {
   Metrics metrics;
   AccuracyReport accuracy;
   OverallRunReport overall;  // method "overall" only
+  ContactReport contacts;    // with colliders only
   ObjectiveWeights weights;  // the overall method's metric (method "overall" only)
   double seconds = 0.0;      // wall time of the computation
 

@@ -14,6 +14,7 @@
 #include "run/sweep_pipeline.h"
 #include "sequential/rule_table.h"
 #include "sequential/sweep.h"
+#include "world/contact.h"
 
 namespace flexkin {
 namespace {
@@ -32,6 +33,53 @@ void ValidateLeaderSteps(const Points& steps, int dim) {
         throw InputError("leader_steps[" + std::to_string(i) + "][" + std::to_string(k) + "]",
                          "is not a finite number");
       }
+    }
+  }
+}
+
+// With colliders: the chain starts outside every one, and the leading end's path (straight
+// from the start through every target) never enters one.
+void CheckOutsideColliders(const Chain& chain, const Points& leader_steps,
+                           const std::vector<Collider>& colliders) {
+  const int dim = chain.dim();
+  const auto at = [dim](const auto& row) {
+    return Eigen::Vector3d(row(0), row(1), dim == 3 ? row(2) : 0.0);
+  };
+  const double shortest = chain.lengths.minCoeff();
+  const auto depth_text = [](double clearance) { return FormatNumber(-clearance); };
+  for (size_t c = 0; c < colliders.size(); ++c) {
+    const std::string name =
+        "colliders[" + std::to_string(c) + "] (" + ColliderShapeName(colliders[c].shape) + ")";
+    for (Eigen::Index i = 0; i < chain.points.rows(); ++i) {
+      const double clearance = QuerySurface(colliders[c], at(chain.points.row(i))).distance;
+      if (clearance < -internal::kContactSlack * shortest) {
+        throw InputError("points[" + std::to_string(i) + "]",
+                         "lies inside " + name + " by " + depth_text(clearance) +
+                             "; the chain must start outside every collider");
+      }
+    }
+    for (Eigen::Index i = 1; i < chain.points.rows(); ++i) {
+      const double clearance = internal::SegmentClearance(colliders[c], at(chain.points.row(i - 1)),
+                                                          at(chain.points.row(i)));
+      if (clearance < -internal::kContactSlack * chain.lengths[i - 1]) {
+        throw InputError("points[" + std::to_string(i) + "]",
+                         "link " + std::to_string(i) + " (points " + std::to_string(i - 1) +
+                             " to " + std::to_string(i) + ") passes through " + name + ", " +
+                             depth_text(clearance) +
+                             " deep; the chain must start outside every collider");
+      }
+    }
+    Eigen::Vector3d from = at(chain.points.row(0));
+    for (Eigen::Index s = 0; s < leader_steps.rows(); ++s) {
+      const Eigen::Vector3d to = at(leader_steps.row(s));
+      const double clearance = internal::SegmentClearance(colliders[c], from, to);
+      if (clearance < -internal::kContactSlack * shortest) {
+        throw InputError("leader_steps[" + std::to_string(s) + "]",
+                         "the leading end's path to this target enters " + name + ", " +
+                             depth_text(clearance) +
+                             " deep; the path must stay outside every collider");
+      }
+      from = to;
     }
   }
 }
@@ -98,7 +146,13 @@ class ChainMover {
     }
   }
   void Step(const Eigen::VectorXd& head, int64_t step, int substep, Points* points) {
-    if (!stepper_) {
+    if (!options_.colliders.empty()) {
+      internal::ContactSweep(stepper_->method, stepper_->dim, head.data(), stepper_->lengths.data(),
+                             stepper_->inv_lengths.data(), static_cast<int>(lengths_.size()),
+                             points->data(), options_.colliders, &contacts_);
+      result_->contacts.contact_link_steps = contacts_.contact_link_steps;
+      result_->contacts.least_clearance = contacts_.least_clearance;
+    } else if (!stepper_) {
       internal::OverallStepUnchecked(lengths_, head, options_.overall, points, &*workspace_,
                                      &report_);
       Record(report_, step, substep, &result_->overall);
@@ -114,6 +168,7 @@ class ChainMover {
   std::optional<Stepper> stepper_;
   std::optional<OverallWorkspace> workspace_;
   OverallReport report_;
+  internal::ContactStats contacts_;
 };
 
 // The metrics of a run (paper eq. 6 and Sec. 3.2), accumulated sub-step by sub-step.
@@ -180,12 +235,14 @@ RunResult RunOn(const Chain& chain, const Points& leader_steps, const RunOptions
   ValidateChain(chain);
   ValidateLeaderSteps(leader_steps, chain.dim());
   ThrowIfAny(options.Validate());
+  if (!options.colliders.empty()) CheckOutsideColliders(chain, leader_steps, options.colliders);
   const auto start_time = Clock::now();
 
   RunResult result;
   result.method = options.method;
   result.lengths = chain.lengths;
   result.num_steps = leader_steps.rows();
+  result.contacts.num_colliders = static_cast<int>(options.colliders.size());
   result.accuracy.order = MethodOrder(options.method);
   result.accuracy.substeps = options.substeps;
   if (options.method == Method::kOverall) result.weights = options.overall.weights;
@@ -214,7 +271,7 @@ RunResult RunOn(const Chain& chain, const Points& leader_steps, const RunOptions
     }
   };
 
-  if (pipeline && internal::Pipelined(options.method)) {
+  if (pipeline && internal::Pipelined(options.method) && options.colliders.empty()) {
     const Stepper stepper = internal::MakeStepperUnchecked(options.method, chain);
     internal::SweepPipeline pipeline(stepper, chain.points, leader_steps, substeps,
                                      &result.metrics);

@@ -45,6 +45,23 @@ Problems RunOptions::Validate() const {
                           std::to_string(max_substeps), ">= substeps");
   }
   if (method == Method::kOverall) AppendNested("overall", overall.Validate(), &problems);
+  for (size_t i = 0; i < colliders.size(); ++i) {
+    const Problems collider = CheckCollider(colliders[i], "colliders[" + std::to_string(i) + "]");
+    problems.insert(problems.end(), collider.begin(), collider.end());
+  }
+  if (!colliders.empty() && method != Method::kTractrix && method != Method::kFollowTheLeader) {
+    problems.emplace_back("method",
+                          std::string("\"") + MethodName(method) +
+                              "\" does not take colliders yet; with colliders use \"tractrix\" "
+                              "or \"ftl\"",
+                          std::string("\"") + MethodName(method) + "\"", "\"tractrix\" or \"ftl\"");
+  }
+  if (!colliders.empty() && tolerance > 0.0) {
+    problems.emplace_back("tolerance",
+                          "accuracy control does not account for colliders; set it to 0 and "
+                          "choose the sub-steps",
+                          FormatNumber(tolerance), "0 with colliders");
+  }
   return problems;
 }
 

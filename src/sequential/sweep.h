@@ -4,8 +4,10 @@
 // method's rule. `points` is the (n+1) by dim row-major chain, updated in place.
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
+#include "flexkin/colliders.h"
 #include "flexkin/propagate.h"
 
 namespace flexkin::internal {
@@ -85,6 +87,22 @@ void TracedSweepsScalarFrom(Method method, int dim, const double* heads, int64_t
 void TracedSweepsWavefront(Method method, int dim, const double* heads, int64_t num_sweeps,
                            const double* lengths, const double* inv_lengths, int num_links,
                            double* points, SweepTrace* trace);
+
+// What the colliders did to a run's sweeps (ContactSweep).
+struct ContactStats {
+  int64_t contact_link_steps = 0;  // link steps whose rule step entered a collider
+  // The least clearance of any link after any sweep, relative to its length (+inf: none
+  // measured); at least -kContactSlack (world/contact.h).
+  double least_clearance = std::numeric_limits<double>::infinity();
+};
+
+// One sweep (the leading end to `head`) of a per-link rule (tractrix, ftl) with colliders: each
+// link's rule step, kept where the link stays outside every collider, else replaced by the
+// least-motion position of its trailing end that keeps it outside (contact_sweep.cc). 2D chains
+// lie in the plane z = 0. Throws InputError when the colliders leave a link no room.
+void ContactSweep(Method method, int dim, const double* head, const double* lengths,
+                  const double* inv_lengths, int num_links, double* points,
+                  const std::vector<Collider>& colliders, ContactStats* stats);
 
 // The sequential rules of the rotation and joint-angle metrics (metric_rules.cc).
 void SweepsMinRotation(int dim, const double* heads, int64_t num_sweeps, int num_links,

@@ -287,14 +287,24 @@ SurfaceQuery QuerySurface(const Collider& c, const Vector3d& x) {
 
 std::vector<Problem> CheckCollider(const Collider& c, const std::string& field) {
   std::vector<Problem> problems;
-  const auto positive = [&](const std::string& name, double value) {
+  // A JSON pointer's children ("/c/radius", "/c/extents/1") or a member path's ("c.radius",
+  // "c.extents[1]").
+  const bool pointer = !field.empty() && field[0] == '/';
+  const auto child = [&](const std::string& name, int index = -1) {
+    std::string path = field + (pointer ? "/" : ".") + name;
+    if (index >= 0) {
+      path += pointer ? "/" + std::to_string(index) : "[" + std::to_string(index) + "]";
+    }
+    return path;
+  };
+  const auto positive = [&](const std::string& name, double value, int index = -1) {
     if (!(std::isfinite(value) && value > 0.0)) {
-      problems.push_back(Problem::Invalid(field + "/" + name, Num(value), "a finite number > 0"));
+      problems.push_back(Problem::Invalid(child(name, index), Num(value), "a finite number > 0"));
     }
   };
   const auto non_negative = [&](const std::string& name, double value) {
     if (!(std::isfinite(value) && value >= 0.0)) {
-      problems.push_back(Problem::Invalid(field + "/" + name, Num(value), "a finite number >= 0"));
+      problems.push_back(Problem::Invalid(child(name), Num(value), "a finite number >= 0"));
     }
   };
   switch (c.shape) {
@@ -311,17 +321,17 @@ std::vector<Problem> CheckCollider(const Collider& c, const std::string& field) 
       break;
     case ColliderShape::kEllipsoid:
     case ColliderShape::kBox:
-      for (int k = 0; k < 3; ++k) positive("extents/" + std::to_string(k), c.extents[k]);
+      for (int k = 0; k < 3; ++k) positive("extents", c.extents[k], k);
       break;
     case ColliderShape::kHalfSpace:
       break;
   }
   const Eigen::Matrix3d r = c.pose.linear();
   if (!r.allFinite() || !c.pose.translation().allFinite()) {
-    problems.emplace_back(field + "/pose", "has a value that is not a finite number");
+    problems.emplace_back(child("pose"), "has a value that is not a finite number");
   } else if ((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-12 ||
              r.determinant() < 0.0) {
-    problems.emplace_back(field + "/pose",
+    problems.emplace_back(child("pose"),
                           "is not a rotation (orthonormal, determinant +1) and a translation");
   }
   return problems;

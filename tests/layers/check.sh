@@ -10,6 +10,7 @@ cd "$root"
 # The layer of each public header (include/flexkin/NAME.h).
 declare -A header_layer=(
   [error]=chain [chain]=chain [vocabulary]=chain [curves]=chain [leader]=chain
+  [colliders]=world
   [link_step]=sequential [propagate]=sequential
   [overall]=overall
   [run]=run [frames]=run
@@ -22,21 +23,22 @@ declare -A header_layer=(
 # What each layer may include besides itself.
 declare -A allowed=(
   [chain]=""
-  [sequential]="chain"
-  [overall]="chain sequential"
-  [run]="chain sequential overall"
-  [arm]="chain sequential"
-  [strands]="chain sequential"
-  [io]="chain sequential overall run arm strands"
-  [groom]="chain sequential overall run arm io strands"
-  [scenario]="chain sequential overall run arm io strands groom"
-  [umbrella]="chain sequential overall run arm strands io groom scenario"
-  [render]="chain sequential overall run arm io strands groom"
-  [viewer]="chain sequential overall run arm io strands groom"
-  [gltf]="chain sequential overall run arm io render"
-  [urdf]="chain sequential overall run arm io"
-  [draw]="chain sequential overall run arm io strands groom render viewer gltf"
-  [apps]="chain sequential overall run arm io strands groom scenario render viewer gltf urdf draw"
+  [world]="chain"
+  [sequential]="chain world"
+  [overall]="chain world sequential"
+  [run]="chain world sequential overall"
+  [arm]="chain world sequential"
+  [strands]="chain world sequential"
+  [io]="chain world sequential overall run arm strands"
+  [groom]="chain world sequential overall run arm io strands"
+  [scenario]="chain world sequential overall run arm io strands groom"
+  [umbrella]="chain world sequential overall run arm strands io groom scenario"
+  [render]="chain world sequential overall run arm io strands groom"
+  [viewer]="chain world sequential overall run arm io strands groom"
+  [gltf]="chain world sequential overall run arm io render"
+  [urdf]="chain world sequential overall run arm io"
+  [draw]="chain world sequential overall run arm io strands groom render viewer gltf"
+  [apps]="chain world sequential overall run arm io strands groom scenario render viewer gltf urdf draw"
 )
 
 layer_of_path() {  # a file of the tree -> its layer

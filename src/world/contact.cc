@@ -1,0 +1,249 @@
+// A link against the colliders (src/world/contact.h, docs/colliders.md).
+#include "world/contact.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+namespace flexkin::internal {
+namespace {
+
+using Eigen::Vector3d;
+
+// The closest points of the segments [p, q] and [r, s]: parameters (t, u) of p + t (q - p) and
+// r + u (s - r) in [0, 1], minimizing the distance (the convex quadratic in (t, u) on the unit
+// square: its minimum on an edge when the interior one is outside).
+double SegmentSegmentDistance(const Vector3d& p, const Vector3d& q, const Vector3d& r,
+                              const Vector3d& s) {
+  const Vector3d d1 = q - p, d2 = s - r, w = p - r;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(w);
+  double t = 0.0, u = 0.0;
+  if (a == 0.0 && e == 0.0) return w.norm();
+  if (a == 0.0) {
+    u = std::clamp(f / e, 0.0, 1.0);
+  } else {
+    const double c = d1.dot(w);
+    if (e == 0.0) {
+      t = std::clamp(-c / a, 0.0, 1.0);
+    } else {
+      const double b = d1.dot(d2), denom = a * e - b * b;
+      t = denom > 0.0 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
+      u = (b * t + f) / e;
+      if (u < 0.0) {
+        u = 0.0;
+        t = std::clamp(-c / a, 0.0, 1.0);
+      } else if (u > 1.0) {
+        u = 1.0;
+        t = std::clamp((b - c) / a, 0.0, 1.0);
+      }
+    }
+  }
+  return (p + t * d1 - (r + u * d2)).norm();
+}
+
+// The minimum of the signed distance along [a, b] by golden-section search (the function is
+// convex), with the ends.
+double ConvexMinimumAlong(const Collider& c, const Vector3d& a, const Vector3d& b) {
+  const auto f = [&](double t) { return QuerySurface(c, a + t * (b - a)).distance; };
+  constexpr double kInvPhi = 0.6180339887498949;
+  double lo = 0.0, hi = 1.0;
+  double x1 = hi - kInvPhi * (hi - lo), x2 = lo + kInvPhi * (hi - lo);
+  double f1 = f(x1), f2 = f(x2);
+  for (int i = 0; i < 90 && hi - lo > 1e-15; ++i) {
+    if (f1 <= f2) {
+      hi = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = hi - kInvPhi * (hi - lo);
+      f1 = f(x1);
+    } else {
+      lo = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = lo + kInvPhi * (hi - lo);
+      f2 = f(x2);
+    }
+  }
+  return std::min({f1, f2, f(0.0), f(1.0)});
+}
+
+}  // namespace
+
+double SegmentClearance(const Collider& c, const Vector3d& a, const Vector3d& b) {
+  switch (c.shape) {
+    case ColliderShape::kSphere: {
+      const Vector3d center = c.pose.translation(), ab = b - a;
+      const double ab2 = ab.squaredNorm();
+      const double t = ab2 > 0.0 ? std::clamp((center - a).dot(ab) / ab2, 0.0, 1.0) : 0.0;
+      return (a + t * ab - center).norm() - c.radius;
+    }
+    case ColliderShape::kCapsule: {
+      const Vector3d axis = c.pose.linear().col(2) * c.half_length;
+      const Vector3d center = c.pose.translation();
+      return SegmentSegmentDistance(a, b, center - axis, center + axis) - c.radius;
+    }
+    case ColliderShape::kHalfSpace: {
+      const Vector3d up = c.pose.linear().col(2), origin = c.pose.translation();
+      return std::min(up.dot(a - origin), up.dot(b - origin));
+    }
+    case ColliderShape::kEllipsoid:
+    case ColliderShape::kCylinder:
+    case ColliderShape::kBox:
+      return ConvexMinimumAlong(c, a, b);
+  }
+  return 0.0;
+}
+
+double SegmentClearance(const std::vector<Collider>& colliders, const Vector3d& a,
+                        const Vector3d& b) {
+  double least = std::numeric_limits<double>::infinity();
+  for (const Collider& c : colliders) least = std::min(least, SegmentClearance(c, a, b));
+  return least;
+}
+
+namespace {
+
+// The directions from the head: d(theta, psi) = cos(theta) d0 + sin(theta) (cos(psi) e1 +
+// sin(psi) e2), theta the angle from d0 (the direction of the old tail).
+struct Directions {
+  Vector3d d0, e1, e2;
+  Vector3d At(double theta, double psi) const {
+    return std::cos(theta) * d0 + std::sin(theta) * (std::cos(psi) * e1 + std::sin(psi) * e2);
+  }
+};
+
+class TailSearch {
+ public:
+  TailSearch(const Vector3d& head, double length, const std::vector<Collider>& colliders,
+             const Directions& dirs)
+      : head_(head), length_(length), colliders_(colliders), dirs_(dirs) {}
+
+  Vector3d Tail(double theta, double psi) const { return head_ + length_ * dirs_.At(theta, psi); }
+  bool Blocks(const Collider& c, double theta, double psi) const {
+    return SegmentClearance(c, head_, Tail(theta, psi)) < -kContactSlack * length_;
+  }
+
+  // The least angle theta along the half great circle psi at which no collider blocks the link
+  // (+inf if none). Each collider, convex, blocks the directions of a spherically convex set seen
+  // from the head (outside it), within an open hemisphere: along the half circle from a direction
+  // it blocks, it blocks an arc and then never again. So the colliders are passed one after
+  // another, each by bisection to the last bit, at most once each.
+  double ExitAngle(double psi) const {
+    double theta = 0.0;
+    for (size_t round = 0; round <= colliders_.size(); ++round) {
+      const Collider* blocking = nullptr;
+      for (const Collider& c : colliders_) {
+        if (Blocks(c, theta, psi)) {
+          blocking = &c;
+          break;
+        }
+      }
+      if (blocking == nullptr) return theta;
+      double lo = theta, hi = M_PI;
+      if (Blocks(*blocking, hi, psi)) return std::numeric_limits<double>::infinity();
+      for (;;) {
+        const double mid = 0.5 * (lo + hi);
+        if (mid <= lo || mid >= hi) break;
+        (Blocks(*blocking, mid, psi) ? lo : hi) = mid;
+      }
+      theta = hi;
+    }
+    return std::numeric_limits<double>::infinity();
+  }
+
+ private:
+  const Vector3d& head_;
+  const double length_;
+  const std::vector<Collider>& colliders_;
+  const Directions& dirs_;
+};
+
+// The least exit angle near *psi (a sample no larger than its neighbours kStep away, whose exit
+// angle is *theta): golden-section search, then Newton's method on the central differences'
+// slope. Golden-section search places the minimum to about the square root of the rounding (the
+// function is flat there: its values cannot tell closer); the slope can, to about 1e-10. A
+// Newton step is kept unless it raises the exit angle beyond the rounding.
+void RefineExit(const TailSearch& search, double step, double* psi, double* theta) {
+  constexpr double kInvPhi = 0.6180339887498949;
+  double lo = *psi - step, hi = *psi + step;
+  double p1 = hi - kInvPhi * (hi - lo), p2 = lo + kInvPhi * (hi - lo);
+  double t1 = search.ExitAngle(p1), t2 = search.ExitAngle(p2);
+  for (int i = 0; i < 60 && hi - lo > 1e-13; ++i) {
+    if (t1 <= t2) {
+      hi = p2, p2 = p1, t2 = t1;
+      p1 = hi - kInvPhi * (hi - lo);
+      t1 = search.ExitAngle(p1);
+    } else {
+      lo = p1, p1 = p2, t1 = t2;
+      p2 = lo + kInvPhi * (hi - lo);
+      t2 = search.ExitAngle(p2);
+    }
+  }
+  if (t1 < *theta) *theta = t1, *psi = p1;
+  if (t2 < *theta) *theta = t2, *psi = p2;
+  constexpr double kH = 2e-6;
+  for (int i = 0; i < 4; ++i) {
+    const double minus = search.ExitAngle(*psi - kH), plus = search.ExitAngle(*psi + kH);
+    const double slope = (plus - minus) / (2.0 * kH);
+    const double curvature = (plus - 2.0 * *theta + minus) / (kH * kH);
+    if (!(curvature > 0.0) || !std::isfinite(slope)) break;
+    const double move = std::clamp(-slope / curvature, -step, step);
+    const double moved_psi = *psi + move, moved_theta = search.ExitAngle(moved_psi);
+    if (!(moved_theta <= *theta + 4e-16 * (1.0 + *theta))) break;
+    *theta = moved_theta;
+    *psi = moved_psi;
+    if (std::fabs(move) < 1e-12) break;
+  }
+}
+
+}  // namespace
+
+bool ContactTail(int dim, const Vector3d& head, const Vector3d& tail, double length,
+                 const std::vector<Collider>& colliders, Vector3d* x) {
+  Directions dirs;
+  const Vector3d from_head = tail - head;
+  const double distance = from_head.norm();
+  dirs.d0 = distance > 0.0 ? Vector3d(from_head / distance) : Vector3d::UnitX();
+  if (dim == 2) {
+    dirs.e1 = Vector3d(-dirs.d0.y(), dirs.d0.x(), 0.0);
+    dirs.e2 = Vector3d::Zero();
+  } else {
+    // Any orthonormal pair across d0.
+    const Vector3d helper = std::fabs(dirs.d0.x()) < 0.9 ? Vector3d::UnitX() : Vector3d::UnitY();
+    dirs.e1 = dirs.d0.cross(helper).normalized();
+    dirs.e2 = dirs.d0.cross(dirs.e1);
+  }
+  const TailSearch search(head, length, colliders, dirs);
+  double best_theta = std::numeric_limits<double>::infinity(), best_psi = 0.0;
+  if (dim == 2) {
+    // The two ways round.
+    for (double psi : {0.0, M_PI}) {
+      const double theta = search.ExitAngle(psi);
+      if (theta < best_theta) best_theta = theta, best_psi = psi;
+    }
+  } else {
+    // The exit angle over the directions of departure, sampled.
+    constexpr int kSamples = 32;
+    constexpr double kStep = 2.0 * M_PI / kSamples;
+    std::array<double, kSamples> sampled;
+    for (int k = 0; k < kSamples; ++k) sampled[k] = search.ExitAngle(k * kStep);
+    // Every local minimum of the samples is refined (a box's or a cylinder's blocked region has
+    // one per face near the old direction, whose values can be close).
+    for (int k = 0; k < kSamples; ++k) {
+      const double here = sampled[k];
+      if (!std::isfinite(here) || here > sampled[(k + 1) % kSamples] ||
+          here > sampled[(k + kSamples - 1) % kSamples]) {
+        continue;
+      }
+      double psi = k * kStep, theta = here;
+      if (theta > 0.0) RefineExit(search, kStep, &psi, &theta);
+      if (theta < best_theta) best_theta = theta, best_psi = psi;
+    }
+  }
+  if (!std::isfinite(best_theta)) return false;
+  *x = search.Tail(best_theta, best_psi);
+  return true;
+}
+
+}  // namespace flexkin::internal

@@ -1,0 +1,37 @@
+#pragma once
+// A link against the colliders (docs/colliders.md): the clearance of a segment, and the sequential
+// step of a link whose rule would put it into a collider.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "flexkin/colliders.h"
+
+namespace flexkin::internal {
+
+// What a link may lie inside a collider, relative to its length: the rounding of positions
+// computed on a surface (a point found on it to the last bit, then the head of the next link).
+constexpr double kContactSlack = 1e-13;
+
+// The least signed distance of any point of the segment [a, b] to `collider` (negative: the
+// segment enters it, by that depth). Closed form for the sphere, capsule and half-space; for the
+// others, the minimum of the signed distance along the segment (a convex function: the collider is
+// convex) by golden-section search to the last bits of the parameter.
+double SegmentClearance(const Collider& collider, const Eigen::Vector3d& a,
+                        const Eigen::Vector3d& b);
+
+// The smallest clearance of [a, b] over `colliders` (+inf for none).
+double SegmentClearance(const std::vector<Collider>& colliders, const Eigen::Vector3d& a,
+                        const Eigen::Vector3d& b);
+
+// The sequential step of one link with colliders: its leading end is at `head` (already moved,
+// outside every collider); its trailing end was at `tail`. Of the positions x at distance `length`
+// from `head` whose link [head, x] stays outside every collider (to kContactSlack), the one
+// nearest to `tail` (the
+// least motion; direction = the unit direction from head to x, nearest in angle to that of tail).
+// In 2D (dim 2, z = 0) the directions are a circle, in 3D a sphere. Returns false if every
+// direction is blocked (the head is wedged between colliders), leaving *x alone.
+bool ContactTail(int dim, const Eigen::Vector3d& head, const Eigen::Vector3d& tail, double length,
+                 const std::vector<Collider>& colliders, Eigen::Vector3d* x);
+
+}  // namespace flexkin::internal
