@@ -2,8 +2,6 @@
 // flexkin's files shares.
 #include "io/atomic_file.h"
 
-#include "flexkin/result_io.h"
-
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -20,6 +18,7 @@
 #include <vector>
 
 #include "flexkin/error.h"
+#include "flexkin/result_io.h"
 
 namespace flexkin {
 namespace {
