@@ -15,7 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "flexkin/colliders.h"
 #include "flexkin/result_io.h"
+#include "flexkin/scenario.h"
 #include "test_util.h"
 
 namespace flexkin {
@@ -96,6 +98,41 @@ TEST_F(CliTest, EveryExampleRuns) {
     EXPECT_EQ(r.out, "") << "--quiet printed something";
     EXPECT_GT(ReadResultJson(Path("out.json")).result.num_steps, 0) << file;
   }
+}
+
+// A scenario's colliders reach `flexkin run`: the rope of examples/rope_round_post.json slides
+// round its post, every link of every frame outside it (sampled at 201 points per link with
+// QuerySurface), with the tractrix and ftl; without the post the rope cuts through it.
+TEST_F(CliTest, ARopeRoundAPostStaysOutsideIt) {
+  const std::string example = Example("rope_round_post.json");
+  const Collider post = LoadScenarioFile(example).options.colliders.at(0);
+  const auto deepest = [&](const std::string& file) {
+    const ResultFile f = ReadResultJson(Path(file));
+    double least = 1.0;
+    for (const Frame& frame : f.result.frames) {
+      for (Eigen::Index i = 1; i < frame.points.rows(); ++i) {
+        for (int k = 0; k <= 200; ++k) {
+          const Eigen::RowVector2d p =
+              frame.points.row(i - 1) +
+              (k / 200.0) * (frame.points.row(i) - frame.points.row(i - 1));
+          least = std::min(least, QuerySurface(post, Eigen::Vector3d(p.x(), p.y(), 0.0)).distance);
+        }
+      }
+    }
+    return least;
+  };
+  for (const char* method : {"tractrix", "ftl"}) {
+    const CliResult r = Cli("run '" + example + "' -o out.json --method " + method);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_CONTAINS(r.out, "1 collider: ");
+    EXPECT_GE(deepest("out.json"), -1e-12 * 0.05) << method;
+  }
+  EXPECT_LT(deepest("out.json"), 1e-3);  // the post is touched
+  // The same scenario without its "colliders" (the file's last member).
+  const std::string text = ReadFile(example);
+  Write("free.json", text.substr(0, text.find(",\n  \"colliders\"")) + "\n}\n");
+  ASSERT_EQ(Cli("run free.json -o free_out.json").exit_code, 0);
+  EXPECT_LT(deepest("free_out.json"), -0.1 * post.radius) << "without the post the rope cuts it";
 }
 
 TEST_F(CliTest, OptionsOverrideTheScenario) {

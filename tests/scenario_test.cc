@@ -14,6 +14,7 @@
 #include <system_error>
 #include <vector>
 
+#include "flexkin/colliders.h"
 #include "flexkin/error.h"
 #include "flexkin/run.h"
 #include "io/json_file.h"      // ParseJsonText, ReadJsonFile
@@ -457,6 +458,60 @@ TEST(ScenarioSchemaTest, SchemaAndParserAcceptTheSameKeys) {
     doc["curve"] = {{"shape", shape}, {"links", 1}, {"link_length", 1}};
     EXPECT_EQ(AcceptedKeys(doc, "/curve"), SchemaKeys(defs[std::string(shape) + "Curve"])) << shape;
   }
+  doc["curve"] = {{"points", {{0, 0}, {1, 0}}}};
+  for (const auto& [shape, def] :
+       std::vector<std::pair<std::string, std::string>>{{"sphere", "sphereCollider"},
+                                                        {"capsule", "capsuleCollider"},
+                                                        {"cylinder", "cylinderCollider"},
+                                                        {"box", "boxCollider"},
+                                                        {"ellipsoid", "ellipsoidCollider"},
+                                                        {"half_space", "halfSpaceCollider"}}) {
+    doc["colliders"] = json::array({{{"shape", shape}}});
+    EXPECT_EQ(AcceptedKeys(doc, "/colliders/0"), SchemaKeys(defs[def])) << shape;
+  }
+}
+
+// Colliders in a scenario: each shape read into the collider it names (2D shapes in the plane
+// z = 0), and every mistake named by its JSON pointer.
+TEST(ScenarioCollidersTest, ShapesAreReadAndMistakesNamed) {
+  const Scenario s = ParseScenarioText(R"({
+    "curve": {"points": [[0, 0], [0, -1], [0, -2]]}, "leader": {"pull": [0, 1]},
+    "colliders": [
+      {"shape": "sphere", "center": [3, 0], "radius": 0.5},
+      {"shape": "capsule", "from": [2, 2], "to": [4, 2], "radius": 0.25},
+      {"shape": "cylinder", "from": [-3, 0], "to": [-3, 2], "radius": 0.5},
+      {"shape": "box", "center": [5, 5], "half_extents": [1, 2], "angle": 0.5},
+      {"shape": "ellipsoid", "center": [-5, 5], "semi_axes": [1, 0.5]},
+      {"shape": "half_space", "point": [0, -10], "normal": [0, 2]}]})");
+  const std::vector<Collider>& c = s.options.colliders;
+  ASSERT_EQ(c.size(), 6u);
+  EXPECT_EQ(c[0].shape, ColliderShape::kSphere);
+  EXPECT_NEAR(QuerySurface(c[0], Eigen::Vector3d(3, 1, 0)).distance, 0.5, 1e-15);
+  EXPECT_EQ(c[1].shape, ColliderShape::kCapsule);
+  EXPECT_NEAR(c[1].half_length, 1.0, 1e-15);
+  EXPECT_NEAR(QuerySurface(c[1], Eigen::Vector3d(5, 2, 0)).distance, 0.75, 1e-15);
+  EXPECT_NEAR(QuerySurface(c[2], Eigen::Vector3d(-3, 3, 0)).distance, 1.0, 1e-15);
+  EXPECT_NEAR(QuerySurface(c[3], Eigen::Vector3d(5, 5, 0)).distance, -1.0, 1e-15);
+  EXPECT_NEAR(QuerySurface(c[4], Eigen::Vector3d(-5, 6, 0)).distance, 0.5, 1e-12);
+  EXPECT_NEAR(QuerySurface(c[5], Eigen::Vector3d(7, -9, 0)).distance, 1.0, 1e-15);
+  for (const Collider& collider : c) EXPECT_TRUE(CheckCollider(collider, "/c").empty());
+
+  const auto problems = ValidateScenario(ParseJsonText(R"({
+    "curve": {"points": [[0, 0], [0, -1]]}, "leader": {"pull": [0, 1]},
+    "colliders": [
+      {"shape": "sphere", "center": [3, 0, 1], "radius": 0},
+      {"shape": "cube"},
+      {"shape": "cylinder", "from": [1, 1], "to": [1, 1], "radius": 1},
+      {"shape": "box", "center": [5, 5], "half_extents": [1, -2], "rotation": [1, 0, 0, 0]},
+      {"shape": "half_space", "point": [0, 0], "normal": [0, 0]},
+      {"shape": "sphere", "centre": [0, 0], "radius": 1}]})"));
+  std::set<std::string> fields;
+  for (const Problem& p : problems) fields.insert(p.field);
+  EXPECT_EQ(fields, (std::set<std::string>{
+                        "/colliders/0/center", "/colliders/0/radius", "/colliders/1/shape",
+                        "/colliders/2/to", "/colliders/3/half_extents/1", "/colliders/3/rotation",
+                        "/colliders/4/normal", "/colliders/5/center", "/colliders/5/centre"}))
+      << problems.size();
 }
 
 TEST(ScenarioSummaryTest, NamesDimensionLinksStepsAndMethod) {

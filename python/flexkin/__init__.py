@@ -27,6 +27,7 @@ from ._flexkin import (
     ArmStepReport,
     BodyPose,
     Chain,
+    ContactReport,
     InputError,
     Metrics,
     ObjectiveWeights,
@@ -99,7 +100,7 @@ for _name in ("arm_from_urdf", "urdf_from_arm"):
 
 # The C++ classes are defined in flexkin._flexkin; they are documented and pickled as flexkin's.
 _CLASSES = ("AccuracyReport", "ArmModel", "ArmOptions", "ArmStepReport", "BodyPose", "Chain",
-            "Metrics", "ObjectiveWeights", "OverallOptions", "OverallReport", "OverallRunReport",
+            "ContactReport", "Metrics", "ObjectiveWeights", "OverallOptions", "OverallReport", "OverallRunReport",
             "Result", "RobotResult", "RobotScenario", "RunOptions", "Scenario", "StrandBatch",
             "StrandOptions", "StrandRunReport") + _RENDER_CLASSES
 for _name in _CLASSES:
@@ -432,7 +433,7 @@ def _constructor(cls):
 
 __all__ = [
     "AccuracyReport", "AnimationOptions", "ArmModel", "ArmOptions", "ArmStepReport", "BodyPose",
-    "Chain",
+    "Chain", "ContactReport",
     "FigureOptions", "GltfOptions", "InputError", "KeywordError", "Metrics", "ObjectiveWeights",
     "OverallOptions", "OverallReport", "OverallRunReport", "PlotOptions", "Result",
     "RobotResult", "RobotScenario", "RunOptions", "Scenario", "StrandBatch", "StrandOptions",

@@ -91,6 +91,11 @@ class OverallRunReport:
     optimality: float
     first_failure: str
 
+class ContactReport:
+    num_colliders: int
+    contact_link_steps: int
+    least_clearance: float
+
 class StrandRunReport:
     max_length_error: float
     seconds: float
@@ -133,6 +138,7 @@ class Result:
     metrics: Metrics
     accuracy: AccuracyReport
     overall: OverallRunReport
+    contacts: ContactReport
     weights: ObjectiveWeights
     method: str
     lengths: Float64Array

@@ -328,6 +328,21 @@ What the overall solver did over a run (method "overall"); read only.
               "'leader step s, sub-step j: <report>' of the first failure; '' if none.")
       .Finish();
 
+  py::class_<ContactReport> contacts(m, "ContactReport", R"doc(
+What the colliders did to a run (a scenario's "colliders"; docs/colliders.md); read only.
+  num_colliders, contact_link_steps (link steps that slid along a collider), least_clearance
+  (of any link after any sub-step, relative to its length; inf without colliders).
+)doc");
+  Fields<ContactReport>(contacts, "ContactReport")
+      .Member("num_colliders", &ContactReport::num_colliders, "Colliders of the run.")
+      .Member("contact_link_steps", &ContactReport::contact_link_steps,
+              "Link steps (a link's move in one sub-step) that would have entered a collider and "
+              "slid along it instead.")
+      .Member("least_clearance", &ContactReport::least_clearance,
+              "Least clearance of any link from any collider after any sub-step, relative to the "
+              "link's length (inf without colliders; never below -1e-13).")
+      .Finish();
+
   py::class_<OverallReport> report(m, "OverallReport", R"doc(
 What the overall solver did in one step (flexkin.overall_step); read only.
   status ("converged", "max_iterations", "stalled", "failed"), converged, iterations,

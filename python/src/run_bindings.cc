@@ -345,7 +345,8 @@ The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
   frames: (F, n+1, dim) float64, the recorded configurations, row 0 the leading end
   steps: (F,) int64, leader steps done at each frame (0 the initial configuration)
   link_angles: (F, n) float64 (radians, each link's angle to the pull) or None
-  metrics: Metrics; accuracy: AccuracyReport; overall: OverallRunReport (method "overall")
+  metrics: Metrics; accuracy: AccuracyReport; overall: OverallRunReport (method "overall");
+  contacts: ContactReport (colliders)
   method, lengths (n,), num_steps, substeps (used), weights, seconds, scenario, dim, num_links
 )doc");
   Fields<Result>(result, "Result")
@@ -378,6 +379,9 @@ The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
       .Property(
           "overall", RunGet(&RunResult::overall), RunSet(&RunResult::overall),
           "OverallRunReport: what the overall solver did (method 'overall'; zeros otherwise).")
+      .Property("contacts", RunGet(&RunResult::contacts), RunSet(&RunResult::contacts),
+                "ContactReport: what the colliders did (a scenario's \"colliders\"; "
+                "num_colliders 0 otherwise).")
       .Property("weights", RunGet(&RunResult::weights), RunSet(&RunResult::weights),
                 "ObjectiveWeights: the overall method's metric (method 'overall').")
       .Property("seconds", RunGet(&RunResult::seconds), RunSet(&RunResult::seconds),

@@ -104,6 +104,7 @@ def samples():
             {"strands": [{"points": [[0, 0], [0, 1], [0, 2]]}],
              "motion": {"keyframes": [{"time": 0}, {"time": 1, "translation": [1, 0]}]}},
             os.path.join(directory, "h.npz"), threads=2)
+    rope = flexkin.run_scenario(EXAMPLES / "rope_round_post.json")
     out = {
         "AccuracyReport": [controlled.accuracy],
         "ArmModel": [limited, spherical, axes, slide],
@@ -115,13 +116,14 @@ def samples():
                                           pointing_tolerance=1e-7)],
         "ArmStepReport": [first, second],
         "Chain": [flexkin.Chain(p, link_length=0.25), flexkin.Chain(flexkin.helix(links=4))],
+        "ContactReport": [rope.contacts],
         "Metrics": [controlled.metrics, overall.metrics],
         "ObjectiveWeights": [flexkin.ObjectiveWeights(rotation=0.5, l2_weighted=2)],
         "OverallOptions": [flexkin.OverallOptions(weights={"squared": 1, "joint_angle": 0.5},
                                                   max_iterations=7)],
         "OverallReport": [report],
         "OverallRunReport": [overall.overall],
-        "Result": [controlled, overall, no_angles],
+        "Result": [controlled, overall, no_angles, rope],
         "RobotResult": [robot, flexkin.run_robot(EXAMPLES / "robot_planar_8link.json")],
         "RobotScenario": [flexkin.load_robot_scenario(EXAMPLES / "robot_ravi_circle.json"),
                           flexkin.RobotScenario(limited, [[2.0, 2.0]], name="one target")],

@@ -19,7 +19,7 @@ Scenario Parser::Parse(const json& root) {
   if (!ExpectObject(root, "", "an object with \"curve\" and \"leader\"")) return s;
   CheckKeys(root, "",
             {"$schema", "name", "description", "curve", "leader", "method", "objective", "solver",
-             "record", "accuracy"});
+             "record", "accuracy", "colliders"});
   for (const char* key : {"$schema", "name", "description"}) {
     if (const json* v = Find(root, key)) {
       if (const auto text = String(*v, std::string("/") + key)) {
@@ -34,6 +34,9 @@ Scenario Parser::Parse(const json& root) {
     chain = ParseCurve(*c, "/curve");
   }
   ParseOptions(root, &s.options);
+  if (const json* c = Find(root, "colliders"); c != nullptr && chain) {
+    ParseColliders(*c, "/colliders", chain->dim(), &s.options.colliders);
+  }
   const bool max_substeps_given = root.contains("accuracy") && root["accuracy"].is_object() &&
                                   root["accuracy"].contains("max_substeps");
   std::optional<Points> steps;
@@ -66,6 +69,7 @@ const std::vector<OptionLocation>& RunOptionLocations() {
       {"link_angles", "/record/link_angles", "--no-link-angles"},
       {"tolerance", "/accuracy/tolerance", "--tolerance"},
       {"max_substeps", "/accuracy/max_substeps", "--max-substeps"},
+      {"colliders", "/colliders", ""},
       {"overall.weights.", "/objective", ""},
       {"overall.weights", "/objective", ""},
       {"overall.", "/solver", ""},

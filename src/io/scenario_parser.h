@@ -49,6 +49,10 @@ class Parser : public json_internal::JsonReader {
   std::optional<Points> ParseLeader(const json& v, const std::string& ptr, const Chain* chain,
                                     RunOptions* options);
   void ParseOptions(const json& root, RunOptions* options);
+  // "colliders": an array of shapes in the chain's dimension (scenario_colliders.cc).
+  void ParseColliders(const json& v, const std::string& ptr, int dim,
+                      std::vector<Collider>* colliders);
+  std::optional<Collider> ParseCollider(const json& v, const std::string& ptr, int dim);
 
   // Lets the curve module check and build a shape whose values were all read. Its own checks
   // (radius vs. link length, a zero direction) only run then, so that a default standing in for

@@ -31,6 +31,12 @@ std::string RunResult::BriefReport() const {
         << overall.max_iterations << " per step)";
     if (overall.failures > 0) out << ", FIRST FAILURE " << overall.first_failure;
   }
+  if (contacts.num_colliders > 0) {
+    out << ", " << contacts.num_colliders
+        << (contacts.num_colliders == 1 ? " collider: " : " colliders: ")
+        << contacts.contact_link_steps << " link steps in contact, least clearance "
+        << Format("%.3g", contacts.least_clearance) << " of a link";
+  }
   if (accuracy.enabled) {
     out << ", estimated error " << Format("%.3g", accuracy.estimated_error)
         << (accuracy.met ? " (tolerance met)" : " (TOLERANCE NOT MET)");

@@ -1,0 +1,158 @@
+// The "colliders" of a chain scenario (docs/scenario-format.md, docs/colliders.md): each shape in
+// the chain's dimension (2D shapes lie in the plane z = 0), read into a Collider placed by a pose.
+#include <Eigen/Geometry>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "io/scenario_parser.h"
+
+namespace flexkin::scenario_internal {
+namespace {
+
+Eigen::Vector3d In3d(const Eigen::VectorXd& v) {
+  return Eigen::Vector3d(v[0], v[1], v.size() == 3 ? v[2] : 0.0);
+}
+
+// The rotation that takes the frame's z axis to `axis` (nonzero).
+Eigen::Matrix3d ZAxisAlong(const Eigen::Vector3d& axis) {
+  return Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis).toRotationMatrix();
+}
+
+}  // namespace
+
+void Parser::ParseColliders(const json& v, const std::string& ptr, int dim,
+                            std::vector<Collider>* colliders) {
+  if (!v.is_array()) {
+    TypeProblem(v, ptr, "an array of colliders, e.g. [{\"shape\": \"sphere\", ...}]");
+    return;
+  }
+  dimension_of_ = "the curve";
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (auto c = ParseCollider(v[i], ptr + "/" + std::to_string(i), dim)) {
+      colliders->push_back(*c);
+    }
+  }
+}
+
+std::optional<Collider> Parser::ParseCollider(const json& v, const std::string& ptr, int dim) {
+  static const std::vector<std::string> kShapes = {"sphere",   "ellipsoid", "capsule",
+                                                   "cylinder", "box",       "half_space"};
+  if (!ExpectObject(v, ptr, "an object {\"shape\": ..., ...}")) return std::nullopt;
+  const json* shape_value = Required(v, ptr, "shape", "one of " + QuotedList(kShapes));
+  if (shape_value == nullptr) return std::nullopt;
+  const auto shape = Choice(*shape_value, ptr + "/shape", kShapes);
+  if (!shape) return std::nullopt;
+  const size_t before = problems.size();
+  Collider c;
+  const auto vector = [&](const char* key) -> std::optional<Eigen::VectorXd> {
+    const json* x = Required(v, ptr, key, "an array of " + std::to_string(dim) + " numbers");
+    return x != nullptr ? Vector(*x, ptr + "/" + key, dim) : std::nullopt;
+  };
+  const auto positive = [&](const char* key) {
+    double value = 0.0;
+    Require(
+        v, ptr, key, "a finite number > 0",
+        [&](const json& x, const std::string& p) { return Number(x, p, Range::kPositive); },
+        &value);
+    return value;
+  };
+  // The orientation of a box or an ellipsoid: "angle" (2D, radians about z) or "rotation" (3D, a
+  // unit quaternion [w, x, y, z]); axis-aligned without one.
+  const auto orientation = [&]() {
+    if (dim == 2) {
+      double angle = 0.0;
+      Optional(
+          v, ptr, "angle",
+          [&](const json& x, const std::string& p) { return Number(x, p, Range::kAny); }, &angle);
+      c.pose.linear() = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    } else if (const json* r = Find(v, "rotation")) {
+      if (const auto q = Vector(*r, ptr + "/rotation", 4)) {
+        const double norm = q->norm();
+        if (!(norm > 0.0)) {
+          Add(ptr + "/rotation",
+              "is not a rotation; expected a quaternion [w, x, y, z] of length 1", ShowJson(*r),
+              "a unit quaternion [w, x, y, z]");
+        } else if (std::fabs(norm - 1.0) > 1e-9) {
+          Add(ptr + "/rotation",
+              "has length " + FormatNumber(norm) + "; expected a unit quaternion [w, x, y, z]",
+              ShowJson(*r), "a unit quaternion [w, x, y, z]");
+        } else {
+          c.pose.linear() = Eigen::Quaterniond((*q)[0], (*q)[1], (*q)[2], (*q)[3])
+                                .normalized()
+                                .toRotationMatrix();
+        }
+      }
+    }
+  };
+  // The extents of a box or an ellipsoid: `dim` positive numbers (a 2D shape's third is 1, which
+  // its slice by the plane z = 0 does not see).
+  const auto extents = [&](const char* key) {
+    if (const auto e = vector(key)) {
+      for (int k = 0; k < dim; ++k) {
+        if (!((*e)[k] > 0.0)) {
+          Add(ptr + "/" + key + "/" + std::to_string(k),
+              "value " + FormatNumber((*e)[k]) + " is not valid; expected a finite number > 0",
+              FormatNumber((*e)[k]), "a finite number > 0");
+        }
+        c.extents[k] = (*e)[k];
+      }
+      if (dim == 2) c.extents[2] = 1.0;
+    }
+  };
+  std::vector<std::string> keys = {"shape"};
+  if (*shape == "sphere") {
+    c.shape = ColliderShape::kSphere;
+    keys.insert(keys.end(), {"center", "radius"});
+    if (const auto center = vector("center")) c.pose.translation() = In3d(*center);
+    c.radius = positive("radius");
+  } else if (*shape == "capsule" || *shape == "cylinder") {
+    c.shape = *shape == "capsule" ? ColliderShape::kCapsule : ColliderShape::kCylinder;
+    keys.insert(keys.end(), {"from", "to", "radius"});
+    const auto from = vector("from"), to = vector("to");
+    c.radius = positive("radius");
+    if (from && to) {
+      const Eigen::Vector3d a = In3d(*from), b = In3d(*to);
+      c.pose.translation() = 0.5 * (a + b);
+      c.half_length = 0.5 * (b - a).norm();
+      if (c.half_length > 0.0) {
+        c.pose.linear() = ZAxisAlong(b - a);
+      } else if (c.shape == ColliderShape::kCylinder) {
+        Add(ptr + "/to", "equals \"from\"; a cylinder needs an axis of positive length",
+            ShowJson(v["to"]), "a point other than \"from\"");
+      }
+    }
+  } else if (*shape == "box" || *shape == "ellipsoid") {
+    const bool box = *shape == "box";
+    c.shape = box ? ColliderShape::kBox : ColliderShape::kEllipsoid;
+    const char* size_key = box ? "half_extents" : "semi_axes";
+    keys.insert(keys.end(), {"center", size_key, "angle", "rotation"});
+    const char* other = dim == 2 ? "rotation" : "angle";
+    if (Find(v, other) != nullptr) {
+      Add(ptr + "/" + other,
+          dim == 2 ? "is for 3D shapes; a 2D shape turns by \"angle\" (radians about z)"
+                   : "is for 2D shapes; a 3D shape turns by \"rotation\" (a unit quaternion "
+                     "[w, x, y, z])");
+    }
+    if (const auto center = vector("center")) c.pose.translation() = In3d(*center);
+    extents(size_key);
+    orientation();
+  } else {
+    c.shape = ColliderShape::kHalfSpace;
+    keys.insert(keys.end(), {"point", "normal"});
+    if (const auto point = vector("point")) c.pose.translation() = In3d(*point);
+    if (const auto normal = vector("normal")) {
+      if (normal->norm() > 0.0) {
+        c.pose.linear() = ZAxisAlong(In3d(*normal));
+      } else {
+        Add(ptr + "/normal", "is zero; expected the outward normal of the half-space's plane",
+            ShowJson(v["normal"]), "a nonzero vector");
+      }
+    }
+  }
+  CheckKeys(v, ptr, keys);
+  if (problems.size() != before) return std::nullopt;
+  return c;
+}
+
+}  // namespace flexkin::scenario_internal
