@@ -1,6 +1,7 @@
 // The "colliders" of a chain scenario (docs/scenario-format.md, docs/colliders.md): each shape in
 // the chain's dimension (2D shapes lie in the plane z = 0), read into a Collider placed by a pose.
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -41,8 +42,12 @@ std::optional<Collider> Parser::ParseCollider(const json& v, const std::string& 
   if (!ExpectObject(v, ptr, "an object {\"shape\": ..., ...}")) return std::nullopt;
   const json* shape_value = Required(v, ptr, "shape", "one of " + QuotedList(kShapes));
   if (shape_value == nullptr) return std::nullopt;
-  const auto shape = Choice(*shape_value, ptr + "/shape", kShapes);
+  const auto shape = String(*shape_value, ptr + "/shape");
   if (!shape) return std::nullopt;
+  if (std::find(kShapes.begin(), kShapes.end(), *shape) == kShapes.end()) {
+    problems.push_back(UnknownName(ptr + "/shape", "collider shape", *shape, kShapes));
+    return std::nullopt;
+  }
   const size_t before = problems.size();
   Collider c;
   const auto vector = [&](const char* key) -> std::optional<Eigen::VectorXd> {
