@@ -4,7 +4,9 @@
 #include <iosfwd>
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "flexkin/colliders.h"
 #include "flexkin/run.h"
 
 namespace flexkin {
@@ -39,8 +41,11 @@ struct ResultHeader {
   int dim = 2;                // 2 or 3
   Eigen::VectorXd lengths;    // the n link lengths
   std::string scenario_name;  // written as "scenario" if not empty
+  // The run's colliders (RunOptions::colliders), written as "colliders" in the scenario's form if
+  // any (a file without them is written as before colliders existed).
+  std::vector<Collider> colliders;
 };
-// The header of a run of `chain` with `options`.
+// The header of a run of `chain` with `options` (its colliders included).
 ResultHeader MakeResultHeader(const Chain& chain, const RunOptions& options,
                               const std::string& scenario_name = "");
 
@@ -164,7 +169,22 @@ struct ResultFile {
   RunResult result;           // method, lengths, num_steps, frames, metrics, accuracy, seconds
   int dim = 0;                // 2 or 3
   std::string scenario_name;  // "" if the file has none
+  // The colliders the chain stayed outside of ("colliders", in the scenario's form; empty if the
+  // file has none). Here rather than in RunResult, beside the scenario's name: like it they are
+  // the run's input, known before it starts (RunOptions::colliders), which a run hands on
+  // unchanged; what the run made of them is RunResult::contacts.
+  std::vector<Collider> colliders;
 };
+
+// ValidateResult of the file's result, and its colliders: each passes CheckCollider and, in 2D,
+// lies in the plane z = 0 as a 2D scenario's (fields "colliders[k]"). What every writer of a
+// ResultFile (the result writers, the figures, the viewer, glTF) checks.
+Problems ValidateResult(const ResultFile& file);
+
+// Writes a whole ResultFile (its result, scenario name and colliders) as WriteResultFile and
+// WriteResultJson write a RunResult: what reads back as the same ResultFile.
+void WriteResultFile(const ResultFile& file, const std::string& path, ResultFileFormat format);
+void WriteResultJson(const ResultFile& file, std::ostream& out);
 
 // Reads a result file of either format, recognised by its content (an .npz file starts with
 // "PK\x03\x04"; anything else is read as JSON): the same ResultFile as ReadResultJson gives for

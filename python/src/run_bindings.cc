@@ -120,6 +120,7 @@ Result RunToArrays(const Chain& chain, const Points& leader_steps, RunOptions op
   Result result;
   result.file.dim = chain.dim();
   result.file.scenario_name = std::move(scenario);
+  result.file.colliders = options.colliders;  // written with the result, drawn with it
   ProgressHook hook(std::move(progress));
   hook.Install(&options.progress);
   try {
@@ -207,7 +208,7 @@ Result ReadResult(PathLike path_arg) {
 void WriteResult(const Result& r, PathLike path_arg) {
   const std::string path = RequiredPath(path_arg, "path");
   const ResultFileFormat format = ResultFileFormatOfPath(path);
-  OnFile(path, [&] { WriteResultFile(r.file.result, path, format, r.file.scenario_name); });
+  OnFile(path, [&] { WriteResultFile(r.file, path, format); });
 }
 
 void WriteCsv(const Result& r, PathLike path_arg) {

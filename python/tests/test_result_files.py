@@ -178,3 +178,20 @@ def test_run_scenario_files_equal_the_command_lines(cli, tmp_path):
                     str(tmp_path / "cli.csv"), "-q"], check=True)
     assert (tmp_path / "cli.csv").read_bytes() == (tmp_path / "py.csv").read_bytes()
     assert np.array_equal(flexkin.read_result(tmp_path / "cli.npz").frames, res.frames)
+
+
+def test_colliders_travel_with_the_result(tmp_path):
+    # The rope round its post: run_scenario's Result, its files and a Result read back and written
+    # again all carry the post, in the scenario's form (docs/result-format.md, "colliders").
+    scenario = EXAMPLES / "rope_round_post.json"
+    posts = json.loads(scenario.read_text())["colliders"]
+    res = flexkin.run_scenario(scenario, output=tmp_path / "rope.npz")
+    res.write(tmp_path / "memory.json")
+    assert json.loads((tmp_path / "memory.json").read_text())["colliders"] == posts
+    again = tmp_path / "again.json"
+    flexkin.read_result(tmp_path / "rope.npz").write(again)
+    assert json.loads(again.read_text())["colliders"] == posts
+    # A result without colliders has no such key.
+    plain = tmp_path / "plain.json"
+    flexkin.run_scenario(EXAMPLES / "fig10_planar_curve.json").write(plain)
+    assert "colliders" not in json.loads(plain.read_text())

@@ -295,7 +295,7 @@ std::vector<OutputFormat> ParseOutputFormats(const std::string& list, const std:
 std::vector<std::string> Draw(const ResultFile& result, const DrawOptions& options) {
   ThrowIfAny(ValidateDrawOptions(DrawnKind::kChainResult, options));
   if (result.result.frames.empty()) throw InputError("frames", "no frames; nothing to draw");
-  ThrowIfAny(ValidateResult(result.result, result.dim));
+  ThrowIfAny(ValidateResult(result));
   Output o(options);
   o.drawing.emplace(internal::CheckedDrawing{result});
   return DrawChecked(DrawnKind::kChainResult, o);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <ostream>
 #include <stdexcept>
 #include <string>
@@ -16,6 +17,7 @@
 #include "gltf/rig.h"
 #include "gltf/tube.h"
 #include "io/atomic_file.h"
+#include "io/collider_mesh.h"
 
 namespace flexkin {
 namespace {
@@ -235,11 +237,61 @@ void AddMesh(const ResultFile& file, const GltfOptions& options, const Eigen::Ma
                        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_MAT4, n + 1);
 }
 
+// Each collider as a mesh node "collider_k" under the "flexkin" node (node 0), so in the chain's
+// up axis and scale: its surface (io/collider_mesh.h) in flexkin's coordinates, every vertex on
+// it; a half-space as a square of its plane, 20 times the motion's extent across, about the
+// plane's point nearest the motion's centre.
+void AddColliders(const ResultFile& file, BufferWriter* buffer, tinygltf::Model* model) {
+  if (file.colliders.empty()) return;
+  Eigen::Vector3d lo, hi;
+  BoundsOfMotion(file, &lo, &hi);
+  const double extent = std::max((hi - lo).norm(), file.result.lengths.sum());
+  const int material = static_cast<int>(model->materials.size());
+  tinygltf::Material stone;
+  stone.name = "collider";
+  stone.pbrMetallicRoughness.baseColorFactor = {0.62, 0.62, 0.60, 1.0};
+  stone.pbrMetallicRoughness.metallicFactor = 0.0;
+  stone.pbrMetallicRoughness.roughnessFactor = 0.9;
+  stone.doubleSided = true;  // a half-space's square is seen from both sides
+  model->materials.push_back(stone);
+  for (size_t k = 0; k < file.colliders.size(); ++k) {
+    const Collider& collider = file.colliders[k];
+    const ColliderMesh mesh = MeshOfCollider(collider, 48, 0.5 * (lo + hi), 10.0 * extent);
+    const std::string name = "collider_" + std::to_string(k);
+    std::vector<float> positions;
+    for (const Eigen::Vector3d& v : mesh.vertices) {
+      for (int c = 0; c < 3; ++c) positions.push_back(static_cast<float>(v[c]));
+    }
+    std::vector<uint32_t> indices;
+    for (const auto& t : mesh.triangles) indices.insert(indices.end(), t.begin(), t.end());
+    std::vector<double> min, max;
+    MinMax(positions, 3, &min, &max);
+    tinygltf::Primitive primitive;
+    primitive.attributes["POSITION"] = buffer->Accessor(
+        buffer->View(positions, kArrayBuffer, name + " positions"), 0,
+        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, mesh.vertices.size(), min, max);
+    primitive.indices = buffer->Accessor(
+        buffer->View(indices, kElementArrayBuffer, name + " indices"), 0,
+        TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, indices.size());
+    primitive.mode = TINYGLTF_MODE_TRIANGLES;
+    primitive.material = material;
+    tinygltf::Mesh gltf_mesh;
+    gltf_mesh.name = name + " (" + ColliderShapeName(collider.shape) + ")";
+    gltf_mesh.primitives.push_back(primitive);
+    model->meshes.push_back(gltf_mesh);
+    tinygltf::Node node;
+    node.name = name;
+    node.mesh = static_cast<int>(model->meshes.size() - 1);
+    model->nodes.push_back(node);
+    model->nodes[0].children.push_back(static_cast<int>(model->nodes.size() - 1));
+  }
+}
+
 }  // namespace
 
 void WriteGltf(const ResultFile& file, const GltfOptions& options, const std::string& path) {
   ThrowIfAny(options.Validate());
-  ThrowIfAny(ValidateResult(file.result, file.dim));
+  ThrowIfAny(ValidateResult(file));
   internal::WriteGltf({file}, options, path);
 }
 
@@ -270,7 +322,8 @@ void internal::WriteGltf(const CheckedDrawing& drawing, const GltfOptions& optio
   model.asset.extras = Extras(file, options, axis);
   BufferWriter buffer(&model);
 
-  // Nodes: 0 the "flexkin" node (axes and scale), 1 + j joint j, n + 2 the tube.
+  // Nodes: 0 the "flexkin" node (axes and scale), 1 + j joint j, n + 2 the tube, then the
+  // colliders (children of node 0).
   tinygltf::Node root;
   root.name = "flexkin";
   if (axis == GltfUpAxis::kZ) root.rotation = {-std::sqrt(0.5), 0.0, 0.0, std::sqrt(0.5)};
@@ -301,6 +354,7 @@ void internal::WriteGltf(const CheckedDrawing& drawing, const GltfOptions& optio
     model.nodes.push_back(tube);
     scene.nodes.push_back(n + 2);
   }
+  AddColliders(file, &buffer, &model);
   model.scenes.push_back(scene);
   model.defaultScene = 0;
 

@@ -7,6 +7,7 @@
 
 #include "flexkin/error.h"
 #include "flexkin/result_io.h"
+#include "io/colliders_json.h"
 
 namespace flexkin {
 namespace {
@@ -117,6 +118,13 @@ std::optional<Problem> FirstProblem(const RunResult& r, int dim) {
 Problems ValidateResult(const RunResult& result, int dim) {
   if (std::optional<Problem> problem = FirstProblem(result, dim)) return {*problem};
   return {};
+}
+
+Problems ValidateResult(const ResultFile& file) {
+  if (std::optional<Problem> problem = FirstProblem(file.result, file.dim)) return {*problem};
+  Problems problems = CollidersProblems(file.colliders, file.dim);
+  if (problems.size() > 1) problems.resize(1);  // the first, as for the rest of the result
+  return problems;
 }
 
 }  // namespace flexkin

@@ -6,6 +6,7 @@
 
 #include "flexkin/error.h"
 #include "flexkin/result_io.h"
+#include "io/colliders_json.h"
 #include "io/json_checked.h"
 #include "io/json_file.h"
 #include "io/result_json.h"
@@ -76,6 +77,11 @@ void ReadResultSummary(const json& j, const ResultArrays* arrays, ResultFile* ou
   file.dim = static_cast<int>(ReadInteger(Member(j, "", "dim"), "/dim", 2));
   if (file.dim > 3)
     throw InputError("/dim", "value " + std::to_string(file.dim) + " is not 2 or 3");
+  if (const auto it = j.find("colliders"); it != j.end()) {
+    Problems problems;
+    file.colliders = ReadCollidersJson(*it, "/colliders", file.dim, &problems);
+    ThrowIfAny(problems);
+  }
   r.lengths =
       arrays ? arrays->lengths : ReadVector(Member(j, "", "link_lengths"), "/link_lengths", -1);
   const Eigen::Index n = r.lengths.size();

@@ -12,6 +12,7 @@
 #include "flexkin/error.h"
 #include "flexkin/result_io.h"
 #include "io/atomic_file.h"
+#include "io/colliders_json.h"
 #include "io/result_check.h"
 #include "io/result_writers.h"
 
@@ -51,13 +52,23 @@ int CheckResult(const RunResult& r) {
   return dim;
 }
 
-ResultHeader HeaderOfResult(const RunResult& r, int dim, const std::string& scenario_name) {
+ResultHeader HeaderOfResult(const RunResult& r, int dim, const std::string& scenario_name,
+                            const std::vector<Collider>& colliders = {}) {
   ResultHeader h;
   h.method = r.method;
   h.dim = dim;
   h.lengths = r.lengths;
   h.scenario_name = scenario_name;
+  h.colliders = colliders;
   return h;
+}
+
+// ValidateResult of a ResultFile, before the destination is touched; its dimension.
+int CheckResultFile(const ResultFile& file) {
+  if (Problems problems = ValidateResult(file); !problems.empty()) {
+    ThrowNothingWritten(problems.front());
+  }
+  return file.dim;
 }
 
 // Appends to `text` and hands it to `out` in pieces, so that a result of any size is written
@@ -197,6 +208,15 @@ void AppendResultHeaderJson(const ResultHeader& h, bool with_lengths, std::strin
     AppendVector(h.lengths, &t);
     t += ",\n";
   }
+  // Only with colliders: a result without them is the file it was before they existed.
+  if (!h.colliders.empty()) {
+    t += "\"colliders\": [\n";
+    for (size_t k = 0; k < h.colliders.size(); ++k) {
+      if (k > 0) t += ",\n";
+      AppendColliderJson(h.colliders[k], h.dim, &t);
+    }
+    t += "\n],\n";
+  }
 }
 
 void AppendResultSummaryJson(const RunResult& result, bool with_arrays, std::string* out) {
@@ -284,6 +304,7 @@ ResultHeader MakeResultHeader(const Chain& chain, const RunOptions& options,
   h.dim = chain.dim();
   h.lengths = chain.lengths;
   h.scenario_name = scenario_name;
+  h.colliders = options.colliders;
   return h;
 }
 
@@ -292,6 +313,9 @@ ResultFileWriter::ResultFileWriter(const std::string& path, ResultFileFormat for
     : header_(header) {
   if (auto problem = ResultHeaderProblem(header.lengths, header.dim)) {
     ThrowNothingWritten(*problem);
+  }
+  if (Problems problems = CollidersProblems(header.colliders, header.dim); !problems.empty()) {
+    ThrowNothingWritten(problems.front());
   }
   if (format == ResultFileFormat::kNpz) {
     impl_ = MakeNpzResultWriter(path, header);
@@ -364,6 +388,26 @@ void WriteResultFile(const RunResult& result, const std::string& path, ResultFil
 void WriteResultJson(const RunResult& result, const std::string& path,
                      const std::string& scenario_name) {
   WriteResultFile(result, path, ResultFileFormat::kJson, scenario_name);
+}
+
+void WriteResultJson(const ResultFile& file, std::ostream& out) {
+  const int dim = CheckResultFile(file);
+  JsonResultStream stream(out,
+                          HeaderOfResult(file.result, dim, file.scenario_name, file.colliders));
+  for (const Frame& frame : file.result.frames) {
+    stream.Add(frame.step, frame.points, frame.link_angles);
+  }
+  stream.End(file.result);
+}
+
+void WriteResultFile(const ResultFile& file, const std::string& path, ResultFileFormat format) {
+  const int dim = CheckResultFile(file);
+  ResultFileWriter writer(path, format,
+                          HeaderOfResult(file.result, dim, file.scenario_name, file.colliders));
+  for (const Frame& frame : file.result.frames) {
+    writer.Add(frame.step, frame.points, frame.link_angles);
+  }
+  writer.Commit(file.result);
 }
 
 class FramesCsvWriter::Impl {

@@ -1,11 +1,14 @@
 // The "colliders" of a chain scenario (docs/scenario-format.md, docs/colliders.md): each shape in
-// the chain's dimension (2D shapes lie in the plane z = 0), read into a Collider placed by a pose.
+// the chain's dimension (2D shapes lie in the plane z = 0), read into a Collider placed by a pose;
+// and the same form written back from a Collider, for result files (io/colliders_json.h).
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
 
+#include "io/colliders_json.h"
+#include "io/result_writers.h"
 #include "io/scenario_parser.h"
 
 namespace flexkin::scenario_internal {
@@ -23,12 +26,12 @@ Eigen::Matrix3d ZAxisAlong(const Eigen::Vector3d& axis) {
 }  // namespace
 
 void Parser::ParseColliders(const json& v, const std::string& ptr, int dim,
-                            std::vector<Collider>* colliders) {
+                            std::vector<Collider>* colliders, const char* whose) {
   if (!v.is_array()) {
     TypeProblem(v, ptr, "an array of colliders, e.g. [{\"shape\": \"sphere\", ...}]");
     return;
   }
-  dimension_of_ = "the curve";
+  dimension_of_ = whose;
   for (size_t i = 0; i < v.size(); ++i) {
     if (auto c = ParseCollider(v[i], ptr + "/" + std::to_string(i), dim)) {
       colliders->push_back(*c);
@@ -161,3 +164,127 @@ std::optional<Collider> Parser::ParseCollider(const json& v, const std::string& 
 }
 
 }  // namespace flexkin::scenario_internal
+
+namespace flexkin {
+namespace {
+
+// How far off the plane z = 0 a 2D collider's numbers may be (rounding of its pose).
+constexpr double kPlaneTolerance = 1e-9;
+
+void AppendPoint(const Eigen::Vector3d& p, int dim, std::string* out) {
+  out->push_back('[');
+  for (int k = 0; k < dim; ++k) {
+    if (k > 0) out->append(", ");
+    AppendJsonDouble(p[k], out);
+  }
+  out->push_back(']');
+}
+
+void AppendKey(const char* key, std::string* out) {
+  out->append(", \"");
+  out->append(key);
+  out->append("\": ");
+}
+
+}  // namespace
+
+std::vector<Collider> ReadCollidersJson(const nlohmann::json& v, const std::string& ptr, int dim,
+                                        Problems* problems) {
+  scenario_internal::Parser parser;
+  std::vector<Collider> colliders;
+  parser.ParseColliders(v, ptr, dim, &colliders, "the result");
+  problems->insert(problems->end(), parser.problems.begin(), parser.problems.end());
+  return colliders;
+}
+
+Problems CollidersProblems(const std::vector<Collider>& colliders, int dim) {
+  Problems problems;
+  for (size_t k = 0; k < colliders.size(); ++k) {
+    const Collider& c = colliders[k];
+    const std::string field = "colliders[" + std::to_string(k) + "]";
+    const size_t before = problems.size();
+    for (Problem& p : CheckCollider(c, field)) problems.push_back(std::move(p));
+    if (problems.size() != before || dim != 2) continue;
+    const Eigen::Vector3d t = c.pose.translation(), z = c.pose.linear().col(2);
+    const bool axis_in_plane = std::fabs(z.z()) <= kPlaneTolerance;  // capsule, cylinder, floor
+    bool in_plane = std::fabs(t.z()) <= kPlaneTolerance * (1.0 + t.norm());
+    switch (c.shape) {
+      case ColliderShape::kSphere:
+        break;
+      case ColliderShape::kCapsule:
+        in_plane = in_plane && (c.half_length == 0.0 || axis_in_plane);
+        break;
+      case ColliderShape::kCylinder:
+      case ColliderShape::kHalfSpace:
+        in_plane = in_plane && axis_in_plane;
+        break;
+      case ColliderShape::kBox:
+      case ColliderShape::kEllipsoid:  // turned about z only
+        in_plane = in_plane && std::fabs(z.z() - 1.0) <= kPlaneTolerance;
+        break;
+    }
+    if (!in_plane) {
+      problems.emplace_back(field,
+                            std::string("is a ") + ColliderShapeName(c.shape) +
+                                " that does not lie in the plane z = 0; a 2D result's colliders "
+                                "are written in the 2D form of a scenario's (docs/"
+                                "scenario-format.md), centred in that plane, their axes and "
+                                "normals in it, turned about z only");
+    }
+  }
+  return problems;
+}
+
+void AppendColliderJson(const Collider& c, int dim, std::string* out) {
+  const Eigen::Vector3d t = c.pose.translation();
+  const Eigen::Matrix3d r = c.pose.linear();
+  out->append("{\"shape\": \"");
+  out->append(ColliderShapeName(c.shape));
+  out->push_back('"');
+  const auto point = [&](const char* key, const Eigen::Vector3d& p) {
+    AppendKey(key, out);
+    AppendPoint(p, dim, out);
+  };
+  const auto number = [&](const char* key, double x) {
+    AppendKey(key, out);
+    AppendJsonDouble(x, out);
+  };
+  switch (c.shape) {
+    case ColliderShape::kSphere:
+      point("center", t);
+      number("radius", c.radius);
+      break;
+    case ColliderShape::kCapsule:
+    case ColliderShape::kCylinder:
+      point("from", t - c.half_length * r.col(2));
+      point("to", t + c.half_length * r.col(2));
+      number("radius", c.radius);
+      break;
+    case ColliderShape::kBox:
+    case ColliderShape::kEllipsoid:
+      point("center", t);
+      point(c.shape == ColliderShape::kBox ? "half_extents" : "semi_axes", c.extents);
+      if (r.isIdentity(0.0)) break;  // axis-aligned: as a scenario without "angle" says it
+      if (dim == 2) {
+        number("angle", std::atan2(r(1, 0), r(0, 0)));
+      } else {
+        Eigen::Quaterniond q(r);
+        if (q.w() < 0.0) q.coeffs() = -q.coeffs();
+        AppendKey("rotation", out);
+        const double wxyz[4] = {q.w(), q.x(), q.y(), q.z()};
+        for (int k = 0; k < 4; ++k) {
+          out->append(k == 0 ? "[" : ", ");
+          AppendJsonDouble(wxyz[k], out);
+        }
+        out->push_back(']');
+      }
+      break;
+    case ColliderShape::kHalfSpace:
+      point("point", t);
+      point("normal", r.col(2));
+      break;
+  }
+  out->push_back('}');
+}
+
+}  // namespace flexkin

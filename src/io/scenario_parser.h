@@ -38,6 +38,10 @@ inline std::string FieldToPointer(const std::string& field) { return MemberPathT
 class Parser : public json_internal::JsonReader {
  public:
   Scenario Parse(const json& root);
+  // "colliders": an array of shapes in `dim` dimensions (scenario_colliders.cc), of a scenario
+  // (`whose` "the curve") or a result file ("the result"; io/colliders_json.h).
+  void ParseColliders(const json& v, const std::string& ptr, int dim,
+                      std::vector<Collider>* colliders, const char* whose = "the curve");
 
  private:
   // A point list of the curve or the leader's path: at most kMaxLeaderSteps points.
@@ -49,9 +53,6 @@ class Parser : public json_internal::JsonReader {
   std::optional<Points> ParseLeader(const json& v, const std::string& ptr, const Chain* chain,
                                     RunOptions* options);
   void ParseOptions(const json& root, RunOptions* options);
-  // "colliders": an array of shapes in the chain's dimension (scenario_colliders.cc).
-  void ParseColliders(const json& v, const std::string& ptr, int dim,
-                      std::vector<Collider>* colliders);
   std::optional<Collider> ParseCollider(const json& v, const std::string& ptr, int dim);
 
   // Lets the curve module check and build a shape whose values were all read. Its own checks

@@ -32,6 +32,7 @@ void DrawBackground(render::Canvas* canvas, const ChainScene& scene, const Resul
   const double ui = canvas->ui();
   render::DrawTitle(cr, ui, canvas->width(), render::MainTitle(file, title), look.summary);
   scene.DrawAxes(cr);
+  scene.DrawColliders(cr, file.colliders);
   const std::vector<double> leader = render::LeaderPath(file);
   const int num_frames = static_cast<int>(file.result.frames.size());
   scene.DrawChains(cr, {leader.data()}, {num_frames},

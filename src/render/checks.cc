@@ -13,7 +13,7 @@
 namespace flexkin {
 namespace render {
 
-void CheckDrawable(const ResultFile& file) { ThrowIfAny(ValidateResult(file.result, file.dim)); }
+void CheckDrawable(const ResultFile& file) { ThrowIfAny(ValidateResult(file)); }
 
 void CheckRange(const char* field, double value, double lo, double hi, bool integer,
                 Problems* problems) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "io/collider_mesh.h"
 #include "render/canvas.h"
 
 namespace flexkin::render {
@@ -34,6 +35,10 @@ ChainScene::ChainScene(const ResultFile& file, const Rect& area, double ui, doub
       lo_ = lo_.cwiseMin(q);
       hi_ = hi_.cwiseMax(q);
     }
+  }
+  const Eigen::Vector3d center = 0.5 * (lo_ + hi_);
+  for (const Collider& collider : file.colliders) {
+    ExtendByCollider(collider, dim_, center, &lo_, &hi_);
   }
   const double extent = std::max((hi_ - lo_).maxCoeff(), 1e-12);
 

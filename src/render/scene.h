@@ -23,7 +23,8 @@ struct ChainStyle {
 
 class ChainScene {
  public:
-  // Fits every point of every frame of `file` into `area` (pixels). Angles in degrees.
+  // Fits every point of every frame of `file` and its colliders (a half-space: its boundary's
+  // point nearest the frames) into `area` (pixels). Angles in degrees.
   ChainScene(const ResultFile& file, const Rect& area, double ui, double azimuth, double elevation);
 
   int dim() const { return dim_; }
@@ -50,6 +51,11 @@ class ChainScene {
   // the farther lighter and thinner; dashes continue along a chain.
   void DrawChains(cairo_t* cr, const std::vector<const double*>& chains,
                   const std::vector<int>& rows, const std::vector<ChainStyle>& styles) const;
+  // Draws the colliders filled in kColliderFill, outlined in kColliderEdge, within the plot
+  // (render/scene_colliders.cc): 2D, the exact outline of each (a half-plane: the part of the
+  // plot below its line); 3D, each finite shape's silhouette (the hull of its projected surface),
+  // far to near, and a half-space's plane within the axes' box. Before the chains: under them.
+  void DrawColliders(cairo_t* cr, const std::vector<Collider>& colliders) const;
 
  private:
   Eigen::Vector3d Lift(const double* point) const;  // 2D points get z = 0

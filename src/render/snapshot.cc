@@ -109,6 +109,7 @@ void DrawSnapshotFigure(const ResultFile& file, const Look& look, const FigureOp
   DrawTitle(cr, ui, canvas.width(), MainTitle(file, options.title),
             look.summary + " \u00b7 " + frames_note);
   scene.DrawAxes(cr);
+  scene.DrawColliders(cr, file.colliders);
 
   // The leading end's path under the chains, which mostly follow it.
   const std::vector<double> leader = LeaderPath(file);

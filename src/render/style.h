@@ -23,6 +23,10 @@ inline constexpr Rgb kFinal{0.70, 0.09, 0.17};       // the last configuration
 inline constexpr Rgb kLeaderPath{0.90, 0.45, 0.05};  // the leading end's path
 inline constexpr Rgb kMarker{0.13, 0.40, 0.67};      // plot markers and lines
 
+// Colliders: filled in a neutral stone grey under the chains, outlined a little darker.
+inline constexpr Rgb kColliderFill{0.80, 0.80, 0.78};
+inline constexpr Rgb kColliderEdge{0.50, 0.50, 0.48};
+
 // The fade of the snapshots from old (t = 0, light) to new (t = 1, dark): a blue ramp.
 Rgb FadeColor(double t);
 // A perceptually uniform colour map (viridis) for t in [0, 1], for the link index.

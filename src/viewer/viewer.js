@@ -42,6 +42,15 @@
     }
   }
   if (dim === 2) { lo[2] = 0; hi[2] = 0; }
+  // The colliders (viewer_data.cc): each holds the box the view must show and the points whose
+  // projected convex hull is drawn.
+  const colliders = data.colliders || [];
+  for (const c of colliders) {
+    for (let k = 0; k < 3; ++k) {
+      lo[k] = Math.min(lo[k], c.bounds[k]);
+      hi[k] = Math.max(hi[k], c.bounds[3 + k]);
+    }
+  }
   const totalLength = data.link_lengths.reduce((a, b) => a + b, 0);
   const center = [0, 1, 2].map((k) => (lo[k] + hi[k]) / 2);
   const radius = Math.max(0.5 * Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]),
@@ -128,6 +137,7 @@
   const colors = {
     background: '#fbfbfd', grid: '#e6e9ef', gridLabel: '#8a93a5', axis: '#c9ced8',
     leader: '#e08a1e', lead: '#d62f2f', tail: '#1d2330', shadow: 'rgba(60, 70, 90, 0.18)',
+    collider: '#d2d2cc', colliderEdge: '#85857f',
   };
   const trailColors = ['#2a9d8f', '#8e44ad', '#e76f51', '#1f77b4', '#c2185b', '#6a8d1f'];
   // Chain colour and width by depth in 3D: far links light and thin, near ones dark and thick.
@@ -238,6 +248,7 @@
     g.fillRect(0, 0, background.width, background.height);
     g.setTransform(pixelRatio, 0, 0, pixelRatio, 0, 0);
     if (dim === 2) drawGrid2d(g); else drawGrid3d(g);
+    drawColliders(g);
     if (state.showLeader && numFrames > 1) {
       // The whole leader path, faint and dashed; the part travelled is drawn on top per frame.
       g.strokeStyle = colors.leader;
@@ -249,6 +260,54 @@
       g.globalAlpha = 1;
     }
     state.backgroundDirty = false;
+  }
+
+  // The convex hull of 2D points (Andrew's monotone chain), in order round it.
+  function convexHull(points) {
+    points.sort((p, q) => p[0] - q[0] || p[1] - q[1]);
+    if (points.length < 3) return points;
+    const cross = (o, a, b) => (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+    const lower = [], upper = [];
+    for (const p of points) {
+      while (lower.length >= 2 && cross(lower[lower.length - 2], lower[lower.length - 1], p) <= 0) lower.pop();
+      lower.push(p);
+    }
+    for (let i = points.length - 1; i >= 0; --i) {
+      const p = points[i];
+      while (upper.length >= 2 && cross(upper[upper.length - 2], upper[upper.length - 1], p) <= 0) upper.pop();
+      upper.push(p);
+    }
+    return lower.slice(0, -1).concat(upper.slice(0, -1));
+  }
+
+  // The colliders under everything else, far to near: each the hull of its projected points.
+  function drawColliders(g) {
+    if (colliders.length === 0) return;
+    const shapes = colliders.map((c) => {
+      const projected = [];
+      let depth = 0;
+      for (let j = 0; j < c.points.length; j += dim) {
+        project(c.points[j], c.points[j + 1], dim === 3 ? c.points[j + 2] : 0);
+        projected.push([sx, sy]);
+        depth += sdepth;
+      }
+      const floor = c.shape === 'half_space';
+      return {hull: convexHull(projected), depth: floor ? -Infinity : depth / projected.length};
+    });
+    shapes.sort((a, b) => a.depth - b.depth);
+    g.fillStyle = colors.collider;
+    g.strokeStyle = colors.colliderEdge;
+    g.lineWidth = 1.25;
+    g.lineJoin = 'round';
+    for (const s of shapes) {
+      if (s.hull.length < 3) continue;
+      g.beginPath();
+      g.moveTo(s.hull[0][0], s.hull[0][1]);
+      for (let i = 1; i < s.hull.length; ++i) g.lineTo(s.hull[i][0], s.hull[i][1]);
+      g.closePath();
+      g.fill();
+      g.stroke();
+    }
   }
 
   // Strokes point i's positions from frame 0 to frame `last`.

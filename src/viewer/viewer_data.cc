@@ -5,14 +5,17 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
+#include "io/collider_mesh.h"
+#include "io/colliders_json.h"
 
 namespace flexkin::viewer_internal {
 
 void CheckResult(const ResultFile& file, const ViewerOptions& options) {
-  ThrowIfAny(ValidateResult(file.result, file.dim));
+  ThrowIfAny(ValidateResult(file));
   const Eigen::Index n = file.result.lengths.size();
   for (size_t i = 0; i < options.trail_points.size(); ++i) {
     if (options.trail_points[i] > n) {
@@ -76,6 +79,61 @@ double FrameLengthError(const Points& p, const Eigen::VectorXd& lengths) {
     worst = std::max(worst, std::abs(d - lengths[i - 1]) / lengths[i - 1]);
   }
   return worst;
+}
+
+// The colliders: each in its scenario form (io/colliders_json.h) with "bounds" (the box the view
+// must hold: lo then hi, 3 numbers each; a half-space's is its boundary's point nearest the
+// motion) and "points", what the page fills the convex hull of once projected: in 2D the outline
+// of the collider, in 3D points of its surface. A half-space is cut to the cube about the scene
+// 1.2 times its largest extent across: in front of the perspective camera (viewer.js, 3 radii of
+// the scene away).
+void AppendColliders(const ResultFile& file, int digits, std::string* out) {
+  Eigen::Vector3d lo, hi;
+  BoundsOfMotion(file, &lo, &hi);
+  const Eigen::Vector3d center = 0.5 * (lo + hi);
+  for (const Collider& c : file.colliders) ExtendByCollider(c, file.dim, center, &lo, &hi);
+  const double half = 0.6 * std::max((hi - lo).maxCoeff(), 1e-3 * file.result.lengths.sum());
+  const Eigen::Vector3d mid = 0.5 * (lo + hi);
+  Eigen::Vector3d big_lo = mid - Eigen::Vector3d::Constant(half);
+  Eigen::Vector3d big_hi = mid + Eigen::Vector3d::Constant(half);
+  if (file.dim == 2) big_lo.z() = big_hi.z() = 0.0;
+  const auto numbers = [&](const auto& values) {
+    out->push_back('[');
+    for (size_t i = 0; i < values.size(); ++i) {
+      if (i > 0) out->push_back(',');
+      AppendNumber(values[i], digits, out);
+    }
+    out->push_back(']');
+  };
+  AppendKey("colliders", out);
+  out->push_back('[');
+  for (size_t k = 0; k < file.colliders.size(); ++k) {
+    const Collider& c = file.colliders[k];
+    if (k > 0) out->push_back(',');
+    AppendColliderJson(c, file.dim, out);
+    out->pop_back();  // its '}': the page's keys follow
+    Eigen::Vector3d c_lo = Eigen::Vector3d::Constant(HUGE_VAL), c_hi = -c_lo;
+    ExtendByCollider(c, 3, center, &c_lo, &c_hi);
+    if (file.dim == 2) c_lo.z() = c_hi.z() = 0.0;
+    out->append(",\"bounds\":");
+    numbers(std::vector<double>{c_lo.x(), c_lo.y(), c_lo.z(), c_hi.x(), c_hi.y(), c_hi.z()});
+    std::vector<double> points;
+    if (file.dim == 2) {
+      for (const Eigen::Vector2d& p :
+           OutlineOfCollider2d(c, 64, big_lo.head<2>(), big_hi.head<2>())) {
+        points.insert(points.end(), {p.x(), p.y()});
+      }
+    } else {
+      const std::vector<Eigen::Vector3d> surface =
+          c.shape == ColliderShape::kHalfSpace ? HalfSpacePlaneInBox(c, big_lo, big_hi)
+                                               : MeshOfCollider(c, 32, center, 0.0).vertices;
+      for (const Eigen::Vector3d& p : surface) points.insert(points.end(), {p.x(), p.y(), p.z()});
+    }
+    out->append(",\"points\":");
+    numbers(points);
+    out->push_back('}');
+  }
+  out->push_back(']');
 }
 
 }  // namespace
@@ -150,6 +208,7 @@ std::string ViewerDataJson(const ResultFile& file, const ViewerOptions& options,
     }
   }
   out.push_back(']');
+  if (!file.colliders.empty()) AppendColliders(file, options.digits, &out);
 
   const Metrics& m = r.metrics;
   AppendKey("metrics", &out);

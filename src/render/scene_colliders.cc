@@ -1,0 +1,105 @@
+// ChainScene::DrawColliders: the colliders under the chains, in a neutral grey, from the one
+// geometry of the colliders (io/collider_mesh.h).
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <vector>
+
+#include "io/collider_mesh.h"
+#include "render/canvas.h"
+#include "render/scene.h"
+
+namespace flexkin::render {
+namespace {
+
+// Round parts are drawn with this many segments: a polygon a pixel from the curve at 1000 px.
+constexpr int kSegments = 96;
+
+double Cross(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+}
+
+// The convex hull of `points` (Andrew's monotone chain), in order round it.
+std::vector<Eigen::Vector2d> ConvexHull(std::vector<Eigen::Vector2d> points) {
+  std::sort(points.begin(), points.end(), [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  if (points.size() < 3) return points;
+  std::vector<Eigen::Vector2d> hull(2 * points.size());
+  size_t k = 0;
+  for (size_t i = 0; i < points.size(); ++i) {  // lower hull
+    while (k >= 2 && Cross(hull[k - 2], hull[k - 1], points[i]) <= 0) --k;
+    hull[k++] = points[i];
+  }
+  for (size_t i = points.size() - 1, t = k + 1; i > 0; --i) {  // upper hull
+    while (k >= t && Cross(hull[k - 2], hull[k - 1], points[i - 1]) <= 0) --k;
+    hull[k++] = points[i - 1];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+void FillPolygon(cairo_t* cr, const std::vector<Eigen::Vector2d>& pixels, double ui) {
+  if (pixels.size() < 3) return;
+  for (size_t i = 0; i < pixels.size(); ++i) {
+    i == 0 ? cairo_move_to(cr, pixels[i].x(), pixels[i].y())
+           : cairo_line_to(cr, pixels[i].x(), pixels[i].y());
+  }
+  cairo_close_path(cr);
+  SetColor(cr, kColliderFill);
+  cairo_fill_preserve(cr);
+  SetColor(cr, kColliderEdge);
+  cairo_set_line_width(cr, 1.2 * ui);
+  cairo_stroke(cr);
+}
+
+}  // namespace
+
+void ChainScene::DrawColliders(cairo_t* cr, const std::vector<Collider>& colliders) const {
+  if (colliders.empty()) return;
+  cairo_save(cr);
+  cairo_set_dash(cr, nullptr, 0, 0.0);
+  cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+  const auto pixel = [&](const Eigen::Vector3d& q) { return Pixel(q.data()); };
+  if (dim_ == 2) {
+    cairo_rectangle(cr, plot_.x, plot_.y, plot_.w, plot_.h);
+    cairo_clip(cr);
+    // A half-plane's region reaches a little beyond the frame, so that its sides are clipped
+    // rather than outlined.
+    const double margin = 0.05 * std::max(x1_ - x0_, y1_ - y0_);
+    const Eigen::Vector2d lo(x0_ - margin, y0_ - margin), hi(x1_ + margin, y1_ + margin);
+    for (const Collider& c : colliders) {
+      std::vector<Eigen::Vector2d> pixels;
+      for (const Eigen::Vector2d& p : OutlineOfCollider2d(c, kSegments, lo, hi)) {
+        pixels.push_back(Pixel(p.data()));
+      }
+      FillPolygon(cr, pixels, ui_);
+    }
+    cairo_restore(cr);
+    return;
+  }
+  // 3D: far to near by the depth of each shape's centre (a half-space's plane first: it is the
+  // ground the rest stands on).
+  std::vector<std::pair<double, const Collider*>> order;
+  for (const Collider& c : colliders) {
+    const bool plane = c.shape == ColliderShape::kHalfSpace;
+    order.emplace_back(plane ? 2.0 : Depth(c.pose.translation().data()), &c);
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (const auto& [depth, c] : order) {
+    std::vector<Eigen::Vector2d> pixels;
+    if (c->shape == ColliderShape::kHalfSpace) {
+      for (const Eigen::Vector3d& q : HalfSpacePlaneInBox(*c, lo_, hi_)) pixels.push_back(pixel(q));
+    } else {
+      for (const Eigen::Vector3d& q :
+           MeshOfCollider(*c, kSegments / 2, Eigen::Vector3d::Zero(), 0.0).vertices) {
+        pixels.push_back(pixel(q));
+      }
+      pixels = ConvexHull(std::move(pixels));
+    }
+    FillPolygon(cr, pixels, ui_);
+  }
+  cairo_restore(cr);
+}
+
+}  // namespace flexkin::render
