@@ -4,14 +4,21 @@
 //   2. follow-the-leader on the same engine, 1 and 2 threads;
 //   3. a loop of the single-chain MoveLeader over the strands (one thread);
 //   4. the conventional one-pass follow-the-leader loop hair simulators run (one thread);
-// and the strand engine's tractrix over 100 to 100,000 strands and 8 to 64 links (linear cost).
+// and the strand engine's tractrix over 100 to 100,000 strands and 8 to 64 links (linear cost);
+// and, with colliders (docs/colliders.md), hair draped over a turning head with the scalp and 4
+// capsules (a neck, two shoulders, a torso), against the same hair without colliders and against
+// the baseline hair simulators use: follow-the-leader, then each point pushed out of the
+// colliders (BM_Draped*; the counters give the deepest link inside a collider after the frame and
+// the worst relative link-length error, over the run).
 // ns_per_link_step is the time per link per strand per frame (printed in seconds: "3.3n").
 // Run: build/bench/strands_benchmark --benchmark_repetitions=5
 //        --benchmark_report_aggregates_only=true ; FLEXKIN_SIMD=avx2 caps the engine at AVX2.
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -147,6 +154,185 @@ void BM_StrandsSweep(benchmark::State& state) {
   StrandEngine(state, Method::kTractrix, static_cast<int>(state.range(0)),
                static_cast<int>(state.range(1)), 1);
 }
+// 6. Colliders. Hair draped over the unit-sphere scalp: roots on the upper half, each link turned a
+// little off the surface (radial part 0.1 to 0.25), so that every point starts outside and a
+// turning head drags the strands through the scalp where nothing stops them.
+std::vector<Points> Draped(int count, int links) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  std::uniform_real_distribution<double> radial(0.1, 0.25), length(0.01, 0.02);
+  std::vector<Points> strands;
+  for (int s = 0; s < count; ++s) {
+    Points p(links + 1, 3);
+    Eigen::Vector3d root(normal(rng), normal(rng), normal(rng));
+    root.normalize();
+    root.z() = std::fabs(root.z());
+    Eigen::Vector3d tangent(normal(rng), normal(rng), normal(rng));
+    p.row(0) = root.transpose();
+    for (int i = 1; i <= links; ++i) {
+      const Eigen::Vector3d out = p.row(i - 1).transpose().normalized();
+      const Eigen::Vector3d t = (tangent - tangent.dot(out) * out).normalized();
+      const double a = radial(rng);
+      p.row(i) = p.row(i - 1) + length(rng) * (a * out + std::sqrt(1 - a * a) * t).transpose();
+      tangent = t;
+    }
+    strands.push_back(p);
+  }
+  return strands;
+}
+
+Collider Capsule(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double radius) {
+  Collider c;
+  c.shape = ColliderShape::kCapsule;
+  c.pose.translation() = 0.5 * (from + to);
+  c.pose.linear() =
+      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), to - from).matrix();
+  c.half_length = 0.5 * (to - from).norm();
+  c.radius = radius;
+  return c;
+}
+
+// The scalp and 4 capsules, in body coordinates.
+std::vector<Collider> Body() {
+  Collider scalp;
+  scalp.shape = ColliderShape::kSphere;
+  scalp.radius = 1.0;
+  return {scalp, Capsule({0, 0, -1.1}, {0, 0, -2.4}, 0.45),
+          Capsule({0.5, 0, -2.0}, {1.8, 0, -2.2}, 0.35),
+          Capsule({-0.5, 0, -2.0}, {-1.8, 0, -2.2}, 0.35),
+          Capsule({0, 0, -2.6}, {0, 0, -4.0}, 0.9)};
+}
+
+// A faster turn than HeadPose, as a head shaken left and right (about z) while nodding: the
+// draped strands lag and are pulled across the scalp.
+BodyPose ShakePose(int64_t frame) {
+  const double t = frame / 60.0;
+  const double yaw = 0.9 * std::sin(3.0 * t), pitch = 0.25 * std::sin(2.0 * t);
+  const Eigen::Matrix3d r = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
+                             Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()))
+                                .toRotationMatrix();
+  BodyPose pose;
+  pose.rotation = r;
+  return pose;
+}
+
+void DrapedEngine(benchmark::State& state, bool colliders) {
+  StrandOptions options;
+  options.threads = static_cast<int>(state.range(0));
+  if (colliders) options.body_colliders = Body();
+  StrandBatch batch(Draped(10000, 32), options);
+  int64_t frame = 0;
+  for (auto _ : state) {
+    StepStrands(&batch, ShakePose(++frame));
+    benchmark::ClobberMemory();
+  }
+  state.SetLabel(batch.engine());
+  SetRate(state, 10000.0 * 32);
+  if (colliders) {
+    state.counters["contact_steps_per_frame"] =
+        static_cast<double>(batch.contacts().contact_link_steps) / static_cast<double>(frame);
+    state.counters["least_clearance"] = batch.contacts().least_clearance;
+  }
+}
+void BM_DrapedFree(benchmark::State& state) { DrapedEngine(state, false); }
+void BM_DrapedColliders(benchmark::State& state) { DrapedEngine(state, true); }
+BENCHMARK(BM_DrapedFree)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_DrapedColliders)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The baseline: one follow-the-leader pass per strand, then every point inside a collider moved to
+// its nearest surface point (sphere: radially; capsule: radially from its axis), on plain arrays
+// of points, one thread (as hair simulators write it). Its deepest link inside a collider and its
+// length error are measured after the frame, outside the timer.
+void BM_DrapedFtlPushOut(benchmark::State& state) {
+  const std::vector<Points> strands = Draped(10000, 32);
+  const std::vector<Collider> body = Body();
+  std::vector<double> pts, rest, body_pts;
+  std::vector<int> first;
+  for (const Points& p : strands) {
+    first.push_back(static_cast<int>(pts.size() / 3));
+    for (int i = 0; i < p.rows(); ++i) {
+      for (int k = 0; k < 3; ++k) pts.push_back(p(i, k));
+      if (i > 0) rest.push_back((p.row(i) - p.row(i - 1)).norm());
+    }
+  }
+  first.push_back(static_cast<int>(pts.size() / 3));
+  std::vector<Eigen::Vector3d> roots;
+  for (const Points& p : strands) roots.emplace_back(p(0, 0), p(0, 1), p(0, 2));
+  // Placed colliders of the frame: centre, axis end points, radius.
+  struct Placed {
+    bool sphere;
+    Eigen::Vector3d a, b;
+    double r;
+  };
+  std::vector<Placed> placed(body.size());
+  double deepest = 0.0, worst_length = 0.0;
+  int64_t frame = 0;
+  auto step = [&](const BodyPose& pose) {
+    for (size_t c = 0; c < body.size(); ++c) {
+      const Eigen::Vector3d center = pose.rotation * body[c].pose.translation() + pose.translation;
+      const Eigen::Vector3d axis =
+          pose.rotation * body[c].pose.linear().col(2) * body[c].half_length;
+      placed[c] = {body[c].shape == ColliderShape::kSphere, center - axis, center + axis,
+                   body[c].radius};
+    }
+    int link = 0;
+    for (size_t s = 0; s + 1 < first.size(); ++s) {
+      double* p = pts.data() + 3 * first[s];
+      const Eigen::Vector3d root = pose.rotation * roots[s] + pose.translation;
+      for (int k = 0; k < 3; ++k) p[k] = root[k];
+      const int n = first[s + 1] - first[s] - 1;
+      for (int i = 1; i <= n; ++i, ++link) {
+        double* q = p + 3 * i;
+        const double d[3] = {q[0] - q[-3], q[1] - q[-2], q[2] - q[-1]};
+        const double scale = rest[link] / std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (int k = 0; k < 3; ++k) q[k] = q[k - 3] + d[k] * scale;
+        Eigen::Map<Eigen::Vector3d> x(q);
+        for (const Placed& c : placed) {
+          Eigen::Vector3d nearest = c.a;
+          if (!c.sphere) {
+            const Eigen::Vector3d ab = c.b - c.a;
+            nearest = c.a + std::clamp((x - c.a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) * ab;
+          }
+          const Eigen::Vector3d off = x - nearest;
+          const double dist = off.norm();
+          if (dist < c.r && dist > 0.0) x = nearest + off * (c.r / dist);
+        }
+      }
+    }
+  };
+  for (auto _ : state) {
+    const BodyPose pose = ShakePose(++frame);
+    step(pose);
+    benchmark::ClobberMemory();
+    state.PauseTiming();
+    // How far the links reach into the colliders, and how far the pushing moved the lengths.
+    int link = 0;
+    for (size_t s = 0; s + 1 < first.size(); ++s) {
+      for (int i = first[s] + 1; i < first[s + 1]; ++i, ++link) {
+        const Eigen::Vector3d a(&pts[3 * (i - 1)]), b(&pts[3 * i]);
+        worst_length = std::max(worst_length, std::fabs((b - a).norm() - rest[link]) / rest[link]);
+        for (const Placed& c : placed) {
+          // Deepest point of the link inside: sampled at 9 points along it.
+          for (int k = 0; k <= 8; ++k) {
+            const Eigen::Vector3d x = a + (k / 8.0) * (b - a);
+            Eigen::Vector3d nearest = c.a;
+            if (!c.sphere) {
+              const Eigen::Vector3d ab = c.b - c.a;
+              nearest = c.a + std::clamp((x - c.a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) * ab;
+            }
+            deepest = std::min(deepest, ((x - nearest).norm() - c.r) / rest[link]);
+          }
+        }
+      }
+    }
+    state.ResumeTiming();
+  }
+  SetRate(state, 10000.0 * 32);
+  state.counters["deepest_link_inside"] = deepest;
+  state.counters["max_length_error"] = worst_length;
+}
+BENCHMARK(BM_DrapedFtlPushOut)->Iterations(120)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 BENCHMARK(BM_StrandsSweep)
     ->Args({100, 32})
     ->Args({1000, 32})

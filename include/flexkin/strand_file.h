@@ -9,13 +9,15 @@
 //   frames.npy            (F,) int64: the frame number of each recorded frame (0: the start)
 //   times.npy             (F,) float64: seconds
 //   body_rotation.npy     (F, 3, 3) float64, body_translation.npy (F, 3) float64: the body pose
-//   groom.json            the run's description (name, method, substeps, pinned, scalp, report)
+//   groom.json            the run's description (name, method, substeps, pinned, scalp, the
+//                         colliders when there are any, report)
 //
 // The writer streams: it holds one frame, never the run, and writes the file whole or not at all
 // (an existing file is left as it was on any failure). The reader reads frame by frame.
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -62,6 +64,10 @@ struct StrandFileHeader {
   std::string method = "tractrix";
   int substeps = 1, pinned = 1, record_every = 1;
   ScalpShape scalp;
+  // The run's colliders (StrandOptions): those moving with the body, in body coordinates (a
+  // groom's scalp among them unless it said "scalp_collider": false), and those fixed in the
+  // world. Written only when there are any.
+  std::vector<Collider> body_colliders, world_colliders;
 
   int num_strands() const { return static_cast<int>(offsets.empty() ? 0 : offsets.size() - 1); }
   int64_t num_points() const { return offsets.empty() ? 0 : offsets.back(); }
@@ -83,6 +89,10 @@ struct StrandRunReport {
   double seconds = 0.0;           // wall time of the stepping
   std::string engine;             // "avx512", "avx2" or "scalar"
   int threads = 1;
+  // With colliders: the contact link steps and the least clearance of a link near one, relative
+  // to its length (StrandContacts; +inf: none came near). Written only with colliders.
+  int64_t contact_link_steps = 0;
+  double least_clearance = std::numeric_limits<double>::infinity();
 };
 
 class StrandFileWriter {

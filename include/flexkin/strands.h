@@ -14,10 +14,14 @@
 // point k-1 (docs/strands.md). Results do not depend on the number of threads, bit for bit.
 
 #include <Eigen/Core>
+#include <cstdint>
+#include <limits>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "flexkin/chain.h"
+#include "flexkin/colliders.h"
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
 
@@ -36,9 +40,27 @@ struct StrandOptions {
   // Threads stepping the strands (>= 0; 0: std::thread::hardware_concurrency()). Only the speed
   // depends on it, never the result.
   int threads = 1;
+  // Colliders the free points and links of every strand stay outside of (docs/colliders.md):
+  // `body_colliders` are in body coordinates and move with the body (a groom's scalp, a neck);
+  // `colliders` stay where they are in the world. A link whose rule step would enter one takes
+  // the least-motion step that keeps it outside instead; a strand that touches nothing is
+  // stepped exactly as without colliders. With body colliders and sub-steps > 1 the pinned
+  // points follow the body's own motion between frames (the rotation interpolated by slerp, the
+  // translation linearly), so that the roots stay on the body at every sub-step.
+  std::vector<Collider> colliders;
+  std::vector<Collider> body_colliders;
 
-  // Problems with fields "method", "substeps", "pinned", "threads".
+  // Problems with fields "method", "substeps", "pinned", "threads", "colliders[i]...",
+  // "body_colliders[i]...".
   Problems Validate() const;
+};
+
+// What the colliders did to the strands, from the batch's making on.
+struct StrandContacts {
+  int64_t contact_link_steps = 0;  // link steps that took the contact step
+  // The least clearance, relative to the link's length, of the links near a collider after each
+  // sub-step (+inf when no link came near one); never below -1e-13.
+  double least_clearance = std::numeric_limits<double>::infinity();
 };
 
 // The methods the strand engine runs, from the one table of link rules
@@ -48,6 +70,24 @@ std::vector<std::string> StrandMethodNames();
 // The strand method named `name`; throws InputError naming `field`: for an unknown name (with a
 // suggestion for a near miss) or a method the strand engine does not run, listing those it does.
 Method ParseStrandMethod(std::string_view name, const std::string& field);
+
+// A strand that starts inside a collider: the first free point (after the pinned ones) inside
+// one, or else the first free link through one.
+struct StrandInside {
+  int strand = 0;
+  int point = 0;      // the point inside, or the link's trailing end (link `point` joins
+  bool link = false;  // points point-1 and point)
+  bool body = false;  // the collider is options.body_colliders[collider], else colliders[...]
+  int collider = 0;
+  double depth = 0.0;     // how far inside
+  double relative = 0.0;  // depth / the link's length
+};
+struct BodyPose;
+// The first free point or link of `strands` (at the body pose `rest`, body colliders placed at
+// it) that lies inside a collider of `options` by more than 1e-13 of its link's length; none if
+// every strand starts outside. StrandBatch refuses such a start.
+std::optional<StrandInside> FindStrandInside(const std::vector<Points>& strands,
+                                             const StrandOptions& options, const BodyPose& rest);
 
 // The pose of the body the strands grow from: x -> rotation x + translation. In 2D the top-left
 // 2x2 block of `rotation` and the first two components of `translation` are used. `rotation`
@@ -87,6 +127,8 @@ class StrandBatch {
   const StrandOptions& options() const;
   // The engine that steps the batch: "avx512", "avx2" or "scalar" (FLEXKIN_SIMD caps it).
   const char* engine() const;
+  // What the colliders did so far (zeros and +inf without colliders).
+  StrandContacts contacts() const;
 
   // Strand `strand`'s points now, (n_i + 1) by dim. Throws InputError ("strand") out of range.
   Points strand(int strand) const;
@@ -105,7 +147,7 @@ void StepStrands(StrandBatch* batch, const BodyPose& pose);
 
 // One frame: root i moves to `roots.row(i)` (S by dim); the strand's other pinned points (k > 1)
 // translate with it. Allocates nothing. Throws InputError ("roots") for a wrong shape or a
-// non-finite value.
+// non-finite value, or for a batch with body colliders (it has no body pose to place them at).
 void StepStrands(StrandBatch* batch, const Eigen::Ref<const Points>& roots);
 
 }  // namespace flexkin

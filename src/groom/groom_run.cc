@@ -58,6 +58,8 @@ StrandFileHeader MakeStrandFileHeader(const GroomScenario& scenario) {
   h.pinned = scenario.options.pinned;
   h.record_every = scenario.record_every;
   h.scalp = scenario.scalp;
+  h.body_colliders = scenario.options.body_colliders;
+  h.world_colliders = scenario.options.colliders;
   return h;
 }
 
@@ -109,6 +111,8 @@ StrandRunReport RunGroom(const GroomScenario& scenario, StrandFileWriter* writer
     }
   }
   report.seconds = std::chrono::duration<double>(stepping).count();
+  report.contact_link_steps = batch.contacts().contact_link_steps;
+  report.least_clearance = batch.contacts().least_clearance;
   return report;
 }
 

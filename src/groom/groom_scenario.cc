@@ -19,6 +19,7 @@
 #include "flexkin/vocabulary.h"
 #include "groom/groom_reader.h"
 #include "groom/grow_internal.h"
+#include "io/colliders_json.h"
 #include "io/json_file.h"
 #include "io/json_values.h"
 #include "io/scenario_kinds.h"
@@ -74,7 +75,7 @@ class GroomParser : public json_internal::JsonReader {
     if (!ExpectObject(root, "", kRootExpected)) return s;
     CheckKeys(root, "",
               {"$schema", "name", "description", "groom", "strands", "motion", "method", "substeps",
-               "pinned", "threads", "record"});
+               "pinned", "threads", "record", "colliders", "world_colliders", "scalp_collider"});
     for (const char* key : {"$schema", "name", "description"}) {
       if (const json* v = Find(root, key)) {
         if (const auto text = String(*v, std::string("/") + key)) {
@@ -109,6 +110,22 @@ class GroomParser : public json_internal::JsonReader {
       motion = ParseMotion(*m, "/motion", dim);
     }
     ParseOptions(root, &s);
+    bool scalp_collider = true;
+    if (const json* v = Find(root, "scalp_collider")) {
+      if (!v->is_boolean()) {
+        TypeProblem(*v, "/scalp_collider", "true or false");
+      } else {
+        scalp_collider = v->get<bool>();
+      }
+    }
+    if (dim != 0) {
+      if (const json* c = Find(root, "colliders")) {
+        s.options.body_colliders = ReadCollidersJson(*c, "/colliders", dim, &problems);
+      }
+      if (const json* c = Find(root, "world_colliders")) {
+        s.options.colliders = ReadCollidersJson(*c, "/world_colliders", dim, &problems);
+      }
+    }
     if (!problems.empty()) return s;
 
     s.dim = dim;
@@ -130,10 +147,64 @@ class GroomParser : public json_internal::JsonReader {
     } else {
       s.strands = std::move(*strands);
     }
+    // The scalp is a collider too, unless the file says otherwise: the last body collider.
+    if (spec && scalp_collider) {
+      Collider scalp;
+      scalp.pose.translation() = spec->scalp.center;
+      if (spec->scalp.shape == "sphere") {
+        scalp.shape = ColliderShape::kSphere;
+        scalp.radius = spec->scalp.radii[0];
+      } else {
+        scalp.shape = ColliderShape::kEllipsoid;
+        scalp.extents = spec->scalp.radii;
+      }
+      s.options.body_colliders.push_back(scalp);
+    }
+    if (problems.empty() && !s.strands.empty()) CheckStart(s, spec.has_value() && scalp_collider);
     return s;
   }
 
  private:
+  // A strand that starts inside a collider (at the first keyframe's pose) is a problem of the
+  // collider's entry, naming the root (the strand) and the point.
+  void CheckStart(const GroomScenario& s, bool scalp_last) {
+    StrandOptions options = s.options;
+    // The strands are in body coordinates: the world's colliders brought into them.
+    const BodyPose start = s.motion.PoseAt(0);
+    Eigen::Isometry3d to_body = Eigen::Isometry3d::Identity();
+    to_body.linear() = start.rotation;
+    to_body.translation() = start.translation;
+    if (s.dim == 2) {
+      to_body.linear().row(2).setZero(), to_body.linear().col(2).setZero();
+      to_body.linear()(2, 2) = 1.0;
+      to_body.translation()[2] = 0.0;
+    }
+    to_body = to_body.inverse();
+    for (Collider& c : options.colliders) c.pose = to_body * c.pose;
+    const std::optional<StrandInside> in = FindStrandInside(s.strands, options, BodyPose());
+    if (!in) return;
+    const int num_body = static_cast<int>(s.options.body_colliders.size());
+    std::string ptr;
+    if (in->body && scalp_last && in->collider == num_body - 1) {
+      ptr = "/groom/scalp";
+    } else {
+      ptr = std::string(in->body ? "/colliders/" : "/world_colliders/") +
+            std::to_string(in->collider);
+    }
+    const std::string strand = s.scalp.shape.empty()
+                                   ? "strand " + std::to_string(in->strand) + " (/strands/" +
+                                         std::to_string(in->strand) + ")"
+                                   : "the strand of root " + std::to_string(in->strand);
+    Add(ptr, "holds " + strand + " at the start: " +
+                 (in->link ? "its link " + std::to_string(in->point) + " (points " +
+                                 std::to_string(in->point - 1) + " to " +
+                                 std::to_string(in->point) + ") passes through it"
+                           : "its point " + std::to_string(in->point) + " lies inside it") +
+                 " by " + FormatNumber(in->depth) + " (" + FormatNumber(in->relative) +
+                 " of the link's length); every strand must start outside every collider (move or "
+                 "shrink the collider, or set \"scalp_collider\": false for the scalp)");
+  }
+
   std::optional<int> Int(const json& v, const std::string& ptr, int64_t min, int64_t max) {
     const auto n = Integer(v, ptr, min, max);
     return n ? std::optional<int>(static_cast<int>(*n)) : std::nullopt;

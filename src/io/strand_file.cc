@@ -13,6 +13,7 @@
 
 #include "flexkin/error.h"
 #include "io/atomic_file.h"
+#include "io/colliders_json.h"
 #include "io/json_file.h"
 #include "io/npz.h"
 
@@ -73,6 +74,15 @@ Problems HeaderProblems(const StrandFileHeader& h) {
   if (!(std::isfinite(h.fps) && h.fps > 0.0)) {
     add("fps", "is not a finite number > 0", "", "a finite number > 0");
   }
+  if (h.dim == 2 || h.dim == 3) {
+    for (const auto& [key, list] :
+         {std::pair{"body_", &h.body_colliders}, std::pair{"world_", &h.world_colliders}}) {
+      for (Problem p : CollidersProblems(*list, h.dim)) {
+        p.field = "header." + std::string(key) + p.field;
+        problems.push_back(std::move(p));
+      }
+    }
+  }
   return problems;
 }
 
@@ -97,10 +107,30 @@ std::string GroomJson(const StrandFileHeader& h, const StrandRunReport& report) 
   j["scalp"] = {{"shape", h.scalp.shape},
                 {"center", VectorJson(h.scalp.center)},
                 {"radii", VectorJson(h.scalp.radii)}};
+  const bool colliders = !h.body_colliders.empty() || !h.world_colliders.empty();
+  if (colliders) {
+    for (const auto& [key, list] : {std::pair{"body_colliders", &h.body_colliders},
+                                    std::pair{"world_colliders", &h.world_colliders}}) {
+      nlohmann::json array = nlohmann::json::array();
+      for (const Collider& c : *list) {
+        std::string text;
+        AppendColliderJson(c, h.dim, &text);
+        array.push_back(nlohmann::json::parse(text));
+      }
+      j[key] = array;
+    }
+  }
   j["report"] = {{"max_length_error", report.max_length_error},
                  {"seconds", report.seconds},
                  {"engine", report.engine},
                  {"threads", report.threads}};
+  if (colliders) {
+    j["report"]["contact_link_steps"] = report.contact_link_steps;
+    // +inf (no link came near a collider) has no JSON number: null.
+    j["report"]["least_clearance"] = std::isfinite(report.least_clearance)
+                                         ? nlohmann::json(report.least_clearance)
+                                         : nlohmann::json(nullptr);
+  }
   return j.dump(2) + "\n";
 }
 
@@ -335,7 +365,22 @@ StrandFileReader::StrandFileReader(const std::string& path) : impl_(std::make_un
   h.scalp.shape = Get<std::string>(scalp, "shape");
   h.scalp.center = GetVector(scalp, "center");
   h.scalp.radii = GetVector(scalp, "radii");
+  for (const auto& [key, list] : {std::pair{"body_colliders", &h.body_colliders},
+                                  std::pair{"world_colliders", &h.world_colliders}}) {
+    const auto it = j.find(key);
+    if (it == j.end()) continue;
+    Problems problems;
+    *list = ReadCollidersJson(*it, std::string("groom.json/") + key, h.dim, &problems);
+    ThrowIfAny(problems);
+  }
   const nlohmann::json report = Get<nlohmann::json>(j, "report");
+  if (const auto it = report.find("contact_link_steps"); it != report.end()) {
+    r.report.contact_link_steps = Get<int64_t>(report, "contact_link_steps");
+    const auto least = report.find("least_clearance");
+    if (least != report.end() && !least->is_null()) {
+      r.report.least_clearance = Get<double>(report, "least_clearance");
+    }
+  }
   r.report.max_length_error = Get<double>(report, "max_length_error");
   r.report.seconds = Get<double>(report, "seconds");
   r.report.engine = Get<std::string>(report, "engine");

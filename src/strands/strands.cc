@@ -19,7 +19,9 @@
 #include "chain/substep.h"
 #include "sequential/link_rules.h"
 #include "sequential/rule_table.h"
+#include "sequential/sweep.h"
 #include "strands/strand_engine.h"
+#include "world/contact.h"
 
 namespace flexkin {
 namespace internal {
@@ -157,6 +159,60 @@ struct Block {
   int source[L] = {};  // the strand each lane carries (padding lanes repeat the first)
 };
 
+// A collider as the lanes' first test sees it: a ball that holds it (exact for a sphere), or a
+// half-space's plane.
+struct ColliderBound {
+  bool half_space = false;
+  bool exact = false;     // a sphere: the ball is the collider
+  double center[3] = {};  // the ball's centre, or a point of the plane
+  double up[3] = {};      // the plane's outward normal
+  double radius = 0.0;    // the ball's radius
+};
+
+ColliderBound BoundOf(const Collider& c) {
+  ColliderBound b;
+  const Eigen::Vector3d t = c.pose.translation();
+  for (int k = 0; k < 3; ++k) b.center[k] = t[k];
+  switch (c.shape) {
+    case ColliderShape::kHalfSpace: {
+      b.half_space = true;
+      const Eigen::Vector3d up = c.pose.linear().col(2);
+      for (int k = 0; k < 3; ++k) b.up[k] = up[k];
+      break;
+    }
+    case ColliderShape::kSphere:
+      b.exact = true;
+      b.radius = c.radius;
+      break;
+    case ColliderShape::kCapsule:
+      b.radius = c.half_length + c.radius;
+      break;
+    case ColliderShape::kCylinder:
+      b.radius = std::hypot(c.half_length, c.radius);
+      break;
+    case ColliderShape::kBox:
+      b.radius = c.extents.norm();
+      break;
+    case ColliderShape::kEllipsoid:
+      b.radius = c.extents.maxCoeff();
+      break;
+  }
+  return b;
+}
+
+// Per thread: what the contact steps need, made once.
+struct ContactScratch {
+  std::vector<double> start;    // the leading ends of a block at the frame's start (dim x L)
+  std::vector<double> saved;    // a block's points before a sub-step's sweep
+  std::vector<double> chain;    // one lane's points, point by point
+  std::vector<double> lengths;  // one lane's link lengths and their inverses
+  std::vector<double> inv_lengths;
+  std::vector<double> least;  // per lane: least relative clearance of the sub-step
+  std::vector<char> enters;   // per lane: a link entered a collider
+  ContactStats stats;
+  std::string error;  // the first contact step that found no room
+};
+
 }  // namespace
 
 struct StrandBatchImpl {
@@ -178,11 +234,44 @@ struct StrandBatchImpl {
   const double* roots = nullptr;
   Eigen::Index roots_stride = 0;
 
+  // Colliders: at every sub-step s (1 .. substeps) of the frame being stepped, all of them
+  // placed in the world (placed[s - 1]) and their bounds; the body's pose at each sub-step
+  // (body colliders with sub-steps > 1); the pose of the frame before.
+  bool has_colliders = false;
+  std::vector<std::vector<Collider>> placed;
+  std::vector<std::vector<ColliderBound>> bounds;
+  std::vector<BodyPose> substep_poses;
+  BodyPose last_pose;
+  std::vector<ContactScratch> contact;  // per thread
+  StrandContacts contacts;
+
   void StepBlock(int b, double* scratch_heads);
+  void StepBlockWithColliders(int b, double* scratch_heads, ContactScratch* cs);
+  // The pinned points of a block at the frame's end: all but the last into the points, the last
+  // (the sweeps' leading end) into `target` (dim x L).
+  void PlacePinned(const Block& block, double* pts, double* target) const;
+  void PlaceColliders(const BodyPose* pose);
+  // Adds the threads' contact counts to `contacts`; throws the first contact step that found no
+  // room (InputError "colliders").
+  void GatherContacts() {
+    std::string error;
+    for (ContactScratch& cs : contact) {
+      contacts.contact_link_steps += cs.stats.contact_link_steps;
+      contacts.least_clearance = std::min(contacts.least_clearance, cs.stats.least_clearance);
+      cs.stats = ContactStats();
+      if (error.empty()) error = cs.error;
+      cs.error.clear();
+    }
+    if (!error.empty()) throw InputError("colliders", error);
+  }
   static void Job(void* self, int t) {
     auto* impl = static_cast<StrandBatchImpl*>(self);
     for (int b = impl->first_block[t]; b < impl->first_block[t + 1]; ++b) {
-      impl->StepBlock(b, impl->scratch[t].data());
+      if (impl->has_colliders) {
+        impl->StepBlockWithColliders(b, impl->scratch[t].data(), &impl->contact[t]);
+      } else {
+        impl->StepBlock(b, impl->scratch[t].data());
+      }
     }
   }
 };
@@ -209,13 +298,8 @@ inline double FromBody(const BodyPose& pose, int dim, int r, const double* body,
 
 }  // namespace
 
-// One frame of one block: the pinned points, then the sweeps of the free links.
-void StrandBatchImpl::StepBlock(int b, double* scratch_heads) {
-  const Block& block = blocks[b];
-  const int S = options.substeps;
+void StrandBatchImpl::PlacePinned(const Block& block, double* pts, double* target) const {
   const int head = block.pinned - 1;
-  double* pts = points.data() + block.points;
-  double* target = scratch_heads + static_cast<size_t>(S) * dim * L;  // dim x L
   // From the last pinned point to the root: the root's old position is read before it moves.
   for (int j = block.pinned - 1; j >= 0; --j) {
     for (int k = 0; k < dim; ++k) {
@@ -234,6 +318,16 @@ void StrandBatchImpl::StepBlock(int b, double* scratch_heads) {
       }
     }
   }
+}
+
+// One frame of one block: the pinned points, then the sweeps of the free links.
+void StrandBatchImpl::StepBlock(int b, double* scratch_heads) {
+  const Block& block = blocks[b];
+  const int S = options.substeps;
+  const int head = block.pinned - 1;
+  double* pts = points.data() + block.points;
+  double* target = scratch_heads + static_cast<size_t>(S) * dim * L;  // dim x L
+  PlacePinned(block, pts, target);
   // The sub-steps' heads, from the old position of point `head` to its target.
   const double* from = pts + head * dim * L;
   for (int s = 1; s <= S; ++s) {
@@ -247,6 +341,146 @@ void StrandBatchImpl::StepBlock(int b, double* scratch_heads) {
   const SubnormalsAsZero subnormals;  // as every sweep engine (src/chain/denormals.h)
   sweeps(options.method, dim, block.n, head, S, scratch_heads, lengths.data() + block.lengths,
          inv_lengths.data() + block.lengths, pts);
+}
+
+namespace {
+
+// Marks the lanes whose free links (head + 1 .. n) enter a collider after a sweep and lowers
+// `least` (per lane) to the relative clearance of the links near one. Each link is first
+// measured against every collider's bound in a loop over the lanes (the compiler's vector
+// code); only links within a link's length of a bound are measured exactly.
+void CheckLanes(int dim, int n, int head, const double* pts, const double* lengths,
+                const double* inv_lengths, const std::vector<Collider>& colliders,
+                const std::vector<ColliderBound>& bounds, double* least, char* enters) {
+  for (int i = head + 1; i <= n; ++i) {
+    const double* a = pts + (i - 1) * dim * L;
+    const double* b = pts + i * dim * L;
+    const double* len = lengths + (i - 1) * L;
+    const double* inv = inv_lengths + (i - 1) * L;
+    for (size_t c = 0; c < bounds.size(); ++c) {
+      const ColliderBound& bound = bounds[c];
+      double clear[L];
+      if (bound.half_space) {
+        for (int lane = 0; lane < L; ++lane) {
+          double da = 0.0, db = 0.0;
+          for (int k = 0; k < dim; ++k) {
+            da += bound.up[k] * (a[k * L + lane] - bound.center[k]);
+            db += bound.up[k] * (b[k * L + lane] - bound.center[k]);
+          }
+          clear[lane] = std::min(da, db);
+        }
+      } else {
+        for (int lane = 0; lane < L; ++lane) {
+          double ab[3], ac[3], dot = 0.0, ab2 = 0.0;
+          for (int k = 0; k < dim; ++k) {
+            ab[k] = b[k * L + lane] - a[k * L + lane];
+            ac[k] = bound.center[k] - a[k * L + lane];
+            dot += ab[k] * ac[k];
+            ab2 += ab[k] * ab[k];
+          }
+          const double t = std::clamp(dot / ab2, 0.0, 1.0);
+          double d2 = 0.0;
+          for (int k = 0; k < dim; ++k) {
+            const double d = a[k * L + lane] + t * ab[k] - bound.center[k];
+            d2 += d * d;
+          }
+          clear[lane] = std::sqrt(d2) - bound.radius;
+        }
+      }
+      for (int lane = 0; lane < L; ++lane) {
+        double c_lane = clear[lane];
+        if (c_lane >= len[lane]) continue;  // far: not near this collider
+        if (!bound.exact && !bound.half_space) {
+          const Eigen::Vector3d pa(a[lane], a[L + lane], dim == 3 ? a[2 * L + lane] : 0.0);
+          const Eigen::Vector3d pb(b[lane], b[L + lane], dim == 3 ? b[2 * L + lane] : 0.0);
+          c_lane = SegmentClearance(colliders[c], pa, pb);
+        }
+        if (c_lane < -kContactSlack * len[lane]) enters[lane] = 1;
+        least[lane] = std::min(least[lane], c_lane * inv[lane]);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+// One frame of one block with colliders: sub-step by sub-step, the sweep of the engine, kept for
+// every lane whose links stay outside the colliders; a lane whose links would enter one is
+// stepped again from where it was by the contact sweep (sequential/sweep.h), link by link.
+void StrandBatchImpl::StepBlockWithColliders(int b, double* scratch_heads, ContactScratch* cs) {
+  const Block& block = blocks[b];
+  const int S = options.substeps;
+  const int head = block.pinned - 1;
+  const int n = block.n;
+  double* pts = points.data() + block.points;
+  double* heads = scratch_heads;                                      // dim x L
+  double* target = scratch_heads + static_cast<size_t>(S) * dim * L;  // dim x L
+  PlacePinned(block, pts, target);
+  const double* block_lengths = lengths.data() + block.lengths;
+  const double* block_inv = inv_lengths.data() + block.lengths;
+  const size_t free_begin = static_cast<size_t>(head) * dim * L;
+  const size_t free_size = static_cast<size_t>(n + 1 - head) * dim * L;
+  const SubnormalsAsZero subnormals;
+  // Where the leading end starts the frame (the sweeps move it).
+  std::copy(pts + head * dim * L, pts + (head + 1) * dim * L, cs->start.data());
+  for (int s = 1; s <= S; ++s) {
+    const bool on_body = !substep_poses.empty() && s < S;
+    for (int k = 0; k < dim; ++k) {
+      double* h = heads + k * L;
+      const double* from = cs->start.data() + k * L;
+      for (int lane = 0; lane < L; ++lane) {
+        if (on_body) {
+          const double* q = body.data() + block.body + (head * dim) * L + lane;
+          h[lane] = FromBody(substep_poses[s - 1], dim, k, q, L);
+        } else {
+          // As the engine without colliders: the last sub-step ends on the target.
+          h[lane] = SubstepHead(from[lane], target[k * L + lane], s, S);
+        }
+      }
+    }
+    std::copy(pts + free_begin, pts + free_begin + free_size, cs->saved.data());
+    sweeps(options.method, dim, n, head, 1, heads, block_lengths, block_inv, pts);
+    std::fill(cs->least.begin(), cs->least.end(), std::numeric_limits<double>::infinity());
+    std::fill(cs->enters.begin(), cs->enters.end(), 0);
+    CheckLanes(dim, n, head, pts, block_lengths, block_inv, placed[s - 1], bounds[s - 1],
+               cs->least.data(), cs->enters.data());
+    for (int lane = 0; lane < L; ++lane) {
+      if (!cs->enters[lane]) {
+        cs->stats.least_clearance = std::min(cs->stats.least_clearance, cs->least[lane]);
+        continue;
+      }
+      // From where the lane was: its points head .. n and link lengths, point by point.
+      const int m = n - head;
+      for (int i = 0; i <= m; ++i) {
+        for (int k = 0; k < dim; ++k) {
+          cs->chain[i * dim + k] = cs->saved[(i * dim + k) * L + lane];
+        }
+      }
+      double lead[3];
+      for (int k = 0; k < dim; ++k) lead[k] = heads[k * L + lane];
+      for (int i = 0; i < m; ++i) {
+        cs->lengths[i] = block_lengths[(head + i) * L + lane];
+        cs->inv_lengths[i] = block_inv[(head + i) * L + lane];
+      }
+      try {
+        ContactSweep(options.method, dim, lead, cs->lengths.data(), cs->inv_lengths.data(), m,
+                     cs->chain.data(), placed[s - 1], &cs->stats);
+      } catch (const InputError& e) {
+        // No room: the lane stays where it was; the frame reports it.
+        for (int i = 0; i <= m; ++i) {
+          for (int k = 0; k < dim; ++k)
+            cs->chain[i * dim + k] = cs->saved[(i * dim + k) * L + lane];
+        }
+        if (cs->error.empty()) {
+          cs->error = "strands[" + std::to_string(block.source[lane]) + "]: " + e.problem().Text();
+        }
+      }
+      for (int i = 0; i <= m; ++i) {
+        for (int k = 0; k < dim; ++k)
+          pts[free_begin + (i * dim + k) * L + lane] = cs->chain[i * dim + k];
+      }
+    }
+  }
 }
 
 namespace {
@@ -325,6 +559,17 @@ Problems StrandOptions::Validate() const {
     problems.push_back(
         Problem::Invalid("threads", std::to_string(threads), "an integer from 0 to 1024"));
   }
+  for (size_t i = 0; i < colliders.size(); ++i) {
+    for (Problem& p : CheckCollider(colliders[i], "colliders[" + std::to_string(i) + "]")) {
+      problems.push_back(std::move(p));
+    }
+  }
+  for (size_t i = 0; i < body_colliders.size(); ++i) {
+    for (Problem& p :
+         CheckCollider(body_colliders[i], "body_colliders[" + std::to_string(i) + "]")) {
+      problems.push_back(std::move(p));
+    }
+  }
   return problems;
 }
 
@@ -366,6 +611,84 @@ void ValidatePose(const BodyPose& pose, int dim) {
     throw InputError("pose.rotation",
                      "is not a rotation (orthonormal with determinant +1, to 1e-9)");
   }
+}
+
+// The rigid motion x -> R x + t of a body pose as an isometry (in 2D: the rotation's top-left
+// 2x2 block, about z).
+Eigen::Isometry3d IsometryOf(const BodyPose& pose, int dim) {
+  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+  if (dim == 2) {
+    m.linear().topLeftCorner<2, 2>() = pose.rotation.topLeftCorner<2, 2>();
+    m.translation().head<2>() = pose.translation.head<2>();
+  } else {
+    m.linear() = pose.rotation;
+    m.translation() = pose.translation;
+  }
+  return m;
+}
+
+// The body's pose a fraction u of the way from `from` to `to`: the rotation by slerp (the shorter
+// arc), the translation linearly.
+BodyPose Between(const BodyPose& from, const BodyPose& to, double u, int dim) {
+  const Eigen::Isometry3d a = IsometryOf(from, dim), b = IsometryOf(to, dim);
+  const Eigen::Quaterniond qa(a.linear()), qb(b.linear());
+  BodyPose pose;
+  pose.rotation = qa.slerp(u, qb).toRotationMatrix();
+  pose.translation = a.translation() + u * (b.translation() - a.translation());
+  return pose;
+}
+
+}  // namespace
+
+namespace internal {
+
+// All colliders placed for the frame's sub-steps: the world's as they are, the body's at the
+// body's pose (at each sub-step's pose with sub-steps > 1, else at `pose`). `pose` null: the
+// roots are stepped as points, and only world colliders exist.
+void StrandBatchImpl::PlaceColliders(const BodyPose* frame_pose) {
+  const int S = options.substeps;
+  const auto& world = options.colliders;
+  const auto& attached = options.body_colliders;
+  for (int s = 1; s <= S; ++s) {
+    BodyPose at = frame_pose != nullptr ? *frame_pose : last_pose;
+    if (!substep_poses.empty()) {
+      if (s < S) at = Between(last_pose, *frame_pose, static_cast<double>(s) / S, dim);
+      substep_poses[s - 1] = at;
+    }
+    const Eigen::Isometry3d body_to_world = IsometryOf(at, dim);
+    std::vector<Collider>& out = placed[s - 1];
+    for (size_t j = 0; j < world.size(); ++j) out[j] = world[j];
+    for (size_t j = 0; j < attached.size(); ++j) {
+      out[world.size() + j] = attached[j];
+      out[world.size() + j].pose = body_to_world * attached[j].pose;
+    }
+    for (size_t j = 0; j < out.size(); ++j) bounds[s - 1][j] = BoundOf(out[j]);
+  }
+}
+
+}  // namespace internal
+
+namespace {
+
+// Refuses strands that start inside a collider, naming the strand, the point or link, the
+// collider and the depth.
+void CheckStart(const std::vector<Points>& strands, const StrandOptions& options,
+                const BodyPose& rest) {
+  const std::optional<StrandInside> inside = FindStrandInside(strands, options, rest);
+  if (!inside) return;
+  const StrandInside& in = *inside;
+  const std::vector<Collider>& list = in.body ? options.body_colliders : options.colliders;
+  const std::string collider = std::string(in.body ? "body_colliders[" : "colliders[") +
+                               std::to_string(in.collider) + "] (a " +
+                               ColliderShapeName(list[in.collider].shape) + ")";
+  const std::string what =
+      in.link ? "link " + std::to_string(in.point) + " (points " + std::to_string(in.point - 1) +
+                    " to " + std::to_string(in.point) + ") passes through " + collider
+              : "point " + std::to_string(in.point) + " lies inside " + collider;
+  throw InputError("strands[" + std::to_string(in.strand) + "]",
+                   what + " by " + FormatNumber(in.depth) + " at the start (" +
+                       FormatNumber(in.relative) +
+                       " of the link's length); a strand must start outside every collider");
 }
 
 }  // namespace
@@ -476,6 +799,66 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
     m.scratch.emplace_back(static_cast<size_t>(options.substeps + 1) * std::max(dim, 1) * L);
   }
   m.pool = std::make_unique<internal::WorkerPool>(threads);
+  m.last_pose = rest;
+  m.has_colliders = !options.colliders.empty() || !options.body_colliders.empty();
+  if (m.has_colliders && count > 0) {
+    const int S = options.substeps;
+    const size_t num = options.colliders.size() + options.body_colliders.size();
+    m.placed.assign(S, std::vector<Collider>(num));
+    m.bounds.assign(S, std::vector<internal::ColliderBound>(num));
+    if (!options.body_colliders.empty() && S > 1) m.substep_poses.resize(S);
+    m.PlaceColliders(&rest);
+    CheckStart(strands, options, rest);
+    int most_links = 0;
+    for (int n : m.links) most_links = std::max(most_links, n);
+    m.contact.resize(threads);
+    for (auto& cs : m.contact) {
+      cs.start.resize(static_cast<size_t>(dim) * L);
+      cs.saved.resize(static_cast<size_t>(most_links + 1) * dim * L);
+      cs.chain.resize(static_cast<size_t>(most_links + 1) * dim);
+      cs.lengths.resize(most_links);
+      cs.inv_lengths.resize(most_links);
+      cs.least.resize(L);
+      cs.enters.resize(L);
+    }
+  }
+}
+
+std::optional<StrandInside> FindStrandInside(const std::vector<Points>& strands,
+                                             const StrandOptions& options, const BodyPose& rest) {
+  const size_t num_world = options.colliders.size();
+  std::vector<Collider> colliders = options.colliders;
+  for (const Collider& c : options.body_colliders) {
+    colliders.push_back(c);
+    const int dim = strands.empty() ? 3 : static_cast<int>(strands[0].cols());
+    colliders.back().pose = IsometryOf(rest, dim) * c.pose;
+  }
+  for (size_t i = 0; i < strands.size(); ++i) {
+    const Points& p = strands[i];
+    const int n = static_cast<int>(p.rows()) - 1;
+    const int head = std::min(options.pinned, n + 1) - 1;
+    const auto at = [&](int j) {
+      return Eigen::Vector3d(p(j, 0), p(j, 1), p.cols() == 3 ? p(j, 2) : 0.0);
+    };
+    for (int j = head + 1; j <= n; ++j) {
+      const double length = (at(j) - at(j - 1)).norm();
+      for (size_t c = 0; c < colliders.size(); ++c) {
+        const double through = -internal::SegmentClearance(colliders[c], at(j - 1), at(j));
+        if (!(through > internal::kContactSlack * length)) continue;
+        const double inside = -QuerySurface(colliders[c], at(j)).distance;
+        StrandInside in;
+        in.strand = static_cast<int>(i);
+        in.point = j;
+        in.link = !(inside > internal::kContactSlack * length);
+        in.body = c >= num_world;
+        in.collider = static_cast<int>(in.body ? c - num_world : c);
+        in.depth = in.link ? through : inside;
+        in.relative = in.depth / length;
+        return in;
+      }
+    }
+  }
+  return std::nullopt;
 }
 
 StrandBatch::StrandBatch(StrandBatch&&) noexcept = default;
@@ -493,6 +876,7 @@ int StrandBatch::num_links(int strand) const {
 }
 const StrandOptions& StrandBatch::options() const { return impl_->options; }
 const char* StrandBatch::engine() const { return impl_->engine; }
+StrandContacts StrandBatch::contacts() const { return impl_->contacts; }
 
 void StrandBatch::CopyStrand(int strand, Points* out) const {
   using internal::L;
@@ -520,8 +904,11 @@ void StepStrands(StrandBatch* batch, const BodyPose& pose) {
   ValidatePose(pose, m.dim);
   m.pose = &pose;
   m.roots = nullptr;
+  if (m.has_colliders) m.PlaceColliders(&pose);
   m.pool->Run(internal::StrandBatchImpl::Job, &m);
   m.pose = nullptr;
+  m.last_pose = pose;
+  m.GatherContacts();
 }
 
 void StepStrands(StrandBatch* batch, const Eigen::Ref<const Points>& roots) {
@@ -534,11 +921,17 @@ void StepStrands(StrandBatch* batch, const Eigen::Ref<const Points>& roots) {
   }
   if (m.blocks.empty()) return;
   if (!roots.allFinite()) throw InputError("roots", "has a value that is not finite");
+  if (!m.options.body_colliders.empty()) {
+    throw InputError("roots",
+                     "cannot move a batch with body colliders: it has no body pose to place them "
+                     "at; step it by the body's pose (StepStrands(batch, pose))");
+  }
   m.roots = roots.data();
   m.roots_stride = roots.outerStride();
   m.pose = nullptr;
   m.pool->Run(internal::StrandBatchImpl::Job, &m);
   m.roots = nullptr;
+  m.GatherContacts();
 }
 
 }  // namespace flexkin

@@ -197,6 +197,55 @@ void RefineExit(const TailSearch& search, double step, double* psi, double* thet
   }
 }
 
+// A sphere blocks, from a head outside it, a circular cone of directions about the direction u
+// of its centre (docs/colliders.md, "One sphere"): of half-angle asin(r / D) when the link
+// reaches the tangent points (L >= sqrt(D^2 - r^2)), else of the angle at which the link's end
+// lies on the sphere, cos = (D^2 + L^2 - r^2) / (2 L D). The nearest direction outside the cone
+// to d0, inside it, lies on the great circle through u and d0, at the cone's angle from u. Sets
+// *x to the link's end in that direction; false if the head is inside the sphere (beyond the
+// slack).
+bool SphereExit(int dim, const Collider& sphere, const Vector3d& head, const Vector3d& d0,
+                double length, double widen, Vector3d* x) {
+  const Vector3d to_center = sphere.pose.translation() - head;
+  const double distance = to_center.norm(), r = sphere.radius;
+  // A head on the surface (a contact step put it there, to the last bits, or a root): the cone
+  // is the half-space of directions into the sphere; its boundary, the tangent plane.
+  if (!(distance > r) && (r - distance > kContactSlack * length || !(distance > 0.0))) {
+    return false;
+  }
+  const Vector3d u = to_center / distance;
+  const double tangent = distance > r ? std::sqrt((distance - r) * (distance + r)) : 0.0;
+  double cos_a, sin_a;
+  if (distance <= r) {
+    sin_a = 1.0;
+    cos_a = 0.0;
+  } else if (length >= tangent) {
+    sin_a = r / distance;
+    cos_a = tangent / distance;
+  } else {
+    cos_a = std::clamp((distance * distance + length * length - r * r) / (2.0 * length * distance),
+                       -1.0, 1.0);
+    sin_a = std::sqrt((1.0 - cos_a) * (1.0 + cos_a));
+  }
+  if (widen != 0.0) {
+    const double a = std::atan2(sin_a, cos_a) + widen;
+    cos_a = std::cos(a);
+    sin_a = std::sin(a);
+  }
+  Vector3d w = d0 - d0.dot(u) * u;
+  const double w_norm = w.norm();
+  if (w_norm > 1e-300) {
+    w /= w_norm;
+  } else if (dim == 2) {
+    w = Vector3d(-u.y(), u.x(), 0.0);
+  } else {
+    const Vector3d helper = std::fabs(u.x()) < 0.9 ? Vector3d::UnitX() : Vector3d::UnitY();
+    w = u.cross(helper).normalized();
+  }
+  *x = head + length * (cos_a * u + sin_a * w);
+  return true;
+}
+
 }  // namespace
 
 bool ContactTail(int dim, const Vector3d& head, const Vector3d& tail, double length,
@@ -215,6 +264,24 @@ bool ContactTail(int dim, const Vector3d& head, const Vector3d& tail, double len
     dirs.e2 = dirs.d0.cross(dirs.e1);
   }
   const TailSearch search(head, length, colliders, dirs);
+  // One sphere blocking the old direction, and its exit clear of the others: closed form.
+  const Collider* only = nullptr;
+  int blocking = 0;
+  for (const Collider& c : colliders) {
+    if (search.Blocks(c, 0.0, 0.0)) ++blocking, only = &c;
+  }
+  if (blocking == 1 && only->shape == ColliderShape::kSphere) {
+    // On the cone's boundary to the last bits; widened by a few ulps of the angle if rounding
+    // leaves the link inside by more than the slack.
+    for (double widen : {0.0, 1e-15, 1e-14, 1e-13}) {
+      Vector3d candidate;
+      if (!SphereExit(dim, *only, head, dirs.d0, length, widen, &candidate)) break;
+      if (SegmentClearance(colliders, head, candidate) >= -kContactSlack * length) {
+        *x = candidate;
+        return true;
+      }
+    }
+  }
   double best_theta = std::numeric_limits<double>::infinity(), best_psi = 0.0;
   if (dim == 2) {
     // The two ways round.

@@ -1,0 +1,379 @@
+// The strand engine with colliders (flexkin/strands.h, docs/colliders.md): no free point or link
+// inside a collider after any frame, lengths kept, a batch that touches nothing stepped exactly as
+// without colliders, strands that touch equal to the single chain's contact sweep, the same
+// result on every engine and thread count, and the refusals.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "flexkin/groom.h"
+#include "flexkin/run.h"
+#include "flexkin/strands.h"
+#include "strands/strand_engine.h"
+
+namespace flexkin {
+namespace {
+
+using Eigen::Vector3d;
+
+// Strands lying close over the unit sphere (circle in 2D): each link turns a little away from
+// the surface (radial component 0.1 to 0.25 of the link), so every point is farther from the
+// centre than the one before, yet near enough that a turning body drags them through it.
+std::vector<Points> LyingStrands(int count, int dim, int links, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal;
+  std::uniform_real_distribution<double> radial(0.1, 0.25), length(0.03, 0.06);
+  std::vector<Points> strands;
+  for (int s = 0; s < count; ++s) {
+    Points p(links + 1, dim);
+    Eigen::VectorXd root(dim), tangent(dim);
+    for (int k = 0; k < dim; ++k) root[k] = normal(rng), tangent[k] = normal(rng);
+    root.normalize();
+    if (dim == 3 && root[2] < -0.3) root[2] = -root[2];  // clear of a neck below
+    p.row(0) = root.transpose();
+    for (int i = 1; i <= links; ++i) {
+      const Eigen::VectorXd out = p.row(i - 1).transpose().normalized();
+      Eigen::VectorXd t = tangent - tangent.dot(out) * out;
+      t.normalize();
+      const double a = radial(rng);
+      const Eigen::VectorXd dir = a * out + std::sqrt(1.0 - a * a) * t;
+      p.row(i) = p.row(i - 1) + length(rng) * dir.transpose();
+      tangent = t;
+    }
+    strands.push_back(p);
+  }
+  return strands;
+}
+
+// The body turns back and forth about a tilted axis (about z in 2D) and shifts a little.
+BodyPose TurningPose(int frame, int dim) {
+  const double t = 0.15 * frame;
+  const double angle = 1.2 * std::sin(t);
+  if (dim == 2) return BodyPose::Planar(angle, 0.05 * std::sin(0.5 * t), 0.0);
+  const Vector3d axis = Vector3d(0.3, 0.2, 1.0).normalized();
+  return BodyPose::FromQuaternion(std::cos(angle / 2), std::sin(angle / 2) * axis[0],
+                                  std::sin(angle / 2) * axis[1], std::sin(angle / 2) * axis[2],
+                                  Vector3d(0.05 * std::sin(0.5 * t), 0.0, 0.0));
+}
+
+Collider Sphere(const Vector3d& center, double radius) {
+  Collider c;
+  c.shape = ColliderShape::kSphere;
+  c.pose.translation() = center;
+  c.radius = radius;
+  return c;
+}
+
+Collider Capsule(const Vector3d& from, const Vector3d& to, double radius) {
+  Collider c;
+  c.shape = ColliderShape::kCapsule;
+  c.pose.translation() = 0.5 * (from + to);
+  c.pose.linear() = Eigen::Quaterniond::FromTwoVectors(Vector3d::UnitZ(), to - from).matrix();
+  c.half_length = 0.5 * (to - from).norm();
+  c.radius = radius;
+  return c;
+}
+
+Vector3d At(const Points& p, int i) {
+  return Vector3d(p(i, 0), p(i, 1), p.cols() == 3 ? p(i, 2) : 0.0);
+}
+
+// The least distance from the segment [a, b] to the point set f measures, by ternary search on
+// the segment's parameter (the distance to a convex set is convex along a segment): the test's
+// own measure, independent of the library's closed forms.
+template <class Distance>
+double LeastAlong(const Vector3d& a, const Vector3d& b, Distance f) {
+  double lo = 0.0, hi = 1.0;
+  for (int i = 0; i < 200; ++i) {
+    const double m1 = lo + (hi - lo) / 3, m2 = hi - (hi - lo) / 3;
+    if (f(a + m1 * (b - a)) < f(a + m2 * (b - a))) {
+      hi = m2;
+    } else {
+      lo = m1;
+    }
+  }
+  return std::min({f(a), f(b), f(a + 0.5 * (lo + hi) * (b - a))});
+}
+
+// The signed distance of x to a sphere or capsule placed in the world: |x - centre| - r, or the
+// distance to the axis segment - r.
+double Signed(const Collider& c, const Vector3d& x) {
+  if (c.shape == ColliderShape::kSphere) return (x - c.pose.translation()).norm() - c.radius;
+  const Vector3d axis = c.pose.linear().col(2) * c.half_length;
+  const Vector3d p = c.pose.translation() - axis, q = c.pose.translation() + axis;
+  const double t = std::clamp((x - p).dot(q - p) / (q - p).squaredNorm(), 0.0, 1.0);
+  return (x - (p + t * (q - p))).norm() - c.radius;
+}
+
+// The colliders placed at the body's pose (body colliders) or as they are (world).
+std::vector<Collider> Placed(const std::vector<Collider>& body, const BodyPose& pose, int dim) {
+  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+  if (dim == 2) {
+    m.linear().topLeftCorner<2, 2>() = pose.rotation.topLeftCorner<2, 2>();
+    m.translation().head<2>() = pose.translation.head<2>();
+  } else {
+    m.linear() = pose.rotation;
+    m.translation() = pose.translation;
+  }
+  std::vector<Collider> out = body;
+  for (Collider& c : out) c.pose = m * c.pose;
+  return out;
+}
+
+// The least clearance of strand `s`'s free links (after `pinned` - 1), relative to each link's
+// length, over `colliders`.
+double LeastClearance(const Points& p, int pinned, const std::vector<Collider>& colliders) {
+  double least = std::numeric_limits<double>::infinity();
+  for (int i = pinned; i < p.rows(); ++i) {
+    const Vector3d a = At(p, i - 1), b = At(p, i);
+    for (const Collider& c : colliders) {
+      const double d = LeastAlong(a, b, [&](const Vector3d& x) { return Signed(c, x); });
+      least = std::min(least, d / (b - a).norm());
+    }
+  }
+  return least;
+}
+
+struct Case {
+  int dim, substeps, pinned;
+  const char* engine;
+};
+
+class StrandColliders : public ::testing::TestWithParam<Case> {};
+
+// A scalp of radius 1 with the strands lying over it and, in 3D, a neck capsule below; the body
+// turns for 40 frames. After every frame: no free link inside either (beyond 1e-12 of its
+// length), every length kept to 1e-12, and many contact steps taken (the free strands cut
+// through the scalp: the case is not vacuous).
+TEST_P(StrandColliders, NothingEntersTheBodyAndLengthsAreKept) {
+  const Case c = GetParam();
+  const std::vector<Points> strands = LyingStrands(40, c.dim, 12, 7);
+  StrandOptions options;
+  options.substeps = c.substeps;
+  options.pinned = c.pinned;
+  options.threads = 2;
+  options.body_colliders = {Sphere(Vector3d::Zero(), 1.0)};
+  if (c.dim == 3) {
+    options.body_colliders.push_back(Capsule(Vector3d(0, 0, -0.95), Vector3d(0, 0, -1.8), 0.35));
+  }
+  StrandBatch batch(strands, options);
+  StrandBatch free(strands, [&] {
+    StrandOptions o = options;
+    o.body_colliders.clear();
+    return o;
+  }());
+  if (!internal::SetStrandEngine(&batch, c.engine)) GTEST_SKIP() << "no " << c.engine << " here";
+  ASSERT_TRUE(internal::SetStrandEngine(&free, c.engine));
+  double free_least = std::numeric_limits<double>::infinity();
+  for (int f = 1; f <= 40; ++f) {
+    const BodyPose pose = TurningPose(f, c.dim);
+    StepStrands(&batch, pose);
+    StepStrands(&free, pose);
+    const std::vector<Collider> placed = Placed(options.body_colliders, pose, c.dim);
+    for (int s = 0; s < batch.size(); ++s) {
+      const Points p = batch.strand(s);
+      ASSERT_GE(LeastClearance(p, c.pinned, placed), -1e-12) << "frame " << f << " strand " << s;
+      for (int i = 1; i < p.rows(); ++i) {
+        const double rest = (strands[s].row(i) - strands[s].row(i - 1)).norm();
+        ASSERT_NEAR((p.row(i) - p.row(i - 1)).norm(), rest, 1e-12 * rest);
+      }
+      free_least = std::min(free_least, LeastClearance(free.strand(s), c.pinned, placed));
+    }
+  }
+  EXPECT_LT(free_least, -0.05) << "the strands without colliders should cut through the body";
+  EXPECT_GT(batch.contacts().contact_link_steps, 100);
+  EXPECT_GE(batch.contacts().least_clearance, -1e-13);
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, StrandColliders,
+                         ::testing::Values(Case{3, 1, 1, "scalar"}, Case{3, 1, 1, "avx2"},
+                                           Case{3, 1, 1, "avx512"}, Case{3, 3, 1, "avx2"},
+                                           Case{3, 1, 2, "scalar"}, Case{2, 1, 1, "scalar"},
+                                           Case{2, 2, 1, "avx2"}, Case{2, 1, 1, "avx512"}),
+                         [](const auto& info) {
+                           return std::to_string(info.param.dim) + "d_substeps" +
+                                  std::to_string(info.param.substeps) + "_pinned" +
+                                  std::to_string(info.param.pinned) + "_" + info.param.engine;
+                         });
+
+// Colliders that nothing comes near change nothing: bit for bit the batch without them, on
+// every engine (world colliders with sub-steps; body colliders with one sub-step: with more, the
+// pinned points follow the body's own motion between frames, flexkin/strands.h).
+TEST(StrandCollidersTest, FarCollidersChangeNoBit) {
+  for (const char* engine : {"scalar", "avx2", "avx512"}) {
+    for (int substeps : {1, 2}) {
+      const std::vector<Points> strands = LyingStrands(37, 3, 9, 3);
+      StrandOptions options;
+      options.substeps = substeps;
+      StrandBatch plain(strands, options);
+      options.colliders = {Sphere(Vector3d(50, 0, 0), 1.0)};
+      if (substeps == 1) {
+        options.body_colliders = {Capsule(Vector3d(0, 0, -40), Vector3d(0, 0, -60), 1.0)};
+      }
+      StrandBatch with(strands, options);
+      if (!internal::SetStrandEngine(&plain, engine)) continue;
+      ASSERT_TRUE(internal::SetStrandEngine(&with, engine));
+      for (int f = 1; f <= 30; ++f) {
+        StepStrands(&plain, TurningPose(f, 3));
+        StepStrands(&with, TurningPose(f, 3));
+      }
+      for (int s = 0; s < plain.size(); ++s) {
+        ASSERT_TRUE(plain.strand(s) == with.strand(s))
+            << engine << " substeps " << substeps << " strand " << s << "\n"
+            << plain.strand(s) << "\n\n"
+            << with.strand(s);
+      }
+      EXPECT_EQ(with.contacts().contact_link_steps, 0);
+    }
+  }
+}
+
+// A strand whose root is moved as a point past a world sphere is the single chain run with the
+// same collider (Run with RunOptions::colliders, the contact sweep), on the scalar engine bit
+// for bit.
+TEST(StrandCollidersTest, AStrandIsItsChainsContactRun) {
+  Points chain(9, 3);
+  for (int i = 0; i <= 8; ++i) chain.row(i) << -0.25 * i, 0.02 * i, 0.0;
+  const Collider post = Sphere(Vector3d(-0.4, -0.4, 0.0), 0.25);
+  // The root moves down, dragging the strand's tail round the sphere.
+  Points path(31, 3);
+  for (int f = 0; f <= 30; ++f) path.row(f) << 0.0, -0.06 * f, 0.0;
+  StrandOptions options;
+  options.colliders = {post};
+  StrandBatch batch({chain}, options);
+  ASSERT_TRUE(internal::SetStrandEngine(&batch, "scalar"));
+  for (int f = 1; f <= 30; ++f) StepStrands(&batch, path.row(f));
+
+  RunOptions run;
+  run.method = Method::kTractrix;
+  run.colliders = {post};
+  const RunResult result = flexkin::Run(MakeChain(chain), path, run);
+  EXPECT_GT(result.contacts.contact_link_steps, 0) << result.frames.back().points;
+  const Points last = result.frames.back().points;
+  EXPECT_TRUE(batch.strand(0) == last) << batch.strand(0) << "\n\n" << last;
+}
+
+// The same frames whatever the number of threads, with contacts.
+TEST(StrandCollidersTest, ThreadsChangeNoBit) {
+  const std::vector<Points> strands = LyingStrands(70, 3, 10, 11);
+  StrandOptions options;
+  options.body_colliders = {Sphere(Vector3d::Zero(), 1.0)};
+  options.threads = 1;
+  StrandBatch one(strands, options);
+  options.threads = 3;
+  StrandBatch three(strands, options);
+  for (int f = 1; f <= 20; ++f) {
+    StepStrands(&one, TurningPose(f, 3));
+    StepStrands(&three, TurningPose(f, 3));
+  }
+  EXPECT_GT(one.contacts().contact_link_steps, 0);
+  EXPECT_EQ(one.contacts().contact_link_steps, three.contacts().contact_link_steps);
+  for (int s = 0; s < one.size(); ++s) ASSERT_TRUE(one.strand(s) == three.strand(s));
+}
+
+TEST(StrandCollidersTest, AStartInsideIsRefusedWithPointColliderAndDepth) {
+  std::vector<Points> strands = LyingStrands(5, 3, 6, 1);
+  strands[3](4, 0) *= 0.5, strands[3](4, 1) *= 0.5, strands[3](4, 2) *= 0.5;  // into the scalp
+  StrandOptions options;
+  options.colliders = {Sphere(Vector3d(5, 0, 0), 0.1)};
+  options.body_colliders = {Sphere(Vector3d::Zero(), 1.0)};
+  try {
+    StrandBatch batch(strands, options);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problem().field, "strands[3]");
+    const std::string text = e.what();
+    EXPECT_NE(text.find("point 4 lies inside body_colliders[0] (a sphere) by 0.4"),
+              std::string::npos)
+        << text;
+  }
+}
+
+TEST(StrandCollidersTest, BadCollidersAndRootStepsAreRefused) {
+  const std::vector<Points> strands = LyingStrands(2, 3, 4, 1);
+  StrandOptions options;
+  options.body_colliders = {Sphere(Vector3d::Zero(), 0.0)};
+  try {
+    StrandBatch batch(strands, options);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problem().field, "body_colliders[0].radius") << e.what();
+  }
+  options.body_colliders = {Sphere(Vector3d::Zero(), 1.0)};
+  StrandBatch batch(strands, options);
+  Points roots(2, 3);
+  roots << 0, 0, 1, 1, 0, 0;
+  try {
+    StepStrands(&batch, roots);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problem().field, "roots");
+  }
+}
+
+}  // namespace
+}  // namespace flexkin
+
+namespace flexkin {
+namespace {
+
+// A small head groom: the scalp (a collider by default) and a neck capsule, turning.
+std::string HeadGroom(const std::string& colliders, const std::string& extra = "") {
+  return R"({
+    "groom": {"scalp": {"shape": "sphere", "radius": 0.1}, "roots": 300,
+              "region": {"axis": [0, 0, 1], "max_angle_deg": 110}, "links": 12,
+              "link_length": 0.008, "direction": {"droop": 0.6}, "seed": 3},
+    "motion": {"fps": 30, "keyframes": [
+      {"time": 0, "rotation": {"axis": [0, 0, 1], "angle_deg": 0}},
+      {"time": 0.5, "rotation": {"axis": [0, 0, 1], "angle_deg": 70}},
+      {"time": 1.0, "rotation": {"axis": [1, 0, 0], "angle_deg": 25}}]},
+    "colliders": )" +
+         colliders + extra + "}";
+}
+
+TEST(GroomCollidersTest, TheScalpAndANeckKeepTheHairOut) {
+  const GroomScenario s =
+      ParseGroomText(HeadGroom(R"([{"shape": "capsule", "from": [0, 0, -0.09], "to": [0, 0, -0.3],
+                     "radius": 0.05}])"));
+  ASSERT_EQ(s.options.body_colliders.size(), 2u);
+  EXPECT_EQ(s.options.body_colliders[0].shape, ColliderShape::kCapsule);
+  EXPECT_EQ(s.options.body_colliders[1].shape, ColliderShape::kSphere);  // the scalp, last
+  const StrandRunReport report = RunGroom(s, nullptr);
+  EXPECT_GT(report.contact_link_steps, 0);
+  EXPECT_GE(report.least_clearance, -1e-13);
+  EXPECT_LT(report.max_length_error, 1e-13);
+  // Without the scalp collider, nothing is in contact with it.
+  const GroomScenario bare = ParseGroomText(HeadGroom("[]", R"(, "scalp_collider": false)"));
+  EXPECT_TRUE(bare.options.body_colliders.empty());
+}
+
+TEST(GroomCollidersTest, AStartInsideNamesTheColliderTheRootAndThePoint) {
+  try {
+    ParseGroomText(HeadGroom(R"([{"shape": "sphere", "center": [0, 0, 0], "radius": 0.13}])"));
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problem().field, "/colliders/0") << e.what();
+    const std::string text = e.what();
+    EXPECT_NE(text.find("the strand of root "), std::string::npos) << text;
+    EXPECT_NE(text.find("lies inside it by"), std::string::npos) << text;
+  }
+  try {
+    ParseGroomText(HeadGroom("[]", R"(, "scalp_collider": 1)"));
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problem().field, "/scalp_collider") << e.what();
+  }
+  try {
+    ParseGroomText(HeadGroom(R"([{"shape": "capsule", "from": [0, 0, 1], "to": [0, 0, 2],
+                                  "radius": 0}])"));
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problem().field, "/colliders/0/radius") << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace flexkin
