@@ -207,8 +207,10 @@ struct ContactScratch {
   std::vector<double> chain;    // one lane's points, point by point
   std::vector<double> lengths;  // one lane's link lengths and their inverses
   std::vector<double> inv_lengths;
-  std::vector<double> least;  // per lane: least relative clearance of the sub-step
-  std::vector<char> enters;   // per lane: a link entered a collider
+  std::vector<double> least;             // per lane: least relative clearance of the sub-step
+  std::vector<int> first_enter;          // per lane: the first link that entered a collider
+  std::vector<uint64_t> near;            // per lane: the colliders a link came near (bits)
+  std::vector<Collider> near_colliders;  // one lane's near colliders
   ContactStats stats;
   std::string error;  // the first contact step that found no room
 };
@@ -345,16 +347,20 @@ void StrandBatchImpl::StepBlock(int b, double* scratch_heads) {
 
 namespace {
 
-// Marks the lanes whose free links (head + 1 .. n) enter a collider after a sweep and lowers
-// `least` (per lane) to the relative clearance of the links near one. Each link is first
+// Finds, per lane, the first free link (head + 1 .. n) that enters a collider after a sweep
+// (first_enter: n + 1 for none), the colliders some link comes near (near: bit c for collider c;
+// all bits from the 64th collider on) and lowers `least` to the relative clearance of the links
+// near one. Each link is first
 // measured against every collider's bound in a loop over the lanes (the compiler's vector
 // code); only links within a link's length of a bound are measured exactly.
-void CheckLanes(int dim, int n, int head, const double* pts, const double* lengths,
-                const double* inv_lengths, const std::vector<Collider>& colliders,
-                const std::vector<ColliderBound>& bounds, double* least, char* enters) {
+template <int Dim>
+void CheckLanesOf(int n, int head, const double* pts, const double* lengths,
+                  const double* inv_lengths, const std::vector<Collider>& colliders,
+                  const std::vector<ColliderBound>& bounds, double* least, int* first_enter,
+                  uint64_t* near) {
   for (int i = head + 1; i <= n; ++i) {
-    const double* a = pts + (i - 1) * dim * L;
-    const double* b = pts + i * dim * L;
+    const double* a = pts + (i - 1) * Dim * L;
+    const double* b = pts + i * Dim * L;
     const double* len = lengths + (i - 1) * L;
     const double* inv = inv_lengths + (i - 1) * L;
     for (size_t c = 0; c < bounds.size(); ++c) {
@@ -363,7 +369,7 @@ void CheckLanes(int dim, int n, int head, const double* pts, const double* lengt
       if (bound.half_space) {
         for (int lane = 0; lane < L; ++lane) {
           double da = 0.0, db = 0.0;
-          for (int k = 0; k < dim; ++k) {
+          for (int k = 0; k < Dim; ++k) {
             da += bound.up[k] * (a[k * L + lane] - bound.center[k]);
             db += bound.up[k] * (b[k * L + lane] - bound.center[k]);
           }
@@ -372,7 +378,7 @@ void CheckLanes(int dim, int n, int head, const double* pts, const double* lengt
       } else {
         for (int lane = 0; lane < L; ++lane) {
           double ab[3], ac[3], dot = 0.0, ab2 = 0.0;
-          for (int k = 0; k < dim; ++k) {
+          for (int k = 0; k < Dim; ++k) {
             ab[k] = b[k * L + lane] - a[k * L + lane];
             ac[k] = bound.center[k] - a[k * L + lane];
             dot += ab[k] * ac[k];
@@ -380,7 +386,7 @@ void CheckLanes(int dim, int n, int head, const double* pts, const double* lengt
           }
           const double t = std::clamp(dot / ab2, 0.0, 1.0);
           double d2 = 0.0;
-          for (int k = 0; k < dim; ++k) {
+          for (int k = 0; k < Dim; ++k) {
             const double d = a[k * L + lane] + t * ab[k] - bound.center[k];
             d2 += d * d;
           }
@@ -390,16 +396,51 @@ void CheckLanes(int dim, int n, int head, const double* pts, const double* lengt
       for (int lane = 0; lane < L; ++lane) {
         double c_lane = clear[lane];
         if (c_lane >= len[lane]) continue;  // far: not near this collider
+        near[lane] |= c < 64 ? uint64_t{1} << c : ~uint64_t{0};
         if (!bound.exact && !bound.half_space) {
-          const Eigen::Vector3d pa(a[lane], a[L + lane], dim == 3 ? a[2 * L + lane] : 0.0);
-          const Eigen::Vector3d pb(b[lane], b[L + lane], dim == 3 ? b[2 * L + lane] : 0.0);
+          const Eigen::Vector3d pa(a[lane], a[L + lane], Dim == 3 ? a[2 * L + lane] : 0.0);
+          const Eigen::Vector3d pb(b[lane], b[L + lane], Dim == 3 ? b[2 * L + lane] : 0.0);
           c_lane = SegmentClearance(colliders[c], pa, pb);
         }
-        if (c_lane < -kContactSlack * len[lane]) enters[lane] = 1;
+        if (c_lane < -kContactSlack * len[lane]) first_enter[lane] = std::min(first_enter[lane], i);
         least[lane] = std::min(least[lane], c_lane * inv[lane]);
       }
     }
   }
+}
+
+void CheckLanes(int dim, int n, int head, const double* pts, const double* lengths,
+                const double* inv_lengths, const std::vector<Collider>& colliders,
+                const std::vector<ColliderBound>& bounds, double* least, int* first_enter,
+                uint64_t* near) {
+  (dim == 2 ? CheckLanesOf<2> : CheckLanesOf<3>)(n, head, pts, lengths, inv_lengths, colliders,
+                                                 bounds, least, first_enter, near);
+}
+
+// Whether a link of the chain `points` (m links, point by point) enters, beyond the slack, a
+// collider not among those in `skip` (bits, as CheckLanes' near): each link measured against the
+// collider's bound first, exactly only where it reaches into the bound.
+bool EntersOther(int dim, int m, const double* points, const double* lengths,
+                 const std::vector<Collider>& colliders, const std::vector<ColliderBound>& bounds,
+                 uint64_t skip) {
+  for (size_t c = 0; c < colliders.size(); ++c) {
+    if (skip & (c < 64 ? uint64_t{1} << c : ~uint64_t{0})) continue;
+    const ColliderBound& bound = bounds[c];
+    for (int i = 1; i <= m; ++i) {
+      const double* a = points + (i - 1) * dim;
+      const double* b = points + i * dim;
+      const Eigen::Vector3d pa(a[0], a[1], dim == 3 ? a[2] : 0.0);
+      const Eigen::Vector3d pb(b[0], b[1], dim == 3 ? b[2] : 0.0);
+      if (!bound.half_space) {
+        const Eigen::Vector3d center(bound.center[0], bound.center[1], bound.center[2]);
+        const Eigen::Vector3d ab = pb - pa;
+        const double t = std::clamp((center - pa).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+        if ((pa + t * ab - center).norm() >= bound.radius) continue;
+      }
+      if (SegmentClearance(colliders[c], pa, pb) < -kContactSlack * lengths[i - 1]) return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace
@@ -441,43 +482,74 @@ void StrandBatchImpl::StepBlockWithColliders(int b, double* scratch_heads, Conta
     std::copy(pts + free_begin, pts + free_begin + free_size, cs->saved.data());
     sweeps(options.method, dim, n, head, 1, heads, block_lengths, block_inv, pts);
     std::fill(cs->least.begin(), cs->least.end(), std::numeric_limits<double>::infinity());
-    std::fill(cs->enters.begin(), cs->enters.end(), 0);
-    CheckLanes(dim, n, head, pts, block_lengths, block_inv, placed[s - 1], bounds[s - 1],
-               cs->least.data(), cs->enters.data());
+    std::fill(cs->first_enter.begin(), cs->first_enter.end(), n + 1);
+    std::fill(cs->near.begin(), cs->near.end(), 0);
+    const std::vector<Collider>& all = placed[s - 1];
+    CheckLanes(dim, n, head, pts, block_lengths, block_inv, all, bounds[s - 1], cs->least.data(),
+               cs->first_enter.data(), cs->near.data());
     for (int lane = 0; lane < L; ++lane) {
-      if (!cs->enters[lane]) {
+      const int first = cs->first_enter[lane];
+      if (first > n) {
         cs->stats.least_clearance = std::min(cs->stats.least_clearance, cs->least[lane]);
         continue;
       }
-      // From where the lane was: its points head .. n and link lengths, point by point.
-      const int m = n - head;
+      // The links before the first that entered stand as swept; from its leading end on, the
+      // contact sweep from where the lane was, first against the colliders the lane came near.
+      const int from = first - 1;  // the point the contact sweep leads from
+      const int m = n - from;
+      double lead[3];
+      for (int k = 0; k < dim; ++k) {
+        lead[k] = from == head ? heads[k * L + lane] : pts[(from * dim + k) * L + lane];
+      }
+      for (int i = 0; i < m; ++i) {
+        cs->lengths[i] = block_lengths[(from + i) * L + lane];
+        cs->inv_lengths[i] = block_inv[(from + i) * L + lane];
+      }
+      cs->near_colliders.clear();
+      for (size_t c = 0; c < all.size(); ++c) {
+        if (cs->near[lane] & (c < 64 ? uint64_t{1} << c : ~uint64_t{0})) {
+          cs->near_colliders.push_back(all[c]);
+        }
+      }
+      const bool some = cs->near_colliders.size() < all.size();
+      ContactStats stats;
+      for (int pass = some ? 0 : 1; pass < 2; ++pass) {
+        const std::vector<Collider>& against = pass == 0 ? cs->near_colliders : all;
+        for (int i = 0; i <= m; ++i) {
+          for (int k = 0; k < dim; ++k) {
+            cs->chain[i * dim + k] = cs->saved[((from - head + i) * dim + k) * L + lane];
+          }
+        }
+        stats = ContactStats();
+        try {
+          ContactSweep(options.method, dim, lead, cs->lengths.data(), cs->inv_lengths.data(), m,
+                       cs->chain.data(), against, &stats);
+        } catch (const InputError& e) {
+          // No room: the lane stays where it was; the frame reports it.
+          for (int i = 0; i <= m; ++i) {
+            for (int k = 0; k < dim; ++k) {
+              cs->chain[i * dim + k] = cs->saved[((from - head + i) * dim + k) * L + lane];
+            }
+          }
+          if (cs->error.empty()) {
+            cs->error =
+                "strands[" + std::to_string(block.source[lane]) + "]: " + e.problem().Text();
+          }
+          break;
+        }
+        // Against the near colliders only: kept if no link entered another one, else again
+        // against all.
+        if (pass == 0 && !EntersOther(dim, m, cs->chain.data(), cs->lengths.data(), all,
+                                      bounds[s - 1], cs->near[lane])) {
+          break;
+        }
+      }
+      cs->stats.contact_link_steps += stats.contact_link_steps;
+      cs->stats.least_clearance = std::min(cs->stats.least_clearance, stats.least_clearance);
       for (int i = 0; i <= m; ++i) {
         for (int k = 0; k < dim; ++k) {
-          cs->chain[i * dim + k] = cs->saved[(i * dim + k) * L + lane];
+          pts[((from + i) * dim + k) * L + lane] = cs->chain[i * dim + k];
         }
-      }
-      double lead[3];
-      for (int k = 0; k < dim; ++k) lead[k] = heads[k * L + lane];
-      for (int i = 0; i < m; ++i) {
-        cs->lengths[i] = block_lengths[(head + i) * L + lane];
-        cs->inv_lengths[i] = block_inv[(head + i) * L + lane];
-      }
-      try {
-        ContactSweep(options.method, dim, lead, cs->lengths.data(), cs->inv_lengths.data(), m,
-                     cs->chain.data(), placed[s - 1], &cs->stats);
-      } catch (const InputError& e) {
-        // No room: the lane stays where it was; the frame reports it.
-        for (int i = 0; i <= m; ++i) {
-          for (int k = 0; k < dim; ++k)
-            cs->chain[i * dim + k] = cs->saved[(i * dim + k) * L + lane];
-        }
-        if (cs->error.empty()) {
-          cs->error = "strands[" + std::to_string(block.source[lane]) + "]: " + e.problem().Text();
-        }
-      }
-      for (int i = 0; i <= m; ++i) {
-        for (int k = 0; k < dim; ++k)
-          pts[free_begin + (i * dim + k) * L + lane] = cs->chain[i * dim + k];
       }
     }
   }
@@ -819,7 +891,9 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
       cs.lengths.resize(most_links);
       cs.inv_lengths.resize(most_links);
       cs.least.resize(L);
-      cs.enters.resize(L);
+      cs.first_enter.resize(L);
+      cs.near.resize(L);
+      cs.near_colliders.reserve(m.placed.back().size());
     }
   }
 }
