@@ -26,6 +26,48 @@ void StrandSweepsScalar(Method method, int dim, int n, int head, int num_sweeps,
                         const double* heads, const double* lengths, const double* inv_lengths,
                         double* points);
 
+// A collider as the lanes' first test sees it: a ball that holds it (exact for a sphere), or a
+// half-space's plane.
+struct ColliderBound {
+  bool half_space = false;
+  bool exact = false;     // a sphere: the ball is the collider
+  double center[3] = {};  // the ball's centre, or a point of the plane
+  double up[3] = {};      // the plane's outward normal
+  double radius = 0.0;    // the ball's radius
+};
+
+// The clearance of every free link (head + 1 .. n) of every lane from every bound: link i's from
+// bound c at clearances[((i - head - 1) * num_bounds + c) * kStrandLanes + lane] (the least
+// distance of the segment to the ball less its radius, or the least height of its ends above the
+// plane).
+using StrandBoundsFn = void (*)(int dim, int n, int head, const double* points,
+                                const ColliderBound* bounds, int num_bounds, double* clearances);
+void StrandBoundsScalar(int dim, int n, int head, const double* points, const ColliderBound* bounds,
+                        int num_bounds, double* clearances);
+
+// One sphere the lanes stay outside of (flexkin/strands.h colliders, docs/colliders.md), placed
+// in the world, and what a sweep against it reports.
+struct StrandSphere {
+  double center[3] = {};
+  double radius = 0.0;
+  double slack = 0.0;  // the relative depth a link may lie inside (world/contact.h kContactSlack)
+};
+
+// One sweep (the leading end to `heads`, dim x lanes) of the method's rule, as StrandSweeps*,
+// with the contact step against one sphere in the lanes: where a link's rule step would enter
+// it, the least-motion step that keeps it outside, in closed form (the direction of the old
+// trailing end where that is clear, else the boundary of the cone of directions the sphere
+// blocks, on the great circle through that direction: docs/colliders.md, "One sphere"), as the
+// scalar contact step (world/contact.h ContactTail) computes it, to rounding. contact[i * lanes +
+// j] is set to 1 where link i of lane j took the contact step (0 elsewhere); fallback[j] is
+// lowered to the first link of lane j that the closed form could not step (a head inside the
+// sphere, a degenerate direction, a result the rounding left inside): that link and those after it
+// hold meaningless values, for the caller to step again.
+using StrandSphereSweepFn = void (*)(Method method, int dim, int n, int head, const double* heads,
+                                     const double* lengths, const double* inv_lengths,
+                                     double* points, const StrandSphere& sphere, uint8_t* contact,
+                                     int* fallback);
+
 #if FLEXKIN_HAVE_WAVEFRONT
 // The lanes in SIMD registers (strands_isa.cc, compiled per instruction set); equal to the
 // reference up to the vector exp's rounding, as the wavefront engine.
@@ -34,6 +76,16 @@ void StrandSweepsAvx2(Method method, int dim, int n, int head, int num_sweeps, c
 void StrandSweepsAvx512(Method method, int dim, int n, int head, int num_sweeps,
                         const double* heads, const double* lengths, const double* inv_lengths,
                         double* points);
+void StrandBoundsAvx2(int dim, int n, int head, const double* points, const ColliderBound* bounds,
+                      int num_bounds, double* clearances);
+void StrandBoundsAvx512(int dim, int n, int head, const double* points, const ColliderBound* bounds,
+                        int num_bounds, double* clearances);
+void StrandSphereSweepAvx2(Method method, int dim, int n, int head, const double* heads,
+                           const double* lengths, const double* inv_lengths, double* points,
+                           const StrandSphere& sphere, uint8_t* contact, int* fallback);
+void StrandSphereSweepAvx512(Method method, int dim, int n, int head, const double* heads,
+                             const double* lengths, const double* inv_lengths, double* points,
+                             const StrandSphere& sphere, uint8_t* contact, int* fallback);
 #endif
 
 }  // namespace flexkin::internal

@@ -159,16 +159,6 @@ struct Block {
   int source[L] = {};  // the strand each lane carries (padding lanes repeat the first)
 };
 
-// A collider as the lanes' first test sees it: a ball that holds it (exact for a sphere), or a
-// half-space's plane.
-struct ColliderBound {
-  bool half_space = false;
-  bool exact = false;     // a sphere: the ball is the collider
-  double center[3] = {};  // the ball's centre, or a point of the plane
-  double up[3] = {};      // the plane's outward normal
-  double radius = 0.0;    // the ball's radius
-};
-
 ColliderBound BoundOf(const Collider& c) {
   ColliderBound b;
   const Eigen::Vector3d t = c.pose.translation();
@@ -209,6 +199,9 @@ struct ContactScratch {
   std::vector<double> inv_lengths;
   std::vector<double> least;             // per lane: least relative clearance of the sub-step
   std::vector<int> first_enter;          // per lane: the first link that entered a collider
+  std::vector<int> fallback;             // per lane: the first link the lanes' step left
+  std::vector<double> clearances;        // per link, bound and lane: the bound's clearance
+  std::vector<uint8_t> contact_flags;    // per link and lane: the lanes' contact step taken
   std::vector<uint64_t> near;            // per lane: the colliders a link came near (bits)
   std::vector<Collider> near_colliders;  // one lane's near colliders
   ContactStats stats;
@@ -228,6 +221,10 @@ struct StrandBatchImpl {
   std::vector<AlignedDoubles> scratch;  // per thread: the heads of the sub-steps and the target
   std::vector<int> first_block;         // thread t steps blocks [first_block[t], first_block[t+1])
   StrandSweepsFn sweeps = StrandSweepsScalar;
+  // The SIMD engines' sweep with the contact step against one sphere in the lanes (null: the
+  // scalar engine, whose lanes take the contact sweep link by link).
+  StrandSphereSweepFn sphere_sweep = nullptr;
+  StrandBoundsFn measure_bounds = StrandBoundsScalar;
   const char* engine = "scalar";
   std::unique_ptr<WorkerPool> pool;
 
@@ -243,6 +240,10 @@ struct StrandBatchImpl {
   std::vector<std::vector<Collider>> placed;
   std::vector<std::vector<ColliderBound>> bounds;
   std::vector<BodyPose> substep_poses;
+  // Per sub-step: the one sphere among the colliders, if there is exactly one (a scalp), for
+  // the lanes' own contact step.
+  std::vector<char> lone_sphere;
+  std::vector<StrandSphere> spheres;
   BodyPose last_pose;
   std::vector<ContactScratch> contact;  // per thread
   StrandContacts contacts;
@@ -354,34 +355,28 @@ namespace {
 // measured against every collider's bound in a loop over the lanes (the compiler's vector
 // code); only links within a link's length of a bound are measured exactly.
 template <int Dim>
-void CheckLanesOf(int n, int head, const double* pts, const double* lengths,
-                  const double* inv_lengths, const std::vector<Collider>& colliders,
-                  const std::vector<ColliderBound>& bounds, double* least, int* first_enter,
-                  uint64_t* near) {
+void LinkBoundsOf(int n, int head, const double* points, const ColliderBound* bounds,
+                  int num_bounds, double* clearances) {
   for (int i = head + 1; i <= n; ++i) {
-    const double* a = pts + (i - 1) * Dim * L;
-    const double* b = pts + i * Dim * L;
-    const double* len = lengths + (i - 1) * L;
-    const double* inv = inv_lengths + (i - 1) * L;
-    for (size_t c = 0; c < bounds.size(); ++c) {
+    const double* a = points + (i - 1) * Dim * L;
+    const double* b = points + i * Dim * L;
+    double* out = clearances + static_cast<size_t>(i - head - 1) * num_bounds * L;
+    for (int c = 0; c < num_bounds; ++c) {
       const ColliderBound& bound = bounds[c];
-      double clear[L];
-      if (bound.half_space) {
-        for (int lane = 0; lane < L; ++lane) {
+      for (int lane = 0; lane < L; ++lane) {
+        double clear;
+        if (bound.half_space) {
           double da = 0.0, db = 0.0;
           for (int k = 0; k < Dim; ++k) {
             da += bound.up[k] * (a[k * L + lane] - bound.center[k]);
             db += bound.up[k] * (b[k * L + lane] - bound.center[k]);
           }
-          clear[lane] = std::min(da, db);
-        }
-      } else {
-        for (int lane = 0; lane < L; ++lane) {
-          double ab[3], ac[3], dot = 0.0, ab2 = 0.0;
+          clear = std::min(da, db);
+        } else {
+          double ab[3], dot = 0.0, ab2 = 0.0;
           for (int k = 0; k < Dim; ++k) {
             ab[k] = b[k * L + lane] - a[k * L + lane];
-            ac[k] = bound.center[k] - a[k * L + lane];
-            dot += ab[k] * ac[k];
+            dot += ab[k] * (bound.center[k] - a[k * L + lane]);
             ab2 += ab[k] * ab[k];
           }
           const double t = std::clamp(dot / ab2, 0.0, 1.0);
@@ -390,16 +385,36 @@ void CheckLanesOf(int n, int head, const double* pts, const double* lengths,
             const double d = a[k * L + lane] + t * ab[k] - bound.center[k];
             d2 += d * d;
           }
-          clear[lane] = std::sqrt(d2) - bound.radius;
+          clear = std::sqrt(d2) - bound.radius;
         }
+        out[c * L + lane] = clear;
       }
+    }
+  }
+}
+
+void CheckLanes(StrandBoundsFn measure, int dim, int n, int head, const double* pts,
+                const double* lengths, const double* inv_lengths,
+                const std::vector<Collider>& colliders, const std::vector<ColliderBound>& bounds,
+                double* clearances, double* least, int* first_enter, uint64_t* near) {
+  const int nb = static_cast<int>(bounds.size());
+  measure(dim, n, head, pts, bounds.data(), nb, clearances);
+  for (int i = head + 1; i <= n; ++i) {
+    const double* a = pts + (i - 1) * dim * L;
+    const double* b = pts + i * dim * L;
+    const double* len = lengths + (i - 1) * L;
+    const double* inv = inv_lengths + (i - 1) * L;
+    const double* clear = clearances + static_cast<size_t>(i - head - 1) * nb * L;
+    for (int c = 0; c < nb; ++c, clear += L) {
+      const ColliderBound& bound = bounds[c];
+      const uint64_t bit = c < 64 ? uint64_t{1} << c : ~uint64_t{0};
       for (int lane = 0; lane < L; ++lane) {
         double c_lane = clear[lane];
         if (c_lane >= len[lane]) continue;  // far: not near this collider
-        near[lane] |= c < 64 ? uint64_t{1} << c : ~uint64_t{0};
+        near[lane] |= bit;
         if (!bound.exact && !bound.half_space) {
-          const Eigen::Vector3d pa(a[lane], a[L + lane], Dim == 3 ? a[2 * L + lane] : 0.0);
-          const Eigen::Vector3d pb(b[lane], b[L + lane], Dim == 3 ? b[2 * L + lane] : 0.0);
+          const Eigen::Vector3d pa(a[lane], a[L + lane], dim == 3 ? a[2 * L + lane] : 0.0);
+          const Eigen::Vector3d pb(b[lane], b[L + lane], dim == 3 ? b[2 * L + lane] : 0.0);
           c_lane = SegmentClearance(colliders[c], pa, pb);
         }
         if (c_lane < -kContactSlack * len[lane]) first_enter[lane] = std::min(first_enter[lane], i);
@@ -407,14 +422,6 @@ void CheckLanesOf(int n, int head, const double* pts, const double* lengths,
       }
     }
   }
-}
-
-void CheckLanes(int dim, int n, int head, const double* pts, const double* lengths,
-                const double* inv_lengths, const std::vector<Collider>& colliders,
-                const std::vector<ColliderBound>& bounds, double* least, int* first_enter,
-                uint64_t* near) {
-  (dim == 2 ? CheckLanesOf<2> : CheckLanesOf<3>)(n, head, pts, lengths, inv_lengths, colliders,
-                                                 bounds, least, first_enter, near);
 }
 
 // Whether a link of the chain `points` (m links, point by point) enters, beyond the slack, a
@@ -480,15 +487,29 @@ void StrandBatchImpl::StepBlockWithColliders(int b, double* scratch_heads, Conta
       }
     }
     std::copy(pts + free_begin, pts + free_begin + free_size, cs->saved.data());
-    sweeps(options.method, dim, n, head, 1, heads, block_lengths, block_inv, pts);
+    const bool in_lanes = sphere_sweep != nullptr && lone_sphere[s - 1];
+    if (in_lanes) {
+      std::fill(cs->fallback.begin(), cs->fallback.end(), n + 1);
+      sphere_sweep(options.method, dim, n, head, heads, block_lengths, block_inv, pts,
+                   spheres[s - 1], cs->contact_flags.data(), cs->fallback.data());
+    } else {
+      sweeps(options.method, dim, n, head, 1, heads, block_lengths, block_inv, pts);
+    }
     std::fill(cs->least.begin(), cs->least.end(), std::numeric_limits<double>::infinity());
     std::fill(cs->first_enter.begin(), cs->first_enter.end(), n + 1);
     std::fill(cs->near.begin(), cs->near.end(), 0);
     const std::vector<Collider>& all = placed[s - 1];
-    CheckLanes(dim, n, head, pts, block_lengths, block_inv, all, bounds[s - 1], cs->least.data(),
-               cs->first_enter.data(), cs->near.data());
+    CheckLanes(measure_bounds, dim, n, head, pts, block_lengths, block_inv, all, bounds[s - 1],
+               cs->clearances.data(), cs->least.data(), cs->first_enter.data(), cs->near.data());
     for (int lane = 0; lane < L; ++lane) {
-      const int first = cs->first_enter[lane];
+      int first = cs->first_enter[lane];
+      if (in_lanes) {
+        // The lanes' own contact steps stand up to the first link stepped again.
+        first = std::min(first, cs->fallback[lane]);
+        for (int i = head + 1; i < first && i <= n; ++i) {
+          cs->stats.contact_link_steps += cs->contact_flags[i * L + lane];
+        }
+      }
       if (first > n) {
         cs->stats.least_clearance = std::min(cs->stats.least_clearance, cs->least[lane]);
         continue;
@@ -582,6 +603,12 @@ void LaneSweeps(int lane, int n, int head, int num_sweeps, const double* heads,
 }
 
 }  // namespace
+
+void StrandBoundsScalar(int dim, int n, int head, const double* points, const ColliderBound* bounds,
+                        int num_bounds, double* clearances) {
+  dim == 2 ? LinkBoundsOf<2>(n, head, points, bounds, num_bounds, clearances)
+           : LinkBoundsOf<3>(n, head, points, bounds, num_bounds, clearances);
+}
 
 void StrandSweepsScalar(Method method, int dim, int n, int head, int num_sweeps,
                         const double* heads, const double* lengths, const double* inv_lengths,
@@ -734,7 +761,17 @@ void StrandBatchImpl::PlaceColliders(const BodyPose* frame_pose) {
       out[world.size() + j] = attached[j];
       out[world.size() + j].pose = body_to_world * attached[j].pose;
     }
-    for (size_t j = 0; j < out.size(); ++j) bounds[s - 1][j] = BoundOf(out[j]);
+    int count = 0;
+    for (size_t j = 0; j < out.size(); ++j) {
+      bounds[s - 1][j] = BoundOf(out[j]);
+      if (out[j].shape != ColliderShape::kSphere) continue;
+      ++count;
+      StrandSphere& sphere = spheres[s - 1];
+      for (int k = 0; k < 3; ++k) sphere.center[k] = out[j].pose.translation()[k];
+      sphere.radius = out[j].radius;
+      sphere.slack = kContactSlack;
+    }
+    lone_sphere[s - 1] = count == 1;
   }
 }
 
@@ -846,9 +883,13 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
 #if FLEXKIN_HAVE_WAVEFRONT
   if (internal::AllowedSimd().avx512) {
     m.sweeps = internal::StrandSweepsAvx512;
+    m.sphere_sweep = internal::StrandSphereSweepAvx512;
+    m.measure_bounds = internal::StrandBoundsAvx512;
     m.engine = "avx512";
   } else if (internal::AllowedSimd().avx2_fma) {
     m.sweeps = internal::StrandSweepsAvx2;
+    m.sphere_sweep = internal::StrandSphereSweepAvx2;
+    m.measure_bounds = internal::StrandBoundsAvx2;
     m.engine = "avx2";
   }
 #endif
@@ -878,6 +919,8 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
     const size_t num = options.colliders.size() + options.body_colliders.size();
     m.placed.assign(S, std::vector<Collider>(num));
     m.bounds.assign(S, std::vector<internal::ColliderBound>(num));
+    m.lone_sphere.assign(S, 0);
+    m.spheres.assign(S, internal::StrandSphere());
     if (!options.body_colliders.empty() && S > 1) m.substep_poses.resize(S);
     m.PlaceColliders(&rest);
     CheckStart(strands, options, rest);
@@ -892,6 +935,9 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
       cs.inv_lengths.resize(most_links);
       cs.least.resize(L);
       cs.first_enter.resize(L);
+      cs.fallback.resize(L);
+      cs.clearances.resize(static_cast<size_t>(most_links) * num * L);
+      cs.contact_flags.resize(static_cast<size_t>(most_links + 1) * L);
       cs.near.resize(L);
       cs.near_colliders.reserve(m.placed.back().size());
     }
@@ -1015,13 +1061,25 @@ namespace flexkin::internal {
 bool SetStrandEngine(StrandBatch* batch, const char* name) {
   const std::string engine = name;
   StrandSweepsFn fn = nullptr;
+  StrandSphereSweepFn sphere = nullptr;
+  StrandBoundsFn bounds = StrandBoundsScalar;
   if (engine == "scalar") fn = StrandSweepsScalar;
 #if FLEXKIN_HAVE_WAVEFRONT
-  if (engine == "avx2" && CpuSimd().avx2_fma) fn = StrandSweepsAvx2;
-  if (engine == "avx512" && CpuSimd().avx512) fn = StrandSweepsAvx512;
+  if (engine == "avx2" && CpuSimd().avx2_fma) {
+    fn = StrandSweepsAvx2;
+    sphere = StrandSphereSweepAvx2;
+    bounds = StrandBoundsAvx2;
+  }
+  if (engine == "avx512" && CpuSimd().avx512) {
+    fn = StrandSweepsAvx512;
+    sphere = StrandSphereSweepAvx512;
+    bounds = StrandBoundsAvx512;
+  }
 #endif
   if (fn == nullptr) return false;
   batch->impl().sweeps = fn;
+  batch->impl().sphere_sweep = sphere;
+  batch->impl().measure_bounds = bounds;
   batch->impl().engine = engine == "scalar" ? "scalar" : engine == "avx2" ? "avx2" : "avx512";
   return true;
 }

@@ -18,9 +18,13 @@ namespace flexkin::internal {
 
 #if FLEXKIN_ISA == 2
 #define FLEXKIN_STRAND_ENTRY StrandSweepsAvx2
+#define FLEXKIN_SPHERE_ENTRY StrandSphereSweepAvx2
+#define FLEXKIN_BOUNDS_ENTRY StrandBoundsAvx2
 using Arch = xsimd::fma3<xsimd::avx2>;
 #elif FLEXKIN_ISA == 3
 #define FLEXKIN_STRAND_ENTRY StrandSweepsAvx512
+#define FLEXKIN_SPHERE_ENTRY StrandSphereSweepAvx512
+#define FLEXKIN_BOUNDS_ENTRY StrandBoundsAvx512
 using Arch = xsimd::avx512f;
 #else
 #error "FLEXKIN_ISA must be 2 or 3"
@@ -86,7 +90,214 @@ void BlockSweeps(int n, int head, int num_sweeps, const double* heads, const dou
   }
 }
 
+// The least distance of the segment [h, h + ab] to `c`, less `r`: the sphere's clearance.
+template <class B, int Dim>
+__attribute__((always_inline)) inline B SphereClearance(const B* h, const B* ab, const B* c, const B& r) {
+  B dot(0.0), ab2(0.0);
+  for (int k = 0; k < Dim; ++k) {
+    dot += ab[k] * (c[k] - h[k]);
+    ab2 += ab[k] * ab[k];
+  }
+  const B t = xsimd::max(B(0.0), xsimd::min(dot / ab2, B(1.0)));
+  B d2(0.0);
+  for (int k = 0; k < Dim; ++k) {
+    const B e = h[k] + t * ab[k] - c[k];
+    d2 += e * e;
+  }
+  return xsimd::sqrt(d2) - r;
+}
+
+// The contact step of lanes `enter` of one link against the sphere (strand_engine.h): the new
+// trailing end into `tail`, the lanes it could not step in `bad`.
+template <class B, int Dim>
+void SphereContact(const B* h, const B* old, const B& length, const B* c, const B& r,
+                   const B& slack, B* tail, typename B::batch_bool_type* bad) {
+  using Bool = typename B::batch_bool_type;
+  const B limit = -slack * length;
+  // The direction of the old trailing end.
+  B d0[Dim], n0(0.0);
+  for (int k = 0; k < Dim; ++k) {
+    d0[k] = old[k] - h[k];
+    n0 += d0[k] * d0[k];
+  }
+  n0 = xsimd::sqrt(n0);
+  Bool no = !(n0 > B(0.0));
+  for (int k = 0; k < Dim; ++k) d0[k] /= n0;
+  B along[Dim], step[Dim];
+  for (int k = 0; k < Dim; ++k) {
+    along[k] = h[k] + length * d0[k];
+    step[k] = along[k] - h[k];
+  }
+  const Bool blocked = SphereClearance<B, Dim>(h, step, c, r) < limit;
+  // The cone the sphere blocks, about u, the direction of its centre.
+  B u[Dim], D2(0.0);
+  for (int k = 0; k < Dim; ++k) {
+    u[k] = c[k] - h[k];
+    D2 += u[k] * u[k];
+  }
+  const B D = xsimd::sqrt(D2);
+  for (int k = 0; k < Dim; ++k) u[k] /= D;
+  const Bool on_surface = D <= r;
+  no = no | (on_surface & (r - D > slack * length)) | !(D > B(0.0));
+  const B tangent = xsimd::sqrt(xsimd::max((D - r) * (D + r), B(0.0)));
+  const Bool reach = length >= tangent;
+  const B cos_far = xsimd::max(
+      B(-1.0), xsimd::min((D2 + length * length - r * r) / (B(2.0) * length * D), B(1.0)));
+  const B sin_far = xsimd::sqrt((B(1.0) - cos_far) * (B(1.0) + cos_far));
+  const B sin_a = xsimd::select(on_surface, B(1.0), xsimd::select(reach, r / D, sin_far));
+  const B cos_a = xsimd::select(on_surface, B(0.0), xsimd::select(reach, tangent / D, cos_far));
+  B du(0.0);
+  for (int k = 0; k < Dim; ++k) du += d0[k] * u[k];
+  B w[Dim], wn(0.0);
+  for (int k = 0; k < Dim; ++k) {
+    w[k] = d0[k] - du * u[k];
+    wn += w[k] * w[k];
+  }
+  wn = xsimd::sqrt(wn);
+  no = no | (blocked & !(wn > B(1e-300)));
+  B x[Dim];
+  for (int k = 0; k < Dim; ++k) {
+    const B exit = h[k] + length * (cos_a * u[k] + sin_a * (w[k] / wn));
+    x[k] = xsimd::select(blocked, exit, along[k]);
+    step[k] = x[k] - h[k];
+  }
+  no = no | !(SphereClearance<B, Dim>(h, step, c, r) >= limit);
+  for (int k = 0; k < Dim; ++k) tail[k] = xsimd::select(no, old[k], x[k]);
+  *bad = no;
+}
+
+template <class Rule, int Dim>
+void BlockSphereSweep(int n, int head, const double* heads, const double* lengths,
+                      const double* inv_lengths, double* points, const StrandSphere& sphere,
+                      uint8_t* contact, int* fallback) {
+  using B = xsimd::batch<double, Arch>;
+  constexpr int W = B::size;
+  constexpr int U = kStrandLanes / W;
+  constexpr int L = kStrandLanes;
+  B c[Dim];
+  for (int k = 0; k < Dim; ++k) c[k] = B(sphere.center[k]);
+  const B r(sphere.radius), slack(sphere.slack);
+  B lead_old[U][Dim], lead_new[U][Dim];
+  double* lead = points + head * Dim * L;
+  for (int u = 0; u < U; ++u) {
+    for (int k = 0; k < Dim; ++k) {
+      lead_old[u][k] = B::load_aligned(lead + k * L + u * W);
+      lead_new[u][k] = B::load_aligned(heads + k * L + u * W);
+      lead_new[u][k].store_aligned(lead + k * L + u * W);
+    }
+  }
+  for (int i = head + 1; i <= n; ++i) {
+    double* tail_ptr = points + i * Dim * L;
+    const double* len_ptr = lengths + (i - 1) * L;
+    const double* inv_ptr = inv_lengths + (i - 1) * L;
+    uint8_t* flags = contact + i * L;
+    for (int u = 0; u < U; ++u) {
+      B old[Dim], tail[Dim];
+      for (int k = 0; k < Dim; ++k) old[k] = tail[k] = B::load_aligned(tail_ptr + k * L + u * W);
+      const B length = B::load_aligned(len_ptr + u * W);
+      const B neg_inv_length = -B::load_aligned(inv_ptr + u * W);
+      const auto fix = Rule::Apply(lead_old[u], lead_new[u], tail, length, neg_inv_length);
+      if (xsimd::any(fix)) {
+        alignas(64) double lo[Dim][W], ln[Dim][W], was[Dim][W], out[Dim][W], mask[W];
+        for (int k = 0; k < Dim; ++k) {
+          lead_old[u][k].store_aligned(lo[k]);
+          lead_new[u][k].store_aligned(ln[k]);
+          old[k].store_aligned(was[k]);
+          tail[k].store_aligned(out[k]);
+        }
+        xsimd::select(fix, B(1.0), B(0.0)).store_aligned(mask);
+        for (int j = 0; j < W; ++j) {
+          if (mask[j] == 0.0) continue;
+          double a[Dim], b[Dim], cc[Dim];
+          for (int k = 0; k < Dim; ++k) a[k] = lo[k][j], b[k] = ln[k][j], cc[k] = was[k][j];
+          Rule::Reference(a, b, cc, len_ptr[u * W + j]);
+          for (int k = 0; k < Dim; ++k) out[k][j] = cc[k];
+        }
+        for (int k = 0; k < Dim; ++k) tail[k] = B::load_aligned(out[k]);
+      }
+      // The sphere: lanes whose rule step enters it take the contact step.
+      B step[Dim];
+      for (int k = 0; k < Dim; ++k) step[k] = tail[k] - lead_new[u][k];
+      const auto enter = SphereClearance<B, Dim>(lead_new[u], step, c, r) < -slack * length;
+      alignas(64) double entered[W], failed[W];
+      xsimd::select(enter, B(1.0), B(0.0)).store_aligned(entered);
+      if (xsimd::any(enter)) {
+        B moved[Dim];
+        typename B::batch_bool_type bad;
+        SphereContact<B, Dim>(lead_new[u], old, length, c, r, slack, moved, &bad);
+        for (int k = 0; k < Dim; ++k) tail[k] = xsimd::select(enter, moved[k], tail[k]);
+        xsimd::select(enter & bad, B(1.0), B(0.0)).store_aligned(failed);
+        for (int j = 0; j < W; ++j) {
+          if (failed[j] != 0.0 && fallback[u * W + j] > i) fallback[u * W + j] = i;
+        }
+      }
+      for (int j = 0; j < W; ++j) flags[u * W + j] = entered[j] != 0.0;
+      for (int k = 0; k < Dim; ++k) {
+        tail[k].store_aligned(tail_ptr + k * L + u * W);
+        lead_old[u][k] = old[k];
+        lead_new[u][k] = tail[k];
+      }
+    }
+  }
+}
+
+template <int Dim>
+void LinkBounds(int n, int head, const double* points, const ColliderBound* bounds, int num_bounds,
+                double* clearances) {
+  using B = xsimd::batch<double, Arch>;
+  constexpr int W = B::size;
+  constexpr int L = kStrandLanes;
+  for (int i = head + 1; i <= n; ++i) {
+    const double* a = points + (i - 1) * Dim * L;
+    const double* b = points + i * Dim * L;
+    double* out = clearances + static_cast<size_t>(i - head - 1) * num_bounds * L;
+    for (int u = 0; u < L; u += W) {
+      B pa[Dim], ab[Dim];
+      for (int k = 0; k < Dim; ++k) {
+        pa[k] = B::load_aligned(a + k * L + u);
+        ab[k] = B::load_aligned(b + k * L + u) - pa[k];
+      }
+      for (int c = 0; c < num_bounds; ++c) {
+        const ColliderBound& bound = bounds[c];
+        B clear;
+        if (bound.half_space) {
+          B da(0.0), db(0.0);
+          for (int k = 0; k < Dim; ++k) {
+            const B h = pa[k] - B(bound.center[k]);
+            da += B(bound.up[k]) * h;
+            db += B(bound.up[k]) * (h + ab[k]);
+          }
+          clear = xsimd::min(da, db);
+        } else {
+          B center[Dim];
+          for (int k = 0; k < Dim; ++k) center[k] = B(bound.center[k]);
+          clear = SphereClearance<B, Dim>(pa, ab, center, B(bound.radius));
+        }
+        clear.store_unaligned(out + c * L + u);
+      }
+    }
+  }
+}
+
 }  // namespace
+
+void FLEXKIN_BOUNDS_ENTRY(int dim, int n, int head, const double* points,
+                          const ColliderBound* bounds, int num_bounds, double* clearances) {
+  dim == 2 ? LinkBounds<2>(n, head, points, bounds, num_bounds, clearances)
+           : LinkBounds<3>(n, head, points, bounds, num_bounds, clearances);
+}
+
+void FLEXKIN_SPHERE_ENTRY(Method method, int dim, int n, int head, const double* heads,
+                          const double* lengths, const double* inv_lengths, double* points,
+                          const StrandSphere& sphere, uint8_t* contact, int* fallback) {
+  DispatchRule<kStrandEngine>(method, [&](auto rule) {
+    using Rule = decltype(rule);
+    dim == 2 ? BlockSphereSweep<typename Rule::template Step<2, BatchExp>, 2>(
+                   n, head, heads, lengths, inv_lengths, points, sphere, contact, fallback)
+             : BlockSphereSweep<typename Rule::template Step<3, BatchExp>, 3>(
+                   n, head, heads, lengths, inv_lengths, points, sphere, contact, fallback);
+  });
+}
 
 void FLEXKIN_STRAND_ENTRY(Method method, int dim, int n, int head, int num_sweeps,
                           const double* heads, const double* lengths, const double* inv_lengths,
