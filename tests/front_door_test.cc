@@ -165,9 +165,12 @@ TEST(RuleTableTest, OrdersAndEnginesComeFromTheTable) {
   EXPECT_EQ(internal::RuleNamesOn(internal::kWholeChainEngine),
             (std::vector<std::string>{"min_rotation", "min_joint_angle"}));
   EXPECT_FALSE(internal::RuleRunsOn(Method::kOverall, ~0u));
+  EXPECT_FALSE(internal::RuleRunsOn(Method::kFollowPath, ~0u));
   for (const auto& entry : Vocabulary<Method>::kEntries) {
-    // Every method but overall is a link rule of some engine.
-    EXPECT_EQ(internal::RuleRunsOn(entry.value, ~0u), entry.value != Method::kOverall)
+    // Every method but overall and follow_path (which places points on the head's path, not
+    // link by link from their old places) is a link rule of some engine.
+    EXPECT_EQ(internal::RuleRunsOn(entry.value, ~0u),
+              entry.value != Method::kOverall && entry.value != Method::kFollowPath)
         << entry.name;
   }
 }

@@ -23,6 +23,10 @@ enum class Method {
   // "overall": all points at once, each step minimizing a metric under the length constraints
   // (paper Sec. 3 and 4; overall.h). Not a link rule: used by Run and OverallStep, not Stepper.
   kOverall,
+  // "follow_path": every point is placed on the head's path (the initial points reversed, then
+  // the targets), behind the one before it at its link's length (run/follow_path.cc,
+  // docs/colliders.md "Follow the path"). Not a link rule: used by Run only.
+  kFollowPath,
 };
 
 // The method names, defined once (flexkin/vocabulary.h).
@@ -41,6 +45,9 @@ struct Vocabulary<Method> {
        "(Sec. 4.2)"},
       {Method::kOverall, "overall",
        "all points at once, minimizing the objective under the length constraints (Sec. 3, 4)"},
+      {Method::kFollowPath, "follow_path",
+       "every joint on the head's path: each point where the path meets the sphere of its link "
+       "around the point before"},
   };
 };
 

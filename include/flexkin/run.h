@@ -18,13 +18,16 @@ namespace flexkin {
 
 // Options of a whole run: a chain whose leading end visits a list of targets (the leader steps).
 struct RunOptions {
-  // Tractrix (the paper's sequential optimization), follow-the-leader, or overall (all points
-  // at once, each sub-step solved by OverallStep with `overall`).
+  // Tractrix (the paper's sequential optimization), follow-the-leader, overall (all points
+  // at once, each sub-step solved by OverallStep with `overall`), or follow_path (every point on
+  // the head's path; RunResult::path reports it).
   Method method = Method::kTractrix;
   // The metric and solver options of the overall method; unused by the others.
   OverallOptions overall;
   // Equal sub-steps each leader step is split into; computed but not recorded. >= 1.
   // With `tolerance` > 0 this is the starting value of the automatic choice. Typical: 1 to 64.
+  // follow_path: the configuration after a leader step does not depend on them (every point is
+  // placed from the head's position alone); they refine the metrics and the clearance checks.
   int substeps = 1;
   // Keep the initial frame, every `record_every`-th leader step and the last one. >= 1.
   int record_every = 1;
@@ -47,7 +50,8 @@ struct RunOptions {
   // link's rule step is kept where the link stays outside every collider, else replaced by the
   // least-motion position of its trailing end that keeps it outside. Tractrix and ftl; no
   // accuracy control. A 2D chain lies in the plane z = 0. Empty: the run is exactly the one
-  // without colliders.
+  // without colliders. follow_path does not move points off the head's path: it only measures
+  // the clearances (RunResult::path, ContactReport::least_clearance, which may then be < 0).
   std::vector<Collider> colliders;
 
   // Every problem with the options (empty if valid), each naming its member ("substeps",
@@ -62,9 +66,55 @@ struct ContactReport {
   // that slid along it instead.
   int64_t contact_link_steps = 0;
   // The least clearance of any link from any collider after any sub-step, relative to the link's
-  // length (+inf without colliders); never below -1e-13 (the rounding of points on a surface).
+  // length (+inf without colliders); never below -1e-13 (the rounding of points on a surface),
+  // except with follow_path, which measures the clearances without acting on them (after each
+  // sub-step; < 0 where the body passes through a collider).
   double least_clearance = std::numeric_limits<double>::infinity();
 };
+
+// What a follow_path run did (method "follow_path" only; docs/colliders.md "Follow the path").
+// The head's path is the polyline through the chain's initial points reversed (point n first),
+// then the leader targets (HeadPath); s_head is its arc length up to the head's position.
+struct PathReport {
+  bool enabled = false;  // the run's method is follow_path (all else empty otherwise)
+  // Per leader step (m values); the tip error and the deviation after its last sub-step.
+  // The least clearance of any link from any collider after any of the step's sub-steps, in the
+  // length unit (+inf without colliders; negative: the body passes through a collider, which the
+  // head's path does too, or a link's chord cuts a corner into it).
+  Eigen::VectorXd clearance;
+  // The distance of the last point (the tip) from the point of the head's path at arc length
+  // s_head - (L_1 + ... + L_n) (the path's start if that is negative): 0 on a straight path,
+  // > 0 where the path turns (the chords of the links are shorter than the arcs they span).
+  Eigen::VectorXd tip_error;
+  // The largest distance of any point from the head's path travelled so far (~1e-16 by
+  // construction; computed as PathDeviation does for any run).
+  Eigen::VectorXd deviation;
+  // Over the run: the least clearance (+inf without colliders), the largest tip error and the
+  // largest deviation; the leader step (1-based) of the least clearance (0 without colliders).
+  double least_clearance = std::numeric_limits<double>::infinity();
+  int64_t least_clearance_step = 0;
+  double max_tip_error = 0.0;
+  double max_deviation = 0.0;
+};
+
+// How far a run's frames are from the head's path (PathDeviation).
+struct PathComparison {
+  // (F, n+1): per frame, each point's distance from the head's path up to the head's position at
+  // that frame's step (the initial points reversed, then the targets reached).
+  Eigen::MatrixXd deviation;
+  // (F,): per frame, the tip error as PathReport::tip_error.
+  Eigen::VectorXd tip_error;
+};
+
+// The head's path of a run of `chain` through `leader_steps`: the chain's points reversed (point
+// n first, point 0 last), then the rows of `leader_steps`: (n+1+m) by dim.
+Points HeadPath(const Chain& chain, const Points& leader_steps);
+
+// The distance of every point of every frame of a run (any method: a follow_path run's are ~0,
+// a tractrix run's are > 0 where the path turns) from the head's path (HeadPath) up to the head's
+// position at the frame's step, and each frame's tip error. `frames` must be a run of `chain`
+// through `leader_steps` (steps within 0..m). Throws InputError otherwise.
+PathComparison PathDeviation(const Chain& chain, const Points& leader_steps, const Frames& frames);
 
 // Metrics of a run (paper eq. 6 and Sec. 3.2).
 struct Metrics {
@@ -119,6 +169,7 @@ struct RunResult {
   AccuracyReport accuracy;
   OverallRunReport overall;  // method "overall" only
   ContactReport contacts;    // with colliders only
+  PathReport path;           // method "follow_path" only
   ObjectiveWeights weights;  // the overall method's metric (method "overall" only)
   double seconds = 0.0;      // wall time of the computation
 
@@ -153,7 +204,8 @@ int64_t CountRecordedFrames(int64_t num_steps, int record_every);
 // Runs `chain` with its leading end moved in straight lines through the rows of `leader_steps`
 // (m by dim, the successive targets, not including the start). The recorded frames go to `sink`
 // (RunResult::frames stays empty). Throws InputError on invalid input (chain, targets, options)
-// before any frame is produced.
+// before any frame is produced; with follow_path, also at the leader step where the head's path
+// turns out too short for the body (naming it), after the frames before it.
 RunResult Run(const Chain& chain, const Points& leader_steps, const RunOptions& options,
               FrameSink* sink);
 // The same with the frames kept in RunResult::frames.

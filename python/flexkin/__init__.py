@@ -34,6 +34,7 @@ from ._flexkin import (
     OverallOptions,
     OverallReport,
     OverallRunReport,
+    PathReport,
     Result,
     RobotResult,
     RobotScenario,
@@ -58,6 +59,7 @@ from ._flexkin import (
     load_robot_scenario,
     load_scenario,
     move_leader,
+    path_deviation,
     overall_objective,
     overall_step,
     parabola,
@@ -101,7 +103,7 @@ for _name in ("arm_from_urdf", "urdf_from_arm"):
 # The C++ classes are defined in flexkin._flexkin; they are documented and pickled as flexkin's.
 _CLASSES = ("AccuracyReport", "ArmModel", "ArmOptions", "ArmStepReport", "BodyPose", "Chain",
             "ContactReport", "Metrics", "ObjectiveWeights", "OverallOptions", "OverallReport", "OverallRunReport",
-            "Result", "RobotResult", "RobotScenario", "RunOptions", "Scenario", "StrandBatch",
+            "PathReport", "Result", "RobotResult", "RobotScenario", "RunOptions", "Scenario", "StrandBatch",
             "StrandOptions", "StrandRunReport") + _RENDER_CLASSES
 for _name in _CLASSES:
     if isinstance(globals()[_name], type):
@@ -435,14 +437,14 @@ __all__ = [
     "AccuracyReport", "AnimationOptions", "ArmModel", "ArmOptions", "ArmStepReport", "BodyPose",
     "Chain", "ContactReport",
     "FigureOptions", "GltfOptions", "InputError", "KeywordError", "Metrics", "ObjectiveWeights",
-    "OverallOptions", "OverallReport", "OverallRunReport", "PlotOptions", "Result",
+    "OverallOptions", "OverallReport", "OverallRunReport", "PathReport", "PlotOptions", "Result",
     "RobotResult", "RobotScenario", "RunOptions", "Scenario", "StrandBatch", "StrandOptions",
     "StrandRunReport", "ViewerOptions",
     "arc", "arm_from_urdf", "arm_step", "chain_points", "estimate_output", "follow_the_leader_step",
     "forward_kinematics", "gltf_joint_positions", "groom_summary", "helix", "joint_angles_from_points", "joint_groups",
     "joint_groups_report", "joint_quaternions", "line",
     "load_robot_scenario", "load_scenario", "move_leader", "overall_objective", "overall_step",
-    "parabola", "read_result", "render", "resample_path", "run", "run_robot", "run_scenario",
+    "parabola", "path_deviation", "read_result", "render", "resample_path", "run", "run_robot", "run_scenario",
     "run_groom", "run_strands",
     "split_pull", "tool_pose", "track_path", "tractrix_step", "urdf_from_arm", "validate_scenario",
     "within_limits", "write_result",

@@ -96,6 +96,16 @@ class ContactReport:
     contact_link_steps: int
     least_clearance: float
 
+class PathReport:
+    enabled: bool
+    clearance: Float64Array  # (m,)
+    tip_error: Float64Array  # (m,)
+    deviation: Float64Array  # (m,)
+    least_clearance: float
+    least_clearance_step: int
+    max_tip_error: float
+    max_deviation: float
+
 class StrandRunReport:
     max_length_error: float
     seconds: float
@@ -139,6 +149,7 @@ class Result:
     accuracy: AccuracyReport
     overall: OverallRunReport
     contacts: ContactReport
+    path: PathReport
     weights: ObjectiveWeights
     method: str
     lengths: Float64Array
@@ -239,6 +250,8 @@ def run_robot(scenario: Union[PathLike, Dict[str, Any], "RobotScenario"], *,
               csv: Optional[PathLike] = None) -> RobotResult: ...
 def load_robot_scenario(scenario: Union[PathLike, Dict[str, Any]], *,
                         directory: Optional[PathLike] = None) -> "RobotScenario": ...
+def path_deviation(points: PointsArg, leader_steps: ArrayLike,
+                   result: Result) -> Dict[str, Float64Array]: ...
 def read_result(path: PathLike) -> Result: ...
 def write_result(result: Result, path: PathLike) -> None: ...
 def validate_scenario(scenario: Union[PathLike, Dict[str, Any]], *,

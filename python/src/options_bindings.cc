@@ -218,7 +218,7 @@ Options of a whole run (flexkin::RunOptions), the keyword arguments of flexkin.r
 
 RunOptions(method="tractrix", substeps=1, record_every=1, tolerance=0.0, max_substeps=65536,
            link_angles=True, overall=None)
-  method: "tractrix", "ftl", "min_rotation", "min_joint_angle" or "overall".
+  method: "tractrix", "ftl", "min_rotation", "min_joint_angle", "overall" or "follow_path".
   substeps: equal sub-steps per leader step (>= 1; the start of the automatic choice).
   record_every: keep frame 0, every record_every-th leader step and the last.
   tolerance: if > 0, sub-steps are doubled until the estimated largest distance to the
@@ -237,7 +237,7 @@ RunOptions(method="tractrix", substeps=1, record_every=1, tolerance=0.0, max_sub
           "method", [](const RunOptions& o) { return std::string(MethodName(o.method)); },
           [](RunOptions& o, py::handle name) { o.method = MethodArg(py::cast<std::string>(name)); },
           "How the chain follows its leading end: 'tractrix' (default), 'ftl', 'min_rotation', "
-          "'min_joint_angle' or 'overall'.",
+          "'min_joint_angle', 'overall' or 'follow_path'.",
           true)
       .Member("substeps", &RunOptions::substeps,
               "Equal sub-steps per leader step, >= 1 (default 1; with tolerance > 0 the start of "
@@ -341,6 +341,35 @@ What the colliders did to a run (a scenario's "colliders"; docs/colliders.md); r
       .Member("least_clearance", &ContactReport::least_clearance,
               "Least clearance of any link from any collider after any sub-step, relative to the "
               "link's length (inf without colliders; never below -1e-13).")
+      .Finish();
+
+  py::class_<PathReport> path(m, "PathReport", R"doc(
+What a follow_path run did (method "follow_path"; docs/colliders.md "Follow the path"); read
+only. Per leader step, (m,) float64: clearance (least clearance of any link from any collider,
+length unit; inf without colliders; < 0 where the body passes through a collider), tip_error
+(distance of the last point from the head's path at arc length s_head - body length) and
+deviation (largest distance of any point from the head's path). Over the run: least_clearance,
+least_clearance_step, max_tip_error, max_deviation. enabled is False for the other methods.
+)doc");
+  Fields<PathReport>(path, "PathReport")
+      .Member("enabled", &PathReport::enabled, "Whether the run's method is follow_path.")
+      .Member("clearance", &PathReport::clearance,
+              "(m,) float64: per leader step, the least clearance of any link from any collider "
+              "over its sub-steps (length unit; inf without colliders; negative: the body passes "
+              "through a collider, as the head's path does).")
+      .Member("tip_error", &PathReport::tip_error,
+              "(m,) float64: per leader step, the distance of the last point from the point of "
+              "the head's path at arc length s_head - (L_1 + ... + L_n) (length unit).")
+      .Member("deviation", &PathReport::deviation,
+              "(m,) float64: per leader step, the largest distance of any point from the head's "
+              "path travelled so far (length unit; ~1e-16 by construction).")
+      .Member("least_clearance", &PathReport::least_clearance,
+              "The least of clearance (length unit; inf without colliders).")
+      .Member("least_clearance_step", &PathReport::least_clearance_step,
+              "The leader step (1-based) of least_clearance; 0 without colliders.")
+      .Member("max_tip_error", &PathReport::max_tip_error, "The largest tip error (length unit).")
+      .Member("max_deviation", &PathReport::max_deviation,
+              "The largest deviation from the head's path (length unit).")
       .Finish();
 
   py::class_<OverallReport> report(m, "OverallReport", R"doc(

@@ -185,7 +185,7 @@ run(points, leader_steps, *, method="tractrix", substeps=1, record_every=1, tole
           the points) or a Chain.
   leader_steps: (m, dim) array-like, m >= 1: the successive targets of the leading end, not
           including its start (flexkin.split_pull, flexkin.resample_path make them).
-  method: "tractrix", "ftl", "min_rotation", "min_joint_angle" or "overall".
+  method: "tractrix", "ftl", "min_rotation", "min_joint_angle", "overall" or "follow_path".
   substeps: equal sub-steps per leader step (>= 1).
   record_every: keep frame 0, every record_every-th leader step and the last.
   tolerance: if > 0, sub-steps are doubled until the estimated largest distance to the
@@ -347,7 +347,7 @@ The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
   steps: (F,) int64, leader steps done at each frame (0 the initial configuration)
   link_angles: (F, n) float64 (radians, each link's angle to the pull) or None
   metrics: Metrics; accuracy: AccuracyReport; overall: OverallRunReport (method "overall");
-  contacts: ContactReport (colliders)
+  contacts: ContactReport (colliders); path: PathReport (method "follow_path")
   method, lengths (n,), num_steps, substeps (used), weights, seconds, scenario, dim, num_links
 )doc");
   Fields<Result>(result, "Result")
@@ -356,8 +356,8 @@ The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
           [](Result& r, py::handle name) {
             r.file.result.method = MethodArg(py::cast<std::string>(name));
           },
-          "The method of the run: 'tractrix', 'ftl', 'min_rotation', 'min_joint_angle' or "
-          "'overall'.")
+          "The method of the run: 'tractrix', 'ftl', 'min_rotation', 'min_joint_angle', "
+          "'overall' or 'follow_path'.")
       .Property("lengths", RunGet(&RunResult::lengths), RunSet(&RunResult::lengths),
                 "(n,) float64, a copy: the link lengths, fixed at the start (length unit).")
       .Property("num_steps", RunGet(&RunResult::num_steps), RunSet(&RunResult::num_steps),
@@ -383,6 +383,9 @@ The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
       .Property("contacts", RunGet(&RunResult::contacts), RunSet(&RunResult::contacts),
                 "ContactReport: what the colliders did (a scenario's \"colliders\"; "
                 "num_colliders 0 otherwise).")
+      .Property("path", RunGet(&RunResult::path), RunSet(&RunResult::path),
+                "PathReport: clearance, tip error and deviation from the head's path per leader "
+                "step (method 'follow_path'; enabled False otherwise).")
       .Property("weights", RunGet(&RunResult::weights), RunSet(&RunResult::weights),
                 "ObjectiveWeights: the overall method's metric (method 'overall').")
       .Property("seconds", RunGet(&RunResult::seconds), RunSet(&RunResult::seconds),
@@ -421,6 +424,35 @@ The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
            "Writes the frames as CSV, as `flexkin run --csv`: a header step,point,x,y (,z), "
            "then one row per point per frame, 17 significant digits; all-or-nothing.");
 
+  m.def(
+      "path_deviation",
+      [](PointsOrChain points, ArrayLike leader_steps, const Result& result) {
+        const Chain chain = ChainArg(points);
+        const Points steps = ReadPoints(leader_steps, "leader_steps", 1, chain.dim());
+        PathComparison c;
+        {
+          py::gil_scoped_release release;
+          c = PathDeviation(chain, steps, result.file.result.frames);
+        }
+        py::dict out;
+        out["deviation"] = ToArray(Points(c.deviation));
+        out["tip_error"] = ToArray(c.tip_error);
+        return out;
+      },
+      py::arg("points"), py::arg("leader_steps"), py::arg("result"), R"doc(
+How far a run's frames are from the head's path (flexkin::PathDeviation), for any method: a
+"follow_path" run's points lie on it, a "tractrix" run's cut its corners.
+
+path_deviation(points, leader_steps, result) -> dict
+  points: (n+1, dim) array-like or Chain: the run's initial chain.
+  leader_steps: (m, dim) array-like: the run's targets.
+  result: the Result of the run of points through leader_steps.
+The head's path is the polyline through the initial points reversed (point n first), then the
+targets. Returns {"deviation": (F, n+1) float64, each point's distance from that path up to the
+head's position at the frame's step; "tip_error": (F,) float64, the distance of the last point
+from the path's point at arc length s_head - (L_1 + ... + L_n)} (length unit). Raises
+InputError if the frames do not fit the chain or the targets.
+)doc");
   m.def("read_result", &ReadResult, py::arg("path"),
         "Reads a result file (JSON or .npz, recognised by its content) as a Result. Raises "
         "OSError if it cannot be read, InputError (field: the path, then the member) if it is "

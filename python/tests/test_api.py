@@ -105,6 +105,7 @@ def samples():
              "motion": {"keyframes": [{"time": 0}, {"time": 1, "translation": [1, 0]}]}},
             os.path.join(directory, "h.npz"), threads=2)
     rope = flexkin.run_scenario(EXAMPLES / "rope_round_post.json")
+    snake = flexkin.run_scenario(EXAMPLES / "snake_pegs.json")
     out = {
         "AccuracyReport": [controlled.accuracy],
         "ArmModel": [limited, spherical, axes, slide],
@@ -123,7 +124,8 @@ def samples():
                                                   max_iterations=7)],
         "OverallReport": [report],
         "OverallRunReport": [overall.overall],
-        "Result": [controlled, overall, no_angles, rope],
+        "PathReport": [snake.path],
+        "Result": [controlled, overall, no_angles, rope, snake],
         "RobotResult": [robot, flexkin.run_robot(EXAMPLES / "robot_planar_8link.json")],
         "RobotScenario": [flexkin.load_robot_scenario(EXAMPLES / "robot_ravi_circle.json"),
                           flexkin.RobotScenario(limited, [[2.0, 2.0]], name="one target")],

@@ -11,6 +11,7 @@
 #include "chain/substep.h"
 #include "flexkin/error.h"
 #include "overall/step.h"
+#include "run/follow_path.h"
 #include "run/sweep_pipeline.h"
 #include "sequential/rule_table.h"
 #include "sequential/sweep.h"
@@ -136,9 +137,12 @@ void Record(const OverallReport& report, int64_t step, int substep, OverallRunRe
 // are checked once, before the run).
 class ChainMover {
  public:
-  ChainMover(const Chain& chain, const RunOptions& options, RunResult* result)
+  ChainMover(const Chain& chain, const Points& leader_steps, const RunOptions& options,
+             RunResult* result)
       : lengths_(chain.lengths), options_(options), result_(result) {
-    if (options.method == Method::kOverall) {
+    if (options.method == Method::kFollowPath) {
+      follow_path_.emplace(chain, leader_steps, options.colliders);
+    } else if (options.method == Method::kOverall) {
       internal::CheckOverallOptionsForChain(options.overall, chain.dim());
       workspace_.emplace();
     } else {
@@ -146,7 +150,9 @@ class ChainMover {
     }
   }
   void Step(const Eigen::VectorXd& head, int64_t step, int substep, Points* points) {
-    if (!options_.colliders.empty()) {
+    if (follow_path_) {
+      follow_path_->Step(head, step, points);
+    } else if (!options_.colliders.empty()) {
       internal::ContactSweep(stepper_->method, stepper_->dim, head.data(), stepper_->lengths.data(),
                              stepper_->inv_lengths.data(), static_cast<int>(lengths_.size()),
                              points->data(), options_.colliders, &contacts_);
@@ -160,6 +166,10 @@ class ChainMover {
       MoveLeader(*stepper_, head, 1, points);
     }
   }
+  // After leader step `step` (1-based): the follow_path report.
+  void EndStep(int64_t step, const Points& points) {
+    if (follow_path_) follow_path_->EndStep(step, points, result_);
+  }
 
  private:
   const Eigen::VectorXd& lengths_;
@@ -167,6 +177,7 @@ class ChainMover {
   RunResult* result_;
   std::optional<Stepper> stepper_;
   std::optional<OverallWorkspace> workspace_;
+  std::optional<internal::FollowPathMover> follow_path_;
   OverallReport report_;
   internal::ContactStats contacts_;
 };
@@ -235,7 +246,11 @@ RunResult RunOn(const Chain& chain, const Points& leader_steps, const RunOptions
   ValidateChain(chain);
   ValidateLeaderSteps(leader_steps, chain.dim());
   ThrowIfAny(options.Validate());
-  if (!options.colliders.empty()) CheckOutsideColliders(chain, leader_steps, options.colliders);
+  // follow_path keeps every point on the head's path: it measures the clearances (negative where
+  // the path enters a collider) rather than requiring them.
+  if (!options.colliders.empty() && options.method != Method::kFollowPath) {
+    CheckOutsideColliders(chain, leader_steps, options.colliders);
+  }
   const auto start_time = Clock::now();
 
   RunResult result;
@@ -246,6 +261,12 @@ RunResult RunOn(const Chain& chain, const Points& leader_steps, const RunOptions
   result.accuracy.order = MethodOrder(options.method);
   result.accuracy.substeps = options.substeps;
   if (options.method == Method::kOverall) result.weights = options.overall.weights;
+  if (options.method == Method::kFollowPath) {
+    result.path.enabled = true;
+    result.path.clearance.resize(leader_steps.rows());
+    result.path.tip_error.resize(leader_steps.rows());
+    result.path.deviation.resize(leader_steps.rows());
+  }
   if (options.tolerance > 0.0)
     result.accuracy = internal::ChooseSubsteps(chain, leader_steps, options);
   const int substeps = result.accuracy.substeps;
@@ -285,7 +306,7 @@ RunResult RunOn(const Chain& chain, const Points& leader_steps, const RunOptions
     if (options.progress) pipeline.after_chunk = report_progress;
     pipeline.Advance(num_steps, recorded, on_frame);
   } else {
-    ChainMover mover(chain, options, &result);
+    ChainMover mover(chain, leader_steps, options, &result);
     MetricsAccumulator metrics(chain.lengths, num_steps, &result.metrics);
     Eigen::VectorXd direction = first_direction;
     Points points = chain.points, before;
@@ -307,6 +328,7 @@ RunResult RunOn(const Chain& chain, const Points& leader_steps, const RunOptions
         metrics.AddSubstep(before, points);
       }
       metrics.EndStep(s, points);
+      mover.EndStep(s + 1, points);
       if (recorded(s + 1)) add_frame(s + 1, points, direction);
       report_progress(s + 1);
     }

@@ -49,12 +49,14 @@ Problems RunOptions::Validate() const {
     const Problems collider = CheckCollider(colliders[i], "colliders[" + std::to_string(i) + "]");
     problems.insert(problems.end(), collider.begin(), collider.end());
   }
-  if (!colliders.empty() && method != Method::kTractrix && method != Method::kFollowTheLeader) {
+  if (!colliders.empty() && method != Method::kTractrix && method != Method::kFollowTheLeader &&
+      method != Method::kFollowPath) {
     problems.emplace_back("method",
                           std::string("\"") + MethodName(method) +
-                              "\" does not take colliders yet; with colliders use \"tractrix\" "
-                              "or \"ftl\"",
-                          std::string("\"") + MethodName(method) + "\"", "\"tractrix\" or \"ftl\"");
+                              "\" does not take colliders yet; with colliders use \"tractrix\", "
+                              "\"ftl\" or \"follow_path\"",
+                          std::string("\"") + MethodName(method) + "\"",
+                          "\"tractrix\", \"ftl\" or \"follow_path\"");
   }
   if (!colliders.empty() && tolerance > 0.0) {
     problems.emplace_back("tolerance",

@@ -31,11 +31,20 @@ std::string RunResult::BriefReport() const {
         << overall.max_iterations << " per step)";
     if (overall.failures > 0) out << ", FIRST FAILURE " << overall.first_failure;
   }
-  if (contacts.num_colliders > 0) {
+  if (contacts.num_colliders > 0 && !path.enabled) {
     out << ", " << contacts.num_colliders
         << (contacts.num_colliders == 1 ? " collider: " : " colliders: ")
         << contacts.contact_link_steps << " link steps in contact, least clearance "
         << Format("%.3g", contacts.least_clearance) << " of a link";
+  }
+  if (path.enabled) {
+    out << ", on the head's path: largest deviation " << Format("%.3g", path.max_deviation)
+        << ", largest tip error " << Format("%.3g", path.max_tip_error);
+    if (contacts.num_colliders > 0) {
+      out << ", least clearance " << Format("%.4g", path.least_clearance) << " at leader step "
+          << path.least_clearance_step
+          << (path.least_clearance < 0.0 ? " (THE BODY PASSES THROUGH A COLLIDER)" : "");
+    }
   }
   if (accuracy.enabled) {
     out << ", estimated error " << Format("%.3g", accuracy.estimated_error)

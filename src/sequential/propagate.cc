@@ -244,8 +244,8 @@ Stepper MakeStepper(Method method, const Chain& chain) {
   ValidateChain(chain);
   if (!internal::RuleRunsOn(method, ~0u)) {
     throw InputError("method", std::string("\"") + MethodName(method) +
-                                   "\" is not a link rule; move the chain with Run or "
-                                   "OverallStep (overall.h), or use " +
+                                   "\" is not a link rule; move the chain with Run (\"overall\" "
+                                   "also with OverallStep, overall.h), or use " +
                                    QuotedList(internal::RuleNamesOn(~0u)));
   }
   return internal::MakeStepperUnchecked(method, chain);
