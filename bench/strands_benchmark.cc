@@ -236,8 +236,18 @@ void DrapedEngine(benchmark::State& state, bool colliders) {
 }
 void BM_DrapedFree(benchmark::State& state) { DrapedEngine(state, false); }
 void BM_DrapedColliders(benchmark::State& state) { DrapedEngine(state, true); }
-BENCHMARK(BM_DrapedFree)->Arg(1)->Arg(2)->Iterations(120)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_DrapedColliders)->Arg(1)->Arg(2)->Iterations(120)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_DrapedFree)
+    ->Arg(1)
+    ->Arg(2)
+    ->Iterations(120)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_DrapedColliders)
+    ->Arg(1)
+    ->Arg(2)
+    ->Iterations(120)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // The baseline: one follow-the-leader pass per strand, then every point inside a collider moved to
 // its nearest surface point (sphere: radially; capsule: radially from its axis), on plain arrays

@@ -92,7 +92,8 @@ void BlockSweeps(int n, int head, int num_sweeps, const double* heads, const dou
 
 // The least distance of the segment [h, h + ab] to `c`, less `r`: the sphere's clearance.
 template <class B, int Dim>
-__attribute__((always_inline)) inline B SphereClearance(const B* h, const B* ab, const B* c, const B& r) {
+__attribute__((always_inline)) inline B SphereClearance(const B* h, const B* ab, const B* c,
+                                                        const B& r) {
   B dot(0.0), ab2(0.0);
   for (int k = 0; k < Dim; ++k) {
     dot += ab[k] * (c[k] - h[k]);
