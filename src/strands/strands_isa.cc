@@ -32,6 +32,35 @@ using Arch = xsimd::avx512f;
 
 namespace {
 
+// One link's rule step in W lanes: `tail` (holding the old trailing end `old`) moved behind its
+// leading end from `lead_old` to `lead_new`. The per-link formula is the wavefront engine's; rare
+// lanes it flags (degenerate or extreme moves) are redone with the scalar reference.
+template <class Rule, class B, int Dim>
+inline void RuleStep(const B* lead_old, const B* lead_new, const B* old, const double* len,
+                     const double* inv, B* tail) {
+  constexpr int W = B::size;
+  const B length = B::load_aligned(len);
+  const B neg_inv_length = -B::load_aligned(inv);
+  const auto fix = Rule::Apply(lead_old, lead_new, tail, length, neg_inv_length);
+  if (!xsimd::any(fix)) return;
+  alignas(64) double lo[Dim][W], ln[Dim][W], was[Dim][W], out[Dim][W], mask[W];
+  for (int k = 0; k < Dim; ++k) {
+    lead_old[k].store_aligned(lo[k]);
+    lead_new[k].store_aligned(ln[k]);
+    old[k].store_aligned(was[k]);
+    tail[k].store_aligned(out[k]);
+  }
+  xsimd::select(fix, B(1.0), B(0.0)).store_aligned(mask);
+  for (int j = 0; j < W; ++j) {
+    if (mask[j] == 0.0) continue;
+    double a[Dim], b[Dim], c[Dim];
+    for (int k = 0; k < Dim; ++k) a[k] = lo[k][j], b[k] = ln[k][j], c[k] = was[k][j];
+    Rule::Reference(a, b, c, len[j]);
+    for (int k = 0; k < Dim; ++k) out[k][j] = c[k];
+  }
+  for (int k = 0; k < Dim; ++k) tail[k] = B::load_aligned(out[k]);
+}
+
 template <class Rule, int Dim>
 void BlockSweeps(int n, int head, int num_sweeps, const double* heads, const double* lengths,
                  const double* inv_lengths, double* points) {
@@ -58,28 +87,8 @@ void BlockSweeps(int n, int head, int num_sweeps, const double* heads, const dou
         for (int k = 0; k < Dim; ++k) {
           old[k] = tail[k] = B::load_aligned(tail_ptr + k * L + u * W);
         }
-        const B length = B::load_aligned(len_ptr + u * W);
-        const B neg_inv_length = -B::load_aligned(inv_ptr + u * W);
-        const auto fix = Rule::Apply(lead_old[u], lead_new[u], tail, length, neg_inv_length);
-        if (xsimd::any(fix)) {
-          // Rare lanes (degenerate or extreme moves): redo them with the scalar reference.
-          alignas(64) double lo[Dim][W], ln[Dim][W], was[Dim][W], out[Dim][W], mask[W];
-          for (int k = 0; k < Dim; ++k) {
-            lead_old[u][k].store_aligned(lo[k]);
-            lead_new[u][k].store_aligned(ln[k]);
-            old[k].store_aligned(was[k]);
-            tail[k].store_aligned(out[k]);
-          }
-          xsimd::select(fix, B(1.0), B(0.0)).store_aligned(mask);
-          for (int j = 0; j < W; ++j) {
-            if (mask[j] == 0.0) continue;
-            double a[Dim], b[Dim], c[Dim];
-            for (int k = 0; k < Dim; ++k) a[k] = lo[k][j], b[k] = ln[k][j], c[k] = was[k][j];
-            Rule::Reference(a, b, c, len_ptr[u * W + j]);
-            for (int k = 0; k < Dim; ++k) out[k][j] = c[k];
-          }
-          for (int k = 0; k < Dim; ++k) tail[k] = B::load_aligned(out[k]);
-        }
+        RuleStep<Rule, B, Dim>(lead_old[u], lead_new[u], old, len_ptr + u * W, inv_ptr + u * W,
+                               tail);
         for (int k = 0; k < Dim; ++k) {
           tail[k].store_aligned(tail_ptr + k * L + u * W);
           lead_old[u][k] = old[k];
@@ -196,26 +205,7 @@ void BlockSphereSweep(int n, int head, const double* heads, const double* length
       B old[Dim], tail[Dim];
       for (int k = 0; k < Dim; ++k) old[k] = tail[k] = B::load_aligned(tail_ptr + k * L + u * W);
       const B length = B::load_aligned(len_ptr + u * W);
-      const B neg_inv_length = -B::load_aligned(inv_ptr + u * W);
-      const auto fix = Rule::Apply(lead_old[u], lead_new[u], tail, length, neg_inv_length);
-      if (xsimd::any(fix)) {
-        alignas(64) double lo[Dim][W], ln[Dim][W], was[Dim][W], out[Dim][W], mask[W];
-        for (int k = 0; k < Dim; ++k) {
-          lead_old[u][k].store_aligned(lo[k]);
-          lead_new[u][k].store_aligned(ln[k]);
-          old[k].store_aligned(was[k]);
-          tail[k].store_aligned(out[k]);
-        }
-        xsimd::select(fix, B(1.0), B(0.0)).store_aligned(mask);
-        for (int j = 0; j < W; ++j) {
-          if (mask[j] == 0.0) continue;
-          double a[Dim], b[Dim], cc[Dim];
-          for (int k = 0; k < Dim; ++k) a[k] = lo[k][j], b[k] = ln[k][j], cc[k] = was[k][j];
-          Rule::Reference(a, b, cc, len_ptr[u * W + j]);
-          for (int k = 0; k < Dim; ++k) out[k][j] = cc[k];
-        }
-        for (int k = 0; k < Dim; ++k) tail[k] = B::load_aligned(out[k]);
-      }
+      RuleStep<Rule, B, Dim>(lead_old[u], lead_new[u], old, len_ptr + u * W, inv_ptr + u * W, tail);
       // The sphere: lanes whose rule step enters it take the contact step.
       B step[Dim];
       for (int k = 0; k < Dim; ++k) step[k] = tail[k] - lead_new[u][k];
