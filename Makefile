@@ -74,7 +74,7 @@ test-fuzz: fuzz-build
 	@bash scripts/fuzz.sh --fresh $(BUILD_FUZZ) $(FUZZ_SHORT_SECONDS)
 
 bench: build
-	@for b in propagation_benchmark scenes_benchmark overall_benchmark arm_benchmark arm_kdl_benchmark arm_limits_benchmark strands_benchmark urdf_kdl_benchmark; do \
+	@for b in propagation_benchmark scenes_benchmark overall_benchmark arm_benchmark arm_kdl_benchmark arm_limits_benchmark strands_benchmark urdf_kdl_benchmark mesh_colliders_benchmark snake_pegs_benchmark; do \
 	  $(BUILD)/bench/$$b --benchmark_repetitions=5 --benchmark_report_aggregates_only=true || exit 1; \
 	done
 	@$(PYTHON) bench/python_benchmark.py --build $(BUILD)

@@ -50,6 +50,12 @@ mkdir -p out/groom_head_readme
 # What the hair did, read back with numpy alone (no flexkin): the motion dying out toward the
 # tips, and every link's length.
 /usr/bin/python3 examples/python/hair_numpy.py out/groom_head.npz
+echo "== colliders (docs/colliders.md): a rope round a post, a thick rope across a floor and round"
+echo "   a post, a snake threading 20 pegs (follow_path and tractrix)"
+for name in rope_round_post rope_post_floor snake_pegs snake_pegs_tractrix; do
+  "$flexkin" run "examples/$name.json" -o "out/$name.json"
+  "$flexkin" render "out/$name.json" -o out --formats png,mp4,html --quiet
+done
 echo "== figures, plots, animations, viewers and glTF (docs/rendering.md)"
 for result in out/fig*.json; do
   "$flexkin" render "$result" -o out --formats svg,png,pdf,plots,mp4,gif,html,glb --quiet
@@ -65,6 +71,10 @@ if [ -d "$build/python/flexkin" ] && ls "$build"/python/flexkin/_flexkin*.so >/d
     PYTHONPATH="$build/python" "$python" "examples/python/$example.py" --out out/python
   done
   PYTHONPATH="$build/python" "$python" examples/python/dask_sweep.py
+  # A 16-module snake robot (its own URDF) threading 20 pegs, tractrix and follow_path, with its
+  # clearance plot and its joints checked against the URDF's limits (docs/colliders.md).
+  PYTHONPATH="$build/python" "$python" scripts/snake_robot_demo.py --build "$build" \
+    --out out/snake_robot
 else
   echo "skipped: the Python module is not built ($build/python/flexkin; docs/python.md)"
 fi

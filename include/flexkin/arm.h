@@ -12,6 +12,7 @@
 // const model or on different ones (include/flexkin/flexkin.h).
 
 #include <Eigen/Core>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "flexkin/chain.h"
+#include "flexkin/colliders.h"
 #include "flexkin/error.h"
 #include "flexkin/vocabulary.h"
 
@@ -111,6 +113,11 @@ struct ArmModel {
   Eigen::Vector4d tip_rotation = Eigen::Vector4d(1.0, 0.0, 0.0, 0.0);
   // Optional names of the n joints (a URDF's), for reports; empty: "joint 0", "joint 1", ...
   std::vector<std::string> joint_names;
+  // The links' radii (length unit, >= 0 and finite): link k is a capsule of radius
+  // link_radii[k-1] about its axis (a URDF's collision cylinder, capsule or sphere), kept outside
+  // ArmOptions::colliders. Empty: every link a segment (radius 0). Typical: 0.02 to 0.05 of a
+  // meter for snake modules.
+  Eigen::VectorXd link_radii;
   JointAngles initial;  // the joint angles at the start; within the limits
 
   bool has_axes() const { return joint_axes.size() > 0; }
@@ -122,6 +129,8 @@ struct ArmModel {
   }
   int num_links() const { return static_cast<int>(link_lengths.size()); }
   bool has_limits() const { return joint_min.size() > 0 || max_bend.size() > 0; }
+  // The largest of link_radii (0 if empty).
+  double max_link_radius() const { return link_radii.size() > 0 ? link_radii.maxCoeff() : 0.0; }
   double reach() const { return link_lengths.sum(); }
   // The problems that make the model unusable (none if it is usable), each field the member as
   // named above ("joint_min[2]", "initial.angle[0]"): the first of each independent part (the
@@ -238,11 +247,19 @@ struct ArmOptions {
   // equal legs along the end effector's straight move, each taking time_step, as keep every joint
   // within its limit (ArmStepReport::velocity_legs). 0: limits ignored.
   double time_step = 0.0;
+  // Things in the world the arm's links stay outside of (docs/robots.md, "Colliders"): planar and
+  // spherical arms (the tractrix sweep) only; arms with joint axes refuse them. Each link is a
+  // capsule of ArmModel::link_radii about its axis. Where a step's free result (the step without
+  // colliders) keeps every link outside, it is that result bit for bit; otherwise the step is
+  // solved again by the sweep in which every link whose tractrix step would enter a collider takes
+  // the contact step instead (the least motion of its trailing end that keeps it outside). A 2D
+  // arm lies in the plane z = 0. Empty: none.
+  std::vector<Collider> colliders;
   // Every problem (empty if valid), each naming its member ("max_iterations").
   Problems Validate() const;
   // The problems of these options on `model` besides Validate's: pointing needs joint axes, and
   // method fixed_point takes only revolute joints across links of positive length within
-  // [-pi, pi] and no pointing.
+  // [-pi, pi] and no pointing; colliders need an arm without joint axes.
   Problems ValidateFor(const ArmModel& model) const;
 };
 
@@ -307,6 +324,16 @@ struct ArmStepReport {
   // With ArmOptions::time_step: the largest joint speed over its limit in any leg (<= 1 when
   // the limits were kept).
   double velocity_ratio = 0.0;
+  // With ArmOptions::colliders: the least clearance of any link's capsule from any collider after
+  // the step (length unit; negative: a link is inside, by that depth); +inf without colliders.
+  double clearance = std::numeric_limits<double>::infinity();
+  // The step's free result would have put a link into a collider, so it was solved again by the
+  // sweep with contact steps.
+  bool contact = false;
+  // No solve left every link outside the colliders (within 1e-12 of its length): the sweep with
+  // contact steps found no root, nor did it in legs, and the other solves entered a collider. The
+  // arm was held where it was (state = the step's start), reached = false.
+  bool blocked = false;
   std::string BriefReport() const;
 };
 
@@ -326,7 +353,11 @@ struct ArmTrajectory {
   double max_ee_error = 0.0, max_base_error = 0.0;
   int unreached = 0;                // steps with reached = false
   double max_pointing_error = 0.0;  // rad, with ArmOptions::pointing
-  long long velocity_legs = 0;      // with ArmOptions::time_step: legs of all steps
+  // With ArmOptions::colliders: the least clearance over the steps (length unit), the steps
+  // solved with contact steps, and those blocked (the arm held where it was).
+  double min_clearance = std::numeric_limits<double>::infinity();
+  int contact_steps = 0, blocked_steps = 0;
+  long long velocity_legs = 0;  // with ArmOptions::time_step: legs of all steps
   int max_iterations = 0;
   long long total_sweeps = 0;
   long long total_passes = 0;  // passes over the links (see ArmStepReport::passes)

@@ -53,6 +53,12 @@ struct RunOptions {
   // without colliders. follow_path does not move points off the head's path: it only measures
   // the clearances (RunResult::path, ContactReport::least_clearance, which may then be < 0).
   std::vector<Collider> colliders;
+  // The links' radius (length unit, >= 0): each link is a capsule of this radius about its axis
+  // (a rope's thickness, a snake robot's body), kept outside the colliders by keeping its axis
+  // outside each collider grown by the radius (Collider::margin; exact, the shapes being
+  // convex). Clearances in the reports are then the capsules' surfaces' distances. 0: links are
+  // segments.
+  double link_radius = 0.0;
 
   // Every problem with the options (empty if valid), each naming its member ("substeps",
   // "overall.weights.l2").
@@ -66,9 +72,10 @@ struct ContactReport {
   // that slid along it instead.
   int64_t contact_link_steps = 0;
   // The least clearance of any link from any collider after any sub-step, relative to the link's
-  // length (+inf without colliders); never below -1e-13 (the rounding of points on a surface),
-  // except with follow_path, which measures the clearances without acting on them (after each
-  // sub-step; < 0 where the body passes through a collider).
+  // length (+inf without colliders); never below -1e-12 (the rounding of points on surfaces:
+  // typically above -1e-13, down to -5e-13 against meshes and where two contacts meet;
+  // docs/colliders.md), except with follow_path, which measures the clearances without acting on
+  // them (after each sub-step; < 0 where the body passes through a collider).
   double least_clearance = std::numeric_limits<double>::infinity();
 };
 

@@ -59,7 +59,8 @@ struct StrandOptions {
 struct StrandContacts {
   int64_t contact_link_steps = 0;  // link steps that took the contact step
   // The least clearance, relative to the link's length, of the links near a collider after each
-  // sub-step (+inf when no link came near one); never below -1e-13.
+  // sub-step (+inf when no link came near one); never below -1e-12 (rounding; as
+  // ContactReport::least_clearance).
   double least_clearance = std::numeric_limits<double>::infinity();
 };
 

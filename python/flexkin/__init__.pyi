@@ -53,6 +53,7 @@ class RunOptions:
     tolerance: float
     max_substeps: int
     link_angles: bool
+    link_radius: float
     overall: OverallOptions
     def __init__(self, *, method: str = "tractrix", substeps: int = 1, record_every: int = 1,
                  tolerance: float = 0.0, max_substeps: int = 65536, link_angles: bool = True,

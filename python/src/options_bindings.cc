@@ -254,6 +254,10 @@ RunOptions(method="tractrix", substeps=1, record_every=1, tolerance=0.0, max_sub
               "Upper bound of the automatic sub-steps (default 65536).", true)
       .Member("link_angles", &RunOptions::link_angles,
               "Compute each frame's link angles to the pull (default True).", true)
+      .Member("link_radius", &RunOptions::link_radius,
+              "The links' radius (length unit, >= 0, default 0): each link a capsule kept "
+              "outside the colliders (a scenario's \"link_radius\"; docs/colliders.md).",
+              true)
       .Property(
           "overall", [](const RunOptions& o) { return o.overall; },
           [](RunOptions& o, py::handle overall) { o.overall = OverallArg(overall); },
@@ -340,7 +344,7 @@ What the colliders did to a run (a scenario's "colliders"; docs/colliders.md); r
               "slid along it instead.")
       .Member("least_clearance", &ContactReport::least_clearance,
               "Least clearance of any link from any collider after any sub-step, relative to the "
-              "link's length (inf without colliders; never below -1e-13).")
+              "link's length (inf without colliders; never below -1e-12, the rounding).")
       .Finish();
 
   py::class_<PathReport> path(m, "PathReport", R"doc(

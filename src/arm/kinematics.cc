@@ -238,6 +238,23 @@ std::optional<Problem> LimitsProblem(const ArmModel& m) {
   return std::nullopt;
 }
 
+// The link radii: none, or n finite values >= 0.
+std::optional<Problem> RadiiProblem(const ArmModel& m) {
+  const Eigen::VectorXd& r = m.link_radii;
+  if (r.size() == 0) return std::nullopt;
+  if (r.size() != m.num_links()) {
+    return Problem("link_radii", "has " + std::to_string(r.size()) + " values; expected " +
+                                     std::to_string(m.num_links()) + " (one per link) or none");
+  }
+  for (int k = 0; k < r.size(); ++k) {
+    if (!(r[k] >= 0.0 && std::isfinite(r[k]))) {
+      return Problem::Invalid(Indexed("link_radii", k), FormatNumber(r[k]),
+                              "a finite radius >= 0 (length unit)");
+    }
+  }
+  return std::nullopt;
+}
+
 std::optional<Problem> NamesAndVelocityProblem(const ArmModel& m) {
   const int n = m.num_links();
   const bool revolute = m.joint() == ArmJoint::kRevolute;
@@ -317,6 +334,7 @@ Problems ArmModel::Validate() const {
   const bool limits_ok = !limits;
   add(std::move(limits));
   add(NamesAndVelocityProblem(*this));
+  add(RadiiProblem(*this));
   if (limits_ok) add(InitialProblem(*this));
   return problems;
 }

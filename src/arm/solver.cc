@@ -20,6 +20,7 @@
 #include <string>
 #include <utility>
 
+#include "arm/colliders.h"
 #include "arm/internal.h"
 #include "arm/joint_space.h"
 #include "arm/revolute.h"
@@ -31,6 +32,9 @@
 namespace flexkin {
 namespace {
 
+// Where the sweep with contact steps finds no root, the move is tried again in up to this many
+// legs.
+constexpr int kContactLegs = 8;
 // Where the sweep finds no root for a far move, the move is tracked in legs of at most this many
 // mean link lengths (see StepChecked).
 constexpr double kLegLength = 0.5;
@@ -374,6 +378,10 @@ Problems ArmOptions::Validate() const {
     problems.push_back(Problem::Invalid("time_step", FormatNumber(time_step),
                                         "a time >= 0 (s; 0: velocity limits ignored)"));
   }
+  for (size_t c = 0; c < colliders.size(); ++c) {
+    const Problems bad = CheckCollider(colliders[c], "colliders[" + std::to_string(c) + "]");
+    problems.insert(problems.end(), bad.begin(), bad.end());
+  }
   if (pointing.enabled) {
     auto unit_vector = [&](const Eigen::Vector3d& v, const char* name) {
       if (!v.allFinite() || !(v.norm() > 0.0)) {
@@ -415,6 +423,15 @@ Problems ArmOptions::ValidateFor(const ArmModel& model) const {
                           "value \"fixed_point\" is not valid for this arm: the fixed-point sweep "
                           "takes revolute joints across links of positive length with limits "
                           "within [-pi, pi] and no pointing; expected \"newton\"");
+  }
+  if (!colliders.empty() && model.has_axes()) {
+    problems.emplace_back(
+        "colliders",
+        "has " + std::to_string(colliders.size()) +
+            " colliders, which arms with joint axes (URDF arms, joint_axes) do not take yet: "
+            "colliders are supported for planar arms (revolute joints about z, including URDF arms "
+            "that read as planar) and spatial arms with spherical joints (the tractrix sweep); "
+            "expected no colliders for this arm");
   }
   return problems;
 }
@@ -561,10 +578,13 @@ ArmStepReport VelocityLimitedStep(const ArmModel& model, const ArmState& state,
 }
 
 // The tractrix sweep's step (planar and spherical arms), solved by Newton or the fixed point.
+// With `contact` (src/arm/colliders.h), the sweep takes the contact step where a link would enter
+// a collider.
 ArmStepReport SweepStep(const ArmModel& model, const ArmState& state, const Eigen::VectorXd& target,
-                        double tol, const ArmOptions& options) {
+                        double tol, const ArmOptions& options,
+                        const std::vector<Collider>* contact = nullptr) {
   const int n = model.num_links();
-  Sweeper sweeper(model, state.points, target, options.substeps);
+  Sweeper sweeper(model, state.points, target, options.substeps, contact);
   const SolveResult solved =
       options.method == FixedBaseMethod::kNewton
           ? SolveNewton(&sweeper, model, target - state.points.row(n).transpose(), options, tol,
@@ -589,7 +609,8 @@ void SetCost(const ArmStepReport& from, ArmStepReport* to) {
 // legs, each a sweep step with the base held, as TrackPath would track that line. Stops at the
 // first leg not reached (reached = false; its error is then the leg's). Costs of all legs.
 ArmStepReport LegsStep(const ArmModel& model, const ArmState& state, const Eigen::VectorXd& target,
-                       int legs, double tol, const ArmOptions& options) {
+                       int legs, double tol, const ArmOptions& options,
+                       const std::vector<Collider>* contact) {
   const Eigen::VectorXd from = state.points.row(model.num_links()).transpose();
   ArmStepReport report, cost;
   ArmState leg_state = state;
@@ -597,7 +618,7 @@ ArmStepReport LegsStep(const ArmModel& model, const ArmState& state, const Eigen
   for (int leg = 1; leg <= legs; ++leg) {
     const Eigen::VectorXd goal =
         leg == legs ? target : Eigen::VectorXd(from + (target - from) * (double(leg) / legs));
-    report = SweepStep(model, leg_state, goal, tol, options);
+    report = SweepStep(model, leg_state, goal, tol, options, contact);
     AddCost(report, &cost);
     if (!report.reached) break;
     leg_state = report.state;
@@ -612,6 +633,58 @@ void CheckOptionsForModel(const ArmModel& model, const ArmOptions& options) {
   Problems problems;
   AppendNested("options", options.ValidateFor(model), &problems);
   ThrowIfAny(problems);
+}
+
+ArmStepReport SweptStep(const arm_internal::JointSpacePlan& plan, const ArmState& state,
+                        const Eigen::VectorXd& target, const ArmOptions& options,
+                        const std::vector<Collider>* contact);
+
+// The step among colliders (planar and spherical arms): the free step where it leaves every link
+// outside (then it is the step without colliders, bit for bit), else the step again with contact
+// steps in the sweep. The clearance after it is measured either way.
+ArmStepReport ContactStep(const arm_internal::JointSpacePlan& plan, const ArmState& state,
+                          const Eigen::VectorXd& target, const ArmOptions& options) {
+  const ArmModel& model = plan.model();
+  double relative = 0.0;
+  ArmStepReport free = SweptStep(plan, state, target, options, nullptr);
+  free.clearance =
+      arm_internal::ArmClearance(model, free.state.points, options.colliders, &relative);
+  if (relative >= -arm_internal::kArmContactSlack) return free;
+  const std::vector<Collider> grown = arm_internal::SweepColliders(model, options);
+  ArmStepReport report = SweptStep(plan, state, target, options, &grown);
+  AddCost(free, &report);
+  // Contact makes F piecewise smooth: where Newton finds no root, the same straight move in
+  // 2, 4 and 8 legs (each leg's Newton starts nearer its root).
+  for (int legs = 2; !report.reached && legs <= kContactLegs; legs *= 2) {
+    ArmStepReport legged = LegsStep(model, state, target, legs,
+                                    options.tolerance * model.link_lengths.mean(), options, &grown);
+    AddCost(report, &legged);
+    legged.legs = std::max(legged.legs, report.legs);
+    // The legs stop at the first leg not reached, with that leg's error: measured to the target.
+    MeasureReach(model, target, options.tolerance * model.link_lengths.mean(), &legged);
+    const bool better = legged.reached || legged.ee_error < report.ee_error;
+    if (!better) {
+      SetCost(legged, &report);
+      continue;
+    }
+    report = std::move(legged);
+  }
+  report.contact = true;
+  report.clearance =
+      arm_internal::ArmClearance(model, report.state.points, options.colliders, &relative);
+  if (relative < -arm_internal::kArmContactSlack) {
+    // No solve keeps every link outside: the arm is held where it was.
+    ArmStepReport held = report;
+    held.state = state;
+    held.state.memory = ArmSolverMemory();
+    held.reached = false;
+    held.blocked = true;
+    MeasureReach(model, target, options.tolerance * model.link_lengths.mean(), &held);
+    held.reached = false;
+    held.clearance = arm_internal::ArmClearance(model, state.points, options.colliders, &relative);
+    return held;
+  }
+  return report;
 }
 
 // ArmStep on a checked model (prepared in `plan`), options, state and target, without velocity
@@ -638,6 +711,22 @@ ArmStepReport StepUnlimited(const arm_internal::JointSpacePlan& plan, const ArmS
     return Report(model, target, tol, solved, sweeper.sweeps(),
                   sweeper.sweeps());  // 1 sweep a pass
   }
+  if (!options.colliders.empty()) return ContactStep(plan, state, target, options);
+  return SweptStep(plan, state, target, options, nullptr);
+}
+
+// The step of a planar or spherical arm (the tractrix sweep, then the legs and the joint-space
+// step where it finds no root). With `contact` (the grown colliders, src/arm/colliders.h) the
+// sweeps take contact steps, and a joint-space result is kept only where it keeps every link
+// outside the colliders.
+ArmStepReport SweptStep(const arm_internal::JointSpacePlan& plan, const ArmState& state,
+                        const Eigen::VectorXd& target, const ArmOptions& options,
+                        const std::vector<Collider>* contact) {
+  const ArmModel& model = plan.model();
+  const int n = model.num_links();
+  const double scale = model.link_lengths.mean();
+  const double tol = options.tolerance * scale;
+  const bool newton = options.method == FixedBaseMethod::kNewton;
   const Vec to_target = target - model.base;
   if (to_target.norm() >= model.reach() * (1.0 - options.edge_margin)) {
     // Out of reach (or on its edge, where the Jacobian is singular): stretched toward the target.
@@ -661,11 +750,11 @@ ArmStepReport StepUnlimited(const arm_internal::JointSpacePlan& plan, const ArmS
   const int legs = static_cast<int>(std::ceil((target - from).norm() / (kLegLength * scale)));
   ArmOptions first = options;
   if (legs > 1 && newton) first.max_iterations = std::min(options.max_iterations, kFarIterations);
-  ArmStepReport report = SweepStep(model, state, target, tol, first);
+  ArmStepReport report = SweepStep(model, state, target, tol, first, contact);
   if (report.reached || !newton) return report;
   // The sweep found no root. (1) A far move: the same straight line in legs.
   if (legs > 1) {
-    ArmStepReport legged = LegsStep(model, state, target, legs, tol, options);
+    ArmStepReport legged = LegsStep(model, state, target, legs, tol, options, contact);
     AddCost(report, &legged);
     if (legged.reached) return legged;
     SetCost(legged, &report);
@@ -674,7 +763,12 @@ ArmStepReport StepUnlimited(const arm_internal::JointSpacePlan& plan, const ArmS
   // base: the joint-space solve from the last state, kept if it gets nearer.
   ArmStepReport fallback = JointSpaceStep(plan, state, target, tol, options);
   AddCost(report, &fallback);
-  if (fallback.reached || fallback.ee_error < report.ee_error) return fallback;
+  double relative = 0.0;
+  const bool fallback_clear =
+      contact == nullptr ||
+      (arm_internal::ArmClearance(model, fallback.state.points, options.colliders, &relative),
+       relative >= -arm_internal::kArmContactSlack);
+  if (fallback_clear && (fallback.reached || fallback.ee_error < report.ee_error)) return fallback;
   SetCost(fallback, &report);
   return report;
 }
@@ -703,6 +797,8 @@ ArmStepReport ArmStep(const ArmModel& model, const ArmState& state,
   CheckOptionsForModel(model, options);
   const Eigen::VectorXd target = target_in;
   CheckState(model, state, target);
+  arm_internal::CheckArmOutside(model, state.points, options.colliders, "state.points");
+  arm_internal::CheckTargetOutside(model, options, target, "target");
   return StepChecked(arm_internal::JointSpacePlan(model), state, target, options);
 }
 
@@ -719,6 +815,12 @@ std::string ArmStepReport::BriefReport() const {
     text += line;
   }
   if (velocity_legs > 1) text += ", " + std::to_string(velocity_legs) + " legs for velocity limits";
+  if (std::isfinite(clearance)) {
+    std::snprintf(line, sizeof(line), ", clearance %.3g%s%s", clearance,
+                  contact ? " (contact steps)" : "",
+                  blocked ? ", BLOCKED: no solve kept the links outside, the arm held" : "");
+    text += line;
+  }
   return text;
 }
 
@@ -745,6 +847,11 @@ ArmTrajectory TrackPath(const ArmModel& model, const Points& path, const ArmOpti
   // The last step's state is the next step's start: two reports, swapped after each step.
   ArmStepReport last;
   last.state = InitialState(model);
+  arm_internal::CheckArmOutside(model, last.state.points, options.colliders, "initial");
+  for (int i = 0; i < path.rows(); ++i) {
+    arm_internal::CheckTargetOutside(model, options, path.row(i).transpose(),
+                                     "path[" + std::to_string(i) + "]");
+  }
   const arm_internal::JointSpacePlan plan(model);  // for every step
   for (int i = 0; i < path.rows(); ++i) {
     const Eigen::VectorXd target = path.row(i).transpose();
@@ -757,6 +864,9 @@ ArmTrajectory TrackPath(const ArmModel& model, const Points& path, const ArmOpti
     trajectory.max_iterations = std::max(trajectory.max_iterations, step.iterations);
     trajectory.total_sweeps += step.sweeps;
     trajectory.total_passes += step.passes;
+    trajectory.min_clearance = std::min(trajectory.min_clearance, step.clearance);
+    trajectory.contact_steps += step.contact ? 1 : 0;
+    trajectory.blocked_steps += step.blocked ? 1 : 0;
     ++trajectory.num_steps;
     if (sink != nullptr) sink->Add(step);
     last = std::move(step);
@@ -788,6 +898,13 @@ std::string ArmTrajectory::BriefReport() const {
   }
   if (velocity_legs > num_steps) {
     text += ", " + std::to_string(velocity_legs) + " legs to keep velocity limits";
+  }
+  if (std::isfinite(min_clearance)) {
+    std::snprintf(line, sizeof(line), ", least clearance %.3g, %d steps with contact steps%s",
+                  min_clearance, contact_steps,
+                  blocked_steps > 0 ? ", BLOCKED steps (the arm held where it was): " : "");
+    text += line;
+    if (blocked_steps > 0) text += std::to_string(blocked_steps);
   }
   return text;
 }

@@ -9,6 +9,7 @@
 #include "chain/simd.h"
 #include "chain/substep.h"
 #include "sequential/link_rules.h"
+#include "world/contact.h"
 
 namespace flexkin::arm_internal {
 
@@ -22,19 +23,20 @@ bool HasAvx2Fma() {
 }
 
 Sweeper::Sweeper(const ArmModel& model, const Points& start, const Eigen::VectorXd& target,
-                 int substeps)
+                 int substeps, const std::vector<Collider>* colliders)
     : model_(model),
       start_(start),
       target_(target),
       substeps_(substeps),
       n_(model.num_links()),
       dim_(model.dim),
-      has_limits_(model.has_limits()) {
+      has_limits_(model.has_limits()),
+      colliders_(colliders != nullptr && !colliders->empty() ? colliders : nullptr) {
   base_direction_ = model.base_direction.normalized();
   inv_lengths_.resize(n_);
   for (int j = 0; j < n_; ++j) inv_lengths_[j] = 1.0 / model.link_lengths[j];
   lanes_[0].resize(n_ + 1, dim_);
-  fast_ = !has_limits_ && HasAvx2Fma();
+  fast_ = !has_limits_ && colliders_ == nullptr && HasAvx2Fma();
 }
 
 SmallVec Sweeper::FastLanes(int lanes, const double* u, double* points0) {
@@ -209,11 +211,33 @@ void Sweeper::Run(double* const* lanes, bool* limited_out) {
         internal::TractrixStep<Dim>(head_old[l], tail + Dim, tail, lengths[j - 1],
                                     inv_lengths[j - 1]);
         if (has_limits_) limited[l] |= Limit(lanes[l], j);
+        if (colliders_ != nullptr) Contact<Dim>(lanes[l], j, tail_old);
         for (int k = 0; k < Dim; ++k) head_old[l][k] = tail_old[k];
       }
     }
   }
   for (int l = 0; l < K; ++l) limited_out[l] = limited[l];
+}
+
+template <int Dim>
+void Sweeper::Contact(double* p, int j, const double* tail_old) {
+  Eigen::Vector3d head = Eigen::Vector3d::Zero(), tail = head, old = head;
+  for (int k = 0; k < Dim; ++k) {
+    head[k] = p[j * Dim + k];
+    tail[k] = p[(j - 1) * Dim + k];
+    old[k] = tail_old[k];
+  }
+  const double length = model_.link_lengths[j - 1];
+  if (internal::SegmentClearance(*colliders_, head, tail) >= -internal::kContactSlack * length) {
+    return;  // the rule's step stands
+  }
+  Eigen::Vector3d x;
+  if (!internal::ContactTail(Dim, head, old, length, *colliders_, &x)) {
+    wedged_ = true;
+    return;
+  }
+  ++contacts_;
+  for (int k = 0; k < Dim; ++k) p[(j - 1) * Dim + k] = x[k];
 }
 
 bool Sweeper::Limit(double* p, int j) const {

@@ -23,8 +23,12 @@ class Sweeper {
  public:
   static constexpr int kMaxLanes = 4;
 
-  // `start` (n+1 by dim, base first) must outlive the sweeper.
-  Sweeper(const ArmModel& model, const Points& start, const Eigen::VectorXd& target, int substeps);
+  // `start` (n+1 by dim, base first) must outlive the sweeper. With `colliders` (grown by the
+  // link radius and the skin: src/arm/colliders.h; must outlive the sweeper), every link whose
+  // tractrix step (and limits) would put it into one takes the contact step instead, in every
+  // lane (the generic loop: the AVX2 lanes are not used).
+  Sweeper(const ArmModel& model, const Points& start, const Eigen::VectorXd& target, int substeps,
+          const std::vector<Collider>* colliders = nullptr);
 
   // F(u) (dim); leaves the swept points in points().
   SmallVec Evaluate(const SmallVec& u);
@@ -43,6 +47,10 @@ class Sweeper {
   const Points& points() const { return lanes_[0]; }
   // Whether a joint limit was active in the last Evaluate (or SweepInPlace).
   bool limited() const { return limited_; }
+  // Link steps so far that took the contact step (every lane counted), and whether one found
+  // every direction blocked (the link was left where the tractrix put it).
+  int contacts() const { return contacts_; }
+  bool wedged() const { return wedged_; }
   // Sweeps so far, every lane counted (cost ~ passes * n).
   int sweeps() const { return sweeps_; }
   // Passes over the links so far: lanes swept together count once.
@@ -61,6 +69,10 @@ class Sweeper {
   // Puts link j (points j-1, j of `p`) back into the limits of joint j and, for the base link, of
   // joint 0, turning it about point j. Returns whether it moved.
   bool Limit(double* p, int j) const;
+  // Link j (points j-1, j of `p`) out of the colliders: where it enters one, its trailing end is
+  // moved from `tail_old` by the contact step (world/contact.h).
+  template <int Dim>
+  void Contact(double* p, int j, const double* tail_old);
   // The AVX2 sweeps of `lanes` translations (u: lanes by dim); copy 0's points into `points0`,
   // the lanes' F into fast_bases_ (lanes by dim). Returns lane 0's F.
   SmallVec FastLanes(int lanes, const double* u, double* points0);
@@ -75,8 +87,9 @@ class Sweeper {
   Eigen::VectorXd base_direction_;
   std::vector<double> inv_lengths_;
   std::array<Points, kMaxLanes> lanes_;
-  bool limited_ = false;
-  int sweeps_ = 0, passes_ = 0;
+  const std::vector<Collider>* colliders_;
+  bool limited_ = false, wedged_ = false;
+  int sweeps_ = 0, passes_ = 0, contacts_ = 0;
 };
 
 }  // namespace flexkin::arm_internal

@@ -10,6 +10,8 @@
 
 namespace flexkin::internal {
 
-GroomScenario ReadGroomScenario(const nlohmann::json& root, Problems* problems);
+// A mesh collider's relative "file" is taken from `directory` ("" : the working directory).
+GroomScenario ReadGroomScenario(const nlohmann::json& root, Problems* problems,
+                                const std::string& directory = "");
 
 }  // namespace flexkin::internal

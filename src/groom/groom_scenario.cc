@@ -120,10 +120,10 @@ class GroomParser : public json_internal::JsonReader {
     }
     if (dim != 0) {
       if (const json* c = Find(root, "colliders")) {
-        s.options.body_colliders = ReadCollidersJson(*c, "/colliders", dim, &problems);
+        s.options.body_colliders = ReadCollidersJson(*c, "/colliders", dim, &problems, directory);
       }
       if (const json* c = Find(root, "world_colliders")) {
-        s.options.colliders = ReadCollidersJson(*c, "/world_colliders", dim, &problems);
+        s.options.colliders = ReadCollidersJson(*c, "/world_colliders", dim, &problems, directory);
       }
     }
     if (!problems.empty()) return s;
@@ -603,6 +603,9 @@ class GroomParser : public json_internal::JsonReader {
   }
 
   bool grow_;
+
+ public:
+  std::string directory;  // of mesh colliders' relative files ("": the working directory)
 };
 
 GroomScenario ParseGroomJson(const json& root) {
@@ -615,8 +618,10 @@ GroomScenario ParseGroomJson(const json& root) {
 }  // namespace
 
 namespace internal {
-GroomScenario ReadGroomScenario(const json& root, Problems* problems) {
+GroomScenario ReadGroomScenario(const json& root, Problems* problems,
+                                const std::string& directory) {
   GroomParser parser(/*grow=*/true);
+  parser.directory = directory;
   GroomScenario scenario = parser.Parse(root);
   for (Problem& p : parser.problems) problems->push_back(std::move(p));
   return scenario;

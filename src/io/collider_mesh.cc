@@ -157,6 +157,16 @@ ColliderMesh MeshOfCollider(const Collider& c, int segments, const Eigen::Vector
       mesh.triangles = {{0, 1, 2}, {0, 2, 3}};  // counter-clockwise seen from +z, the free side
       return mesh;
     }
+    case ColliderShape::kMesh: {  // its own triangles, outward already (MakeColliderMesh)
+      const ColliderMeshData& m = *c.mesh;
+      for (Eigen::Index i = 0; i < m.vertices.rows(); ++i) {
+        mesh.vertices.push_back(c.pose * (c.scale * m.vertices.row(i).transpose()).eval());
+      }
+      for (Eigen::Index f = 0; f < m.triangles.rows(); ++f) {
+        mesh.triangles.push_back({m.triangles(f, 0), m.triangles(f, 1), m.triangles(f, 2)});
+      }
+      return mesh;
+    }
   }
   FaceOutward(&mesh);
   for (Eigen::Vector3d& v : mesh.vertices) v = c.pose * v;
@@ -226,6 +236,8 @@ std::vector<Eigen::Vector2d> OutlineOfCollider2d(const Collider& c, int segments
       }
       break;
     }
+    case ColliderShape::kMesh:  // 3D only: refused in 2D (CollidersProblems)
+      break;
   }
   return outline;
 }
@@ -271,6 +283,17 @@ void ExtendByCollider(const Collider& c, int dim, const Eigen::Vector3d& center,
       const Eigen::Vector3d under = foot - (std::isfinite(extent) ? 0.15 * extent : 0.0) * r.col(2);
       mid = 0.5 * (foot + under);
       half = 0.5 * (foot - under).cwiseAbs();
+      break;
+    }
+    case ColliderShape::kMesh: {  // the box of its vertices, placed
+      Eigen::Vector3d a = Eigen::Vector3d::Constant(HUGE_VAL), b = -a;
+      for (Eigen::Index i = 0; i < c.mesh->vertices.rows(); ++i) {
+        const Eigen::Vector3d v = c.pose * (c.scale * c.mesh->vertices.row(i).transpose()).eval();
+        a = a.cwiseMin(v);
+        b = b.cwiseMax(v);
+      }
+      mid = 0.5 * (a + b);
+      half = 0.5 * (b - a);
       break;
     }
   }

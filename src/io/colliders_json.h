@@ -15,9 +15,10 @@ namespace flexkin {
 
 // A "colliders" array in `dim` dimensions (2D shapes in the plane z = 0), read as a scenario's is;
 // every problem is appended to `problems`, named by JSON pointer under `ptr`
-// ("/colliders/1/radius").
+// ("/colliders/1/radius"). A mesh's relative "file" is read from `directory` ("": the working
+// directory); a mesh given inline ("vertices", "triangles", as result files carry it) reads none.
 std::vector<Collider> ReadCollidersJson(const nlohmann::json& v, const std::string& ptr, int dim,
-                                        Problems* problems);
+                                        Problems* problems, const std::string& directory = "");
 
 // The problems of colliders to be written in `dim` dimensions, fields "colliders[k]...": those of
 // CheckCollider, and, in 2D, a collider that the 2D form cannot say (a centre off the plane z = 0,

@@ -13,11 +13,13 @@
 #include <utility>
 #include <vector>
 
+#include "arm/colliders.h"
 #include "flexkin/arm.h"
 #include "flexkin/error.h"
 #include "flexkin/leader.h"
 #include "flexkin/scenario_kind.h"
 #include "flexkin/vocabulary.h"
+#include "io/colliders_json.h"
 #include "io/json_file.h"
 #include "io/json_values.h"
 #include "io/scenario_kinds.h"
@@ -69,7 +71,7 @@ class RobotParser : public json_internal::JsonReader {
     if (!ExpectObject(root, "", "an object with \"arm\" (or \"urdf\") and \"path\"")) return s;
     CheckKeys(root, "",
               {"format", "name", "arm", "urdf", "base_link", "tip_link", "tip_offset", "pointing",
-               "path", "solver"});
+               "path", "solver", "colliders", "link_radius"});
     if (const json* f = Find(root, "format")) {
       if (!f->is_string()) {
         TypeProblem(*f, "/format", "\"flexkin-robot\"");
@@ -105,11 +107,16 @@ class RobotParser : public json_internal::JsonReader {
     if (const json* pointing = Find(root, "pointing")) {
       ParsePointing(*pointing, "/pointing", &s.options.pointing);
     }
+    if (const json* c = Find(root, "colliders"); c != nullptr && dim != 0) {
+      s.options.colliders = ReadCollidersJson(*c, "/colliders", dim, &problems, directory_);
+    }
+    if (model) ParseLinkRadius(root, &*model);
     if (model) {
       for (const Problem& p : s.options.ValidateFor(*model)) {
         Add(p.field == "method" ? "/solver/method" : "/" + p.field, p.message);
       }
     }
+    if (model && path && problems.empty()) CheckOutside(*model, *path, s.options);
     if (!problems.empty()) return s;
     s.model = std::move(*model);
     s.path = std::move(*path);
@@ -237,6 +244,36 @@ class RobotParser : public json_internal::JsonReader {
     }
     if (problems.size() != before) return std::nullopt;
     return m;
+  }
+
+  // "link_radius": a radius >= 0 for every link, or one per link. A URDF arm's links keep the
+  // radius of their collision geometry; links without one (radius 0) take this value.
+  void ParseLinkRadius(const json& root, ArmModel* model) {
+    const json* v = Find(root, "link_radius");
+    if (v == nullptr) return;
+    const int n = model->num_links();
+    const auto radii = NumberPerItem(*v, "/link_radius", n, Range::kNonNegative, "link");
+    if (!radii) return;
+    if (model->link_radii.size() != n) model->link_radii = Eigen::VectorXd::Zero(n);
+    for (int k = 0; k < n; ++k) {
+      if (model->link_radii[k] == 0.0) model->link_radii[k] = (*radii)[k];
+    }
+  }
+
+  // Neither the start nor a target inside a collider (the checks TrackPath makes, here with the
+  // scenario's pointers).
+  void CheckOutside(const ArmModel& model, const Points& path, const ArmOptions& options) {
+    if (options.colliders.empty() || model.has_axes()) return;
+    try {
+      arm_internal::CheckArmOutside(model, ForwardKinematics(model, model.initial),
+                                    options.colliders, "/colliders");
+      for (int i = 0; i < path.rows(); ++i) {
+        arm_internal::CheckTargetOutside(model, options, path.row(i).transpose(),
+                                         "/path (target " + std::to_string(i) + ")");
+      }
+    } catch (const InputError& e) {
+      problems.push_back(e.problem());
+    }
   }
 
   // "urdf", "base_link", "tip_link": the arm read by the URDF loader.

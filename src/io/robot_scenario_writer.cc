@@ -16,6 +16,7 @@
 #include "flexkin/error.h"
 #include "flexkin/robot_scenario.h"
 #include "io/atomic_file.h"
+#include "io/colliders_json.h"
 
 namespace flexkin {
 namespace {
@@ -63,6 +64,12 @@ json StepJson(const RobotScenario& s, int64_t index, const ArmStepReport& r) {
     step["velocity_legs"] = r.velocity_legs;
     step["velocity_ratio"] = r.velocity_ratio;
   }
+  if (!s.options.colliders.empty()) {
+    // The least clearance of any link's capsule from any collider after the step (length unit).
+    step["clearance"] = r.clearance;
+    step["contact"] = r.contact;
+    step["blocked"] = r.blocked;
+  }
   return step;
 }
 
@@ -97,6 +104,15 @@ json HeadJson(const RobotScenario& s) {
     doc["pointing"] = pointing;
   }
   if (s.options.time_step > 0.0) doc["time_step"] = s.options.time_step;
+  if (s.model.link_radii.size() > 0) doc["link_radii"] = Row(s.model.link_radii);
+  if (!s.options.colliders.empty()) {
+    doc["colliders"] = json::array();
+    for (const Collider& c : s.options.colliders) {
+      std::string text;
+      AppendColliderJson(c, s.model.dim, &text);
+      doc["colliders"].push_back(json::parse(text));
+    }
+  }
   doc["initial"] = StateJson(s.model, InitialState(s.model));
   return doc;
 }
@@ -112,6 +128,11 @@ json SummaryJson(const ArmTrajectory& t, int64_t steps) {
   // Only where the run pointed or kept velocity limits (the steps say which).
   if (t.max_pointing_error > 0.0) summary["max_pointing_error"] = t.max_pointing_error;
   if (t.velocity_legs > 0) summary["velocity_legs"] = t.velocity_legs;
+  if (std::isfinite(t.min_clearance)) {  // with colliders
+    summary["min_clearance"] = t.min_clearance;
+    summary["contact_steps"] = t.contact_steps;
+    summary["blocked_steps"] = t.blocked_steps;
+  }
   return summary;
 }
 

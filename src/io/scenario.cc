@@ -19,7 +19,7 @@ Scenario Parser::Parse(const json& root) {
   if (!ExpectObject(root, "", "an object with \"curve\" and \"leader\"")) return s;
   CheckKeys(root, "",
             {"$schema", "name", "description", "curve", "leader", "method", "objective", "solver",
-             "record", "accuracy", "colliders"});
+             "record", "accuracy", "colliders", "link_radius"});
   for (const char* key : {"$schema", "name", "description"}) {
     if (const json* v = Find(root, key)) {
       if (const auto text = String(*v, std::string("/") + key)) {
@@ -37,6 +37,10 @@ Scenario Parser::Parse(const json& root) {
   if (const json* c = Find(root, "colliders"); c != nullptr && chain) {
     ParseColliders(*c, "/colliders", chain->dim(), &s.options.colliders);
   }
+  Optional(
+      root, "", "link_radius",
+      [&](const json& x, const std::string& p) { return Number(x, p, Range::kNonNegative); },
+      &s.options.link_radius);
   const bool max_substeps_given = root.contains("accuracy") && root["accuracy"].is_object() &&
                                   root["accuracy"].contains("max_substeps");
   std::optional<Points> steps;
@@ -70,6 +74,7 @@ const std::vector<OptionLocation>& RunOptionLocations() {
       {"tolerance", "/accuracy/tolerance", "--tolerance"},
       {"max_substeps", "/accuracy/max_substeps", "--max-substeps"},
       {"colliders", "/colliders", ""},
+      {"link_radius", "/link_radius", ""},
       {"overall.weights.", "/objective", ""},
       {"overall.weights", "/objective", ""},
       {"overall.", "/solver", ""},
@@ -99,8 +104,10 @@ Problem InScenarioFile(Problem problem) {
 }
 
 namespace internal {
-Scenario ReadChainScenario(const nlohmann::json& root, Problems* problems) {
+Scenario ReadChainScenario(const nlohmann::json& root, Problems* problems,
+                           const std::string& directory) {
   scenario_internal::Parser parser;
+  parser.directory = directory;
   Scenario scenario = parser.Parse(root);
   for (Problem& p : parser.problems) problems->push_back(std::move(p));
   return scenario;

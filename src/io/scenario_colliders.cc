@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -40,8 +41,8 @@ void Parser::ParseColliders(const json& v, const std::string& ptr, int dim,
 }
 
 std::optional<Collider> Parser::ParseCollider(const json& v, const std::string& ptr, int dim) {
-  static const std::vector<std::string> kShapes = {"sphere",   "ellipsoid", "capsule",
-                                                   "cylinder", "box",       "half_space"};
+  static const std::vector<std::string> kShapes = {"sphere", "ellipsoid",  "capsule", "cylinder",
+                                                   "box",    "half_space", "mesh"};
   if (!ExpectObject(v, ptr, "an object {\"shape\": ..., ...}")) return std::nullopt;
   const json* shape_value = Required(v, ptr, "shape", "one of " + QuotedList(kShapes));
   if (shape_value == nullptr) return std::nullopt;
@@ -145,6 +146,20 @@ std::optional<Collider> Parser::ParseCollider(const json& v, const std::string& 
     if (const auto center = vector("center")) c.pose.translation() = In3d(*center);
     extents(size_key);
     orientation();
+  } else if (*shape == "mesh") {
+    c.shape = ColliderShape::kMesh;
+    keys.insert(keys.end(), {"file", "scale", "position", "rotation", "vertices", "triangles"});
+    if (dim != 3) {
+      Add(ptr + "/shape",
+          "is a 3D shape; a 2D chain's colliders are its sections by the plane z = 0, which a "
+          "mesh does not give",
+          "\"mesh\"",
+          "one of \"sphere\", \"ellipsoid\", \"capsule\", \"cylinder\", \"box\", "
+          "\"half_space\"");
+      return std::nullopt;
+    }
+    ParseMesh(v, ptr, &c);
+    orientation();
   } else {
     c.shape = ColliderShape::kHalfSpace;
     keys.insert(keys.end(), {"point", "normal"});
@@ -161,6 +176,69 @@ std::optional<Collider> Parser::ParseCollider(const json& v, const std::string& 
   CheckKeys(v, ptr, keys);
   if (problems.size() != before) return std::nullopt;
   return c;
+}
+
+void Parser::ParseMesh(const json& v, const std::string& ptr, Collider* c) {
+  if (const json* x = Find(v, "position")) {
+    if (const auto p = Vector(*x, ptr + "/position", 3)) c->pose.translation() = *p;
+  }
+  Optional(
+      v, ptr, "scale",
+      [&](const json& x, const std::string& p) { return Number(x, p, Range::kPositive); },
+      &c->scale);
+  std::string file;
+  const json* file_value = Find(v, "file");
+  if (file_value != nullptr) {
+    const auto name = String(*file_value, ptr + "/file");
+    if (!name) return;
+    if (name->empty()) {
+      Add(ptr + "/file", "is empty; expected the path of an STL or OBJ file", "\"\"",
+          "a path, relative to the scenario file's directory");
+      return;
+    }
+    file = *name;
+  }
+  // A result file carries the mesh itself (io/colliders_json.h): "vertices" and "triangles".
+  const json* vertices_value = Find(v, "vertices");
+  if (vertices_value != nullptr || Find(v, "triangles") != nullptr) {
+    const json* t = Required(v, ptr, "triangles", "an array of [i, j, k] vertex indices");
+    const json* p = Required(v, ptr, "vertices", "an array of [x, y, z] points");
+    if (t == nullptr || p == nullptr) return;
+    const auto points = JsonReader::PointList(*p, ptr + "/vertices", 3, 0, int64_t{1} << 26);
+    if (!t->is_array()) {
+      TypeProblem(*t, ptr + "/triangles", "an array of [i, j, k] vertex indices");
+      return;
+    }
+    MeshTriangles triangles(static_cast<Eigen::Index>(t->size()), 3);
+    const size_t before = problems.size();
+    for (size_t f = 0; f < t->size(); ++f) {
+      const std::string at = ptr + "/triangles/" + std::to_string(f);
+      if (!(*t)[f].is_array() || (*t)[f].size() != 3) {
+        TypeProblem((*t)[f], at, "an array of 3 vertex indices");
+        continue;
+      }
+      for (int k = 0; k < 3; ++k) {
+        const auto i = Integer((*t)[f][k], at + "/" + std::to_string(k), 0, (int64_t{1} << 31) - 1);
+        triangles(static_cast<Eigen::Index>(f), k) = i ? static_cast<int>(*i) : 0;
+      }
+    }
+    if (!points || problems.size() != before) return;
+    // An empty list reads as 0 by 0: the mesh's own check names it.
+    MeshVertices vertices = points->rows() > 0 ? MeshVertices(*points) : MeshVertices(0, 3);
+    c->mesh = MakeColliderMesh(std::move(vertices), std::move(triangles), file, ptr + "/vertices",
+                               &problems);
+    return;
+  }
+  if (file_value == nullptr) {
+    Add(ptr + "/file", "missing; expected the path of an STL or OBJ file", "",
+        "a path, relative to the scenario file's directory");
+    return;
+  }
+  const std::filesystem::path path(file);
+  const std::string full = path.is_absolute() || directory.empty()
+                               ? file
+                               : (std::filesystem::path(directory) / path).string();
+  c->mesh = ReadColliderMeshFile(full, file, ptr + "/file", &problems);
 }
 
 }  // namespace flexkin::scenario_internal
@@ -189,8 +267,9 @@ void AppendKey(const char* key, std::string* out) {
 }  // namespace
 
 std::vector<Collider> ReadCollidersJson(const nlohmann::json& v, const std::string& ptr, int dim,
-                                        Problems* problems) {
+                                        Problems* problems, const std::string& directory) {
   scenario_internal::Parser parser;
+  parser.directory = directory;
   std::vector<Collider> colliders;
   parser.ParseColliders(v, ptr, dim, &colliders, "the result");
   problems->insert(problems->end(), parser.problems.begin(), parser.problems.end());
@@ -222,6 +301,11 @@ Problems CollidersProblems(const std::vector<Collider>& colliders, int dim) {
       case ColliderShape::kEllipsoid:  // turned about z only
         in_plane = in_plane && std::fabs(z.z() - 1.0) <= kPlaneTolerance;
         break;
+      case ColliderShape::kMesh:
+        problems.emplace_back(field,
+                              "is a mesh, a 3D shape; a 2D result's colliders are "
+                              "sections by the plane z = 0, which a mesh does not give");
+        continue;
     }
     if (!in_plane) {
       problems.emplace_back(field,
@@ -249,6 +333,17 @@ void AppendColliderJson(const Collider& c, int dim, std::string* out) {
     AppendKey(key, out);
     AppendJsonDouble(x, out);
   };
+  const auto rotation = [&]() {
+    Eigen::Quaterniond q(r);
+    if (q.w() < 0.0) q.coeffs() = -q.coeffs();
+    AppendKey("rotation", out);
+    const double wxyz[4] = {q.w(), q.x(), q.y(), q.z()};
+    for (int k = 0; k < 4; ++k) {
+      out->append(k == 0 ? "[" : ", ");
+      AppendJsonDouble(wxyz[k], out);
+    }
+    out->push_back(']');
+  };
   switch (c.shape) {
     case ColliderShape::kSphere:
       point("center", t);
@@ -268,21 +363,43 @@ void AppendColliderJson(const Collider& c, int dim, std::string* out) {
       if (dim == 2) {
         number("angle", std::atan2(r(1, 0), r(0, 0)));
       } else {
-        Eigen::Quaterniond q(r);
-        if (q.w() < 0.0) q.coeffs() = -q.coeffs();
-        AppendKey("rotation", out);
-        const double wxyz[4] = {q.w(), q.x(), q.y(), q.z()};
-        for (int k = 0; k < 4; ++k) {
-          out->append(k == 0 ? "[" : ", ");
-          AppendJsonDouble(wxyz[k], out);
-        }
-        out->push_back(']');
+        rotation();
       }
       break;
     case ColliderShape::kHalfSpace:
       point("point", t);
       point("normal", r.col(2));
       break;
+    case ColliderShape::kMesh: {
+      // The mesh itself, beside its file's name: a result file stands alone (it is read, drawn
+      // and checked where the mesh file is not, and a later edit of that file does not change
+      // what the run met). A reader takes the inline mesh and never opens the file.
+      const ColliderMeshData& m = *c.mesh;
+      if (!m.file.empty()) {
+        AppendKey("file", out);
+        out->append(nlohmann::json(m.file).dump());
+      }
+      number("scale", c.scale);
+      point("position", t);
+      rotation();
+      AppendKey("vertices", out);
+      for (Eigen::Index i = 0; i < m.vertices.rows(); ++i) {
+        out->append(i == 0 ? "[" : ", ");
+        AppendPoint(m.vertices.row(i).transpose(), 3, out);
+      }
+      out->push_back(']');
+      AppendKey("triangles", out);
+      for (Eigen::Index f = 0; f < m.triangles.rows(); ++f) {
+        out->append(f == 0 ? "[[" : ", [");
+        for (int k = 0; k < 3; ++k) {
+          if (k > 0) out->append(", ");
+          out->append(std::to_string(m.triangles(f, k)));
+        }
+        out->push_back(']');
+      }
+      out->push_back(']');
+      break;
+    }
   }
   out->push_back('}');
 }

@@ -19,7 +19,9 @@ namespace flexkin::internal {
 // "strands"; anything else is a chain scenario.
 ScenarioKind KindOf(const nlohmann::json& root);  // scenario_kind.cc
 
-Scenario ReadChainScenario(const nlohmann::json& root, Problems* problems);  // scenario.cc
+// A mesh collider's relative "file" is taken from `directory` ("" : the working directory).
+Scenario ReadChainScenario(const nlohmann::json& root, Problems* problems,
+                           const std::string& directory = "");  // scenario.cc
 // Relative "urdf" paths are taken from `directory` ("" : the working directory).
 RobotScenario ReadRobotScenario(const nlohmann::json& root, const RobotScenarioOptions& options,
                                 const std::string& directory,

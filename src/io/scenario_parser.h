@@ -42,6 +42,9 @@ class Parser : public json_internal::JsonReader {
   // (`whose` "the curve") or a result file ("the result"; io/colliders_json.h).
   void ParseColliders(const json& v, const std::string& ptr, int dim,
                       std::vector<Collider>* colliders, const char* whose = "the curve");
+  // Where a mesh collider's relative "file" is (the scenario file's directory; "": the working
+  // directory).
+  std::string directory;
 
  private:
   // A point list of the curve or the leader's path: at most kMaxLeaderSteps points.
@@ -54,6 +57,7 @@ class Parser : public json_internal::JsonReader {
                                     RunOptions* options);
   void ParseOptions(const json& root, RunOptions* options);
   std::optional<Collider> ParseCollider(const json& v, const std::string& ptr, int dim);
+  void ParseMesh(const json& v, const std::string& ptr, Collider* collider);
 
   // Lets the curve module check and build a shape whose values were all read. Its own checks
   // (radius vs. link length, a zero direction) only run then, so that a default standing in for

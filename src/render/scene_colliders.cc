@@ -2,6 +2,8 @@
 // geometry of the colliders (io/collider_mesh.h).
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <map>
+#include <utility>
 #include <vector>
 
 #include "io/collider_mesh.h"
@@ -52,6 +54,40 @@ void FillPolygon(cairo_t* cr, const std::vector<Eigen::Vector2d>& pixels, double
   cairo_stroke(cr);
 }
 
+// A mesh (not convex: its hull would fill its hollows): the union of its triangles as projected,
+// each turned counter-clockwise so that the nonzero rule fills the union, outlined along its
+// silhouette (the edges whose two triangles face opposite ways once projected).
+void FillMesh(cairo_t* cr, const ColliderMesh& mesh, const std::vector<Eigen::Vector2d>& pixels,
+              double ui) {
+  std::map<std::pair<int, int>, int> facing;  // per edge: +1 / -1 per triangle facing the viewer
+  for (const auto& t : mesh.triangles) {
+    const Eigen::Vector2d a = pixels[t[0]], b = pixels[t[1]], c = pixels[t[2]];
+    const double area = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+    const int side = area >= 0.0 ? 1 : -1;
+    for (int k = 0; k < 3; ++k) {
+      const int i = t[k], j = t[(k + 1) % 3];
+      facing[{std::min(i, j), std::max(i, j)}] += side;
+    }
+    cairo_move_to(cr, a.x(), a.y());
+    const Eigen::Vector2d& second = side > 0 ? b : c;
+    const Eigen::Vector2d& third = side > 0 ? c : b;
+    cairo_line_to(cr, second.x(), second.y());
+    cairo_line_to(cr, third.x(), third.y());
+    cairo_close_path(cr);
+  }
+  cairo_set_fill_rule(cr, CAIRO_FILL_RULE_WINDING);
+  SetColor(cr, kColliderFill);
+  cairo_fill(cr);
+  for (const auto& [edge, sum] : facing) {
+    if (sum != 0) continue;
+    cairo_move_to(cr, pixels[edge.first].x(), pixels[edge.first].y());
+    cairo_line_to(cr, pixels[edge.second].x(), pixels[edge.second].y());
+  }
+  SetColor(cr, kColliderEdge);
+  cairo_set_line_width(cr, 1.2 * ui);
+  cairo_stroke(cr);
+}
+
 }  // namespace
 
 void ChainScene::DrawColliders(cairo_t* cr, const std::vector<Collider>& colliders) const {
@@ -90,6 +126,11 @@ void ChainScene::DrawColliders(cairo_t* cr, const std::vector<Collider>& collide
     std::vector<Eigen::Vector2d> pixels;
     if (c->shape == ColliderShape::kHalfSpace) {
       for (const Eigen::Vector3d& q : HalfSpacePlaneInBox(*c, lo_, hi_)) pixels.push_back(pixel(q));
+    } else if (c->shape == ColliderShape::kMesh) {
+      const ColliderMesh mesh = MeshOfCollider(*c, kSegments / 2, Eigen::Vector3d::Zero(), 0.0);
+      for (const Eigen::Vector3d& q : mesh.vertices) pixels.push_back(pixel(q));
+      FillMesh(cr, mesh, pixels, ui_);
+      continue;
     } else {
       for (const Eigen::Vector3d& q :
            MeshOfCollider(*c, kSegments / 2, Eigen::Vector3d::Zero(), 0.0).vertices) {

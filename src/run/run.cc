@@ -49,8 +49,11 @@ void CheckOutsideColliders(const Chain& chain, const Points& leader_steps,
   const double shortest = chain.lengths.minCoeff();
   const auto depth_text = [](double clearance) { return FormatNumber(-clearance); };
   for (size_t c = 0; c < colliders.size(); ++c) {
-    const std::string name =
+    std::string name =
         "colliders[" + std::to_string(c) + "] (" + ColliderShapeName(colliders[c].shape) + ")";
+    if (colliders[c].margin > 0.0) {
+      name += " grown by the link radius " + FormatNumber(colliders[c].margin);
+    }
     for (Eigen::Index i = 0; i < chain.points.rows(); ++i) {
       const double clearance = QuerySurface(colliders[c], at(chain.points.row(i))).distance;
       if (clearance < -internal::kContactSlack * shortest) {
@@ -240,12 +243,21 @@ void StepDirection(const Points& start, const Points& leader_steps, int64_t s,
   *direction = fallback;
 }
 
+// The options with the colliders grown by the links' radius (RunOptions::link_radius).
+RunOptions WithLinkRadius(const RunOptions& given) {
+  RunOptions options = given;
+  for (Collider& c : options.colliders) c.margin += given.link_radius;
+  return options;
+}
+
 // Run, through the sweep pipeline where `pipeline` and the method has one.
-RunResult RunOn(const Chain& chain, const Points& leader_steps, const RunOptions& options,
+RunResult RunOn(const Chain& chain, const Points& leader_steps, const RunOptions& given,
                 FrameSink* sink, bool pipeline) {
   ValidateChain(chain);
   ValidateLeaderSteps(leader_steps, chain.dim());
-  ThrowIfAny(options.Validate());
+  ThrowIfAny(given.Validate());
+  const RunOptions grown = given.link_radius > 0.0 ? WithLinkRadius(given) : RunOptions();
+  const RunOptions& options = given.link_radius > 0.0 ? grown : given;
   // follow_path keeps every point on the head's path: it measures the clearances (negative where
   // the path enters a collider) rather than requiring them.
   if (!options.colliders.empty() && options.method != Method::kFollowPath) {

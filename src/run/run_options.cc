@@ -58,6 +58,10 @@ Problems RunOptions::Validate() const {
                           std::string("\"") + MethodName(method) + "\"",
                           "\"tractrix\", \"ftl\" or \"follow_path\"");
   }
+  if (!(std::isfinite(link_radius) && link_radius >= 0.0)) {
+    problems.push_back(
+        Problem::Invalid("link_radius", FormatNumber(link_radius), "a finite number >= 0"));
+  }
   if (!colliders.empty() && tolerance > 0.0) {
     problems.emplace_back("tolerance",
                           "accuracy control does not account for colliders; set it to 0 and "

@@ -27,12 +27,12 @@ AnyScenario Read(const std::string& text, const ScenarioReadOptions& options,
   out.kind = internal::KindOf(root);
   switch (out.kind) {
     case ScenarioKind::kChain: {
-      Scenario s = internal::ReadChainScenario(root, &out.problems);
+      Scenario s = internal::ReadChainScenario(root, &out.problems, directory);
       if (out.problems.empty()) out.chain = std::move(s);
       break;
     }
     case ScenarioKind::kGroom: {
-      GroomScenario s = internal::ReadGroomScenario(root, &out.problems);
+      GroomScenario s = internal::ReadGroomScenario(root, &out.problems, directory);
       if (out.problems.empty()) out.groom = std::move(s);
       break;
     }

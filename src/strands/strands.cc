@@ -168,6 +168,8 @@ ColliderBound BoundOf(const Collider& c) {
       b.half_space = true;
       const Eigen::Vector3d up = c.pose.linear().col(2);
       for (int k = 0; k < 3; ++k) b.up[k] = up[k];
+      // The plane raised by the margin.
+      for (int k = 0; k < 3; ++k) b.center[k] += c.margin * up[k];
       break;
     }
     case ColliderShape::kSphere:
@@ -186,7 +188,11 @@ ColliderBound BoundOf(const Collider& c) {
     case ColliderShape::kEllipsoid:
       b.radius = c.extents.maxCoeff();
       break;
+    case ColliderShape::kMesh:  // the ball about its frame's origin that holds every vertex
+      b.radius = c.scale * c.mesh->radius;
+      break;
   }
+  if (!b.half_space) b.radius += c.margin;
   return b;
 }
 
@@ -768,7 +774,7 @@ void StrandBatchImpl::PlaceColliders(const BodyPose* frame_pose) {
       ++count;
       StrandSphere& sphere = spheres[s - 1];
       for (int k = 0; k < 3; ++k) sphere.center[k] = out[j].pose.translation()[k];
-      sphere.radius = out[j].radius;
+      sphere.radius = out[j].radius + out[j].margin;
       sphere.slack = kContactSlack;
     }
     lone_sphere[s - 1] = count == 1;

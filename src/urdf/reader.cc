@@ -193,6 +193,26 @@ urdf::ModelInterfaceSharedPtr Parse(const std::string& text) {
 
 }  // namespace
 
+// The radius of a link's collision geometry: the largest radius of its cylinders and spheres (a
+// link's capsule about its axis), 0 where it has none (boxes and meshes are not read as radii).
+double CollisionRadius(const urdf::LinkConstSharedPtr& link) {
+  double radius = 0.0;
+  if (!link) return radius;
+  std::vector<urdf::CollisionSharedPtr> all = link->collision_array;
+  if (all.empty() && link->collision) all.push_back(link->collision);
+  for (const urdf::CollisionSharedPtr& c : all) {
+    if (!c || !c->geometry) continue;
+    double r = 0.0;
+    if (c->geometry->type == urdf::Geometry::CYLINDER) {
+      r = static_cast<const urdf::Cylinder&>(*c->geometry).radius;
+    } else if (c->geometry->type == urdf::Geometry::SPHERE) {
+      r = static_cast<const urdf::Sphere&>(*c->geometry).radius;
+    }
+    if (std::isfinite(r) && r > radius) radius = r;
+  }
+  return radius;
+}
+
 ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
   const urdf::ModelInterfaceSharedPtr robot = Parse(text);
   auto find = [&](const std::string& name, const char* field) {
@@ -218,12 +238,17 @@ ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
   std::vector<Eigen::Vector3d> origins, axes;
   std::vector<std::string> names;
   std::vector<JointType> types;
-  std::vector<double> lower, upper, speed;
+  std::vector<double> lower, upper, speed, radii;
   bool any_limits = false, any_speed = false;
   for (const urdf::JointConstSharedPtr& joint : ChainJoints(*robot, base, tip)) {
     const std::string field = "joint " + Quote(joint->name);
     pose = pose * Transform(joint->parent_to_joint_origin_transform);
-    if (joint->type == urdf::Joint::FIXED) continue;
+    const double radius = CollisionRadius(robot->getLink(joint->child_link_name));
+    if (joint->type == urdf::Joint::FIXED) {
+      // A fixed joint merges its child into the link of the last movable joint above it.
+      if (!radii.empty()) radii.back() = std::max(radii.back(), radius);
+      continue;
+    }
     if (joint->type == urdf::Joint::FLOATING || joint->type == urdf::Joint::PLANAR) {
       throw InputError(field, std::string("has type ") +
                                   (joint->type == urdf::Joint::FLOATING ? "floating" : "planar") +
@@ -264,6 +289,7 @@ ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
     lower.push_back(lo);
     upper.push_back(hi);
     speed.push_back(v);
+    radii.push_back(radius);
   }
   const int n = static_cast<int>(origins.size());
   if (n == 0) {
@@ -310,6 +336,11 @@ ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
     for (int j = 0; j < n; ++j) model.initial.angle[j] = std::clamp(0.0, lower[j], upper[j]);
   }
   if (any_speed) model.max_velocity = Eigen::Map<Eigen::VectorXd>(speed.data(), n);
+  // Link k+1 (from joint k to the next) is joint k's child link (with what fixed joints merge into
+  // it): its collision cylinder's or sphere's radius. None anywhere: no radii.
+  if (*std::max_element(radii.begin(), radii.end()) > 0.0) {
+    model.link_radii = Eigen::Map<Eigen::VectorXd>(radii.data(), n);
+  }
   // A planar arm: every joint revolute about +z within [-pi, pi] (or continuous), every link of
   // positive length along one direction of the z = 0 plane, and the tool frame the last link's.
   bool planar = std::abs(model.base[2]) == 0.0 &&

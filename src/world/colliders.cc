@@ -7,6 +7,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "world/mesh_collider.h"
+
 namespace flexkin {
 namespace {
 
@@ -253,6 +255,8 @@ const char* ColliderShapeName(ColliderShape shape) {
       return "box";
     case ColliderShape::kHalfSpace:
       return "half_space";
+    case ColliderShape::kMesh:
+      return "mesh";
   }
   return "?";
 }
@@ -279,9 +283,18 @@ SurfaceQuery QuerySurface(const Collider& c, const Vector3d& x) {
     case ColliderShape::kHalfSpace:
       q = HalfSpace(p);
       break;
+    case ColliderShape::kMesh:  // its frame scaled: distances scale with it
+      q = internal::MeshSurface(*c.mesh, p / c.scale);
+      q.distance *= c.scale;
+      q.nearest *= c.scale;
+      break;
   }
   q.nearest = c.pose * q.nearest;
   q.normal = c.pose.linear() * q.normal;
+  if (c.margin != 0.0) {
+    q.distance -= c.margin;
+    q.nearest += c.margin * q.normal;
+  }
   return q;
 }
 
@@ -325,7 +338,16 @@ std::vector<Problem> CheckCollider(const Collider& c, const std::string& field) 
       break;
     case ColliderShape::kHalfSpace:
       break;
+    case ColliderShape::kMesh:
+      positive("scale", c.scale);
+      if (c.mesh == nullptr || c.mesh->bvh == nullptr) {
+        problems.emplace_back(child("mesh"),
+                              "is not set; expected a mesh made by MakeColliderMesh or "
+                              "ReadColliderMeshFile");
+      }
+      break;
   }
+  non_negative("margin", c.margin);
   const Eigen::Matrix3d r = c.pose.linear();
   if (!r.allFinite() || !c.pose.translation().allFinite()) {
     problems.emplace_back(child("pose"), "has a value that is not a finite number");

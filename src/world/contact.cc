@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 
+#include "world/mesh_collider.h"
+
 namespace flexkin::internal {
 namespace {
 
@@ -43,7 +45,7 @@ double SegmentSegmentDistance(const Vector3d& p, const Vector3d& q, const Vector
 }
 
 // The minimum of the signed distance along [a, b] by golden-section search (the function is
-// convex), with the ends.
+// convex), with the ends (the collider's margin included).
 double ConvexMinimumAlong(const Collider& c, const Vector3d& a, const Vector3d& b) {
   const auto f = [&](double t) { return QuerySurface(c, a + t * (b - a)).distance; };
   constexpr double kInvPhi = 0.6180339887498949;
@@ -76,21 +78,27 @@ double SegmentClearance(const Collider& c, const Vector3d& a, const Vector3d& b)
       const Vector3d center = c.pose.translation(), ab = b - a;
       const double ab2 = ab.squaredNorm();
       const double t = ab2 > 0.0 ? std::clamp((center - a).dot(ab) / ab2, 0.0, 1.0) : 0.0;
-      return (a + t * ab - center).norm() - c.radius;
+      return (a + t * ab - center).norm() - (c.radius + c.margin);
     }
     case ColliderShape::kCapsule: {
       const Vector3d axis = c.pose.linear().col(2) * c.half_length;
       const Vector3d center = c.pose.translation();
-      return SegmentSegmentDistance(a, b, center - axis, center + axis) - c.radius;
+      return SegmentSegmentDistance(a, b, center - axis, center + axis) - (c.radius + c.margin);
     }
     case ColliderShape::kHalfSpace: {
       const Vector3d up = c.pose.linear().col(2), origin = c.pose.translation();
-      return std::min(up.dot(a - origin), up.dot(b - origin));
+      return std::min(up.dot(a - origin), up.dot(b - origin)) - c.margin;
     }
     case ColliderShape::kEllipsoid:
     case ColliderShape::kCylinder:
     case ColliderShape::kBox:
-      return ConvexMinimumAlong(c, a, b);
+      return ConvexMinimumAlong(c, a, b);  // the margin is in QuerySurface's distances
+    case ColliderShape::kMesh: {           // not convex: world/mesh_collider.h, in the mesh's frame
+      const Eigen::Isometry3d to_local = c.pose.inverse(Eigen::Isometry);
+      return c.scale *
+                 MeshSegmentClearance(*c.mesh, to_local * a / c.scale, to_local * b / c.scale) -
+             c.margin;
+    }
   }
   return 0.0;
 }
@@ -103,6 +111,10 @@ double SegmentClearance(const std::vector<Collider>& colliders, const Vector3d& 
 }
 
 namespace {
+
+// The finest angle step of the march past a mesh (radians): at most about 3,000 steps round a
+// half circle, whatever the mesh's detail.
+constexpr double kMeshLeastStep = 1e-3;
 
 // The directions from the head: d(theta, psi) = cos(theta) d0 + sin(theta) (cos(psi) e1 +
 // sin(psi) e2), theta the angle from d0 (the direction of the old tail).
@@ -117,11 +129,38 @@ class TailSearch {
  public:
   TailSearch(const Vector3d& head, double length, const std::vector<Collider>& colliders,
              const Directions& dirs)
-      : head_(head), length_(length), colliders_(colliders), dirs_(dirs) {}
+      : head_(head), length_(length), colliders_(colliders), dirs_(dirs) {
+    // A mesh may block the half circle again after another collider is passed.
+    for (const Collider& c : colliders) {
+      if (c.shape == ColliderShape::kMesh) rounds_ = std::numeric_limits<size_t>::max() - 1;
+    }
+    // What a link may lie inside each convex collider: the slack, or, where the rounding of an
+    // earlier contact step left the head itself inside by a hair more, twice the head's depth,
+    // so that the directions leading out of the collider are not held against the link.
+    allowed_.reserve(colliders.size());
+    for (const Collider& c : colliders) {
+      double allowed = -kContactSlack * length;
+      if (c.shape != ColliderShape::kMesh) {
+        const double depth =
+            std::fmin(QuerySurface(c, head).distance, SegmentClearance(c, head, head));
+        if (depth > -1e-9 * length) allowed = std::fmin(allowed, 2.0 * depth);
+      }
+      allowed_.push_back(allowed);
+    }
+  }
 
   Vector3d Tail(double theta, double psi) const { return head_ + length_ * dirs_.At(theta, psi); }
   bool Blocks(const Collider& c, double theta, double psi) const {
-    return SegmentClearance(c, head_, Tail(theta, psi)) < -kContactSlack * length_;
+    if (c.shape == ColliderShape::kMesh) {
+      // The head is outside: the crossings say it. Its depths are sampled (midpoints, the end)
+      // where SegmentClearance samples others: a quarter of the slack keeps what this test lets
+      // through within the slack as SegmentClearance measures it.
+      const Eigen::Isometry3d to_local = c.pose.inverse(Eigen::Isometry);
+      return MeshSegmentEnters(*c.mesh, to_local * head_ / c.scale,
+                               to_local * Tail(theta, psi) / c.scale,
+                               (c.margin - 0.25 * kContactSlack * length_) / c.scale);
+    }
+    return SegmentClearance(c, head_, Tail(theta, psi)) < allowed_[&c - colliders_.data()];
   }
 
   // The least angle theta along the half great circle psi at which no collider blocks the link
@@ -131,7 +170,7 @@ class TailSearch {
   // another, each by bisection to the last bit, at most once each.
   double ExitAngle(double psi) const {
     double theta = 0.0;
-    for (size_t round = 0; round <= colliders_.size(); ++round) {
+    for (size_t round = 0; round <= rounds_; ++round) {
       const Collider* blocking = nullptr;
       for (const Collider& c : colliders_) {
         if (Blocks(c, theta, psi)) {
@@ -141,7 +180,30 @@ class TailSearch {
       }
       if (blocking == nullptr) return theta;
       double lo = theta, hi = M_PI;
-      if (Blocks(*blocking, hi, psi)) return std::numeric_limits<double>::infinity();
+      if (blocking->shape == ColliderShape::kMesh) {
+        // Not convex: along the half circle it may block several arcs. Marched from theta in
+        // steps finer than its features seen from the head to the first direction it leaves
+        // free, then bisected back (docs/colliders.md, "Meshes").
+        const double step = std::clamp(0.5 * blocking->mesh->feature * blocking->scale / length_,
+                                       kMeshLeastStep, M_PI / 32.0);
+        for (;;) {
+          hi = std::min(M_PI, lo + step);
+          if (!Blocks(*blocking, hi, psi)) break;
+          if (hi >= M_PI) return std::numeric_limits<double>::infinity();
+          lo = hi;
+        }
+      } else if (Blocks(*blocking, hi, psi)) {
+        // The opposite direction blocked too: a head on the surface (to the rounding) whose old
+        // direction and its opposite both graze it, within the slack. The blocked set is then
+        // the surface's tangent half-space of directions, and the half circle leaves it between
+        // its ends: the first of a few samples that is free brackets the exit.
+        bool free = false;
+        for (int k = 1; k < 8 && !free; ++k) {
+          hi = theta + k * (M_PI - theta) / 8.0;
+          free = !Blocks(*blocking, hi, psi);
+        }
+        if (!free) return std::numeric_limits<double>::infinity();
+      }
       for (;;) {
         const double mid = 0.5 * (lo + hi);
         if (mid <= lo || mid >= hi) break;
@@ -157,6 +219,8 @@ class TailSearch {
   const double length_;
   const std::vector<Collider>& colliders_;
   const Directions& dirs_;
+  size_t rounds_ = colliders_.size();  // each convex collider is passed at most once
+  std::vector<double> allowed_;        // per collider: the least clearance a link may have
 };
 
 // The least exit angle near *psi (a sample no larger than its neighbours kStep away, whose exit
@@ -207,7 +271,7 @@ void RefineExit(const TailSearch& search, double step, double* psi, double* thet
 bool SphereExit(int dim, const Collider& sphere, const Vector3d& head, const Vector3d& d0,
                 double length, double widen, Vector3d* x) {
   const Vector3d to_center = sphere.pose.translation() - head;
-  const double distance = to_center.norm(), r = sphere.radius;
+  const double distance = to_center.norm(), r = sphere.radius + sphere.margin;
   // A head on the surface (a contact step put it there, to the last bits, or a root): the cone
   // is the half-space of directions into the sphere; its boundary, the tangent plane.
   if (!(distance > r) && (r - distance > kContactSlack * length || !(distance > 0.0))) {

@@ -16,7 +16,8 @@ constexpr double kContactSlack = 1e-13;
 // The least signed distance of any point of the segment [a, b] to `collider` (negative: the
 // segment enters it, by that depth). Closed form for the sphere, capsule and half-space; for the
 // others, the minimum of the signed distance along the segment (a convex function: the collider is
-// convex) by golden-section search to the last bits of the parameter.
+// convex) by golden-section search to the last bits of the parameter; a mesh, not convex, by its
+// distance and crossings (world/mesh_collider.h).
 double SegmentClearance(const Collider& collider, const Eigen::Vector3d& a,
                         const Eigen::Vector3d& b);
 

@@ -1,0 +1,35 @@
+#pragma once
+// Closed triangle meshes as colliders (docs/colliders.md, "Meshes"): where a point and a segment
+// stand with respect to the solid a mesh bounds. FCL's bounding volume hierarchy (OBBRSS, built
+// once per mesh) prunes the triangles; the distances to the triangles left are computed here in
+// closed form, and the side by the angle-weighted pseudo-normal of the nearest feature (a face,
+// an edge or a vertex), which is exact for a closed, consistently oriented mesh (J. A. Baerentzen
+// and H. Aanaes, "Signed distance computation using the angle weighted pseudonormal", IEEE TVCG
+// 2005). Everything here is in the mesh's own frame, before the collider's scale.
+
+#include <Eigen/Core>
+
+#include "flexkin/colliders.h"
+
+namespace flexkin::internal {
+
+// The point `p` (the mesh's frame, unscaled) with respect to the mesh's surface: signed distance
+// (negative inside), nearest point of the surface, outward normal.
+SurfaceQuery MeshSurface(const ColliderMeshData& mesh, const Eigen::Vector3d& p);
+
+// The least signed distance of the segment [a, b] (the mesh's frame, unscaled) to the solid: the
+// distance between the segment and the surface where the segment is outside; negative where any
+// part of it is inside, by at least the depth of its deepest point among the midpoints of its
+// parts between crossings of the surface and its ends (the sign is exact, the depth a lower
+// bound).
+double MeshSegmentClearance(const ColliderMeshData& mesh, const Eigen::Vector3d& a,
+                            const Eigen::Vector3d& b);
+
+// Whether the least signed distance of [a, b] is below `threshold` (the mesh's frame, unscaled),
+// for `a` outside the solid or on its surface (the contact step's head): the contact search's
+// test, which needs no distance, only the crossings (threshold <= 0) or the first triangle
+// nearer than the threshold (> 0).
+bool MeshSegmentEnters(const ColliderMeshData& mesh, const Eigen::Vector3d& a,
+                       const Eigen::Vector3d& b, double threshold);
+
+}  // namespace flexkin::internal
