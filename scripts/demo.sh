@@ -51,8 +51,9 @@ mkdir -p out/groom_head_readme
 # tips, and every link's length.
 /usr/bin/python3 examples/python/hair_numpy.py out/groom_head.npz
 echo "== colliders (docs/colliders.md): a rope round a post, a thick rope across a floor and round"
-echo "   a post, a snake threading 20 pegs (follow_path and tractrix)"
-for name in rope_round_post rope_post_floor snake_pegs snake_pegs_tractrix; do
+echo "   a post, a rope pushed aside by a passing ball (a keyframed collider), a snake threading"
+echo "   20 pegs (follow_path and tractrix)"
+for name in rope_round_post rope_post_floor rope_swept snake_pegs snake_pegs_tractrix; do
   "$flexkin" run "examples/$name.json" -o "out/$name.json"
   "$flexkin" render "out/$name.json" -o out --formats png,mp4,html --quiet
 done

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "collider_test_util.h"
 #include "contact_peer.h"
 #include "flexkin/colliders.h"
 #include "flexkin/curves.h"
@@ -24,15 +25,8 @@
 namespace flexkin {
 namespace {
 
+using collider_test::Sphere;
 using Eigen::Vector3d;
-
-Collider Sphere(const Vector3d& center, double radius) {
-  Collider c;
-  c.shape = ColliderShape::kSphere;
-  c.pose.translation() = center;
-  c.radius = radius;
-  return c;
-}
 
 // A random unit vector (3D), or one in the plane z = 0 (2D).
 Vector3d RandomDirection(int dim, std::mt19937* rng) {

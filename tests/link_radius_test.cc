@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "collider_test_util.h"
 #include "flexkin/chain.h"
 #include "flexkin/colliders.h"
 #include "flexkin/error.h"
@@ -20,32 +21,12 @@
 namespace flexkin {
 namespace {
 
+using collider_test::At;
+using collider_test::Box;
+using collider_test::Capsule;
+using collider_test::SampledDistance;
+using collider_test::Sphere;
 using Eigen::Vector3d;
-
-Collider Sphere(const Vector3d& center, double radius) {
-  Collider c;
-  c.shape = ColliderShape::kSphere;
-  c.pose.translation() = center;
-  c.radius = radius;
-  return c;
-}
-
-Collider Capsule(const Vector3d& center, double radius, double half_length) {
-  Collider c;
-  c.shape = ColliderShape::kCapsule;
-  c.pose.translation() = center;
-  c.radius = radius;
-  c.half_length = half_length;
-  return c;
-}
-
-Collider Box(const Vector3d& center, const Vector3d& half) {
-  Collider c;
-  c.shape = ColliderShape::kBox;
-  c.pose.translation() = center;
-  c.extents = half;
-  return c;
-}
 
 // A rope of `links` links of total length 2 hanging along -y from the origin (2D) or along -y in
 // the plane z = `z` (3D), its leading end pulled up to y = 2 and then along -x: the rope behind
@@ -70,22 +51,6 @@ Scene Corner(int dim, int links, double z = 0.0) {
     if (dim == 3) s.path(k, 2) = z;
   }
   return s;
-}
-
-Vector3d At(const Points& p, Eigen::Index i) {
-  return Vector3d(p(i, 0), p(i, 1), p.cols() == 3 ? p(i, 2) : 0.0);
-}
-
-// Least distance of the link [a, b] to the collider as given (no margin), by sampling QuerySurface
-// along it: independent of the segment clearances the run uses.
-double SampledDistance(const Collider& c, const Vector3d& a, const Vector3d& b,
-                       int samples = 2000) {
-  double least = std::numeric_limits<double>::infinity();
-  for (int i = 0; i <= samples; ++i) {
-    least = std::fmin(least,
-                      QuerySurface(c, a + (static_cast<double>(i) / samples) * (b - a)).distance);
-  }
-  return least;
 }
 
 TEST(LinkRadiusTest, AGrownSphereOrCapsuleIsTheLargerOneBitForBit) {

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <nlohmann/json.hpp>
@@ -394,6 +395,87 @@ TEST(ResultColliders, ViewerHoldsTheColliders) {
   // Without colliders the page has no "colliders" key.
   WriteViewerHtml(SmallScene(2), ViewerOptions(), dir.Path("plain.html"));
   EXPECT_EQ(ReadFile(dir.Path("plain.html")).find("\"colliders\":"), std::string::npos);
+}
+
+// A keyframed collider (docs/colliders.md, "Moving colliders") in everything that shows a run:
+// the result file carries its motion (read back, the same solid at every time), glTF animates its
+// node (each frame's vertices on the collider where its motion has it at that frame's step), and
+// the viewer's page carries each frame's move.
+TEST(ResultColliders, AKeyframedColliderMovesInTheFileGltfAndViewer) {
+  TempDir dir;
+  ResultFile file = SmallScene(3);
+  std::vector<Collider> colliders = Colliders(R"([
+    {"shape": "box", "center": [3, 0.5, 1], "half_extents": [0.4, 0.2, 0.3],
+     "motion": {"interpolation": "linear", "keyframes": [
+       {"time": 1, "translation": [0, 0, 0]},
+       {"time": 5, "translation": [-1, 2, 0.5],
+        "rotation": {"axis": [1, 1, 0], "angle_deg": 70}}]}}])",
+                                              3);
+  ASSERT_EQ(colliders.size(), 1u);
+  ASSERT_NE(colliders[0].motion, nullptr);
+  EXPECT_EQ(colliders[0].motion->keyframes.size(), 2u);
+  file.colliders = colliders;
+  for (const char* name : {"m.json", "m.npz"}) {
+    const std::string path = dir.Path(name);
+    WriteResultFile(file, path, ResultFileFormatOfPath(path));
+    const ResultFile back = ReadResultFile(path);
+    ASSERT_EQ(back.colliders.size(), 1u);
+    ASSERT_NE(back.colliders[0].motion, nullptr) << name;
+    for (const double t : {0.0, 1.0, 2.5, 4.0, 5.0, 6.0}) {
+      ExpectSameColliders({ColliderAt(colliders[0], t)}, {ColliderAt(back.colliders[0], t)}, 3);
+    }
+  }
+
+  WriteGltf(file, GltfOptions(), dir.Path("m.glb"));
+  const Glb glb = ReadGlb(dir.Path("m.glb"));
+  const nlohmann::json& nodes = glb.json["nodes"];
+  int node = -1;
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    if (nodes[i]["name"] == "collider_0") node = static_cast<int>(i);
+  }
+  ASSERT_GE(node, 0);
+  const auto floats = [&](int accessor_index, int components) {
+    const nlohmann::json& accessor = glb.json["accessors"][accessor_index];
+    const nlohmann::json& view = glb.json["bufferViews"][accessor["bufferView"].get<int>()];
+    const size_t offset = view.value("byteOffset", 0) + accessor.value("byteOffset", 0);
+    std::vector<float> values(accessor["count"].get<size_t>() * components);
+    std::memcpy(values.data(), glb.bin.data() + offset, 4 * values.size());
+    return values;
+  };
+  std::vector<float> translation, rotation;
+  for (const nlohmann::json& channel : glb.json["animations"][0]["channels"]) {
+    if (channel["target"]["node"] != node) continue;
+    const nlohmann::json& sampler =
+        glb.json["animations"][0]["samplers"][channel["sampler"].get<int>()];
+    if (channel["target"]["path"] == "translation") translation = floats(sampler["output"], 3);
+    if (channel["target"]["path"] == "rotation") rotation = floats(sampler["output"], 4);
+  }
+  const size_t frames = file.result.frames.size();
+  ASSERT_EQ(translation.size(), 3 * frames);
+  ASSERT_EQ(rotation.size(), 4 * frames);
+  const nlohmann::json& primitive =
+      glb.json["meshes"][nodes[node]["mesh"].get<int>()]["primitives"][0];
+  const std::vector<float> vertices = floats(primitive["attributes"]["POSITION"], 3);
+  double worst = 0.0;
+  for (size_t f = 0; f < frames; ++f) {
+    const Eigen::Quaterniond q(rotation[4 * f + 3], rotation[4 * f], rotation[4 * f + 1],
+                               rotation[4 * f + 2]);
+    const Eigen::Vector3d t(translation[3 * f], translation[3 * f + 1], translation[3 * f + 2]);
+    const Collider at = ColliderAt(colliders[0], double(file.result.frames[f].step));
+    for (size_t v = 0; v < vertices.size(); v += 3) {
+      const Eigen::Vector3d x(vertices[v], vertices[v + 1], vertices[v + 2]);
+      worst = std::max(worst, std::abs(QuerySurface(at, q.normalized() * x + t).distance));
+    }
+  }
+  EXPECT_LT(worst, 1e-5);
+
+  WriteViewerHtml(file, ViewerOptions(), dir.Path("m.html"));
+  const std::string page = ReadFile(dir.Path("m.html"));
+  const size_t moves = page.find("\"moves\":[");
+  ASSERT_NE(moves, std::string::npos);
+  const std::string list = page.substr(moves + 9, page.find(']', moves) - moves - 9);
+  EXPECT_EQ(std::count(list.begin(), list.end(), ',') + 1, static_cast<long>(12 * frames));
+  EXPECT_NE(page.find("movingColliders"), std::string::npos);
 }
 
 // The one call that draws a file: every format of a chain result takes the colliders.

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "collider_test_util.h"
 #include "flexkin/groom.h"
 #include "flexkin/run.h"
 #include "flexkin/strands.h"
@@ -17,6 +18,8 @@
 namespace flexkin {
 namespace {
 
+using collider_test::CapsuleBetween;
+using collider_test::Sphere;
 using Eigen::Vector3d;
 
 // Strands lying close over the unit sphere (circle in 2D): each link turns a little away from
@@ -57,24 +60,6 @@ BodyPose TurningPose(int frame, int dim) {
   return BodyPose::FromQuaternion(std::cos(angle / 2), std::sin(angle / 2) * axis[0],
                                   std::sin(angle / 2) * axis[1], std::sin(angle / 2) * axis[2],
                                   Vector3d(0.05 * std::sin(0.5 * t), 0.0, 0.0));
-}
-
-Collider Sphere(const Vector3d& center, double radius) {
-  Collider c;
-  c.shape = ColliderShape::kSphere;
-  c.pose.translation() = center;
-  c.radius = radius;
-  return c;
-}
-
-Collider Capsule(const Vector3d& from, const Vector3d& to, double radius) {
-  Collider c;
-  c.shape = ColliderShape::kCapsule;
-  c.pose.translation() = 0.5 * (from + to);
-  c.pose.linear() = Eigen::Quaterniond::FromTwoVectors(Vector3d::UnitZ(), to - from).matrix();
-  c.half_length = 0.5 * (to - from).norm();
-  c.radius = radius;
-  return c;
 }
 
 Vector3d At(const Points& p, int i) {
@@ -157,7 +142,8 @@ TEST_P(StrandColliders, NothingEntersTheBodyAndLengthsAreKept) {
   options.threads = 2;
   options.body_colliders = {Sphere(Vector3d::Zero(), 1.0)};
   if (c.dim == 3) {
-    options.body_colliders.push_back(Capsule(Vector3d(0, 0, -0.95), Vector3d(0, 0, -1.8), 0.35));
+    options.body_colliders.push_back(
+        CapsuleBetween(Vector3d(0, 0, -0.95), Vector3d(0, 0, -1.8), 0.35));
   }
   StrandBatch batch(strands, options);
   StrandBatch free(strands, [&] {
@@ -211,7 +197,7 @@ TEST(StrandCollidersTest, FarCollidersChangeNoBit) {
       StrandBatch plain(strands, options);
       options.colliders = {Sphere(Vector3d(50, 0, 0), 1.0)};
       if (substeps == 1) {
-        options.body_colliders = {Capsule(Vector3d(0, 0, -40), Vector3d(0, 0, -60), 1.0)};
+        options.body_colliders = {CapsuleBetween(Vector3d(0, 0, -40), Vector3d(0, 0, -60), 1.0)};
       }
       StrandBatch with(strands, options);
       if (!internal::SetStrandEngine(&plain, engine)) continue;

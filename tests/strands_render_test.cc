@@ -19,6 +19,7 @@
 #include "flexkin/strands.h"
 #include "render/canvas.h"
 #include "render/strands_scene.h"
+#include "render/style.h"
 #include "render_test_util.h"
 
 namespace flexkin {
@@ -35,7 +36,8 @@ using test_util::ReadFile;
 // growing out of its upper part; over `frames` frames it turns 50 degrees about z, then nods 25
 // degrees about y (2D: turns about z and back). Written with StrandFileWriter.
 void WriteHairFile(const std::string& path, int num_strands, int links, int frames, int dim = 3,
-                   bool scalp = true, double link_length = 0.012) {
+                   bool scalp = true, double link_length = 0.012,
+                   const std::vector<Collider>& body_colliders = {}) {
   constexpr double kRadius = 0.1;
   std::vector<Points> strands;
   StrandFileHeader header;
@@ -67,6 +69,7 @@ void WriteHairFile(const std::string& path, int num_strands, int links, int fram
     header.scalp.shape = "sphere";
     header.scalp.radii = Eigen::Vector3d::Constant(kRadius);
   }
+  header.body_colliders = body_colliders;
   StrandBatch batch(strands);
   StrandFileWriter writer(path, header);
   for (int f = 0; f < frames; ++f) {
@@ -219,6 +222,53 @@ TEST_F(StrandsRenderTest, NoScalpWithoutOne) {
   const Image bare = ReadPng(dir_.Path("bare.png")), scalp = ReadPng(dir_.Path("f.png"));
   EXPECT_GT(ScalpPixels(scalp), 10 * ScalpPixels(bare));  // antialiased strands: a few
   EXPECT_GT(StrandPixels(bare), 2000);
+}
+
+// Pixels of the colliders' fill (render::kColliderFill, to antialiasing's rounding).
+int ColliderPixels(const Image& image) {
+  const render::Rgb want = render::kColliderFill;
+  int count = 0;
+  for (const uint32_t p : image.pixels) {
+    const int r = p >> 16 & 255, g = p >> 8 & 255, b = p & 255;
+    if (std::abs(r - std::lround(255 * want.r)) <= 2 &&
+        std::abs(g - std::lround(255 * want.g)) <= 2 &&
+        std::abs(b - std::lround(255 * want.b)) <= 2) {
+      ++count;
+    }
+  }
+  return count;
+}
+
+// A groom's colliders other than the scalp (a neck capsule under the head, moving with it) are
+// drawn, in the colliders' grey; the scalp's own collider is not drawn twice.
+TEST_F(StrandsRenderTest, TheNeckAndOtherCollidersAreDrawn) {
+  Collider scalp;
+  scalp.shape = ColliderShape::kSphere;
+  scalp.radius = 0.1;
+  Collider neck;
+  neck.shape = ColliderShape::kCapsule;
+  neck.radius = 0.045;
+  neck.half_length = 0.06;
+  neck.pose.translation() = Eigen::Vector3d(0.0, 0.0, -0.17);
+  for (const int dim : {2, 3}) {
+    // In 2D the neck lies in the plane: its axis along y (the 3D one is along z).
+    neck.pose.linear() = dim == 2 ? Eigen::AngleAxisd(-M_PI / 2, Eigen::Vector3d::UnitX()).matrix()
+                                  : Eigen::Matrix3d::Identity();
+    neck.pose.translation() =
+        dim == 2 ? Eigen::Vector3d(0.0, -0.17, 0.0) : Eigen::Vector3d(0.0, 0.0, -0.17);
+    WriteHairFile(dir_.Path("neck.npz"), 150, 8, 21, dim, true, 0.012, {scalp, neck});
+    WriteHairFile(dir_.Path("bare.npz"), 150, 8, 21, dim, true, 0.012, {scalp});
+    StrandsRenderOptions options;
+    options.panels = 1;
+    Snapshot("neck.png", options, dir_.Path("neck.npz"));
+    Snapshot("bare.png", options, dir_.Path("bare.npz"));
+    const Image with = ReadPng(dir_.Path("neck.png")), without = ReadPng(dir_.Path("bare.png"));
+    SCOPED_TRACE(std::to_string(dim) + "D");
+    EXPECT_LT(ColliderPixels(without), 50);  // the scalp is shaded, not filled grey
+    EXPECT_GT(ColliderPixels(with), 1000);
+    // The figure grows to hold the neck: its height in the picture is not clipped.
+    EXPECT_GT(ScalpPixels(with), 500);
+  }
 }
 
 // One strand of 6 links from the sphere's surface along `direction` (pointing at the viewer of

@@ -40,7 +40,8 @@ using test_util::ReadFile;
 // circle (2D), swaying over `frames` frames while the body turns and moves a little. Every link
 // is a unit direction times its length, so the lengths are exact.
 void MakeStrandFile(const std::string& path, int dim, int strands, int links, int frames,
-                    bool float32 = true, const std::string& name = "swaying strands") {
+                    bool float32 = true, const std::string& name = "swaying strands",
+                    const std::vector<Collider>& body_colliders = {}) {
   StrandFileHeader h;
   h.name = name;
   h.description = "synthetic strands for the viewer test";
@@ -50,6 +51,7 @@ void MakeStrandFile(const std::string& path, int dim, int strands, int links, in
   h.fps = 30.0;
   h.scalp.shape = dim == 3 ? "sphere" : "";
   h.scalp.radii = Eigen::Vector3d::Constant(1.0);
+  h.body_colliders = body_colliders;
   for (int s = 0; s <= strands; ++s) h.offsets.push_back(static_cast<int64_t>(s) * (links + 1));
   h.link_lengths =
       Eigen::VectorXd::Constant(static_cast<Eigen::Index>(strands) * links, 1.2 / links);
@@ -434,6 +436,17 @@ TEST_F(StrandsViewerTest, PlaysTenThousandStrandsInHeadlessChromium) {
     StrandFileReader reader(Path("small_2d.npz"));
     WriteStrandsViewerHtml(&reader, options, Path("small_2d.html"));
   }
+  // A neck under the head (a capsule moving with the body), drawn by both renderers.
+  Collider neck;
+  neck.shape = ColliderShape::kCapsule;
+  neck.radius = 0.4;
+  neck.half_length = 0.5;
+  neck.pose.translation() = Eigen::Vector3d(0.0, 0.0, -1.4);
+  MakeStrandFile(Path("neck_3d.npz"), 3, 300, 12, 30, true, "strands over a neck", {neck});
+  {
+    StrandFileReader reader(Path("neck_3d.npz"));
+    WriteStrandsViewerHtml(&reader, options, Path("neck_3d.html"));
+  }
   // The size that must play smoothly: 10,000 strands of 32 links.
   MakeStrandFile(Path("hair.npz"), 3, 10000, 32, 40);
   {
@@ -463,7 +476,7 @@ TEST_F(StrandsViewerTest, PlaysTenThousandStrandsInHeadlessChromium) {
   std::string output;
   const int status = RunCommand("node '" + source + "/tests/viewer/strands_browser_check.mjs' '" +
                                     tools + "' '" + dir_ + "' '" + Path("small_2d.html") + "' '" +
-                                    Path("hair_10000x32.html") + "'",
+                                    Path("neck_3d.html") + "' '" + Path("hair_10000x32.html") + "'",
                                 &output);
   std::printf("%s", output.c_str());
   EXPECT_EQ(status, 0) << output;

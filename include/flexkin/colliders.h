@@ -44,6 +44,48 @@ struct ColliderMeshData {
   std::shared_ptr<const internal::MeshBvh> bvh;
 };
 
+// A rigid pose: x -> rotation x + translation (a groom's body, a moving collider's frame). In 2D
+// the top-left 2x2 block of `rotation` and the first two components of `translation` are used.
+// `rotation` must be a rotation (orthonormal, determinant +1) to within 1e-9.
+struct BodyPose {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+  // From a unit quaternion (w, x, y, z) (normalized here; it must not be zero) and a translation.
+  static BodyPose FromQuaternion(double w, double x, double y, double z,
+                                 const Eigen::Vector3d& translation);
+  // A planar pose: rotation by `angle` (radians) about z, then the translation (tx, ty).
+  static BodyPose Planar(double angle, double tx, double ty);
+};
+
+// A keyframe of a rigid motion (a groom's body: time in seconds; a chain scenario's collider:
+// time in leader steps).
+struct BodyKeyframe {
+  double time = 0.0;  // strictly increasing over the keyframes
+  BodyPose pose;
+};
+
+// How a rigid motion passes between keyframes: the translation interpolated linearly and the
+// rotation by slerp (the shorter arc), in the parameter u of the segment (kLinear) or
+// 3u^2 - 2u^3 (kSmooth: at rest at every keyframe).
+enum class KeyframeInterpolation { kLinear, kSmooth };
+
+// The pose at `time` of the motion through `keyframes` (times strictly increasing): a keyframe's
+// own pose at its time (and within 1e-12 of a segment from it), the first keyframe's before it,
+// the last's after it, else interpolated as `interpolation` says. No keyframes: the identity.
+// A part that does not change between two keyframes stays exactly as it is.
+BodyPose InterpolateKeyframes(const std::vector<BodyKeyframe>& keyframes,
+                              KeyframeInterpolation interpolation, double time);
+
+// A keyframed collider's motion (docs/colliders.md, "Moving colliders"): at time t the collider's
+// own frame (its `pose`) is carried by the pose of the keyframes at t. In a chain run, time is
+// counted in leader steps: frame s (after s leader steps) is at time s, sub-step j of m of leader
+// step s (1-based) at s - 1 + j / m.
+struct ColliderMotion {
+  std::vector<BodyKeyframe> keyframes;  // at least 1
+  KeyframeInterpolation interpolation = KeyframeInterpolation::kSmooth;
+};
+
 // A collider: its shape in its own frame, placed in the world by `pose` (a rotation and a
 // translation; world = pose * local).
 struct Collider {
@@ -61,7 +103,20 @@ struct Collider {
   // kMesh: the mesh in its own frame, scaled by `scale` (> 0) about that frame's origin.
   std::shared_ptr<const ColliderMeshData> mesh;
   double scale = 1.0;
+  // Keyframed colliders: the motion that carries `pose` (null: the collider stays where it is).
+  // Copies share it.
+  std::shared_ptr<const ColliderMotion> motion;
 };
+
+// `collider` at `time`: its pose carried by its motion's pose at `time` (motion pose * pose),
+// without the motion; a collider without motion is returned as it is.
+Collider ColliderAt(const Collider& collider, double time);
+
+// Whether any of `colliders` has a motion.
+bool AnyMoves(const std::vector<Collider>& colliders);
+
+// Every one of `colliders` at `time` (ColliderAt).
+std::vector<Collider> CollidersAt(const std::vector<Collider>& colliders, double time);
 
 // Where a point stands with respect to a collider's surface.
 struct SurfaceQuery {
@@ -79,7 +134,9 @@ SurfaceQuery QuerySurface(const Collider& collider, const Eigen::Vector3d& x);
 // The problems of a collider, fields named under `field` (e.g. "/colliders/2"): a radius, length
 // or extent that is not finite and positive (half_length may be 0: a capsule that is a sphere, a
 // cylinder that is a disc is refused), a margin that is not finite and >= 0, a pose that is not a
-// rotation and a finite translation.
+// rotation and a finite translation; a motion without keyframes, with times that are not finite
+// and strictly increasing, or with a keyframe pose that is not a rotation and a finite
+// translation ("field.motion.keyframes[k]...").
 std::vector<Problem> CheckCollider(const Collider& collider, const std::string& field);
 
 // A mesh collider's data from its vertices (#V by 3) and triangles (#F by 3, indices into

@@ -51,14 +51,6 @@ std::vector<Points> GrowStrands(const GrowSpec& spec);
 // exceed kMaxGroomPoints.
 Problems ValidateGrowSpec(const GrowSpec& spec);
 
-// A keyframe of the body's motion.
-struct BodyKeyframe {
-  double time = 0.0;  // seconds, strictly increasing over the keyframes
-  BodyPose pose;
-};
-
-enum class KeyframeInterpolation { kLinear, kSmooth };
-
 struct BodyMotion {
   std::vector<BodyKeyframe> keyframes;  // at least 1
   double fps = 30.0;                    // frames per second, > 0

@@ -39,6 +39,15 @@ Problems ValidateScenarioText(const std::string& json_text);
 Scenario LoadScenarioFile(const std::string& path);
 Problems ValidateScenarioFile(const std::string& path);
 
+// Colliders from the JSON text of an array in the form of a scenario's "colliders"
+// (docs/scenario-format.md), in `dim` dimensions (0: the length of the first collider's "center",
+// "from", "point" or "position", 3 for none); a mesh's relative "file" is read from the working
+// directory. Throws InputError naming the first problem by JSON pointer ("/colliders/1/radius").
+std::vector<Collider> ParseCollidersText(const std::string& json_text, int dim = 0);
+// The JSON text of `colliders` in that form, in `dim` dimensions (io's writer; every collider
+// must be one the form can say in `dim`: InputError otherwise).
+std::string CollidersText(const std::vector<Collider>& colliders, int dim);
+
 // Where a RunOptions member is set: in a scenario file and on the command line. The one map from
 // the fields of RunOptions::Validate's problems to the places a user wrote them.
 struct OptionLocation {

@@ -83,26 +83,12 @@ struct StrandInside {
   double depth = 0.0;     // how far inside
   double relative = 0.0;  // depth / the link's length
 };
-struct BodyPose;
+
 // The first free point or link of `strands` (at the body pose `rest`, body colliders placed at
 // it) that lies inside a collider of `options` by more than 1e-13 of its link's length; none if
 // every strand starts outside. StrandBatch refuses such a start.
 std::optional<StrandInside> FindStrandInside(const std::vector<Points>& strands,
                                              const StrandOptions& options, const BodyPose& rest);
-
-// The pose of the body the strands grow from: x -> rotation x + translation. In 2D the top-left
-// 2x2 block of `rotation` and the first two components of `translation` are used. `rotation`
-// must be a rotation (orthonormal, determinant +1) to within 1e-9.
-struct BodyPose {
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
-
-  // From a unit quaternion (w, x, y, z) (normalized here; it must not be zero) and a translation.
-  static BodyPose FromQuaternion(double w, double x, double y, double z,
-                                 const Eigen::Vector3d& translation);
-  // A planar pose: rotation by `angle` (radians) about z, then the translation (tx, ty).
-  static BodyPose Planar(double angle, double tx, double ty);
-};
 
 namespace internal {
 struct StrandBatchImpl;

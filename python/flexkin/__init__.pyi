@@ -54,10 +54,12 @@ class RunOptions:
     max_substeps: int
     link_angles: bool
     link_radius: float
+    colliders: List[Dict[str, Any]]
     overall: OverallOptions
     def __init__(self, *, method: str = "tractrix", substeps: int = 1, record_every: int = 1,
                  tolerance: float = 0.0, max_substeps: int = 65536, link_angles: bool = True,
-                 overall: OverallArg = None) -> None: ...
+                 overall: OverallArg = None, colliders: Optional[Sequence[Dict[str, Any]]] = None,
+                 link_radius: float = 0.0) -> None: ...
     def validate(self) -> None: ...
 
 class Metrics:
@@ -239,6 +241,7 @@ def overall_step(points: PointsArg, head: ArrayLike, *,
 def run(points: PointsArg, leader_steps: ArrayLike, *, method: str = "tractrix",
         substeps: int = 1, record_every: int = 1, tolerance: float = 0.0,
         max_substeps: int = 65536, link_angles: bool = True, overall: OverallArg = None,
+        colliders: Optional[Sequence[Dict[str, Any]]] = None, link_radius: float = 0.0,
         progress: Progress = None) -> Result: ...
 def load_scenario(scenario: Union[PathLike, Dict[str, Any]]) -> Scenario: ...
 def run_scenario(scenario: Union[PathLike, Dict[str, Any], Scenario], *,

@@ -54,6 +54,7 @@ FLEXKIN_PYTHON_ARG(UrdfSource, "Union[str, PathLike]")
 FLEXKIN_PYTHON_ARG(ArmOptionsLike, "Union[ArmOptions, dict, None]")
 FLEXKIN_PYTHON_ARG(OverallLike, "Union[OverallOptions, ObjectiveWeights, dict, None]")
 FLEXKIN_PYTHON_ARG(WeightsLike, "Union[ObjectiveWeights, dict]")
+FLEXKIN_PYTHON_ARG(CollidersLike, "Optional[Sequence[dict]]")
 FLEXKIN_PYTHON_ARG(FormatList, "Union[str, Sequence[str]]")
 FLEXKIN_PYTHON_ARG(ProgressCallback, "Optional[Callable[[int, int], object]]")
 FLEXKIN_PYTHON_ARG(OptionalInt, "Optional[int]")
@@ -168,8 +169,12 @@ Method MethodArg(const std::string& name, const std::string& field = "method");
 OverallOptions OverallArg(py::handle object);
 // RunOptions from the keyword arguments of flexkin.run (options_bindings.cc).
 RunOptions MakeRunOptions(const std::string& method, int substeps, int record_every,
-                          double tolerance, int max_substeps, bool link_angles,
-                          OverallLike overall);
+                          double tolerance, int max_substeps, bool link_angles, OverallLike overall,
+                          CollidersLike colliders, double link_radius);
+// Colliders from a list of dicts in the form of a scenario's "colliders" (docs/scenario-format.md;
+// None: none), read by the scenario reader (InputError naming "/colliders/k/..."); and back.
+std::vector<Collider> CollidersArg(py::handle colliders);
+py::object CollidersValue(const std::vector<Collider>& colliders);
 // A chain from a `Chain` or from points (link lengths the distances between them; MakeChain).
 Chain ChainArg(py::handle object, const std::string& name = "points");
 }  // namespace flexkin::python

@@ -11,13 +11,16 @@
 #include "fields.h"
 #include "flexkin/overall.h"
 #include "flexkin/run.h"
+#include "flexkin/scenario.h"
 
 namespace flexkin::python {
 
 RunOptions MakeRunOptions(const std::string& method, int substeps, int record_every,
-                          double tolerance, int max_substeps, bool link_angles,
-                          OverallLike overall) {
+                          double tolerance, int max_substeps, bool link_angles, OverallLike overall,
+                          CollidersLike colliders, double link_radius) {
   RunOptions o;
+  o.colliders = CollidersArg(colliders);
+  o.link_radius = link_radius;
   o.method = MethodArg(method);
   o.substeps = substeps;
   o.record_every = record_every;
@@ -26,6 +29,20 @@ RunOptions MakeRunOptions(const std::string& method, int substeps, int record_ev
   o.link_angles = link_angles;
   o.overall = OverallArg(overall);
   return o;
+}
+
+std::vector<Collider> CollidersArg(py::handle colliders) {
+  if (colliders.is_none()) return {};
+  if (!py::isinstance<py::list>(colliders) && !py::isinstance<py::tuple>(colliders)) {
+    ThrowInput("colliders",
+               "is not a list; expected a list of dicts in the form of a scenario's "
+               "\"colliders\" (docs/scenario-format.md), or None");
+  }
+  return ParseCollidersText(JsonOfDict(colliders, "colliders"));
+}
+
+py::object CollidersValue(const std::vector<Collider>& colliders) {
+  return py::module_::import("json").attr("loads")(CollidersText(colliders, 3));
 }
 
 namespace {
@@ -217,7 +234,7 @@ OverallOptions(weights=None, constraint_tolerance=1e-12, optimality_tolerance=1e
 Options of a whole run (flexkin::RunOptions), the keyword arguments of flexkin.run.
 
 RunOptions(method="tractrix", substeps=1, record_every=1, tolerance=0.0, max_substeps=65536,
-           link_angles=True, overall=None)
+           link_angles=True, overall=None, colliders=None, link_radius=0.0)
   method: "tractrix", "ftl", "min_rotation", "min_joint_angle", "overall" or "follow_path".
   substeps: equal sub-steps per leader step (>= 1; the start of the automatic choice).
   record_every: keep frame 0, every record_every-th leader step and the last.
@@ -226,11 +243,14 @@ RunOptions(method="tractrix", substeps=1, record_every=1, tolerance=0.0, max_sub
   max_substeps: upper bound of the automatic sub-steps.
   link_angles: compute each frame's link angles to the pull.
   overall: OverallOptions, ObjectiveWeights or a dict of term weights (method "overall").
+  colliders: a list of dicts in the form of a scenario's "colliders" (docs/scenario-format.md).
+  link_radius: each link a capsule of this radius kept outside the colliders.
 )doc");
   run.def(py::init(&MakeRunOptions), py::kw_only(), py::arg("method") = "tractrix",
           py::arg("substeps") = 1, py::arg("record_every") = 1, py::arg("tolerance") = 0.0,
           py::arg("max_substeps") = 1 << 16, py::arg("link_angles") = true,
-          py::arg("overall") = py::none());
+          py::arg("overall") = py::none(), py::arg("colliders") = py::none(),
+          py::arg("link_radius") = 0.0);
   Fields<RunOptions>(run, "RunOptions")
       .Validate("substeps")
       .Property(
@@ -258,6 +278,13 @@ RunOptions(method="tractrix", substeps=1, record_every=1, tolerance=0.0, max_sub
               "The links' radius (length unit, >= 0, default 0): each link a capsule kept "
               "outside the colliders (a scenario's \"link_radius\"; docs/colliders.md).",
               true)
+      .Property(
+          "colliders", [](const RunOptions& o) { return CollidersValue(o.colliders); },
+          [](RunOptions& o, py::handle colliders) { o.colliders = CollidersArg(colliders); },
+          "Things the chain stays outside of: a list of dicts in the form of a scenario's "
+          "\"colliders\" (docs/scenario-format.md; keyframed ones with \"motion\"), read back in "
+          "that form with 3 coordinates (default []).",
+          true)
       .Property(
           "overall", [](const RunOptions& o) { return o.overall; },
           [](RunOptions& o, py::handle overall) { o.overall = OverallArg(overall); },

@@ -179,7 +179,8 @@ const char* kRunDoc = R"doc(
 Runs a chain whose leading end moves in straight lines through leader_steps.
 
 run(points, leader_steps, *, method="tractrix", substeps=1, record_every=1, tolerance=0.0,
-    max_substeps=65536, link_angles=True, overall=None, progress=None) -> Result
+    max_substeps=65536, link_angles=True, overall=None, colliders=None, link_radius=0.0,
+    progress=None) -> Result
 
   points: (n+1, dim) array-like (row 0 the leading end; link lengths the distances between
           the points) or a Chain.
@@ -192,6 +193,10 @@ run(points, leader_steps, *, method="tractrix", substeps=1, record_every=1, tole
           continuous motion is at most tolerance (length unit), up to max_substeps.
   link_angles: compute each frame's link angles to the pull (radians).
   overall: OverallOptions, ObjectiveWeights or a dict of term weights (method "overall").
+  colliders: things the chain stays outside of, a list of dicts in the form of a scenario's
+          "colliders" (docs/scenario-format.md, docs/colliders.md; keyframed ones with
+          "motion", times in leader steps); methods tractrix, ftl and follow_path.
+  link_radius: each link a capsule of this radius (length unit) kept outside the colliders.
   progress: callable(done, total) called about every 0.1 s with leader steps done.
 
 The GIL is released during the run; Ctrl-C stops it (KeyboardInterrupt). Raises InputError
@@ -477,18 +482,20 @@ InputError if the frames do not fit the chain or the targets.
       "run",
       [](PointsOrChain points, ArrayLike leader_steps, const std::string& method, int substeps,
          int record_every, double tolerance, int max_substeps, bool link_angles,
-         OverallLike overall, ProgressCallback progress) {
+         OverallLike overall, CollidersLike colliders, double link_radius,
+         ProgressCallback progress) {
         const Chain chain = ChainArg(points);
         const Points steps = ReadPoints(leader_steps, "leader_steps", 1, chain.dim());
         return RunToArrays(chain, steps,
                            MakeRunOptions(method, substeps, record_every, tolerance, max_substeps,
-                                          link_angles, overall),
+                                          link_angles, overall, colliders, link_radius),
                            std::move(progress), "");
       },
       kRunDoc, py::arg("points"), py::arg("leader_steps"), py::kw_only(),
       py::arg("method") = "tractrix", py::arg("substeps") = 1, py::arg("record_every") = 1,
       py::arg("tolerance") = 0.0, py::arg("max_substeps") = 1 << 16, py::arg("link_angles") = true,
-      py::arg("overall") = py::none(), py::arg("progress") = py::none());
+      py::arg("overall") = py::none(), py::arg("colliders") = py::none(),
+      py::arg("link_radius") = 0.0, py::arg("progress") = py::none());
 
   py::class_<Scenario> scenario(m, "Scenario", R"doc(
 A scenario (docs/scenario-format.md) read by flexkin.load_scenario: name, description,

@@ -153,7 +153,8 @@ def test_a_keyword_typo_does_not_print_the_arrays():
     text = str(info.value)
     assert text == ('flexkin.run(): unknown keyword "substep"; did you mean "substeps"? Expected '
                     'one of "points", "leader_steps", "method", "substeps", "record_every", '
-                    '"tolerance", "max_substeps", "link_angles", "overall" or "progress"')
+                    '"tolerance", "max_substeps", "link_angles", "overall", "colliders", '
+                    '"link_radius" or "progress"')
     with pytest.raises(TypeError) as info:                  # a value of the wrong type
         flexkin.run(points, steps, substeps="four")
     text = str(info.value)

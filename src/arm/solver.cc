@@ -381,6 +381,12 @@ Problems ArmOptions::Validate() const {
   for (size_t c = 0; c < colliders.size(); ++c) {
     const Problems bad = CheckCollider(colliders[c], "colliders[" + std::to_string(c) + "]");
     problems.insert(problems.end(), bad.begin(), bad.end());
+    if (colliders[c].motion) {
+      problems.emplace_back("colliders[" + std::to_string(c) + "].motion",
+                            "is not supported for fixed-base arms yet; keyframed colliders are "
+                            "for chain runs (docs/colliders.md, \"Moving colliders\")",
+                            "a motion", "a collider without \"motion\"");
+    }
   }
   if (pointing.enabled) {
     auto unit_vector = [&](const Eigen::Vector3d& v, const char* name) {

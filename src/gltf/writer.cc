@@ -237,12 +237,31 @@ void AddMesh(const ResultFile& file, const GltfOptions& options, const Eigen::Ma
                        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_MAT4, n + 1);
 }
 
+// A LINEAR sampler of `output` over the keyframe times `input`, driving `property` of `node`.
+void AddChannel(int input, int output, int node, const char* property,
+                tinygltf::Animation* animation) {
+  tinygltf::AnimationSampler sampler;
+  sampler.input = input;
+  sampler.output = output;
+  sampler.interpolation = "LINEAR";
+  animation->samplers.push_back(sampler);
+  tinygltf::AnimationChannel channel;
+  channel.sampler = static_cast<int>(animation->samplers.size() - 1);
+  channel.target_node = node;
+  channel.target_path = property;
+  animation->channels.push_back(channel);
+}
+
 // Each collider as a mesh node "collider_k" under the "flexkin" node (node 0), so in the chain's
 // up axis and scale: its surface (io/collider_mesh.h) in flexkin's coordinates, every vertex on
 // it; a half-space as a square of its plane, 20 times the motion's extent across, about the
-// plane's point nearest the motion's centre.
-void AddColliders(const ResultFile& file, BufferWriter* buffer, tinygltf::Model* model) {
-  if (file.colliders.empty()) return;
+// plane's point nearest the motion's centre. A keyframed collider's surface is where it is at
+// the first frame; its node's animation (AddColliderMotion) carries it. Returns the node of each
+// keyframed collider, with the collider's index.
+std::vector<std::pair<int, size_t>> AddColliders(const ResultFile& file, BufferWriter* buffer,
+                                                 tinygltf::Model* model) {
+  std::vector<std::pair<int, size_t>> moving;
+  if (file.colliders.empty()) return moving;
   Eigen::Vector3d lo, hi;
   BoundsOfMotion(file, &lo, &hi);
   const double extent = std::max((hi - lo).norm(), file.result.lengths.sum());
@@ -255,7 +274,10 @@ void AddColliders(const ResultFile& file, BufferWriter* buffer, tinygltf::Model*
   stone.doubleSided = true;  // a half-space's square is seen from both sides
   model->materials.push_back(stone);
   for (size_t k = 0; k < file.colliders.size(); ++k) {
-    const Collider& collider = file.colliders[k];
+    const Collider& given = file.colliders[k];
+    const Collider collider = given.motion && !file.result.frames.empty()
+                                  ? ColliderAt(given, double(file.result.frames[0].step))
+                                  : given;
     const ColliderMesh mesh = MeshOfCollider(collider, 48, 0.5 * (lo + hi), 10.0 * extent);
     const std::string name = "collider_" + std::to_string(k);
     std::vector<float> positions;
@@ -284,7 +306,43 @@ void AddColliders(const ResultFile& file, BufferWriter* buffer, tinygltf::Model*
     node.mesh = static_cast<int>(model->meshes.size() - 1);
     model->nodes.push_back(node);
     model->nodes[0].children.push_back(static_cast<int>(model->nodes.size() - 1));
+    if (given.motion) moving.emplace_back(static_cast<int>(model->nodes.size() - 1), k);
   }
+  return moving;
+}
+
+// The motion of a keyframed collider's node: at each recorded frame f, the rotation and the
+// translation of M(t_f) M(t_0)^-1 (M(t) the collider's motion's pose at time t, frame f's step),
+// which carry its surface from where the first frame has it.
+void AddColliderMotion(const ResultFile& file, const Collider& collider, int node, int input,
+                       BufferWriter* buffer, tinygltf::Animation* animation) {
+  const auto carried = [&](const Frame& frame) {
+    const BodyPose p = InterpolateKeyframes(collider.motion->keyframes,
+                                            collider.motion->interpolation, double(frame.step));
+    Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+    m.linear() = p.rotation;
+    m.translation() = p.translation;
+    return m;
+  };
+  const Frames& frames = file.result.frames;
+  const Eigen::Isometry3d to_first = carried(frames[0]).inverse();
+  std::vector<float> translations, rotations;
+  for (const Frame& frame : frames) {
+    const Eigen::Isometry3d t = carried(frame) * to_first;
+    Eigen::Quaterniond q(t.linear());
+    q.normalize();
+    for (int c = 0; c < 3; ++c) translations.push_back(static_cast<float>(t.translation()[c]));
+    for (const double v : {q.x(), q.y(), q.z(), q.w()}) rotations.push_back(static_cast<float>(v));
+  }
+  const std::string name = "collider node " + std::to_string(node);
+  const int translation =
+      buffer->Accessor(buffer->View(translations, 0, name + " translation"), 0,
+                       TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, frames.size());
+  const int rotation =
+      buffer->Accessor(buffer->View(rotations, 0, name + " rotation"), 0,
+                       TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, frames.size());
+  AddChannel(input, translation, node, "translation", animation);
+  AddChannel(input, rotation, node, "rotation", animation);
 }
 
 }  // namespace
@@ -354,7 +412,7 @@ void internal::WriteGltf(const CheckedDrawing& drawing, const GltfOptions& optio
     model.nodes.push_back(tube);
     scene.nodes.push_back(n + 2);
   }
-  AddColliders(file, &buffer, &model);
+  const std::vector<std::pair<int, size_t>> moving_colliders = AddColliders(file, &buffer, &model);
   model.scenes.push_back(scene);
   model.defaultScene = 0;
 
@@ -373,19 +431,11 @@ void internal::WriteGltf(const CheckedDrawing& drawing, const GltfOptions& optio
     const int rotation =
         buffer.Accessor(buffer.View(rig.rotation[j], 0, "joint_" + std::to_string(j) + " rotation"),
                         0, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, times.size());
-    for (const auto& [output, property] :
-         {std::pair<int, const char*>{translation, "translation"}, {rotation, "rotation"}}) {
-      tinygltf::AnimationSampler sampler;
-      sampler.input = input;
-      sampler.output = output;
-      sampler.interpolation = "LINEAR";
-      animation.samplers.push_back(sampler);
-      tinygltf::AnimationChannel channel;
-      channel.sampler = static_cast<int>(animation.samplers.size() - 1);
-      channel.target_node = j + 1;
-      channel.target_path = property;
-      animation.channels.push_back(channel);
-    }
+    AddChannel(input, translation, j + 1, "translation", &animation);
+    AddChannel(input, rotation, j + 1, "rotation", &animation);
+  }
+  for (const auto& [node, k] : moving_colliders) {
+    AddColliderMotion(file, file.colliders[k], node, input, &buffer, &animation);
   }
   model.animations.push_back(animation);
 

@@ -31,14 +31,11 @@ using json_internal::json;
 using json_internal::Range;
 using json_internal::ShowJson;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int64_t kMaxLinks = int64_t{1} << 20;
 constexpr int64_t kMaxSeed = int64_t{1} << 53;  // every integer up to here is exact in JSON
 
 const char* const kRootExpected =
     "an object with \"groom\" (or \"strands\") and \"motion\" (docs/groom-format.md)";
-const char* const kRotationExpected =
-    "an object {\"axis\": [x, y, z], \"angle_deg\": a} or {\"quaternion\": [w, x, y, z]}";
 
 // A GrowSpec member path as the JSON pointer of the key that sets it.
 std::string GrowFieldToPointer(const std::string& field, const std::string& shape) {
@@ -404,49 +401,9 @@ class GroomParser : public json_internal::JsonReader {
     BodyMotion m;
     Optional(motion, ptr, "fps", NumberOf(Range::kPositive), &m.fps);
     const bool fps_ok = problems.size() == before;
-    if (const json* v = Find(motion, "interpolation")) {
-      if (const auto name = Choice(*v, ptr + "/interpolation", {"smooth", "linear"})) {
-        m.interpolation =
-            *name == "linear" ? KeyframeInterpolation::kLinear : KeyframeInterpolation::kSmooth;
-      }
-    }
-    const json* list =
-        Required(motion, ptr, "keyframes", "an array of at least 1 keyframe {\"time\": t, ...}");
-    if (list == nullptr) return std::nullopt;
-    const std::string lp = ptr + "/keyframes";
-    const std::string expected = "an array of at least 1 keyframe {\"time\": t, ...}";
-    if (!list->is_array()) {
-      TypeProblem(*list, lp, expected);
-      return std::nullopt;
-    }
-    if (list->empty()) {
-      Add(lp, "has 0 keyframes; expected " + expected, "[]", expected);
-      return std::nullopt;
-    }
-    if (list->size() > size_t(kMaxGroomKeyframes)) {
-      Add(lp, "has " + std::to_string(list->size()) + " keyframes; expected at most " +
-                  std::to_string(kMaxGroomKeyframes));
-      return std::nullopt;
-    }
-    std::optional<double> previous;  // the last keyframe's time, if it could be read
-    for (size_t k = 0; k < list->size(); ++k) {
-      const std::string kp = lp + "/" + std::to_string(k);
-      std::optional<BodyKeyframe> keyframe = ParseKeyframe((*list)[k], kp, dim);
-      const json* time = (*list)[k].is_object() ? Find((*list)[k], "time") : nullptr;
-      std::optional<double> t;
-      if (time != nullptr && time->is_number() && std::isfinite(time->get<double>())) {
-        t = time->get<double>();
-      }
-      if (t && previous && !(*t > *previous)) {
-        Add(kp + "/time",
-            "value " + ShowJson(*time) + " is not above " + FormatNumber(*previous) +
-                ", the time of " + lp + "/" + std::to_string(k - 1) +
-                "/time; expected keyframe times that increase "
-                "strictly",
-            ShowJson(*time), "a time > " + FormatNumber(*previous));
-      }
-      previous = t;
-      if (keyframe) m.keyframes.push_back(std::move(*keyframe));
+    if (auto keys = ReadKeyframes(motion, ptr, dim, "seconds", kMaxGroomKeyframes)) {
+      m.keyframes = std::move(keys->first);
+      m.interpolation = keys->second;
     }
     if (problems.size() != before) return std::nullopt;
     if (fps_ok) {
@@ -463,98 +420,6 @@ class GroomParser : public json_internal::JsonReader {
       }
     }
     return m;
-  }
-
-  std::optional<BodyKeyframe> ParseKeyframe(const json& v, const std::string& ptr, int dim) {
-    if (!ExpectObject(v, ptr,
-                      "an object {\"time\": t, \"translation\": [...], \"rotation\": {...}} (3D) "
-                      "or {\"time\": t, \"translation\": [x, y], \"angle_deg\": a} (2D)")) {
-      return std::nullopt;
-    }
-    CheckKeys(v, ptr, {"time", "translation", "rotation", "angle_deg"});
-    const size_t before = problems.size();
-    BodyKeyframe keyframe;
-    Require(v, ptr, "time", "a finite number (seconds)", NumberOf(Range::kAny), &keyframe.time);
-    Eigen::VectorXd translation = Eigen::Vector3d::Zero();
-    Optional(v, ptr, "translation", VectorOf(dim), &translation);
-    Eigen::Vector3d t = Eigen::Vector3d::Zero();
-    t.head(translation.size()) = translation;
-    if (dim == 2 && Find(v, "rotation")) {
-      Add(ptr + "/rotation",
-          "is only valid in 3D scenarios; a 2D keyframe turns about z by \"angle_deg\"");
-    }
-    if (dim == 3 && Find(v, "angle_deg")) {
-      Add(ptr + "/angle_deg",
-          "is only valid in 2D scenarios; a 3D keyframe turns by \"rotation\": " +
-              std::string(kRotationExpected));
-    }
-    std::optional<Eigen::Quaterniond> rotation;
-    if (dim != 2) {
-      if (const json* r = Find(v, "rotation")) rotation = ParseRotation(*r, ptr + "/rotation");
-    }
-    double angle_deg = 0.0;
-    if (dim != 3) Optional(v, ptr, "angle_deg", NumberOf(Range::kAny), &angle_deg);
-    if (problems.size() != before) return std::nullopt;
-    if (dim == 2) {
-      keyframe.pose = BodyPose::Planar(angle_deg * (kPi / 180.0), t[0], t[1]);
-    } else {
-      const Eigen::Quaterniond q = rotation.value_or(Eigen::Quaterniond::Identity());
-      keyframe.pose = BodyPose::FromQuaternion(q.w(), q.x(), q.y(), q.z(), t);
-    }
-    return keyframe;
-  }
-
-  std::optional<Eigen::Quaterniond> ParseRotation(const json& r, const std::string& ptr) {
-    if (!ExpectObject(r, ptr, kRotationExpected)) return std::nullopt;
-    CheckKeys(r, ptr, {"axis", "angle_deg", "quaternion"});
-    const size_t before = problems.size();
-    if (const json* q = Find(r, "quaternion")) {
-      for (const char* key : {"axis", "angle_deg"}) {
-        if (Find(r, key)) {
-          Add(ptr + "/" + key,
-              "is not valid with \"quaternion\"; give axis and angle_deg, or "
-              "quaternion, not both");
-        }
-      }
-      const std::string qp = ptr + "/quaternion";
-      const char* expected = "an array of 4 numbers [w, x, y, z], not all zero";
-      if (!q->is_array()) {
-        TypeProblem(*q, qp, expected);
-        return std::nullopt;
-      }
-      if (q->size() != 4) {
-        Add(qp,
-            "value " + ShowJson(*q) + " has " + std::to_string(q->size()) +
-                (q->size() == 1 ? " number" : " numbers") + "; expected " + expected,
-            ShowJson(*q), expected);
-        return std::nullopt;
-      }
-      Eigen::Vector4d c;
-      for (int k = 0; k < 4; ++k) {
-        if (const auto x = Number((*q)[k], qp + "/" + std::to_string(k), Range::kAny)) c[k] = *x;
-      }
-      if (problems.size() != before) return std::nullopt;
-      if (!(c.squaredNorm() > 0.0) || !std::isfinite(c.squaredNorm())) {
-        Add(qp, "value " + ShowJson(*q) + " is not valid; expected " + expected, ShowJson(*q),
-            expected);
-        return std::nullopt;
-      }
-      c.normalize();
-      return Eigen::Quaterniond(c[0], c[1], c[2], c[3]);
-    }
-    Eigen::VectorXd axis = Eigen::Vector3d::UnitZ();
-    double angle_deg = 0.0;
-    Require(r, ptr, "axis", "an array of 3 numbers, not all zero (the axis of the rotation)",
-            VectorOf(3), &axis);
-    Require(r, ptr, "angle_deg", "a finite number (degrees)", NumberOf(Range::kAny), &angle_deg);
-    if (problems.size() != before) return std::nullopt;
-    if (!(axis.squaredNorm() > 0.0) || !std::isfinite(axis.squaredNorm())) {
-      Add(ptr + "/axis", "is zero; expected a non-zero vector", ShowJson(r["axis"]),
-          "a non-zero vector");
-      return std::nullopt;
-    }
-    return Eigen::Quaterniond(
-        Eigen::AngleAxisd(angle_deg * (kPi / 180.0), Eigen::Vector3d(axis.normalized())));
   }
 
   // "method", "substeps", "pinned", "threads" and "record".

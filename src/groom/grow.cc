@@ -70,11 +70,6 @@ void CheckVector(const Eigen::Vector3d& v, const char* field, Problems* problems
   }
 }
 
-// The unit quaternion (w, x, y, z) of a rotation matrix.
-Eigen::Quaterniond QuaternionOf(const Eigen::Matrix3d& rotation) {
-  return Eigen::Quaterniond(rotation).normalized();
-}
-
 }  // namespace
 
 Problems ValidateGrowSpec(const GrowSpec& spec) {
@@ -231,49 +226,7 @@ double BodyMotion::TimeOf(int64_t frame) const {
 
 BodyPose BodyMotion::PoseAt(int64_t frame) const {
   if (keyframes.empty()) return {};
-  const double t = TimeOf(frame);
-  // The segment [k - 1, k] holding t: the first keyframe whose time is not below t.
-  const auto after = std::lower_bound(
-      keyframes.begin(), keyframes.end(), t,
-      [](const BodyKeyframe& keyframe, double time) { return keyframe.time < time; });
-  if (after == keyframes.end()) return keyframes.back().pose;
-  if (after == keyframes.begin() || after->time == t) return after->pose;
-  const BodyKeyframe& a = *(after - 1);
-  const BodyKeyframe& b = *after;
-  const double u = (t - a.time) / (b.time - a.time);
-  // Within 1e-12 of a keyframe (the rounding of first + frame / fps) the keyframe itself.
-  if (u <= 1e-12) return a.pose;
-  if (u >= 1.0 - 1e-12) return b.pose;
-  const double s = interpolation == KeyframeInterpolation::kLinear ? u : u * u * (3.0 - 2.0 * u);
-
-  // A part that does not change between the keyframes stays exactly as it is (a body that rests
-  // moves nothing; a pure turn does not shift, a pure shift does not turn).
-  const Eigen::Vector3d translation =
-      a.pose.translation == b.pose.translation
-          ? a.pose.translation
-          : Eigen::Vector3d((1.0 - s) * a.pose.translation + s * b.pose.translation);
-  if (a.pose.rotation == b.pose.rotation) {
-    BodyPose pose = a.pose;
-    pose.translation = translation;
-    return pose;
-  }
-  const Eigen::Quaterniond qa = QuaternionOf(a.pose.rotation);
-  Eigen::Quaterniond qb = QuaternionOf(b.pose.rotation);
-  double d = qa.coeffs().dot(qb.coeffs());
-  if (d < 0.0) {  // q and -q are the same rotation: take the shorter arc
-    qb.coeffs() = -qb.coeffs();
-    d = -d;
-  }
-  Eigen::Vector4d q;  // (x, y, z, w), Eigen's order
-  if (d > 1.0 - 1e-12) {
-    q = (1.0 - s) * qa.coeffs() + s * qb.coeffs();
-  } else {
-    const double angle = std::acos(d);
-    const double sin_angle = std::sin(angle);
-    q = (std::sin((1.0 - s) * angle) / sin_angle) * qa.coeffs() +
-        (std::sin(s * angle) / sin_angle) * qb.coeffs();
-  }
-  return BodyPose::FromQuaternion(q[3], q[0], q[1], q[2], translation);
+  return InterpolateKeyframes(keyframes, interpolation, TimeOf(frame));
 }
 
 }  // namespace flexkin

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "flexkin/result_io.h"
+#include "flexkin/strand_file.h"
 
 namespace flexkin {
 namespace {
@@ -315,6 +316,23 @@ void BoundsOfMotion(const ResultFile& file, Eigen::Vector3d* lo, Eigen::Vector3d
       *hi = hi->cwiseMax(q);
     }
   }
+}
+
+std::vector<Collider> BodyCollidersBesideScalp(const StrandFileHeader& header) {
+  const ScalpShape& scalp = header.scalp;
+  const auto is_scalp = [&](const Collider& c) {
+    if (c.pose.translation() != scalp.center || !c.pose.linear().isIdentity(0.0)) return false;
+    if (scalp.shape == "sphere") {
+      return c.shape == ColliderShape::kSphere && c.radius == scalp.radii[0];
+    }
+    return scalp.shape == "ellipsoid" && c.shape == ColliderShape::kEllipsoid &&
+           c.extents == scalp.radii;
+  };
+  std::vector<Collider> colliders;
+  for (const Collider& c : header.body_colliders) {
+    if (!is_scalp(c)) colliders.push_back(c);
+  }
+  return colliders;
 }
 
 }  // namespace flexkin

@@ -15,6 +15,12 @@
 namespace flexkin {
 
 struct ResultFile;
+struct StrandFileHeader;
+
+// A strand file's body colliders (in body coordinates) but the scalp's own (the sphere or
+// ellipsoid a groom adds for its scalp, which the pictures shade as the scalp itself): what the
+// strand figures and the strands viewer draw beside the scalp, with the world colliders.
+std::vector<Collider> BodyCollidersBesideScalp(const StrandFileHeader& header);
 
 // The box [*lo, *hi] that holds every point of every frame of `file` (3D; a 2D file's z is 0).
 void BoundsOfMotion(const ResultFile& file, Eigen::Vector3d* lo, Eigen::Vector3d* hi);

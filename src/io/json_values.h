@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "flexkin/chain.h"
+#include "flexkin/colliders.h"
 #include "flexkin/error.h"
 
 namespace flexkin::json_internal {
@@ -80,6 +81,16 @@ class JsonReader {
   std::optional<Eigen::VectorXd> NumberPerItem(const json& v, const std::string& ptr, int size,
                                                Range range, const char* what);
 
+  // The "interpolation" ("smooth" by default, or "linear") and "keyframes" of a keyframed rigid
+  // motion (a groom's "motion", a chain scenario's collider's "motion"; docs/groom-format.md
+  // "motion"): at least 1 and at most `max_keyframes` keyframes {"time": t, "translation": [..],
+  // "rotation": {..}} (3D) or {"time": t, "translation": [x, y], "angle_deg": a} (2D), times
+  // strictly increasing, in `time_unit` ("seconds"). dim 0: the dimension is not known yet. The
+  // caller checks `motion`'s keys. Null where a problem was added.
+  std::optional<std::pair<std::vector<BodyKeyframe>, KeyframeInterpolation>> ReadKeyframes(
+      const json& motion, const std::string& ptr, int dim, const char* time_unit,
+      int64_t max_keyframes);
+
   // Reads obj[key] with `get` into *out if it is there (and valid); Require also reports a
   // missing key.
   template <typename T, typename Get>
@@ -97,6 +108,11 @@ class JsonReader {
     const auto it = obj.find(key);
     return it == obj.end() ? nullptr : &*it;
   }
+
+  std::optional<BodyKeyframe> ReadKeyframe(const json& v, const std::string& ptr, int dim,
+                                           const char* time_unit);
+  // {"axis": [x, y, z], "angle_deg": a} or {"quaternion": [w, x, y, z]} (normalized).
+  std::optional<Eigen::Quaterniond> ReadRotation(const json& r, const std::string& ptr);
 
   // What a Vector's dimension belongs to, for its message: "an array of 2 numbers (the curve is
   // 2D)".

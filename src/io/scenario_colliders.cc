@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "flexkin/scenario.h"
 #include "io/colliders_json.h"
 #include "io/result_writers.h"
 #include "io/scenario_parser.h"
@@ -173,7 +174,21 @@ std::optional<Collider> Parser::ParseCollider(const json& v, const std::string& 
       }
     }
   }
+  keys.push_back("motion");
   CheckKeys(v, ptr, keys);
+  // A keyframed collider (docs/colliders.md, "Moving colliders"): times in leader steps.
+  if (const json* m = Find(v, "motion")) {
+    const std::string mp = ptr + "/motion";
+    if (ExpectObject(*m, mp, "an object {\"keyframes\": [...], \"interpolation\": \"smooth\"}")) {
+      CheckKeys(*m, mp, {"interpolation", "keyframes"});
+      if (auto keys = ReadKeyframes(*m, mp, dim, "leader steps", kMaxLeaderSteps)) {
+        auto motion = std::make_shared<ColliderMotion>();
+        motion->keyframes = std::move(keys->first);
+        motion->interpolation = keys->second;
+        c.motion = std::move(motion);
+      }
+    }
+  }
   if (problems.size() != before) return std::nullopt;
   return c;
 }
@@ -315,6 +330,17 @@ Problems CollidersProblems(const std::vector<Collider>& colliders, int dim) {
                                 "scenario-format.md), centred in that plane, their axes and "
                                 "normals in it, turned about z only");
     }
+    if (!c.motion) continue;
+    // A 2D motion moves in the plane and turns about z only ("angle_deg").
+    for (size_t i = 0; i < c.motion->keyframes.size(); ++i) {
+      const BodyPose& p = c.motion->keyframes[i].pose;
+      if (std::fabs(p.translation.z()) > kPlaneTolerance * (1.0 + p.translation.norm()) ||
+          std::fabs(p.rotation(2, 2) - 1.0) > kPlaneTolerance) {
+        problems.emplace_back(field + ".motion.keyframes[" + std::to_string(i) + "]",
+                              "leaves the plane z = 0; a 2D result's keyframes move in that "
+                              "plane and turn about z only");
+      }
+    }
   }
   return problems;
 }
@@ -401,7 +427,74 @@ void AppendColliderJson(const Collider& c, int dim, std::string* out) {
       break;
     }
   }
+  if (c.motion) {
+    AppendKey("motion", out);
+    out->append("{\"interpolation\": \"");
+    out->append(c.motion->interpolation == KeyframeInterpolation::kLinear ? "linear" : "smooth");
+    out->append("\", \"keyframes\": [");
+    for (size_t k = 0; k < c.motion->keyframes.size(); ++k) {
+      const BodyKeyframe& key = c.motion->keyframes[k];
+      if (k > 0) out->append(", ");
+      out->append("{\"time\": ");
+      AppendJsonDouble(key.time, out);
+      AppendKey("translation", out);
+      AppendPoint(key.pose.translation, dim, out);
+      if (dim == 2) {
+        AppendKey("angle_deg", out);
+        AppendJsonDouble(std::atan2(key.pose.rotation(1, 0), key.pose.rotation(0, 0)) *
+                             (180.0 / 3.14159265358979323846),
+                         out);
+      } else {
+        Eigen::Quaterniond q(key.pose.rotation);
+        if (q.w() < 0.0) q.coeffs() = -q.coeffs();
+        out->append(", \"rotation\": {\"quaternion\": ");
+        const double wxyz[4] = {q.w(), q.x(), q.y(), q.z()};
+        for (int i = 0; i < 4; ++i) {
+          out->append(i == 0 ? "[" : ", ");
+          AppendJsonDouble(wxyz[i], out);
+        }
+        out->append("]}");
+      }
+      out->push_back('}');
+    }
+    out->append("]}");
+  }
   out->push_back('}');
+}
+
+std::vector<Collider> ParseCollidersText(const std::string& json_text, int dim) {
+  nlohmann::json v;
+  try {
+    v = nlohmann::json::parse(json_text);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError("/colliders", std::string("is not valid JSON: ") + e.what());
+  }
+  if (dim == 0) {
+    dim = 3;
+    if (v.is_array() && !v.empty() && v[0].is_object()) {
+      for (const char* key : {"center", "from", "point", "position"}) {
+        const auto it = v[0].find(key);
+        if (it != v[0].end() && it->is_array() && (it->size() == 2 || it->size() == 3)) {
+          dim = static_cast<int>(it->size());
+          break;
+        }
+      }
+    }
+  }
+  Problems problems;
+  std::vector<Collider> colliders = ReadCollidersJson(v, "/colliders", dim, &problems);
+  ThrowIfAny(problems);
+  return colliders;
+}
+
+std::string CollidersText(const std::vector<Collider>& colliders, int dim) {
+  ThrowIfAny(CollidersProblems(colliders, dim));
+  std::string out = "[";
+  for (size_t k = 0; k < colliders.size(); ++k) {
+    if (k > 0) out += ", ";
+    AppendColliderJson(colliders[k], dim, &out);
+  }
+  return out + "]";
 }
 
 }  // namespace flexkin

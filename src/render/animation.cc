@@ -32,7 +32,7 @@ void DrawBackground(render::Canvas* canvas, const ChainScene& scene, const Resul
   const double ui = canvas->ui();
   render::DrawTitle(cr, ui, canvas->width(), render::MainTitle(file, title), look.summary);
   scene.DrawAxes(cr);
-  scene.DrawColliders(cr, file.colliders);
+  scene.DrawColliders(cr, render::StaticColliders(file.colliders));  // moving ones: DrawMoment
   const std::vector<double> leader = render::LeaderPath(file);
   const int num_frames = static_cast<int>(file.result.frames.size());
   scene.DrawChains(cr, {leader.data()}, {num_frames},
@@ -55,6 +55,9 @@ void DrawMoment(render::Canvas* canvas, const ChainScene& scene, const ResultFil
   const Frames& frames = file.result.frames;
   const int f = drawn[d];
   const int rows = static_cast<int>(frames[f].points.rows());
+  if (AnyMoves(file.colliders)) {
+    scene.DrawColliders(cr, render::MovingCollidersAt(file.colliders, double(frames[f].step)));
+  }
   if (f > 0) {
     std::vector<double> path;
     for (int g = 0; g <= f; ++g) {

@@ -6,6 +6,7 @@
 #include <cairo.h>
 
 #include <Eigen/Core>
+#include <functional>
 #include <vector>
 
 #include "flexkin/result_io.h"
@@ -72,5 +73,21 @@ class ChainScene {
   double aspect_ = 1.0;
   double x0_ = 0, x1_ = 1, y0_ = 0, y1_ = 1;  // 2D axis ranges
 };
+
+// Colliders filled in kColliderFill and outlined in kColliderEdge, for any view: `pixel` maps a
+// world point to pixels; in 3D the shapes are drawn in decreasing `farness` of their centres (a
+// half-space first, its plane cut to the box lo..hi), each the convex hull of its projected
+// surface (a mesh: the union of its triangles); in 2D (dim 2) each its exact outline, a
+// half-plane's cut to the box lo..hi (x, y). ChainScene::DrawColliders and the strand figures
+// draw through it.
+void DrawColliderShapes(cairo_t* cr, int dim, const std::vector<Collider>& colliders,
+                        const std::function<Eigen::Vector2d(const Eigen::Vector3d&)>& pixel,
+                        const std::function<double(const Eigen::Vector3d&)>& farness,
+                        const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double ui);
+
+// The colliders that stay where they are (no motion), and the keyframed ones at `time` (leader
+// steps; flexkin/colliders.h ColliderAt): figures draw the first once, the second per frame.
+std::vector<Collider> StaticColliders(const std::vector<Collider>& colliders);
+std::vector<Collider> MovingCollidersAt(const std::vector<Collider>& colliders, double time);
 
 }  // namespace flexkin::render

@@ -2,6 +2,8 @@
 // geometry of the colliders (io/collider_mesh.h).
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
+#include <functional>
 #include <map>
 #include <utility>
 #include <vector>
@@ -90,25 +92,22 @@ void FillMesh(cairo_t* cr, const ColliderMesh& mesh, const std::vector<Eigen::Ve
 
 }  // namespace
 
-void ChainScene::DrawColliders(cairo_t* cr, const std::vector<Collider>& colliders) const {
+void DrawColliderShapes(cairo_t* cr, int dim, const std::vector<Collider>& colliders,
+                        const std::function<Eigen::Vector2d(const Eigen::Vector3d&)>& pixel,
+                        const std::function<double(const Eigen::Vector3d&)>& farness,
+                        const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double ui) {
   if (colliders.empty()) return;
   cairo_save(cr);
   cairo_set_dash(cr, nullptr, 0, 0.0);
   cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
-  const auto pixel = [&](const Eigen::Vector3d& q) { return Pixel(q.data()); };
-  if (dim_ == 2) {
-    cairo_rectangle(cr, plot_.x, plot_.y, plot_.w, plot_.h);
-    cairo_clip(cr);
-    // A half-plane's region reaches a little beyond the frame, so that its sides are clipped
-    // rather than outlined.
-    const double margin = 0.05 * std::max(x1_ - x0_, y1_ - y0_);
-    const Eigen::Vector2d lo(x0_ - margin, y0_ - margin), hi(x1_ + margin, y1_ + margin);
+  if (dim == 2) {
     for (const Collider& c : colliders) {
       std::vector<Eigen::Vector2d> pixels;
-      for (const Eigen::Vector2d& p : OutlineOfCollider2d(c, kSegments, lo, hi)) {
-        pixels.push_back(Pixel(p.data()));
+      for (const Eigen::Vector2d& p :
+           OutlineOfCollider2d(c, kSegments, lo.head<2>(), hi.head<2>())) {
+        pixels.push_back(pixel(Eigen::Vector3d(p.x(), p.y(), 0.0)));
       }
-      FillPolygon(cr, pixels, ui_);
+      FillPolygon(cr, pixels, ui);
     }
     cairo_restore(cr);
     return;
@@ -118,18 +117,18 @@ void ChainScene::DrawColliders(cairo_t* cr, const std::vector<Collider>& collide
   std::vector<std::pair<double, const Collider*>> order;
   for (const Collider& c : colliders) {
     const bool plane = c.shape == ColliderShape::kHalfSpace;
-    order.emplace_back(plane ? 2.0 : Depth(c.pose.translation().data()), &c);
+    order.emplace_back(plane ? HUGE_VAL : farness(c.pose.translation()), &c);
   }
   std::stable_sort(order.begin(), order.end(),
                    [](const auto& a, const auto& b) { return a.first > b.first; });
   for (const auto& [depth, c] : order) {
     std::vector<Eigen::Vector2d> pixels;
     if (c->shape == ColliderShape::kHalfSpace) {
-      for (const Eigen::Vector3d& q : HalfSpacePlaneInBox(*c, lo_, hi_)) pixels.push_back(pixel(q));
+      for (const Eigen::Vector3d& q : HalfSpacePlaneInBox(*c, lo, hi)) pixels.push_back(pixel(q));
     } else if (c->shape == ColliderShape::kMesh) {
       const ColliderMesh mesh = MeshOfCollider(*c, kSegments / 2, Eigen::Vector3d::Zero(), 0.0);
       for (const Eigen::Vector3d& q : mesh.vertices) pixels.push_back(pixel(q));
-      FillMesh(cr, mesh, pixels, ui_);
+      FillMesh(cr, mesh, pixels, ui);
       continue;
     } else {
       for (const Eigen::Vector3d& q :
@@ -138,9 +137,44 @@ void ChainScene::DrawColliders(cairo_t* cr, const std::vector<Collider>& collide
       }
       pixels = ConvexHull(std::move(pixels));
     }
-    FillPolygon(cr, pixels, ui_);
+    FillPolygon(cr, pixels, ui);
   }
   cairo_restore(cr);
+}
+
+void ChainScene::DrawColliders(cairo_t* cr, const std::vector<Collider>& colliders) const {
+  if (colliders.empty()) return;
+  const auto pixel = [&](const Eigen::Vector3d& q) { return Pixel(q.data()); };
+  const auto farness = [&](const Eigen::Vector3d& q) { return Depth(q.data()); };
+  if (dim_ == 2) {
+    cairo_save(cr);
+    cairo_rectangle(cr, plot_.x, plot_.y, plot_.w, plot_.h);
+    cairo_clip(cr);
+    // A half-plane's region reaches a little beyond the frame, so that its sides are clipped
+    // rather than outlined.
+    const double margin = 0.05 * std::max(x1_ - x0_, y1_ - y0_);
+    const Eigen::Vector3d lo(x0_ - margin, y0_ - margin, 0.0), hi(x1_ + margin, y1_ + margin, 0.0);
+    DrawColliderShapes(cr, 2, colliders, pixel, farness, lo, hi, ui_);
+    cairo_restore(cr);
+    return;
+  }
+  DrawColliderShapes(cr, 3, colliders, pixel, farness, lo_, hi_, ui_);
+}
+
+std::vector<Collider> StaticColliders(const std::vector<Collider>& colliders) {
+  std::vector<Collider> kept;
+  for (const Collider& c : colliders) {
+    if (!c.motion) kept.push_back(c);
+  }
+  return kept;
+}
+
+std::vector<Collider> MovingCollidersAt(const std::vector<Collider>& colliders, double time) {
+  std::vector<Collider> moved;
+  for (const Collider& c : colliders) {
+    if (c.motion) moved.push_back(ColliderAt(c, time));
+  }
+  return moved;
 }
 
 }  // namespace flexkin::render

@@ -109,7 +109,9 @@ void DrawSnapshotFigure(const ResultFile& file, const Look& look, const FigureOp
   DrawTitle(cr, ui, canvas.width(), MainTitle(file, options.title),
             look.summary + " \u00b7 " + frames_note);
   scene.DrawAxes(cr);
-  scene.DrawColliders(cr, file.colliders);
+  // Keyframed colliders where they are at the last frame drawn (docs/rendering.md).
+  scene.DrawColliders(cr, StaticColliders(file.colliders));
+  scene.DrawColliders(cr, MovingCollidersAt(file.colliders, double(frames[drawn.back()].step)));
 
   // The leading end's path under the chains, which mostly follow it.
   const std::vector<double> leader = LeaderPath(file);

@@ -134,6 +134,7 @@ void IncludeFrame(const Drawing& d, const StrandsView& view, const Points& point
     }
   }
   view.IncludeScalp(d.header->scalp, pose, bounds);
+  render::IncludeColliders(view, render::FigureColliders(*d.header, pose), bounds);
 }
 
 render::StrandsStyle StyleFor(const Drawing& d, const StrandsRenderOptions& options, double ui) {
@@ -352,6 +353,7 @@ void internal::RenderStrandsAnimation(StrandFileReader* reader, const StrandsRen
     for (const Eigen::Vector3d& q : sample)
       view.Include(pose.rotation * q + pose.translation, &bounds);
     view.IncludeScalp(d.header->scalp, pose, &bounds);
+    render::IncludeColliders(view, render::FigureColliders(*d.header, pose), &bounds);
   }
   constexpr double kMargin = 0.06;
   const int width = (options.width != 0 ? options.width : 960) + (options.width % 2);

@@ -6,7 +6,9 @@
 #include <cstdint>
 #include <limits>
 
+#include "io/collider_mesh.h"
 #include "render/canvas.h"
+#include "render/scene.h"
 
 namespace flexkin::render {
 namespace {
@@ -263,6 +265,34 @@ void StrandsView::IncludeScalp(const ScalpShape& scalp, const BodyPose& pose, Vi
   b->d1 = std::max(b->d1, Depth(e.center) + dd);
 }
 
+std::vector<Collider> FigureColliders(const StrandFileHeader& header, const BodyPose& pose) {
+  Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
+  body.linear() = pose.rotation;
+  body.translation() = pose.translation;
+  std::vector<Collider> colliders = BodyCollidersBesideScalp(header);
+  for (Collider& c : colliders) c.pose = body * c.pose;
+  colliders.insert(colliders.end(), header.world_colliders.begin(), header.world_colliders.end());
+  return colliders;
+}
+
+void IncludeColliders(const StrandsView& view, const std::vector<Collider>& colliders,
+                      ViewBounds* bounds) {
+  for (const Collider& c : colliders) {
+    if (c.shape == ColliderShape::kHalfSpace) continue;
+    if (view.dim() == 2) {
+      const double big = 1e6;
+      for (const Eigen::Vector2d& p : OutlineOfCollider2d(c, 32, Eigen::Vector2d::Constant(-big),
+                                                          Eigen::Vector2d::Constant(big))) {
+        view.Include(Eigen::Vector3d(p.x(), p.y(), 0.0), bounds);
+      }
+      continue;
+    }
+    for (const Eigen::Vector3d& q : MeshOfCollider(c, 16, Eigen::Vector3d::Zero(), 0.0).vertices) {
+      view.Include(q, bounds);
+    }
+  }
+}
+
 void StrandsView::Fit(const ViewBounds& bounds, double margin, const Rect& area) {
   const double size = std::max({bounds.u1 - bounds.u0, bounds.v1 - bounds.v0, 1e-12});
   const double du = bounds.u1 - bounds.u0 + 2 * margin * size;
@@ -339,7 +369,17 @@ void DrawStrandsFrame(cairo_t* cr, const StrandsView& view, const StrandFileHead
   cairo_save(cr);
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
   cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+  const std::vector<Collider> colliders = FigureColliders(header, pose);
   for (int side = 0; side < 2; ++side) {
+    if (side == 1 && !colliders.empty()) {
+      // A half-space's plane is cut to a box about the body, far wider than any picture of it.
+      const double reach = 1e3 * (1.0 + (has_scalp ? header.scalp.radii.maxCoeff() : 0.0));
+      const Eigen::Vector3d lo = pose.translation - Eigen::Vector3d::Constant(reach);
+      const Eigen::Vector3d hi = pose.translation + Eigen::Vector3d::Constant(reach);
+      DrawColliderShapes(
+          cr, header.dim, colliders, [&](const Eigen::Vector3d& q) { return view.Pixel(q); },
+          [&](const Eigen::Vector3d& q) { return -view.Depth(q); }, lo, hi, style.ui);
+    }
     if (side == 1 && has_scalp) DrawScalp(cr, view, scalp, style.ui);
     for (int layer = 0; layer < kLayers; ++layer) {
       const double haze = kHaze * (1.0 - (layer + 0.5) / kLayers);

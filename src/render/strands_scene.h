@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "flexkin/colliders.h"
 #include "flexkin/strand_file.h"
 #include "render/axes.h"
 #include "render/style.h"
@@ -69,8 +70,18 @@ struct StrandsStyle {
   Rgb background = kWhite;  // what far strands fade toward
 };
 
+// The colliders a strand figure draws beside the scalp, at the body pose `pose`: the body colliders
+// placed by it (all but the scalp's own, which the scalp's shading shows) and the world colliders.
+std::vector<Collider> FigureColliders(const StrandFileHeader& header, const BodyPose& pose);
+
+// Grows `bounds` by the surfaces of `colliders` (not half-spaces, which have no end).
+void IncludeColliders(const StrandsView& view, const std::vector<Collider>& colliders,
+                      ViewBounds* bounds);
+
 // Draws one frame: `points` (P by dim, the file's layout) of the strands `strands` (indices
-// into header.offsets), and the scalp of `header` at `pose`.
+// into header.offsets), the scalp of `header` at `pose`, and its other colliders
+// (FigureColliders), in the collider grey after the pieces of strand on the hidden side of the
+// scalp and before the scalp.
 void DrawStrandsFrame(cairo_t* cr, const StrandsView& view, const StrandFileHeader& header,
                       const std::vector<int>& strands, const Points& points, const BodyPose& pose,
                       const StrandsStyle& style, StrandsWork* work);

@@ -54,8 +54,12 @@ void CheckOutsideColliders(const Chain& chain, const Points& leader_steps,
     if (colliders[c].margin > 0.0) {
       name += " grown by the link radius " + FormatNumber(colliders[c].margin);
     }
+    // A moving collider where its motion has it at the start (time 0); its path is checked
+    // sub-step by sub-step during the run (ChainMover::PlaceColliders).
+    const Collider collider = ColliderAt(colliders[c], 0.0);
+    if (colliders[c].motion) name += " at time 0 of its motion";
     for (Eigen::Index i = 0; i < chain.points.rows(); ++i) {
-      const double clearance = QuerySurface(colliders[c], at(chain.points.row(i))).distance;
+      const double clearance = QuerySurface(collider, at(chain.points.row(i))).distance;
       if (clearance < -internal::kContactSlack * shortest) {
         throw InputError("points[" + std::to_string(i) + "]",
                          "lies inside " + name + " by " + depth_text(clearance) +
@@ -63,7 +67,7 @@ void CheckOutsideColliders(const Chain& chain, const Points& leader_steps,
       }
     }
     for (Eigen::Index i = 1; i < chain.points.rows(); ++i) {
-      const double clearance = internal::SegmentClearance(colliders[c], at(chain.points.row(i - 1)),
+      const double clearance = internal::SegmentClearance(collider, at(chain.points.row(i - 1)),
                                                           at(chain.points.row(i)));
       if (clearance < -internal::kContactSlack * chain.lengths[i - 1]) {
         throw InputError("points[" + std::to_string(i) + "]",
@@ -73,6 +77,7 @@ void CheckOutsideColliders(const Chain& chain, const Points& leader_steps,
                              " deep; the chain must start outside every collider");
       }
     }
+    if (colliders[c].motion) continue;
     Eigen::Vector3d from = at(chain.points.row(0));
     for (Eigen::Index s = 0; s < leader_steps.rows(); ++s) {
       const Eigen::Vector3d to = at(leader_steps.row(s));
@@ -141,10 +146,17 @@ void Record(const OverallReport& report, int64_t step, int substep, OverallRunRe
 class ChainMover {
  public:
   ChainMover(const Chain& chain, const Points& leader_steps, const RunOptions& options,
-             RunResult* result)
-      : lengths_(chain.lengths), options_(options), result_(result) {
+             int substeps, RunResult* result)
+      : lengths_(chain.lengths),
+        options_(options),
+        result_(result),
+        moving_(AnyMoves(options.colliders)),
+        posed_(moving_ ? options.colliders : std::vector<Collider>()),
+        substeps_(substeps),
+        shortest_(chain.lengths.minCoeff()) {
+    const std::vector<Collider>& colliders = moving_ ? posed_ : options.colliders;
     if (options.method == Method::kFollowPath) {
-      follow_path_.emplace(chain, leader_steps, options.colliders);
+      follow_path_.emplace(chain, leader_steps, colliders);
     } else if (options.method == Method::kOverall) {
       internal::CheckOverallOptionsForChain(options.overall, chain.dim());
       workspace_.emplace();
@@ -153,12 +165,13 @@ class ChainMover {
     }
   }
   void Step(const Eigen::VectorXd& head, int64_t step, int substep, Points* points) {
+    if (moving_) PlaceColliders(head, step, substep);
     if (follow_path_) {
       follow_path_->Step(head, step, points);
     } else if (!options_.colliders.empty()) {
       internal::ContactSweep(stepper_->method, stepper_->dim, head.data(), stepper_->lengths.data(),
                              stepper_->inv_lengths.data(), static_cast<int>(lengths_.size()),
-                             points->data(), options_.colliders, &contacts_);
+                             points->data(), moving_ ? posed_ : options_.colliders, &contacts_);
       result_->contacts.contact_link_steps = contacts_.contact_link_steps;
       result_->contacts.least_clearance = contacts_.least_clearance;
     } else if (!stepper_) {
@@ -167,6 +180,29 @@ class ChainMover {
       Record(report_, step, substep, &result_->overall);
     } else {
       MoveLeader(*stepper_, head, 1, points);
+    }
+  }
+  // The keyframed colliders at the time of sub-step `substep` of leader step `step` (1-based):
+  // step - 1 + substep / substeps (docs/colliders.md, "Moving colliders"); and the leading end,
+  // which no rule moves aside, outside each of them (follow_path measures instead).
+  void PlaceColliders(const Eigen::VectorXd& head, int64_t step, int substep) {
+    const double time = double(step - 1) + double(substep) / double(substeps_);
+    const Eigen::Vector3d lead(head[0], head[1], head.size() == 3 ? head[2] : 0.0);
+    for (size_t c = 0; c < posed_.size(); ++c) {
+      if (!options_.colliders[c].motion) continue;
+      posed_[c] = ColliderAt(options_.colliders[c], time);
+      if (follow_path_) continue;
+      const double clearance = QuerySurface(posed_[c], lead).distance;
+      if (clearance < -internal::kContactSlack * shortest_) {
+        throw InputError("leader_steps[" + std::to_string(step - 1) + "]",
+                         "colliders[" + std::to_string(c) + "] (" +
+                             ColliderShapeName(posed_[c].shape) +
+                             ", moving) reaches the leading end at sub-step " +
+                             std::to_string(substep) + " of this leader step (time " +
+                             FormatNumber(time) + "), " + FormatNumber(-clearance) +
+                             " deep; the leading end must stay outside every collider "
+                             "at every sub-step");
+      }
     }
   }
   // After leader step `step` (1-based): the follow_path report.
@@ -178,6 +214,10 @@ class ChainMover {
   const Eigen::VectorXd& lengths_;
   const RunOptions& options_;
   RunResult* result_;
+  const bool moving_;            // some collider has a motion
+  std::vector<Collider> posed_;  // then every collider at the current sub-step's time
+  const int substeps_;
+  const double shortest_;  // link
   std::optional<Stepper> stepper_;
   std::optional<OverallWorkspace> workspace_;
   std::optional<internal::FollowPathMover> follow_path_;
@@ -318,7 +358,7 @@ RunResult RunOn(const Chain& chain, const Points& leader_steps, const RunOptions
     if (options.progress) pipeline.after_chunk = report_progress;
     pipeline.Advance(num_steps, recorded, on_frame);
   } else {
-    ChainMover mover(chain, leader_steps, options, &result);
+    ChainMover mover(chain, leader_steps, options, substeps, &result);
     MetricsAccumulator metrics(chain.lengths, num_steps, &result.metrics);
     Eigen::VectorXd direction = first_direction;
     Points points = chain.points, before;

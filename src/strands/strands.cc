@@ -664,41 +664,21 @@ Problems StrandOptions::Validate() const {
     problems.push_back(
         Problem::Invalid("threads", std::to_string(threads), "an integer from 0 to 1024"));
   }
-  for (size_t i = 0; i < colliders.size(); ++i) {
-    for (Problem& p : CheckCollider(colliders[i], "colliders[" + std::to_string(i) + "]")) {
-      problems.push_back(std::move(p));
+  const auto check = [&](const std::vector<Collider>& list, const std::string& name) {
+    for (size_t i = 0; i < list.size(); ++i) {
+      const std::string field = name + "[" + std::to_string(i) + "]";
+      for (Problem& p : CheckCollider(list[i], field)) problems.push_back(std::move(p));
+      if (list[i].motion) {
+        problems.emplace_back(field + ".motion",
+                              "is not supported for strands yet; body colliders move with the "
+                              "body, and keyframed colliders are for chain runs",
+                              "a motion", "a collider without \"motion\"");
+      }
     }
-  }
-  for (size_t i = 0; i < body_colliders.size(); ++i) {
-    for (Problem& p :
-         CheckCollider(body_colliders[i], "body_colliders[" + std::to_string(i) + "]")) {
-      problems.push_back(std::move(p));
-    }
-  }
+  };
+  check(colliders, "colliders");
+  check(body_colliders, "body_colliders");
   return problems;
-}
-
-BodyPose BodyPose::FromQuaternion(double w, double x, double y, double z,
-                                  const Eigen::Vector3d& translation) {
-  const double norm = std::sqrt(w * w + x * x + y * y + z * z);
-  if (!(norm > 0.0) || !std::isfinite(norm)) {
-    throw InputError("quaternion", "must be finite and not zero");
-  }
-  w /= norm, x /= norm, y /= norm, z /= norm;
-  BodyPose pose;
-  pose.rotation << 1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-      2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x), 2 * (x * z - w * y),
-      2 * (y * z + w * x), 1 - 2 * (x * x + y * y);
-  pose.translation = translation;
-  return pose;
-}
-
-BodyPose BodyPose::Planar(double angle, double tx, double ty) {
-  BodyPose pose;
-  const double c = std::cos(angle), s = std::sin(angle);
-  pose.rotation << c, -s, 0, s, c, 0, 0, 0, 1;
-  pose.translation << tx, ty, 0.0;
-  return pose;
 }
 
 namespace {

@@ -326,6 +326,75 @@
     gl.bindVertexArray(null);
   }
 
+  // The groom's other colliders (a neck, shoulders, a floor; strands_viewer.cc): triangulated
+  // surfaces, the body's placed by each frame's pose, the world's where they are, in the colliders'
+  // grey (that of the figures), lit as the scalp is. Shown with the scalp.
+  const colliderMeshes = dim === 3 && Array.isArray(meta.colliders) ? meta.colliders : [];
+  const colliderGrey = [0.80, 0.80, 0.78];
+  const colliderProgram = compile(`#version 300 es
+    layout(location = 0) in vec3 position;
+    layout(location = 1) in vec3 vertexNormal;
+    uniform vec3 translation;
+    uniform mat3 rotation;
+    uniform mat4 viewMatrix, projection;
+    out vec3 normal;
+    out vec3 toEye;
+    void main() {
+      vec4 v = viewMatrix * vec4(rotation * position + translation, 1.0);
+      gl_Position = projection * v;
+      normal = mat3(viewMatrix) * rotation * vertexNormal;
+      toEye = -v.xyz;
+    }`, `#version 300 es
+    precision mediump float;
+    in vec3 normal;
+    in vec3 toEye;
+    out vec4 outColor;
+    void main() {
+      vec3 n = normalize(normal);
+      vec3 l = normalize(normalize(toEye) + vec3(0.3, 0.5, 0.0));
+      float diffuse = abs(dot(n, l));
+      outColor = vec4(vec3(0.80, 0.80, 0.78) * (0.35 + 0.65 * diffuse), 1.0);
+    }`);
+  // Per mesh: its VAO and index count, and (for the software renderer) its triangles' normals.
+  const colliderParts = [];
+  function buildColliders() {
+    for (const mesh of colliderMeshes) {
+      const v = mesh.vertices, tri = mesh.triangles;
+      const normals = new Float32Array(v.length), faces = new Float64Array(tri.length);
+      for (let k = 0; k < tri.length; k += 3) {
+        const a = 3 * tri[k], b = 3 * tri[k + 1], c = 3 * tri[k + 2];
+        const ux = v[b] - v[a], uy = v[b + 1] - v[a + 1], uz = v[b + 2] - v[a + 2];
+        const wx = v[c] - v[a], wy = v[c + 1] - v[a + 1], wz = v[c + 2] - v[a + 2];
+        const n = [uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx];  // area-weighted
+        for (const at of [a, b, c]) for (let j = 0; j < 3; ++j) normals[at + j] += n[j];
+        const len = Math.hypot(n[0], n[1], n[2]) || 1;
+        for (let j = 0; j < 3; ++j) faces[k + j] = n[j] / len;
+      }
+      const vao = gl.createVertexArray();
+      gl.bindVertexArray(vao);
+      gl.bindBuffer(gl.ARRAY_BUFFER, gl.createBuffer());
+      gl.bufferData(gl.ARRAY_BUFFER, new Float32Array(v), gl.STATIC_DRAW);
+      gl.enableVertexAttribArray(0);
+      gl.vertexAttribPointer(0, 3, gl.FLOAT, false, 0, 0);
+      gl.bindBuffer(gl.ARRAY_BUFFER, gl.createBuffer());
+      gl.bufferData(gl.ARRAY_BUFFER, normals, gl.STATIC_DRAW);
+      gl.enableVertexAttribArray(1);
+      gl.vertexAttribPointer(1, 3, gl.FLOAT, false, 0, 0);
+      gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, gl.createBuffer());
+      gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, new Uint32Array(tri), gl.STATIC_DRAW);
+      gl.bindVertexArray(null);
+      colliderParts.push({ vao, count: tri.length, body: mesh.body, vertices: v, triangles: tri,
+                           faces });
+    }
+  }
+  // The body pose between stored frames a and b (rotation row-major, as in the data).
+  function bodyPose(a, b, t) {
+    const fa = meta.frames[a], fb = meta.frames[b];
+    return { R: fa.rotation.map((x, i) => x + t * (fb.rotation[i] - x)),
+             T: fa.translation.map((x, i) => x + t * (fb.translation[i] - x)) };
+  }
+  const identityPose = { R: [1, 0, 0, 0, 1, 0, 0, 0, 1], T: [0, 0, 0] };
+
   // ----- State ------------------------------------------------------------------------------------
   const state = {
     position: 0,  // frames, fractional while blending
@@ -442,6 +511,20 @@
       gl.bindVertexArray(scalpVao);
       gl.drawElements(gl.TRIANGLES, scalpIndices, gl.UNSIGNED_SHORT, 0);
     }
+    if (colliderParts.length > 0 && state.showScalp) {
+      const body = bodyPose(a, b, t);
+      const u = colliderProgram.uniforms;
+      gl.useProgram(colliderProgram.program);
+      gl.uniformMatrix4fv(u.viewMatrix, false, cam.view);
+      gl.uniformMatrix4fv(u.projection, false, cam.projection);
+      for (const part of colliderParts) {
+        const pose = part.body ? body : identityPose;
+        gl.uniformMatrix3fv(u.rotation, true, pose.R);
+        gl.uniform3fv(u.translation, pose.T);
+        gl.bindVertexArray(part.vao);
+        gl.drawElements(gl.TRIANGLES, part.count, gl.UNSIGNED_INT, 0);
+      }
+    }
     const u = strandProgram.uniforms;
     gl.useProgram(strandProgram.program);
     gl.uniform3fv(u.loA, box(a, 'lo'));
@@ -536,6 +619,7 @@
     pixels32.fill(backgroundPacked);
     depths.fill(Infinity);
     if (scalp && state.showScalp) castScalp(cam, a, b, t);
+    if (colliderParts.length > 0 && state.showScalp) fillColliders(cam, a, b, t);
 
     const M = multiply(cam.projection, cam.view);
     const m0 = M[0], m4 = M[4], m8 = M[8], m12 = M[12];
@@ -671,6 +755,71 @@
         const diffuse = Math.max(0, (vx * hx + vy * hy + vz * hz) / (vn * hn));
         const k = 0.35 + 0.65 * diffuse;
         pixels32[at] = pack(0.80 * k, 0.70 * k, 0.62 * k);
+      }
+    }
+  }
+
+  // The colliders into the software picture: each triangle placed (by the body pose for the
+  // body's), projected and filled where it is nearer than what is there (depth: the view distance,
+  // interpolated in 1/w as the GPU does), shaded flat by its normal with the shader's light.
+  // Triangles reaching behind the near plane are left out.
+  function fillColliders(cam, a, b, t) {
+    const W = width, H = height;
+    const M = multiply(cam.projection, cam.view), V = cam.view;
+    const body = bodyPose(a, b, t);
+    const near = cam.near;
+    const sx = new Float64Array(3), sy = new Float64Array(3), iw = new Float64Array(3);
+    const wp = [new Float64Array(3), new Float64Array(3), new Float64Array(3)];
+    for (const part of colliderParts) {
+      const { R, T } = part.body ? body : identityPose;
+      const v = part.vertices, tri = part.triangles, faces = part.faces;
+      for (let k = 0; k < tri.length; k += 3) {
+        let behind = false;
+        for (let c = 0; c < 3; ++c) {
+          const at = 3 * tri[k + c];
+          const p = wp[c];
+          for (let j = 0; j < 3; ++j) {
+            p[j] = R[3 * j] * v[at] + R[3 * j + 1] * v[at + 1] + R[3 * j + 2] * v[at + 2] + T[j];
+          }
+          const cw = M[3] * p[0] + M[7] * p[1] + M[11] * p[2] + M[15];
+          if (cw <= near) { behind = true; break; }
+          sx[c] = ((M[0] * p[0] + M[4] * p[1] + M[8] * p[2] + M[12]) / cw + 1) * W / 2;
+          sy[c] = (1 - (M[1] * p[0] + M[5] * p[1] + M[9] * p[2] + M[13]) / cw) * H / 2;
+          iw[c] = 1 / cw;
+        }
+        if (behind) continue;
+        const area = (sx[1] - sx[0]) * (sy[2] - sy[0]) - (sx[2] - sx[0]) * (sy[1] - sy[0]);
+        if (area === 0) continue;
+        // Flat shade: the face's normal and the way to the eye from its centre, in view space.
+        const fn = [0, 1, 2].map((j) => R[3 * j] * faces[k] + R[3 * j + 1] * faces[k + 1] +
+                                        R[3 * j + 2] * faces[k + 2]);
+        const n = [0, 1, 2].map((j) => V[j] * fn[0] + V[4 + j] * fn[1] + V[8 + j] * fn[2]);
+        const mid = [0, 1, 2].map((j) => (wp[0][j] + wp[1][j] + wp[2][j]) / 3);
+        const e = [0, 1, 2].map((j) => -(V[j] * mid[0] + V[4 + j] * mid[1] + V[8 + j] * mid[2] +
+                                         V[12 + j]));
+        const en = Math.hypot(e[0], e[1], e[2]) || 1;
+        const l = normalize([e[0] / en + 0.3, e[1] / en + 0.5, e[2] / en]);
+        const nn = Math.hypot(n[0], n[1], n[2]) || 1;
+        const shade = 0.35 + 0.65 * Math.abs((n[0] * l[0] + n[1] * l[1] + n[2] * l[2]) / nn);
+        const col = pack(colliderGrey[0] * shade, colliderGrey[1] * shade, colliderGrey[2] * shade);
+        const x0 = Math.max(0, Math.floor(Math.min(sx[0], sx[1], sx[2])));
+        const x1 = Math.min(W - 1, Math.ceil(Math.max(sx[0], sx[1], sx[2])));
+        const y0 = Math.max(0, Math.floor(Math.min(sy[0], sy[1], sy[2])));
+        const y1 = Math.min(H - 1, Math.ceil(Math.max(sy[0], sy[1], sy[2])));
+        const inv = 1 / area;
+        for (let py = y0; py <= y1; ++py) {
+          const y = py + 0.5;
+          for (let px = x0; px <= x1; ++px) {
+            const x = px + 0.5;
+            const b0 = ((sx[1] - x) * (sy[2] - y) - (sx[2] - x) * (sy[1] - y)) * inv;
+            const b1 = ((sx[2] - x) * (sy[0] - y) - (sx[0] - x) * (sy[2] - y)) * inv;
+            const b2 = 1 - b0 - b1;
+            if (b0 < 0 || b1 < 0 || b2 < 0) continue;
+            const depth = 1 / (b0 * iw[0] + b1 * iw[1] + b2 * iw[2]);
+            const at = py * W + px;
+            if (depth < depths[at]) { depths[at] = depth; pixels32[at] = col; }
+          }
+        }
       }
     }
   }
@@ -814,7 +963,7 @@
       if (!state.blend) setPosition(Math.floor(state.position), false);
       requestDraw();
     });
-    $('scalp-control').hidden = !scalp;
+    $('scalp-control').hidden = !scalp && colliderParts.length === 0;
     $('scalp').addEventListener('change', () => { state.showScalp = $('scalp').checked; requestDraw(); });
     common.bindView(canvas, dim, view, {
       // In units of the view's half height.
@@ -841,15 +990,20 @@
       d = new Uint8Array(width * height * 4);
       gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, d);
     }
-    let hash = 2166136261, drawn = 0;
+    let hash = 2166136261, drawn = 0, grey = 0;
     const colors = new Set();
     for (let i = 0; i < d.length; i += 4) {
       const v = (d[i] << 16) | (d[i + 1] << 8) | d[i + 2];
       hash = Math.imul(hash ^ v, 16777619) >>> 0;
       if (v !== 0xfbfbfd) drawn += 1;
       if (colors.size < 64) colors.add(v);
+      // The colliders' grey, lit: red and green equal, blue a little below (not the warm scalp,
+      // the coloured strands or the bluish background).
+      const rb = d[i] - d[i + 2];
+      if (Math.abs(d[i] - d[i + 1]) <= 2 && rb >= 0 && rb <= 6 && d[i] < 240) grey += 1;
     }
-    return { hash, drawnFraction: drawn / (d.length / 4), colors: colors.size };
+    return { hash, drawnFraction: drawn / (d.length / 4), colors: colors.size,
+             colliderFraction: grey / (d.length / 4) };
   };
   // Point i (over the embedded strands) of stored frame k, as both renderers read it.
   api.point = (k, i) => {
@@ -869,6 +1023,7 @@
     codes = all;
     buildStrands();
     if (scalp) buildScalp();
+    buildColliders();
     setSpeed(1);
     state.blend = $('blend').checked;
     state.renderer = softwareGl && numPoints - numStrands >= softwareFrom ? 'software' : 'webgl';

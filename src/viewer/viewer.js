@@ -248,7 +248,7 @@
     g.fillRect(0, 0, background.width, background.height);
     g.setTransform(pixelRatio, 0, 0, pixelRatio, 0, 0);
     if (dim === 2) drawGrid2d(g); else drawGrid3d(g);
-    drawColliders(g);
+    drawColliders(g, stillColliders, 0);
     if (state.showLeader && numFrames > 1) {
       // The whole leader path, faint and dashed; the part travelled is drawn on top per frame.
       g.strokeStyle = colors.leader;
@@ -281,13 +281,26 @@
   }
 
   // The colliders under everything else, far to near: each the hull of its projected points.
-  function drawColliders(g) {
-    if (colliders.length === 0) return;
-    const shapes = colliders.map((c) => {
+  // The background holds those that stay; keyframed ones ("moves": per frame a rotation, row by
+  // row, and a translation that carry their points from frame 0) are drawn with each frame.
+  const movingColliders = colliders.filter((c) => c.moves);
+  const stillColliders = colliders.filter((c) => !c.moves);
+  function drawColliders(g, list, frame) {
+    if (list.length === 0) return;
+    const shapes = list.map((c) => {
       const projected = [];
       let depth = 0;
+      const m = c.moves ? c.moves.slice(12 * frame, 12 * frame + 12) : null;
       for (let j = 0; j < c.points.length; j += dim) {
-        project(c.points[j], c.points[j + 1], dim === 3 ? c.points[j + 2] : 0);
+        let x = c.points[j], y = c.points[j + 1], z = dim === 3 ? c.points[j + 2] : 0;
+        if (m) {
+          const mx = m[0] * x + m[1] * y + m[2] * z + m[9];
+          const my = m[3] * x + m[4] * y + m[5] * z + m[10];
+          z = m[6] * x + m[7] * y + m[8] * z + m[11];
+          x = mx;
+          y = my;
+        }
+        project(x, y, z);
         projected.push([sx, sy]);
         depth += sdepth;
       }
@@ -408,6 +421,7 @@
     g.setTransform(1, 0, 0, 1, 0, 0);
     g.drawImage(background, 0, 0);
     g.setTransform(pixelRatio, 0, 0, pixelRatio, 0, 0);
+    drawColliders(g, movingColliders, state.frame);
     g.lineCap = 'round';
     g.lineJoin = 'round';
     if (state.showLeader && state.frame > 0) {

@@ -356,7 +356,135 @@ std::vector<Problem> CheckCollider(const Collider& c, const std::string& field) 
     problems.emplace_back(child("pose"),
                           "is not a rotation (orthonormal, determinant +1) and a translation");
   }
+  if (c.motion) {
+    const std::vector<BodyKeyframe>& keys = c.motion->keyframes;
+    const std::string motion = child("motion");
+    const auto key = [&](size_t k, const char* name) {
+      return motion + (pointer ? "/keyframes/" + std::to_string(k) + "/" + name
+                               : ".keyframes[" + std::to_string(k) + "]." + name);
+    };
+    if (keys.empty()) {
+      problems.emplace_back(motion + (pointer ? "/keyframes" : ".keyframes"),
+                            "is empty; expected at least 1 keyframe", "[]", "at least 1 keyframe");
+    }
+    for (size_t k = 0; k < keys.size(); ++k) {
+      const BodyPose& p = keys[k].pose;
+      if (!std::isfinite(keys[k].time)) {
+        problems.push_back(Problem::Invalid(key(k, "time"), Num(keys[k].time), "a finite number"));
+      } else if (k > 0 && std::isfinite(keys[k - 1].time) && !(keys[k].time > keys[k - 1].time)) {
+        problems.push_back(Problem::Invalid(key(k, "time"), Num(keys[k].time),
+                                            "a time above " + Num(keys[k - 1].time) +
+                                                ", the keyframe before's (strictly increasing)"));
+      }
+      if (!p.rotation.allFinite() || !p.translation.allFinite()) {
+        problems.emplace_back(key(k, "pose"), "has a value that is not a finite number");
+      } else if ((p.rotation.transpose() * p.rotation - Eigen::Matrix3d::Identity())
+                         .cwiseAbs()
+                         .maxCoeff() > 1e-9 ||
+                 p.rotation.determinant() < 0.0) {
+        problems.emplace_back(key(k, "pose"),
+                              "is not a rotation (orthonormal, determinant +1) and a translation");
+      }
+    }
+  }
   return problems;
+}
+
+BodyPose BodyPose::FromQuaternion(double w, double x, double y, double z,
+                                  const Eigen::Vector3d& translation) {
+  const double norm = std::sqrt(w * w + x * x + y * y + z * z);
+  if (!(norm > 0.0) || !std::isfinite(norm)) {
+    throw InputError("quaternion", "must be finite and not zero");
+  }
+  w /= norm, x /= norm, y /= norm, z /= norm;
+  BodyPose pose;
+  pose.rotation << 1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+      2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x), 2 * (x * z - w * y),
+      2 * (y * z + w * x), 1 - 2 * (x * x + y * y);
+  pose.translation = translation;
+  return pose;
+}
+
+BodyPose BodyPose::Planar(double angle, double tx, double ty) {
+  BodyPose pose;
+  const double c = std::cos(angle), s = std::sin(angle);
+  pose.rotation << c, -s, 0, s, c, 0, 0, 0, 1;
+  pose.translation << tx, ty, 0.0;
+  return pose;
+}
+
+BodyPose InterpolateKeyframes(const std::vector<BodyKeyframe>& keyframes,
+                              KeyframeInterpolation interpolation, double t) {
+  if (keyframes.empty()) return {};
+  // The segment [k - 1, k] holding t: the first keyframe whose time is not below t.
+  const auto after = std::lower_bound(
+      keyframes.begin(), keyframes.end(), t,
+      [](const BodyKeyframe& keyframe, double time) { return keyframe.time < time; });
+  if (after == keyframes.end()) return keyframes.back().pose;
+  if (after == keyframes.begin() || after->time == t) return after->pose;
+  const BodyKeyframe& a = *(after - 1);
+  const BodyKeyframe& b = *after;
+  const double u = (t - a.time) / (b.time - a.time);
+  // Within 1e-12 of a keyframe (the rounding of first + frame / fps) the keyframe itself.
+  if (u <= 1e-12) return a.pose;
+  if (u >= 1.0 - 1e-12) return b.pose;
+  const double s = interpolation == KeyframeInterpolation::kLinear ? u : u * u * (3.0 - 2.0 * u);
+
+  // A part that does not change between the keyframes stays exactly as it is (a body that rests
+  // moves nothing; a pure turn does not shift, a pure shift does not turn).
+  const Eigen::Vector3d translation =
+      a.pose.translation == b.pose.translation
+          ? a.pose.translation
+          : Eigen::Vector3d((1.0 - s) * a.pose.translation + s * b.pose.translation);
+  if (a.pose.rotation == b.pose.rotation) {
+    BodyPose pose = a.pose;
+    pose.translation = translation;
+    return pose;
+  }
+  const Eigen::Quaterniond qa = Eigen::Quaterniond(a.pose.rotation).normalized();
+  Eigen::Quaterniond qb = Eigen::Quaterniond(b.pose.rotation).normalized();
+  double d = qa.coeffs().dot(qb.coeffs());
+  if (d < 0.0) {  // q and -q are the same rotation: take the shorter arc
+    qb.coeffs() = -qb.coeffs();
+    d = -d;
+  }
+  Eigen::Vector4d q;  // (x, y, z, w), Eigen's order
+  if (d > 1.0 - 1e-12) {
+    q = (1.0 - s) * qa.coeffs() + s * qb.coeffs();
+  } else {
+    const double angle = std::acos(d);
+    const double sin_angle = std::sin(angle);
+    q = (std::sin((1.0 - s) * angle) / sin_angle) * qa.coeffs() +
+        (std::sin(s * angle) / sin_angle) * qb.coeffs();
+  }
+  return BodyPose::FromQuaternion(q[3], q[0], q[1], q[2], translation);
+}
+
+Collider ColliderAt(const Collider& collider, double time) {
+  if (!collider.motion) return collider;
+  Collider at = collider;
+  at.motion = nullptr;
+  const BodyPose carried =
+      InterpolateKeyframes(collider.motion->keyframes, collider.motion->interpolation, time);
+  Eigen::Isometry3d frame = Eigen::Isometry3d::Identity();
+  frame.linear() = carried.rotation;
+  frame.translation() = carried.translation;
+  at.pose = frame * collider.pose;
+  return at;
+}
+
+std::vector<Collider> CollidersAt(const std::vector<Collider>& colliders, double time) {
+  std::vector<Collider> at;
+  at.reserve(colliders.size());
+  for (const Collider& c : colliders) at.push_back(ColliderAt(c, time));
+  return at;
+}
+
+bool AnyMoves(const std::vector<Collider>& colliders) {
+  for (const Collider& c : colliders) {
+    if (c.motion) return true;
+  }
+  return false;
 }
 
 }  // namespace flexkin

@@ -192,6 +192,29 @@ async function checkPage(browser, file) {
     check(renderer === 'software', `${name}: the software renderer is chosen (${renderer})`);
   }
 
+  // The groom's colliders beside the scalp (a neck): both renderers draw them in the colliders'
+  // grey, and hiding the scalp hides them too.
+  const colliders = await page.evaluate(() => (JSON.parse(
+      document.getElementById('flexkin-strands').textContent).colliders || []).length);
+  if (colliders > 0) {
+    await page.click('#play');
+    await page.keyboard.press('Home');
+    for (const name2 of ['webgl', 'software']) {
+      await page.evaluate((r) => window.flexkinStrandsViewer.setRenderer(r), name2);
+      const shown = await picture(page);
+      await page.click('#scalp');
+      const hidden = await picture(page);
+      await page.click('#scalp');
+      check(shown.colliderFraction > 0.003 && hidden.colliderFraction < 0.2 * shown.colliderFraction,
+            `${name}: ${colliders} collider(s) drawn by the ${name2} renderer ` +
+            `(${(100 * shown.colliderFraction).toFixed(2)}% of the picture; ` +
+            `${(100 * hidden.colliderFraction).toFixed(2)}% with the scalp hidden)`);
+      await page.screenshot({ path: join(outDir, `${name}-colliders-${name2}.png`) });
+    }
+    await page.evaluate((r) => window.flexkinStrandsViewer.setRenderer(r), renderer);
+    await page.click('#play');
+  }
+
   // G switches renderers; both draw the same strands, so about as many pixels.
   await page.click('#play');
   await page.keyboard.press('Home');
