@@ -134,19 +134,7 @@ class TailSearch {
     for (const Collider& c : colliders) {
       if (c.shape == ColliderShape::kMesh) rounds_ = std::numeric_limits<size_t>::max() - 1;
     }
-    // What a link may lie inside each convex collider: the slack, or, where the rounding of an
-    // earlier contact step left the head itself inside by a hair more, twice the head's depth,
-    // so that the directions leading out of the collider are not held against the link.
-    allowed_.reserve(colliders.size());
-    for (const Collider& c : colliders) {
-      double allowed = -kContactSlack * length;
-      if (c.shape != ColliderShape::kMesh) {
-        const double depth =
-            std::fmin(QuerySurface(c, head).distance, SegmentClearance(c, head, head));
-        if (depth > -1e-9 * length) allowed = std::fmin(allowed, 2.0 * depth);
-      }
-      allowed_.push_back(allowed);
-    }
+    allowed_.assign(colliders.size(), std::numeric_limits<double>::quiet_NaN());
   }
 
   Vector3d Tail(double theta, double psi) const { return head_ + length_ * dirs_.At(theta, psi); }
@@ -160,7 +148,26 @@ class TailSearch {
                                to_local * Tail(theta, psi) / c.scale,
                                (c.margin - 0.25 * kContactSlack * length_) / c.scale);
     }
-    return SegmentClearance(c, head_, Tail(theta, psi)) < allowed_[&c - colliders_.data()];
+    const double clearance = SegmentClearance(c, head_, Tail(theta, psi));
+    // Within the slack: clear, whatever the head's own depth allows (Allowed is never above it).
+    if (clearance >= -kContactSlack * length_) return false;
+    return clearance < Allowed(static_cast<size_t>(&c - colliders_.data()));
+  }
+
+  // What a link may lie inside convex collider k: the slack, or, where the rounding of an earlier
+  // contact step left the head itself inside by a hair more, twice the head's depth, so that the
+  // directions leading out of the collider are not held against the link. Computed when first
+  // needed (a collider the link does not reach never needs it).
+  double Allowed(size_t k) const {
+    double& allowed = allowed_[k];
+    if (std::isnan(allowed)) {
+      const Collider& c = colliders_[k];
+      allowed = -kContactSlack * length_;
+      const double depth =
+          std::fmin(QuerySurface(c, head_).distance, SegmentClearance(c, head_, head_));
+      if (depth > -1e-9 * length_) allowed = std::fmin(allowed, 2.0 * depth);
+    }
+    return allowed;
   }
 
   // The least angle theta along the half great circle psi at which no collider blocks the link
@@ -219,8 +226,8 @@ class TailSearch {
   const double length_;
   const std::vector<Collider>& colliders_;
   const Directions& dirs_;
-  size_t rounds_ = colliders_.size();  // each convex collider is passed at most once
-  std::vector<double> allowed_;        // per collider: the least clearance a link may have
+  size_t rounds_ = colliders_.size();    // each convex collider is passed at most once
+  mutable std::vector<double> allowed_;  // per collider: the least clearance a link may have
 };
 
 // The least exit angle near *psi (a sample no larger than its neighbours kStep away, whose exit

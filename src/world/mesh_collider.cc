@@ -204,28 +204,26 @@ struct Nearest {
   int face = -1, feature = -1;
 };
 
-// Only triangles nearer than `bound` are looked at (none found: best.face stays -1).
-Nearest NearestToPoint(const ColliderMeshData& m, const Vector3d& p,
-                       double bound = std::numeric_limits<double>::infinity()) {
-  const MeshBvh& h = *m.bvh;
+// The branch and bound both nearest searches share: nodes visited nearest-first by `box_bound`
+// (a lower bound of the distance to anything in an oriented box), pruned where that bound, less
+// the hierarchy's padding, is not below the best distance so far; `leaf(face, &best)` measures
+// a triangle and returns true to end the search.
+template <class BoxBound, class Leaf>
+Nearest SearchNearest(const MeshBvh& h, double bound, const BoxBound& box_bound, const Leaf& leaf) {
   Nearest best;
   best.distance = bound;
   NodeStack stack;
-  stack.push(0, PointBoxDistance(h.model.getBV(0).bv.obb, p));
+  stack.push(0, box_bound(h.model.getBV(0).bv.obb));
   while (!stack.empty()) {
     const auto [id, lower] = stack.pop();
     if (lower - h.pad >= best.distance) continue;
     const auto& node = h.model.getBV(id);
     if (node.isLeaf()) {
-      const int f = node.primitiveId();
-      const OnTriangle on = NearestOnTriangle(p, Corner(m, f, 0), Corner(m, f, 1), Corner(m, f, 2));
-      const double d = (p - on.point).norm();
-      if (d < best.distance) best = {d, on.point, f, on.feature};
+      if (leaf(node.primitiveId(), &best)) return best;
       continue;
     }
     const int l = node.leftChild(), r = node.rightChild();
-    const double dl = PointBoxDistance(h.model.getBV(l).bv.obb, p),
-                 dr = PointBoxDistance(h.model.getBV(r).bv.obb, p);
+    const double dl = box_bound(h.model.getBV(l).bv.obb), dr = box_bound(h.model.getBV(r).bv.obb);
     if (dl <= dr) {
       stack.push(r, dr), stack.push(l, dl);
     } else {
@@ -235,6 +233,20 @@ Nearest NearestToPoint(const ColliderMeshData& m, const Vector3d& p,
   return best;
 }
 
+// Only triangles nearer than `bound` are looked at (none found: best.face stays -1).
+Nearest NearestToPoint(const ColliderMeshData& m, const Vector3d& p,
+                       double bound = std::numeric_limits<double>::infinity()) {
+  return SearchNearest(
+      *m.bvh, bound, [&](const fcl::OBBd& box) { return PointBoxDistance(box, p); },
+      [&](int f, Nearest* best) {
+        const OnTriangle on =
+            NearestOnTriangle(p, Corner(m, f, 0), Corner(m, f, 1), Corner(m, f, 2));
+        const double d = (p - on.point).norm();
+        if (d < best->distance) *best = {d, on.point, f, on.feature};
+        return false;
+      });
+}
+
 // The same for the segment [a, b]: the closest pair (s: the segment's parameter). A triangle the
 // segment crosses is at distance 0.
 // With a `bound`, only triangles nearer than it are looked at, and the first found ends the
@@ -242,50 +254,30 @@ Nearest NearestToPoint(const ColliderMeshData& m, const Vector3d& p,
 Nearest NearestToSegment(const ColliderMeshData& m, const Vector3d& a, const Vector3d& b, double* s,
                          double bound = std::numeric_limits<double>::infinity(),
                          bool first = false) {
-  const MeshBvh& h = *m.bvh;
-  Nearest best;
-  best.distance = bound;
-  NodeStack stack;
-  stack.push(0, SegmentBoxBound(h.model.getBV(0).bv.obb, a, b));
-  while (!stack.empty()) {
-    const auto [id, lower] = stack.pop();
-    if (lower - h.pad >= best.distance) continue;
-    const auto& node = h.model.getBV(id);
-    if (node.isLeaf()) {
-      const int f = node.primitiveId();
-      const Vector3d v[3] = {Corner(m, f, 0), Corner(m, f, 1), Corner(m, f, 2)};
-      const auto consider = [&](double t, const OnTriangle& on) {
-        const double d = (a + t * (b - a) - on.point).norm();
-        if (d < best.distance) best = {d, on.point, f, on.feature}, *s = t;
-      };
-      const double crossing = CrossingOf(a, b, v[0], v[1], v[2]);
-      if (crossing >= 0.0) {
-        const Vector3d x = a + crossing * (b - a);
-        consider(crossing, NearestOnTriangle(x, v[0], v[1], v[2]));
-        if (first && best.face >= 0) return best;
-        continue;
-      }
-      consider(0.0, NearestOnTriangle(a, v[0], v[1], v[2]));
-      consider(1.0, NearestOnTriangle(b, v[0], v[1], v[2]));
-      for (int k = 0; k < 3; ++k) {
-        double t, u;
-        ClosestOnSegments(a, b, v[k], v[(k + 1) % 3], &t, &u);
-        const int feature = u <= 0.0 ? k : u >= 1.0 ? (k + 1) % 3 : 3 + k;
-        consider(t, {v[k] + u * (v[(k + 1) % 3] - v[k]), feature});
-      }
-      if (first && best.face >= 0) return best;
-      continue;
-    }
-    const int l = node.leftChild(), r = node.rightChild();
-    const double dl = SegmentBoxBound(h.model.getBV(l).bv.obb, a, b),
-                 dr = SegmentBoxBound(h.model.getBV(r).bv.obb, a, b);
-    if (dl <= dr) {
-      stack.push(r, dr), stack.push(l, dl);
-    } else {
-      stack.push(l, dl), stack.push(r, dr);
-    }
-  }
-  return best;
+  return SearchNearest(
+      *m.bvh, bound, [&](const fcl::OBBd& box) { return SegmentBoxBound(box, a, b); },
+      [&](int f, Nearest* best) {
+        const Vector3d v[3] = {Corner(m, f, 0), Corner(m, f, 1), Corner(m, f, 2)};
+        const auto consider = [&](double t, const OnTriangle& on) {
+          const double d = (a + t * (b - a) - on.point).norm();
+          if (d < best->distance) *best = {d, on.point, f, on.feature}, *s = t;
+        };
+        const double crossing = CrossingOf(a, b, v[0], v[1], v[2]);
+        if (crossing >= 0.0) {
+          const Vector3d x = a + crossing * (b - a);
+          consider(crossing, NearestOnTriangle(x, v[0], v[1], v[2]));
+          return first && best->face >= 0;
+        }
+        consider(0.0, NearestOnTriangle(a, v[0], v[1], v[2]));
+        consider(1.0, NearestOnTriangle(b, v[0], v[1], v[2]));
+        for (int k = 0; k < 3; ++k) {
+          double t, u;
+          ClosestOnSegments(a, b, v[k], v[(k + 1) % 3], &t, &u);
+          const int feature = u <= 0.0 ? k : u >= 1.0 ? (k + 1) % 3 : 3 + k;
+          consider(t, {v[k] + u * (v[(k + 1) % 3] - v[k]), feature});
+        }
+        return first && best->face >= 0;
+      });
 }
 
 // The parameters at which [a, b] crosses a triangle, with the triangle, sorted.
