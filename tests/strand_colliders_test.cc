@@ -331,6 +331,73 @@ TEST(StrandCollidersTest, BadCollidersAndRootStepsAreRefused) {
   }
 }
 
+// A keyframed world collider (Collider::motion, times in seconds as given to StepStrands): a
+// ball swept through hanging strands at every sub-step's time pushes them aside; no free link is
+// ever inside it where its motion has it at the frame's time, lengths are kept; a body collider
+// refuses a motion; a start inside where the motion starts it is refused.
+TEST(StrandCollidersTest, AKeyframedWorldColliderSweepsThroughHangingStrands) {
+  std::vector<Points> strands;
+  for (int i = 0; i < 12; ++i) {
+    Points p(11, 3);
+    for (int j = 0; j <= 10; ++j) p.row(j) << 0.05 * i, 0.0, -0.1 * j;
+    strands.push_back(p);
+  }
+  Collider ball = Sphere(Vector3d(0.3, 0.0, -0.6), 0.2);
+  auto motion = std::make_shared<ColliderMotion>();
+  motion->keyframes.resize(2);
+  motion->keyframes[0].time = 0.0;
+  motion->keyframes[0].pose.translation = Vector3d(0.0, -0.8, 0.0);
+  motion->keyframes[1].time = 1.0;
+  motion->keyframes[1].pose.translation = Vector3d(0.0, 0.8, 0.0);
+  motion->interpolation = KeyframeInterpolation::kLinear;
+  ball.motion = motion;
+  for (int substeps : {1, 3}) {
+    StrandOptions options;
+    options.substeps = substeps;
+    options.colliders = {ball};
+    StrandBatch batch(strands, options);
+    double least = 1e300, moved = 0.0, worst_length = 0.0;
+    for (int f = 1; f <= 60; ++f) {
+      const double time = f / 60.0;
+      StepStrands(&batch, BodyPose(), time);
+      const Collider at = ColliderAt(ball, time);
+      for (int i = 0; i < batch.size(); ++i) {
+        const Points p = batch.strand(i);
+        for (Eigen::Index j = 1; j < p.rows(); ++j) {
+          least = std::min(least, collider_test::SampledDistance(at, collider_test::At(p, j - 1),
+                                                                 collider_test::At(p, j), 200));
+          worst_length = std::max(worst_length, std::abs((p.row(j) - p.row(j - 1)).norm() - 0.1));
+        }
+        moved = std::max(moved, (p - strands[i]).rowwise().norm().maxCoeff());
+      }
+    }
+    SCOPED_TRACE("substeps " + std::to_string(substeps));
+    EXPECT_GE(least, -1e-12 * 0.1);
+    EXPECT_LT(worst_length, 1e-13);
+    EXPECT_GT(moved, 0.15);  // pushed aside (the ball crosses where the strands hang)
+    EXPECT_GT(batch.contacts().contact_link_steps, 0);
+  }
+  // The same ball without its motion (where its own pose puts it, through the strands) is
+  // refused at the start; with the motion it starts 0.8 away.
+  StrandOptions still;
+  still.colliders = {ball};
+  still.colliders[0].motion = nullptr;
+  EXPECT_THROW(StrandBatch(strands, still), InputError);
+  // Where the motion starts it inside (time 0.5: on the strands), the start is refused.
+  StrandOptions moving;
+  moving.colliders = {ball};
+  EXPECT_THROW(StrandBatch(strands, moving, BodyPose(), 0.5), InputError);
+  // A body collider moves with the body: a motion is refused by name.
+  StrandOptions body;
+  body.body_colliders = {ball};
+  try {
+    StrandBatch batch(strands, body);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problem().field, "body_colliders[0].motion") << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace flexkin
 
@@ -389,6 +456,36 @@ TEST(GroomCollidersTest, AStartInsideNamesTheColliderTheRootAndThePoint) {
     FAIL() << "no error";
   } catch (const InputError& e) {
     EXPECT_EQ(e.problem().field, "/colliders/0/radius") << e.what();
+  }
+}
+
+// A groom's world collider may be keyframed (times in seconds, the body motion's clock); one that
+// moves with the body may not.
+TEST(GroomCollidersTest, AKeyframedWorldColliderIsReadAndRunAndABodyOneRefused) {
+  const GroomScenario s = ParseGroomText(HeadGroom("[]", R"(, "world_colliders": [
+      {"shape": "sphere", "center": [0.22, -0.6, 0.05], "radius": 0.06,
+       "motion": {"interpolation": "linear", "keyframes": [
+         {"time": 0, "translation": [0, 0, 0]}, {"time": 1, "translation": [0, 0.9, 0]}]}}])"));
+  ASSERT_EQ(s.options.colliders.size(), 1u);
+  ASSERT_NE(s.options.colliders[0].motion, nullptr);
+  const StrandRunReport report = RunGroom(s, nullptr);
+  EXPECT_GT(report.contact_link_steps, 0);
+  EXPECT_GE(report.least_clearance, -1e-12);
+  EXPECT_LT(report.max_length_error, 1e-13);
+  try {
+    ParseGroomText(HeadGroom(R"([{"shape": "sphere", "center": [0, 0, -0.5], "radius": 0.05,
+        "motion": {"keyframes": [{"time": 0}]}}])"));
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problem().field, "/colliders/0/motion") << e.what();
+  }
+  try {
+    ParseGroomText(HeadGroom("[]", R"(, "world_colliders": [{"shape": "sphere",
+        "center": [0, 0, -0.5], "radius": 0.05,
+        "motion": {"keyframes": [{"time": 1}, {"time": 0.5}]}}])"));
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problem().field, "/world_colliders/0/motion/keyframes/1/time") << e.what();
   }
 }
 

@@ -468,7 +468,7 @@ TEST_F(StrandsRenderTest, DISABLED_Timing) {
     canvas.Clear();
     const double start = cpu_ms();
     render::DrawStrandsFrame(canvas.cr(), view, reader.header(), all, frame.points, frame.pose,
-                             style, &work);
+                             frame.time, style, &work);
     cairo_surface_flush(canvas.surface());
     drawing += cpu_ms() - start;
   }

@@ -42,7 +42,9 @@ struct StrandOptions {
   int threads = 1;
   // Colliders the free points and links of every strand stay outside of (docs/colliders.md):
   // `body_colliders` are in body coordinates and move with the body (a groom's scalp, a neck);
-  // `colliders` stay where they are in the world. A link whose rule step would enter one takes
+  // `colliders` are in the world: where they are, or carried by their keyframed motion
+  // (Collider::motion; times those given to the batch and to StepStrands, a groom's seconds), at
+  // each sub-step's time between the frames'. A link whose rule step would enter one takes
   // the least-motion step that keeps it outside instead; a strand that touches nothing is
   // stepped exactly as without colliders. With body colliders and sub-steps > 1 the pinned
   // points follow the body's own motion between frames (the rotation interpolated by slerp, the
@@ -87,8 +89,10 @@ struct StrandInside {
 // The first free point or link of `strands` (at the body pose `rest`, body colliders placed at
 // it) that lies inside a collider of `options` by more than 1e-13 of its link's length; none if
 // every strand starts outside. StrandBatch refuses such a start.
+// Keyframed world colliders are placed at `time`.
 std::optional<StrandInside> FindStrandInside(const std::vector<Points>& strands,
-                                             const StrandOptions& options, const BodyPose& rest);
+                                             const StrandOptions& options, const BodyPose& rest,
+                                             double time = 0.0);
 
 namespace internal {
 struct StrandBatchImpl;
@@ -101,9 +105,10 @@ class StrandBatch {
   // valid chain (ValidateChain: n_i >= 1, finite, links of positive length) and all of one dim
   // (2 or 3). The strands are taken to be at the body pose `rest` (identity by default): their
   // first `pinned` points are kept in body coordinates from these. Throws InputError naming
-  // "strands[i]" or an option's field.
+  // "strands[i]" or an option's field. `time` is the time of `rest`, at which keyframed world
+  // colliders are placed (and the start is checked against them).
   StrandBatch(const std::vector<Points>& strands, const StrandOptions& options = {},
-              const BodyPose& rest = {});
+              const BodyPose& rest = {}, double time = 0.0);
   StrandBatch(StrandBatch&&) noexcept;
   StrandBatch& operator=(StrandBatch&&) noexcept;
   ~StrandBatch();
@@ -131,6 +136,10 @@ class StrandBatch {
 // coordinates) and the rest follows. Allocates nothing. Throws InputError ("pose.rotation",
 // "pose.translation") for a non-finite pose or a rotation that is not one.
 void StepStrands(StrandBatch* batch, const BodyPose& pose);
+// The same, the frame at `time`: keyframed world colliders are placed at each sub-step's time,
+// from the last frame's time (the batch's `time` for the first) to `time`, linearly. Throws
+// InputError ("time") for a time that is not finite. Without a time (above), the last one stays.
+void StepStrands(StrandBatch* batch, const BodyPose& pose, double time);
 
 // One frame: root i moves to `roots.row(i)` (S by dim); the strand's other pinned points (k > 1)
 // translate with it. Allocates nothing. Throws InputError ("roots") for a wrong shape or a

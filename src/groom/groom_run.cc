@@ -68,7 +68,8 @@ StrandRunReport RunGroom(const GroomScenario& scenario, StrandFileWriter* writer
   const BodyMotion& motion = scenario.motion;
   const int64_t frames = motion.num_frames();
   const BodyPose start = motion.PoseAt(0);
-  StrandBatch batch(Placed(scenario.strands, scenario.dim, start), scenario.options, start);
+  StrandBatch batch(Placed(scenario.strands, scenario.dim, start), scenario.options, start,
+                    motion.TimeOf(0));
   // The batch keeps the pinned points in body coordinates, q = R^T (p - t), which the pose maps
   // back to p only to rounding: one step to the same pose settles them (a move of a few ulps),
   // so that frame 0 is what a body that stays there keeps, bit for bit.
@@ -101,7 +102,7 @@ StrandRunReport RunGroom(const GroomScenario& scenario, StrandFileWriter* writer
   for (int64_t f = 1; f < frames; ++f) {
     const BodyPose pose = motion.PoseAt(f);
     const Clock::time_point t0 = Clock::now();
-    StepStrands(&batch, pose);
+    StepStrands(&batch, pose, motion.TimeOf(f));
     stepping += Clock::now() - t0;
     if (Recorded(f, frames, scenario.record_every)) record(f, pose);
     if (progress && !progress(f + 1, frames)) {

@@ -117,10 +117,21 @@ class GroomParser : public json_internal::JsonReader {
     }
     if (dim != 0) {
       if (const json* c = Find(root, "colliders")) {
-        s.options.body_colliders = ReadCollidersJson(*c, "/colliders", dim, &problems, directory);
+        s.options.body_colliders =
+            ReadCollidersJson(*c, "/colliders", dim, &problems, directory, "seconds");
+        // They move with the body: a keyframed collider is a world collider.
+        for (size_t i = 0; i < s.options.body_colliders.size(); ++i) {
+          if (!s.options.body_colliders[i].motion) continue;
+          Add("/colliders/" + std::to_string(i) + "/motion",
+              "is not valid for a collider that moves with the body; a keyframed collider is a "
+              "world collider (\"world_colliders\")",
+              "{...}", "no \"motion\" here");
+          s.options.body_colliders[i].motion = nullptr;
+        }
       }
       if (const json* c = Find(root, "world_colliders")) {
-        s.options.colliders = ReadCollidersJson(*c, "/world_colliders", dim, &problems, directory);
+        s.options.colliders =
+            ReadCollidersJson(*c, "/world_colliders", dim, &problems, directory, "seconds");
       }
     }
     if (!problems.empty()) return s;
@@ -177,7 +188,10 @@ class GroomParser : public json_internal::JsonReader {
       to_body.translation()[2] = 0.0;
     }
     to_body = to_body.inverse();
-    for (Collider& c : options.colliders) c.pose = to_body * c.pose;
+    for (Collider& c : options.colliders) {
+      c = ColliderAt(c, s.motion.TimeOf(0));  // a keyframed one where its motion starts it
+      c.pose = to_body * c.pose;
+    }
     const std::optional<StrandInside> in = FindStrandInside(s.strands, options, BodyPose());
     if (!in) return;
     const int num_body = static_cast<int>(s.options.body_colliders.size());

@@ -17,8 +17,11 @@ namespace flexkin {
 // every problem is appended to `problems`, named by JSON pointer under `ptr`
 // ("/colliders/1/radius"). A mesh's relative "file" is read from `directory` ("": the working
 // directory); a mesh given inline ("vertices", "triangles", as result files carry it) reads none.
+// A keyframed collider's "motion" has its times in `time_unit` (chains: "leader steps"; grooms
+// and strand files: "seconds").
 std::vector<Collider> ReadCollidersJson(const nlohmann::json& v, const std::string& ptr, int dim,
-                                        Problems* problems, const std::string& directory = "");
+                                        Problems* problems, const std::string& directory = "",
+                                        const char* time_unit = "leader steps");
 
 // The problems of colliders to be written in `dim` dimensions, fields "colliders[k]...": those of
 // CheckCollider, and, in 2D, a collider that the 2D form cannot say (a centre off the plane z = 0,

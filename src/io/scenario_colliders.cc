@@ -181,7 +181,7 @@ std::optional<Collider> Parser::ParseCollider(const json& v, const std::string& 
     const std::string mp = ptr + "/motion";
     if (ExpectObject(*m, mp, "an object {\"keyframes\": [...], \"interpolation\": \"smooth\"}")) {
       CheckKeys(*m, mp, {"interpolation", "keyframes"});
-      if (auto keys = ReadKeyframes(*m, mp, dim, "leader steps", kMaxLeaderSteps)) {
+      if (auto keys = ReadKeyframes(*m, mp, dim, motion_time_unit, kMaxLeaderSteps)) {
         auto motion = std::make_shared<ColliderMotion>();
         motion->keyframes = std::move(keys->first);
         motion->interpolation = keys->second;
@@ -282,9 +282,11 @@ void AppendKey(const char* key, std::string* out) {
 }  // namespace
 
 std::vector<Collider> ReadCollidersJson(const nlohmann::json& v, const std::string& ptr, int dim,
-                                        Problems* problems, const std::string& directory) {
+                                        Problems* problems, const std::string& directory,
+                                        const char* time_unit) {
   scenario_internal::Parser parser;
   parser.directory = directory;
+  parser.motion_time_unit = time_unit;
   std::vector<Collider> colliders;
   parser.ParseColliders(v, ptr, dim, &colliders, "the result");
   problems->insert(problems->end(), parser.problems.begin(), parser.problems.end());

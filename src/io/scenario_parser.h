@@ -45,6 +45,8 @@ class Parser : public json_internal::JsonReader {
   // Where a mesh collider's relative "file" is (the scenario file's directory; "": the working
   // directory).
   std::string directory;
+  // The unit of a keyframed collider's times, for messages ("leader steps"; grooms: "seconds").
+  const char* motion_time_unit = "leader steps";
 
  private:
   // A point list of the curve or the leader's path: at most kMaxLeaderSteps points.

@@ -370,7 +370,8 @@ StrandFileReader::StrandFileReader(const std::string& path) : impl_(std::make_un
     const auto it = j.find(key);
     if (it == j.end()) continue;
     Problems problems;
-    *list = ReadCollidersJson(*it, std::string("groom.json/") + key, h.dim, &problems);
+    *list =
+        ReadCollidersJson(*it, std::string("groom.json/") + key, h.dim, &problems, "", "seconds");
     ThrowIfAny(problems);
   }
   const nlohmann::json report = Get<nlohmann::json>(j, "report");

@@ -127,14 +127,14 @@ void CheckFinite(const Drawing& d, int f, const Points& points) {
 }
 
 void IncludeFrame(const Drawing& d, const StrandsView& view, const Points& points,
-                  const BodyPose& pose, ViewBounds* bounds) {
+                  const BodyPose& pose, double time, ViewBounds* bounds) {
   for (const int i : d.strands) {
     for (int64_t r = d.header->offsets[i]; r < d.header->offsets[i + 1]; ++r) {
       view.Include(view.Lift(points.row(r).data()), bounds);
     }
   }
   view.IncludeScalp(d.header->scalp, pose, bounds);
-  render::IncludeColliders(view, render::FigureColliders(*d.header, pose), bounds);
+  render::IncludeColliders(view, render::FigureColliders(*d.header, pose, time), bounds);
 }
 
 render::StrandsStyle StyleFor(const Drawing& d, const StrandsRenderOptions& options, double ui) {
@@ -272,7 +272,7 @@ void internal::RenderStrandsSnapshot(StrandFileReader* reader, const StrandsRend
 
   StrandsView view(d.header->dim, options.azimuth, options.elevation);
   ViewBounds bounds;
-  for (const StrandFrame& k : kept) IncludeFrame(d, view, k.points, k.pose, &bounds);
+  for (const StrandFrame& k : kept) IncludeFrame(d, view, k.points, k.pose, k.time, &bounds);
   constexpr double kMargin = 0.03;
 
   // A row of panels under the title, each with its time below it.
@@ -303,7 +303,8 @@ void internal::RenderStrandsSnapshot(StrandFileReader* reader, const StrandsRend
   for (int p = 0; p < n; ++p) {
     const render::Rect area{p * panel_w + pad, top, panel_w - 2 * pad, height - top - bottom};
     view.Fit(bounds, kMargin, area);
-    DrawStrandsFrame(cr, view, *d.header, d.strands, kept[p].points, kept[p].pose, style, &work);
+    DrawStrandsFrame(cr, view, *d.header, d.strands, kept[p].points, kept[p].pose, kept[p].time,
+                     style, &work);
     std::string text = Seconds(kept[p].time);
     const double angle = AngleBetween(kept[p].pose.rotation, info.front().pose.rotation);
     if (panels[p] > 0 && angle >= 0.5) {
@@ -353,7 +354,7 @@ void internal::RenderStrandsAnimation(StrandFileReader* reader, const StrandsRen
     for (const Eigen::Vector3d& q : sample)
       view.Include(pose.rotation * q + pose.translation, &bounds);
     view.IncludeScalp(d.header->scalp, pose, &bounds);
-    render::IncludeColliders(view, render::FigureColliders(*d.header, pose), &bounds);
+    render::IncludeColliders(view, render::FigureColliders(*d.header, pose, info[f].time), &bounds);
   }
   constexpr double kMargin = 0.06;
   const int width = (options.width != 0 ? options.width : 960) + (options.width % 2);
@@ -399,7 +400,8 @@ void internal::RenderStrandsAnimation(StrandFileReader* reader, const StrandsRen
         cairo_t* cr = picture.cr();
         cairo_set_source_surface(cr, background.surface(), 0, 0);
         cairo_paint(cr);
-        DrawStrandsFrame(cr, view, *d.header, d.strands, frame.points, frame.pose, style, &work);
+        DrawStrandsFrame(cr, view, *d.header, d.strands, frame.points, frame.pose, frame.time,
+                         style, &work);
         render::DrawText(cr, width - 10 * ui, height - 8 * ui, Seconds(frame.time), counter);
         out->pixels = picture.Pixels();
         out->stride = picture.Stride();

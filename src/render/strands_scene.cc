@@ -265,13 +265,14 @@ void StrandsView::IncludeScalp(const ScalpShape& scalp, const BodyPose& pose, Vi
   b->d1 = std::max(b->d1, Depth(e.center) + dd);
 }
 
-std::vector<Collider> FigureColliders(const StrandFileHeader& header, const BodyPose& pose) {
+std::vector<Collider> FigureColliders(const StrandFileHeader& header, const BodyPose& pose,
+                                      double time) {
   Eigen::Isometry3d body = Eigen::Isometry3d::Identity();
   body.linear() = pose.rotation;
   body.translation() = pose.translation;
   std::vector<Collider> colliders = BodyCollidersBesideScalp(header);
   for (Collider& c : colliders) c.pose = body * c.pose;
-  colliders.insert(colliders.end(), header.world_colliders.begin(), header.world_colliders.end());
+  for (const Collider& c : header.world_colliders) colliders.push_back(ColliderAt(c, time));
   return colliders;
 }
 
@@ -315,7 +316,7 @@ double StrandsView::Nearness(double depth) const {
 
 void DrawStrandsFrame(cairo_t* cr, const StrandsView& view, const StrandFileHeader& header,
                       const std::vector<int>& strands, const Points& points, const BodyPose& pose,
-                      const StrandsStyle& style, StrandsWork* work) {
+                      double time, const StrandsStyle& style, StrandsWork* work) {
   const bool has_scalp = !header.scalp.shape.empty();
   const Ellipsoid scalp = has_scalp ? PosedScalp(header.dim, header.scalp, pose) : Ellipsoid{};
   // FacingSide's normal, once per frame.
@@ -369,7 +370,7 @@ void DrawStrandsFrame(cairo_t* cr, const StrandsView& view, const StrandFileHead
   cairo_save(cr);
   cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
   cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
-  const std::vector<Collider> colliders = FigureColliders(header, pose);
+  const std::vector<Collider> colliders = FigureColliders(header, pose, time);
   for (int side = 0; side < 2; ++side) {
     if (side == 1 && !colliders.empty()) {
       // A half-space's plane is cut to a box about the body, far wider than any picture of it.

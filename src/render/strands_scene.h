@@ -70,9 +70,11 @@ struct StrandsStyle {
   Rgb background = kWhite;  // what far strands fade toward
 };
 
-// The colliders a strand figure draws beside the scalp, at the body pose `pose`: the body colliders
-// placed by it (all but the scalp's own, which the scalp's shading shows) and the world colliders.
-std::vector<Collider> FigureColliders(const StrandFileHeader& header, const BodyPose& pose);
+// The colliders a strand figure draws beside the scalp, at the body pose `pose` and the time
+// `time` (seconds): the body colliders placed by the pose (all but the scalp's own, which the
+// scalp's shading shows) and the world colliders (keyframed ones where their motion has them).
+std::vector<Collider> FigureColliders(const StrandFileHeader& header, const BodyPose& pose,
+                                      double time);
 
 // Grows `bounds` by the surfaces of `colliders` (not half-spaces, which have no end).
 void IncludeColliders(const StrandsView& view, const std::vector<Collider>& colliders,
@@ -84,6 +86,6 @@ void IncludeColliders(const StrandsView& view, const std::vector<Collider>& coll
 // scalp and before the scalp.
 void DrawStrandsFrame(cairo_t* cr, const StrandsView& view, const StrandFileHeader& header,
                       const std::vector<int>& strands, const Points& points, const BodyPose& pose,
-                      const StrandsStyle& style, StrandsWork* work);
+                      double time, const StrandsStyle& style, StrandsWork* work);
 
 }  // namespace flexkin::render

@@ -251,6 +251,8 @@ struct StrandBatchImpl {
   std::vector<char> lone_sphere;
   std::vector<StrandSphere> spheres;
   BodyPose last_pose;
+  // The last frame's time and the one being stepped (keyframed world colliders).
+  double last_time = 0.0, frame_time = 0.0;
   std::vector<ContactScratch> contact;  // per thread
   StrandContacts contacts;
 
@@ -668,11 +670,11 @@ Problems StrandOptions::Validate() const {
     for (size_t i = 0; i < list.size(); ++i) {
       const std::string field = name + "[" + std::to_string(i) + "]";
       for (Problem& p : CheckCollider(list[i], field)) problems.push_back(std::move(p));
-      if (list[i].motion) {
+      if (list[i].motion && &list == &body_colliders) {
         problems.emplace_back(field + ".motion",
-                              "is not supported for strands yet; body colliders move with the "
-                              "body, and keyframed colliders are for chain runs",
-                              "a motion", "a collider without \"motion\"");
+                              "is not valid for a body collider, which moves with the body; "
+                              "keyframed colliders are world colliders (\"colliders\")",
+                              "a motion", "a body collider without \"motion\"");
       }
     }
   };
@@ -742,7 +744,10 @@ void StrandBatchImpl::PlaceColliders(const BodyPose* frame_pose) {
     }
     const Eigen::Isometry3d body_to_world = IsometryOf(at, dim);
     std::vector<Collider>& out = placed[s - 1];
-    for (size_t j = 0; j < world.size(); ++j) out[j] = world[j];
+    const double time = s == S ? frame_time : last_time + (frame_time - last_time) * s / S;
+    for (size_t j = 0; j < world.size(); ++j) {
+      out[j] = world[j].motion ? ColliderAt(world[j], time) : world[j];
+    }
     for (size_t j = 0; j < attached.size(); ++j) {
       out[world.size() + j] = attached[j];
       out[world.size() + j].pose = body_to_world * attached[j].pose;
@@ -768,8 +773,8 @@ namespace {
 // Refuses strands that start inside a collider, naming the strand, the point or link, the
 // collider and the depth.
 void CheckStart(const std::vector<Points>& strands, const StrandOptions& options,
-                const BodyPose& rest) {
-  const std::optional<StrandInside> inside = FindStrandInside(strands, options, rest);
+                const BodyPose& rest, double time) {
+  const std::optional<StrandInside> inside = FindStrandInside(strands, options, rest, time);
   if (!inside) return;
   const StrandInside& in = *inside;
   const std::vector<Collider>& list = in.body ? options.body_colliders : options.colliders;
@@ -789,8 +794,10 @@ void CheckStart(const std::vector<Points>& strands, const StrandOptions& options
 }  // namespace
 
 StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions& options,
-                         const BodyPose& rest)
+                         const BodyPose& rest, double time)
     : impl_(std::make_unique<internal::StrandBatchImpl>()) {
+  if (!std::isfinite(time)) throw InputError("time", "is not finite");
+  impl_->last_time = impl_->frame_time = time;
   using internal::L;
   ThrowIfAny(options.Validate());
   auto& m = *impl_;
@@ -909,7 +916,7 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
     m.spheres.assign(S, internal::StrandSphere());
     if (!options.body_colliders.empty() && S > 1) m.substep_poses.resize(S);
     m.PlaceColliders(&rest);
-    CheckStart(strands, options, rest);
+    CheckStart(strands, options, rest, time);
     int most_links = 0;
     for (int n : m.links) most_links = std::max(most_links, n);
     m.contact.resize(threads);
@@ -931,9 +938,10 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
 }
 
 std::optional<StrandInside> FindStrandInside(const std::vector<Points>& strands,
-                                             const StrandOptions& options, const BodyPose& rest) {
+                                             const StrandOptions& options, const BodyPose& rest,
+                                             double time) {
   const size_t num_world = options.colliders.size();
-  std::vector<Collider> colliders = options.colliders;
+  std::vector<Collider> colliders = CollidersAt(options.colliders, time);
   for (const Collider& c : options.body_colliders) {
     colliders.push_back(c);
     const int dim = strands.empty() ? 3 : static_cast<int>(strands[0].cols());
@@ -1005,15 +1013,22 @@ Points StrandBatch::strand(int strand) const {
 }
 
 void StepStrands(StrandBatch* batch, const BodyPose& pose) {
+  StepStrands(batch, pose, batch->impl().last_time);
+}
+
+void StepStrands(StrandBatch* batch, const BodyPose& pose, double time) {
   auto& m = batch->impl();
+  if (!std::isfinite(time)) throw InputError("time", "is not finite");
   if (m.blocks.empty()) return;
   ValidatePose(pose, m.dim);
   m.pose = &pose;
   m.roots = nullptr;
+  m.frame_time = time;
   if (m.has_colliders) m.PlaceColliders(&pose);
   m.pool->Run(internal::StrandBatchImpl::Job, &m);
   m.pose = nullptr;
   m.last_pose = pose;
+  m.last_time = time;
   m.GatherContacts();
 }
 

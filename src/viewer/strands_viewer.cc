@@ -131,6 +131,23 @@ void CheckFinite(bool ok, const std::string& field, const std::string& what) {
 
 std::string MegabytesText(double bytes) { return FormatNumber(std::round(bytes / 1e5) / 10); }
 
+// Per keyframed world collider (in order), its motion's pose at `time` as 12 numbers: the
+// rotation row by row, then the translation.
+nlohmann::json ColliderMoves(const StrandFileHeader& h, double time) {
+  nlohmann::json moves = nlohmann::json::array();
+  for (const Collider& c : h.world_colliders) {
+    if (!c.motion) continue;
+    const BodyPose p = InterpolateKeyframes(c.motion->keyframes, c.motion->interpolation, time);
+    std::vector<double> m;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) m.push_back(p.rotation(i, j));
+    }
+    for (int i = 0; i < 3; ++i) m.push_back(p.translation[i]);
+    moves.push_back(m);
+  }
+  return moves;
+}
+
 // The colliders the page draws beside the scalp (3D): each body collider but the scalp's own, in
 // body coordinates ("body": true, placed by each frame's pose), and each world collider, as a
 // triangulated surface: "vertices" (x, y, z, ...) and "triangles" (i, j, k, ..., counter-clockwise
@@ -159,7 +176,13 @@ nlohmann::json CollidersOfHeader(const StrandFileHeader& h) {
                     {"triangles", triangles}});
   };
   for (const Collider& c : BodyCollidersBesideScalp(h)) add(c, true);
-  for (const Collider& c : h.world_colliders) add(c, false);
+  int moving = 0;
+  for (const Collider& c : h.world_colliders) {
+    add(c, false);
+    // A keyframed one: its surface where its own pose puts it; each frame's "collider_moves"
+    // carries it by its motion's pose at that frame's time.
+    if (c.motion) list.back()["moves"] = moving++;
+  }
   return list;
 }
 
@@ -360,6 +383,9 @@ void internal::WriteStrandsViewerHtml(StrandFileReader* reader, const StrandsVie
           {rotation(0, 0), rotation(0, 1), rotation(0, 2), rotation(1, 0), rotation(1, 1),
            rotation(1, 2), rotation(2, 0), rotation(2, 1), rotation(2, 2)}},
          {"translation", {translation.x(), translation.y(), translation.z()}}});
+    if (h.dim == 3 && AnyMoves(h.world_colliders)) {
+      frame_meta.back()["collider_moves"] = ColliderMoves(h, info[index].time);
+    }
   }
   meta["frames"] = std::move(frame_meta);
   meta["data_bytes"] = data_bytes;

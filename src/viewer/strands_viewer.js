@@ -383,8 +383,8 @@
       gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, gl.createBuffer());
       gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, new Uint32Array(tri), gl.STATIC_DRAW);
       gl.bindVertexArray(null);
-      colliderParts.push({ vao, count: tri.length, body: mesh.body, vertices: v, triangles: tri,
-                           faces });
+      colliderParts.push({ vao, count: tri.length, body: mesh.body, moves: mesh.moves,
+                           vertices: v, triangles: tri, faces });
     }
   }
   // The body pose between stored frames a and b (rotation row-major, as in the data).
@@ -394,6 +394,15 @@
              T: fa.translation.map((x, i) => x + t * (fb.translation[i] - x)) };
   }
   const identityPose = { R: [1, 0, 0, 0, 1, 0, 0, 0, 1], T: [0, 0, 0] };
+  // A part's pose between stored frames a and b: the body's, a keyframed world collider's
+  // (each frame's "collider_moves", blended as the body pose is), or none.
+  function partPose(part, body, a, b, t) {
+    if (part.body) return body;
+    if (part.moves === undefined) return identityPose;
+    const ma = meta.frames[a].collider_moves[part.moves], mb = meta.frames[b].collider_moves[part.moves];
+    const m = ma.map((x, i) => x + t * (mb[i] - x));
+    return { R: m.slice(0, 9), T: m.slice(9, 12) };
+  }
 
   // ----- State ------------------------------------------------------------------------------------
   const state = {
@@ -518,7 +527,7 @@
       gl.uniformMatrix4fv(u.viewMatrix, false, cam.view);
       gl.uniformMatrix4fv(u.projection, false, cam.projection);
       for (const part of colliderParts) {
-        const pose = part.body ? body : identityPose;
+        const pose = partPose(part, body, a, b, t);
         gl.uniformMatrix3fv(u.rotation, true, pose.R);
         gl.uniform3fv(u.translation, pose.T);
         gl.bindVertexArray(part.vao);
@@ -771,7 +780,7 @@
     const sx = new Float64Array(3), sy = new Float64Array(3), iw = new Float64Array(3);
     const wp = [new Float64Array(3), new Float64Array(3), new Float64Array(3)];
     for (const part of colliderParts) {
-      const { R, T } = part.body ? body : identityPose;
+      const { R, T } = partPose(part, body, a, b, t);
       const v = part.vertices, tri = part.triangles, faces = part.faces;
       for (let k = 0; k < tri.length; k += 3) {
         let behind = false;
