@@ -316,19 +316,9 @@ std::vector<std::pair<int, size_t>> AddColliders(const ResultFile& file, BufferW
 // which carry its surface from where the first frame has it.
 void AddColliderMotion(const ResultFile& file, const Collider& collider, int node, int input,
                        BufferWriter* buffer, tinygltf::Animation* animation) {
-  const auto carried = [&](const Frame& frame) {
-    const BodyPose p = InterpolateKeyframes(collider.motion->keyframes,
-                                            collider.motion->interpolation, double(frame.step));
-    Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
-    m.linear() = p.rotation;
-    m.translation() = p.translation;
-    return m;
-  };
-  const Frames& frames = file.result.frames;
-  const Eigen::Isometry3d to_first = carried(frames[0]).inverse();
+  const size_t frames = file.result.frames.size();
   std::vector<float> translations, rotations;
-  for (const Frame& frame : frames) {
-    const Eigen::Isometry3d t = carried(frame) * to_first;
+  for (const Eigen::Isometry3d& t : MovesFromFirstFrame(collider, file)) {
     Eigen::Quaterniond q(t.linear());
     q.normalize();
     for (int c = 0; c < 3; ++c) translations.push_back(static_cast<float>(t.translation()[c]));
@@ -337,10 +327,9 @@ void AddColliderMotion(const ResultFile& file, const Collider& collider, int nod
   const std::string name = "collider node " + std::to_string(node);
   const int translation =
       buffer->Accessor(buffer->View(translations, 0, name + " translation"), 0,
-                       TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, frames.size());
-  const int rotation =
-      buffer->Accessor(buffer->View(rotations, 0, name + " rotation"), 0,
-                       TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, frames.size());
+                       TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, frames);
+  const int rotation = buffer->Accessor(buffer->View(rotations, 0, name + " rotation"), 0,
+                                        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, frames);
   AddChannel(input, translation, node, "translation", animation);
   AddChannel(input, rotation, node, "rotation", animation);
 }

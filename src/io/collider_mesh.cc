@@ -335,4 +335,42 @@ std::vector<Collider> BodyCollidersBesideScalp(const StrandFileHeader& header) {
   return colliders;
 }
 
+void ExtendByColliderOverFrames(const Collider& collider, const ResultFile& file, int dim,
+                                const Eigen::Vector3d& center, Eigen::Vector3d* lo,
+                                Eigen::Vector3d* hi) {
+  if (!collider.motion) return ExtendByCollider(collider, dim, center, lo, hi);
+  const Frames& frames = file.result.frames;
+  const size_t count = frames.size();
+  const size_t every = std::max<size_t>(1, (count + 255) / 256);
+  for (size_t f = 0; f < count; f += every) {
+    ExtendByCollider(ColliderAt(collider, double(frames[f].step)), dim, center, lo, hi);
+  }
+  if (count > 0) {
+    ExtendByCollider(ColliderAt(collider, double(frames[count - 1].step)), dim, center, lo, hi);
+  }
+}
+
+Eigen::Isometry3d MotionPoseAt(const Collider& collider, double time) {
+  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+  if (!collider.motion) return m;
+  const BodyPose p =
+      InterpolateKeyframes(collider.motion->keyframes, collider.motion->interpolation, time);
+  m.linear() = p.rotation;
+  m.translation() = p.translation;
+  return m;
+}
+
+std::vector<Eigen::Isometry3d> MovesFromFirstFrame(const Collider& collider,
+                                                   const ResultFile& file) {
+  const Frames& frames = file.result.frames;
+  std::vector<Eigen::Isometry3d> moves;
+  if (frames.size() == 0) return moves;
+  const Eigen::Isometry3d to_first = MotionPoseAt(collider, double(frames[0].step)).inverse();
+  moves.reserve(frames.size());
+  for (const Frame& frame : frames) {
+    moves.push_back(MotionPoseAt(collider, double(frame.step)) * to_first);
+  }
+  return moves;
+}
+
 }  // namespace flexkin

@@ -6,7 +6,7 @@
 // viewer and glTF components, beside the colliders' JSON form (io/colliders_json.h). Private to
 // the library.
 
-#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <vector>
 
@@ -56,5 +56,21 @@ std::vector<Eigen::Vector3d> HalfSpacePlaneInBox(const Collider& half_space,
 // box's extent below it, so that its edge and a band of its solid are in view.
 void ExtendByCollider(const Collider& collider, int dim, const Eigen::Vector3d& center,
                       Eigen::Vector3d* lo, Eigen::Vector3d* hi);
+
+// The same for a collider shown with the recorded frames of `file`: a keyframed one wherever it
+// is in a frame (ColliderAt the frame's step; at most 256 frames, evenly, and the last).
+void ExtendByColliderOverFrames(const Collider& collider, const ResultFile& file, int dim,
+                                const Eigen::Vector3d& center, Eigen::Vector3d* lo,
+                                Eigen::Vector3d* hi);
+
+// The pose of a keyframed collider's motion at `time` (the identity without a motion): what
+// carries its own pose there (ColliderAt).
+Eigen::Isometry3d MotionPoseAt(const Collider& collider, double time);
+
+// Per recorded frame f of `file`, M(t_f) M(t_0)^-1 (M: the keyframed collider's MotionPoseAt,
+// t_f: frame f's step): the move that carries it from where the first frame has it, as the
+// viewer and glTF animate it.
+std::vector<Eigen::Isometry3d> MovesFromFirstFrame(const Collider& collider,
+                                                   const ResultFile& file);
 
 }  // namespace flexkin

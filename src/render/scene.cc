@@ -38,21 +38,7 @@ ChainScene::ChainScene(const ResultFile& file, const Rect& area, double ui, doub
   }
   const Eigen::Vector3d center = 0.5 * (lo_ + hi_);
   for (const Collider& collider : file.colliders) {
-    if (!collider.motion) {
-      ExtendByCollider(collider, dim_, center, &lo_, &hi_);
-      continue;
-    }
-    // A keyframed collider: wherever it is in a recorded frame (at most 256 of them, evenly).
-    const size_t count = file.result.frames.size();
-    const size_t every = std::max<size_t>(1, (count + 255) / 256);
-    for (size_t f = 0; f < count; f += every) {
-      const double time = double(file.result.frames[f].step);
-      ExtendByCollider(ColliderAt(collider, time), dim_, center, &lo_, &hi_);
-    }
-    if (count > 0) {
-      const double last = double(file.result.frames[count - 1].step);
-      ExtendByCollider(ColliderAt(collider, last), dim_, center, &lo_, &hi_);
-    }
+    ExtendByColliderOverFrames(collider, file, dim_, center, &lo_, &hi_);
   }
   const double extent = std::max((hi_ - lo_).maxCoeff(), 1e-12);
 

@@ -154,9 +154,8 @@ class ChainMover {
         posed_(moving_ ? options.colliders : std::vector<Collider>()),
         substeps_(substeps),
         shortest_(chain.lengths.minCoeff()) {
-    const std::vector<Collider>& colliders = moving_ ? posed_ : options.colliders;
     if (options.method == Method::kFollowPath) {
-      follow_path_.emplace(chain, leader_steps, colliders);
+      follow_path_.emplace(chain, leader_steps, colliders());
     } else if (options.method == Method::kOverall) {
       internal::CheckOverallOptionsForChain(options.overall, chain.dim());
       workspace_.emplace();
@@ -171,7 +170,7 @@ class ChainMover {
     } else if (!options_.colliders.empty()) {
       internal::ContactSweep(stepper_->method, stepper_->dim, head.data(), stepper_->lengths.data(),
                              stepper_->inv_lengths.data(), static_cast<int>(lengths_.size()),
-                             points->data(), moving_ ? posed_ : options_.colliders, &contacts_);
+                             points->data(), colliders(), &contacts_);
       result_->contacts.contact_link_steps = contacts_.contact_link_steps;
       result_->contacts.least_clearance = contacts_.least_clearance;
     } else if (!stepper_) {
@@ -205,6 +204,8 @@ class ChainMover {
       }
     }
   }
+  // The colliders as the current sub-step has them.
+  const std::vector<Collider>& colliders() const { return moving_ ? posed_ : options_.colliders; }
   // After leader step `step` (1-based): the follow_path report.
   void EndStep(int64_t step, const Points& points) {
     if (follow_path_) follow_path_->EndStep(step, points, result_);

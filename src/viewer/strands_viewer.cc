@@ -137,12 +137,12 @@ nlohmann::json ColliderMoves(const StrandFileHeader& h, double time) {
   nlohmann::json moves = nlohmann::json::array();
   for (const Collider& c : h.world_colliders) {
     if (!c.motion) continue;
-    const BodyPose p = InterpolateKeyframes(c.motion->keyframes, c.motion->interpolation, time);
+    const Eigen::Isometry3d p = MotionPoseAt(c, time);
     std::vector<double> m;
     for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) m.push_back(p.rotation(i, j));
+      for (int j = 0; j < 3; ++j) m.push_back(p.linear()(i, j));
     }
-    for (int i = 0; i < 3; ++i) m.push_back(p.translation[i]);
+    for (int i = 0; i < 3; ++i) m.push_back(p.translation()[i]);
     moves.push_back(m);
   }
   return moves;

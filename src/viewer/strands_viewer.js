@@ -220,6 +220,20 @@
     out vec4 outColor;
     void main() { outColor = vec4(color, 1.0); }`);
 
+  // The fragment shader of a lit surface (the scalp, the colliders): `color` (GLSL numbers r, g, b)
+  // lit from near the viewer, `diffuse` the cosine's expression (one-sided or two-sided).
+  const litSurface = (color, diffuse) => `#version 300 es
+    precision mediump float;
+    in vec3 normal;
+    in vec3 toEye;
+    out vec4 outColor;
+    void main() {
+      vec3 n = normalize(normal);
+      vec3 l = normalize(normalize(toEye) + vec3(0.3, 0.5, 0.0));
+      float diffuse = ${diffuse};
+      outColor = vec4(vec3(${color}) * (0.35 + 0.65 * diffuse), 1.0);
+    }`;
+
   // The scalp: a unit sphere scaled to the radii, placed by the body pose, lit from the viewer.
   const scalpProgram = compile(`#version 300 es
     layout(location = 0) in vec3 unit;
@@ -233,17 +247,7 @@
       gl_Position = projection * v;
       normal = mat3(viewMatrix) * rotation * normalize(unit / max(radii, vec3(1e-12)));
       toEye = -v.xyz;
-    }`, `#version 300 es
-    precision mediump float;
-    in vec3 normal;
-    in vec3 toEye;
-    out vec4 outColor;
-    void main() {
-      vec3 n = normalize(normal);
-      vec3 l = normalize(normalize(toEye) + vec3(0.3, 0.5, 0.0));
-      float diffuse = max(dot(n, l), 0.0);
-      outColor = vec4(vec3(0.80, 0.70, 0.62) * (0.35 + 0.65 * diffuse), 1.0);
-    }`);
+    }`, litSurface('0.80, 0.70, 0.62', 'max(dot(n, l), 0.0)'));
 
   // Static per-vertex data and the index of every link, built once.
   const strandVao = gl.createVertexArray();
@@ -344,17 +348,7 @@
       gl_Position = projection * v;
       normal = mat3(viewMatrix) * rotation * vertexNormal;
       toEye = -v.xyz;
-    }`, `#version 300 es
-    precision mediump float;
-    in vec3 normal;
-    in vec3 toEye;
-    out vec4 outColor;
-    void main() {
-      vec3 n = normalize(normal);
-      vec3 l = normalize(normalize(toEye) + vec3(0.3, 0.5, 0.0));
-      float diffuse = abs(dot(n, l));
-      outColor = vec4(vec3(0.80, 0.80, 0.78) * (0.35 + 0.65 * diffuse), 1.0);
-    }`);
+    }`, litSurface(colliderGrey.join(', '), 'abs(dot(n, l))'));
   // Per mesh: its VAO and index count, and (for the software renderer) its triangles' normals.
   const colliderParts = [];
   function buildColliders() {

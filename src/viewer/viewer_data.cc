@@ -91,23 +91,10 @@ void AppendColliders(const ResultFile& file, int digits, std::string* out) {
   Eigen::Vector3d lo, hi;
   BoundsOfMotion(file, &lo, &hi);
   const Eigen::Vector3d center = 0.5 * (lo + hi);
-  // A keyframed collider is placed at each recorded frame's time (at most 256 frames, evenly,
-  // and the last, for the bounds).
   const size_t num_frames = file.result.frames.size();
-  const size_t every = std::max<size_t>(1, (num_frames + 255) / 256);
-  const auto extend_over_motion = [&](const Collider& c, int dim, Eigen::Vector3d* lo_out,
-                                      Eigen::Vector3d* hi_out) {
-    if (!c.motion) return ExtendByCollider(c, dim, center, lo_out, hi_out);
-    for (size_t f = 0; f < num_frames; f += every) {
-      ExtendByCollider(ColliderAt(c, double(file.result.frames[f].step)), dim, center, lo_out,
-                       hi_out);
-    }
-    if (num_frames > 0) {
-      ExtendByCollider(ColliderAt(c, double(file.result.frames[num_frames - 1].step)), dim, center,
-                       lo_out, hi_out);
-    }
-  };
-  for (const Collider& c : file.colliders) extend_over_motion(c, file.dim, &lo, &hi);
+  for (const Collider& c : file.colliders) {
+    ExtendByColliderOverFrames(c, file, file.dim, center, &lo, &hi);
+  }
   const double half = 0.6 * std::max((hi - lo).maxCoeff(), 1e-3 * file.result.lengths.sum());
   const Eigen::Vector3d mid = 0.5 * (lo + hi);
   Eigen::Vector3d big_lo = mid - Eigen::Vector3d::Constant(half);
@@ -135,20 +122,9 @@ void AppendColliders(const ResultFile& file, int digits, std::string* out) {
                            ? ColliderAt(given, double(file.result.frames[0].step))
                            : given;
     if (given.motion) {
-      const auto carried = [&](size_t f) {
-        const BodyPose p =
-            InterpolateKeyframes(given.motion->keyframes, given.motion->interpolation,
-                                 double(file.result.frames[f].step));
-        Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
-        m.linear() = p.rotation;
-        m.translation() = p.translation;
-        return m;
-      };
-      const Eigen::Isometry3d to_first = carried(0).inverse();
       std::vector<double> moves;
       moves.reserve(12 * num_frames);
-      for (size_t f = 0; f < num_frames; ++f) {
-        const Eigen::Isometry3d t = carried(f) * to_first;
+      for (const Eigen::Isometry3d& t : MovesFromFirstFrame(given, file)) {
         for (int i = 0; i < 3; ++i) {
           for (int j = 0; j < 3; ++j) moves.push_back(t.linear()(i, j));
         }
@@ -158,7 +134,7 @@ void AppendColliders(const ResultFile& file, int digits, std::string* out) {
       numbers(moves);
     }
     Eigen::Vector3d c_lo = Eigen::Vector3d::Constant(HUGE_VAL), c_hi = -c_lo;
-    extend_over_motion(given, 3, &c_lo, &c_hi);
+    ExtendByColliderOverFrames(given, file, 3, center, &c_lo, &c_hi);
     if (file.dim == 2) c_lo.z() = c_hi.z() = 0.0;
     out->append(",\"bounds\":");
     numbers(std::vector<double>{c_lo.x(), c_lo.y(), c_lo.z(), c_hi.x(), c_hi.y(), c_hi.z()});
