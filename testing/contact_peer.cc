@@ -1,9 +1,9 @@
 #include "contact_peer.h"
 
-#include <IpIpoptApplication.hpp>
-#include <IpTNLP.hpp>
 #include <algorithm>
 #include <cmath>
+
+#include "ipopt_contact.h"
 
 namespace flexkin::peers {
 namespace {
@@ -105,19 +105,9 @@ bool IpoptContactTail(const Eigen::Vector3d& head, const Eigen::Vector3d& tail, 
                       const std::vector<SphereObstacle>& spheres, const Eigen::Vector3d& start,
                       Eigen::Vector3d* x) {
   Ipopt::SmartPtr<ContactNlp> nlp = new ContactNlp(head, tail, length, spheres, start);
-  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
-  app->Options()->SetNumericValue("tol", 1e-14);
-  app->Options()->SetNumericValue("constr_viol_tol", 1e-14);
-  app->Options()->SetStringValue("hessian_approximation", "limited-memory");
-  // The constraints as they are: IPOPT relaxes bounds by 1e-8 unless told not to.
-  app->Options()->SetNumericValue("bound_relax_factor", 0.0);
-  app->Options()->SetIntegerValue("print_level", 0);
-  app->Options()->SetStringValue("sb", "yes");
-  app->Options()->SetIntegerValue("max_iter", 3000);
-  if (app->Initialize() != Ipopt::Solve_Succeeded) return false;
-  const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(nlp);
+  const bool solved = SolveTightly(nlp, 3000);
   *x = nlp->solution;
-  return status == Ipopt::Solve_Succeeded || status == Ipopt::Solved_To_Acceptable_Level;
+  return solved;
 }
 
 }  // namespace flexkin::peers

@@ -308,7 +308,9 @@ TEST(ContactTest, BadInputIsRefusedByField) {
   refused(options, "colliders[0].radius");
   options.colliders = {Sphere(Vector3d(5.0, 0.0, 0.0), 1.0)};
   options.method = Method::kOverall;
-  refused(options, "does not take colliders yet");
+  options.overall.weights.l2 = 1.0;  // the overall method takes colliders with a smooth metric
+  refused(options, "overall.weights.l2");
+  options.overall.weights.l2 = 0.0;
   options.method = Method::kTractrix;
   options.tolerance = 1e-6;
   refused(options, "accuracy control does not account for colliders");

@@ -265,10 +265,12 @@ TEST(MovingCollidersTest, StartsAndMotionsThatAreNotValidAreRefusedByName) {
   problems = CheckCollider(c, "/colliders/0");
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_EQ(problems[0].field, "/colliders/0/motion/keyframes");
-  // Methods that take no colliders yet refuse a moving one as they refuse any.
+  // A metric that takes no colliders yet (the overall method's L2) refuses a moving one as it
+  // refuses any.
   c.motion = Slide(Vector3d::Zero(), Vector3d::UnitX(), 0.0, 1.0, KeyframeInterpolation::kLinear);
   options.colliders = {c};
   options.method = Method::kOverall;
+  options.overall.weights.l2 = 1.0;
   EXPECT_THROW(flexkin::Run(r.chain, r.path, options), InputError);
 }
 

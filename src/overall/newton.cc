@@ -15,14 +15,6 @@ int KktBand(const ObjectiveWeights& weights, int dim) {
   return weights.joint_angle > 0.0 ? 3 * dim + 1 : 2 * dim + 1;
 }
 
-// The sum of the weights, each scaled to a curvature (per unit length squared): the scale of the
-// metric's Hessian, for the optimality measure's rounding level and the curvature test.
-double WeightSum(const ObjectiveWeights& w, const Eigen::VectorXd& lengths) {
-  return w.squared + w.squared_weighted * lengths.maxCoeff() +
-         (w.rotation + w.l2 + w.l2_weighted * lengths.maxCoeff()) / lengths.minCoeff() +
-         w.joint_angle;
-}
-
 }  // namespace
 
 void NewtonBuffers::Reserve(int n, int dim, const ObjectiveWeights& weights) {

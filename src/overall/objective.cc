@@ -26,6 +26,12 @@ double L2Weight(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, int j
   return w.l2 + w.l2_weighted * 0.5 * (lengths[j - 1] + (j < n ? lengths[j] : 0.0));
 }
 
+double WeightSum(const ObjectiveWeights& w, const Eigen::VectorXd& lengths) {
+  return w.squared + w.squared_weighted * lengths.maxCoeff() +
+         (w.rotation + w.l2 + w.l2_weighted * lengths.maxCoeff()) / lengths.minCoeff() +
+         w.joint_angle;
+}
+
 double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const Points& old_points,
                 const Points& x, const Sink& sink, int last, double smoothing) {
   const int n = last < 0 ? static_cast<int>(lengths.size()) : last;

@@ -85,4 +85,8 @@ double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const
 // the trailing end).
 double L2Weight(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, int j);
 
+// The sum of the weights, each scaled to a curvature (per unit length squared): the scale of the
+// metric's Hessian, for the optimality measure's rounding level and the curvature test.
+double WeightSum(const ObjectiveWeights& w, const Eigen::VectorXd& lengths);
+
 }  // namespace flexkin::internal

@@ -10,6 +10,7 @@
 
 #include "chain/substep.h"
 #include "flexkin/error.h"
+#include "overall/contact_step.h"
 #include "overall/step.h"
 #include "run/follow_path.h"
 #include "run/sweep_pipeline.h"
@@ -167,6 +168,12 @@ class ChainMover {
     if (moving_) PlaceColliders(head, step, substep);
     if (follow_path_) {
       follow_path_->Step(head, step, points);
+    } else if (!stepper_ && !options_.colliders.empty()) {
+      internal::OverallContactStep(lengths_, head, options_.overall, colliders(), points,
+                                   &*workspace_, &contact_state_, &report_, &contacts_);
+      Record(report_, step, substep, &result_->overall);
+      result_->contacts.contact_link_steps = contacts_.contact_link_steps;
+      result_->contacts.least_clearance = contacts_.least_clearance;
     } else if (!options_.colliders.empty()) {
       internal::ContactSweep(stepper_->method, stepper_->dim, head.data(), stepper_->lengths.data(),
                              stepper_->inv_lengths.data(), static_cast<int>(lengths_.size()),
@@ -224,6 +231,7 @@ class ChainMover {
   std::optional<internal::FollowPathMover> follow_path_;
   OverallReport report_;
   internal::ContactStats contacts_;
+  internal::OverallContactState contact_state_;
 };
 
 // The metrics of a run (paper eq. 6 and Sec. 3.2), accumulated sub-step by sub-step.

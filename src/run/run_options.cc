@@ -49,14 +49,29 @@ Problems RunOptions::Validate() const {
     const Problems collider = CheckCollider(colliders[i], "colliders[" + std::to_string(i) + "]");
     problems.insert(problems.end(), collider.begin(), collider.end());
   }
-  if (!colliders.empty() && method != Method::kTractrix && method != Method::kFollowTheLeader &&
-      method != Method::kFollowPath) {
-    problems.emplace_back("method",
-                          std::string("\"") + MethodName(method) +
-                              "\" does not take colliders yet; with colliders use \"tractrix\", "
-                              "\"ftl\" or \"follow_path\"",
-                          std::string("\"") + MethodName(method) + "\"",
-                          "\"tractrix\", \"ftl\" or \"follow_path\"");
+  if (!colliders.empty() && method == Method::kOverall) {
+    // The overall step with colliders (overall/contact_step.h) needs a smooth metric and convex
+    // colliders.
+    for (const char* term : {"l2", "l2_weighted"}) {
+      const double weight =
+          std::string(term) == "l2" ? overall.weights.l2 : overall.weights.l2_weighted;
+      if (weight > 0.0) {
+        problems.emplace_back(std::string("overall.weights.") + term,
+                              "the overall method with colliders takes the smooth metrics "
+                              "(squared, squared_weighted, rotation, joint_angle); the L2 metric's "
+                              "still points and the contacts are not solved together yet: set it "
+                              "to 0, or use \"tractrix\"",
+                              FormatNumber(weight), "0 with colliders");
+      }
+    }
+    for (size_t i = 0; i < colliders.size(); ++i) {
+      if (colliders[i].shape != ColliderShape::kMesh) continue;
+      problems.emplace_back("colliders[" + std::to_string(i) + "].shape",
+                            "the overall method with colliders takes convex colliders (sphere, "
+                            "ellipsoid, capsule, cylinder, box, half_space); a mesh is not yet "
+                            "supported with it: use \"tractrix\" or \"ftl\"",
+                            "\"mesh\"", "a convex shape with \"overall\"");
+    }
   }
   if (!(std::isfinite(link_radius) && link_radius >= 0.0)) {
     problems.push_back(

@@ -1,12 +1,17 @@
 // One sweep of a sequential rule with colliders (sequential/sweep.h, docs/colliders.md): each
 // link's rule step as without colliders, kept where the link stays outside every collider (the
 // same operations: bit for bit the sweep without colliders); where it would enter one, the
-// least-motion position of its trailing end that keeps it outside (world/contact.h).
+// least-motion position of its trailing end that keeps it outside (world/contact.h). The
+// whole-chain rules (min_rotation, min_joint_angle) are swept link by link here the same way,
+// their rule's tail of each link computed as metric_rules.cc computes it until a link meets a
+// collider, and from there on relative to where that link now lies.
+#include <Eigen/Core>
 #include <cmath>
 #include <string>
 
 #include "flexkin/colliders.h"
 #include "flexkin/error.h"
+#include "sequential/joint_rotation.h"
 #include "sequential/link_rules.h"
 #include "sequential/rule_table.h"
 #include "sequential/sweep.h"
@@ -41,14 +46,48 @@ const std::vector<Collider>& NearColliders(const double* head, double total, dou
   return near->size() == colliders.size() ? colliders : *near;
 }
 
-template <class Rule, int Dim>
-void ContactSweepOf(const double* head, const double* lengths, const double* inv_lengths, int n,
-                    double* pts, const std::vector<Collider>& all, ContactStats* stats) {
+// Link i (1-based) from its leading end `lead` (already placed) to the rule's position of its
+// trailing end `tail`: kept where the link stays outside every collider; else `tail` becomes the
+// clear position at the link's length from `lead` whose direction is nearest in angle to that from
+// `lead` to `toward` (world/contact.h). Counts the contact and the clearance in `stats`; returns
+// whether the link met a collider.
+template <int Dim>
+bool KeepOutside(int i, const double* lead, const double* toward, double* tail, double length,
+                 double inv_length, const std::vector<Collider>& colliders, ContactStats* stats) {
+  const Eigen::Vector3d head = In3d<Dim>(lead);
+  double clearance = SegmentClearance(colliders, head, In3d<Dim>(tail));
+  const bool contact = clearance < -kContactSlack * length;
+  if (contact) {
+    Eigen::Vector3d x;
+    if (!ContactTail(Dim, head, In3d<Dim>(toward), length, colliders, &x)) {
+      throw InputError("colliders", "leave no room for link " + std::to_string(i) +
+                                        ": every position of point " + std::to_string(i) +
+                                        " at its link's length from point " +
+                                        std::to_string(i - 1) + " lies in a collider");
+    }
+    for (int k = 0; k < Dim; ++k) tail[k] = x[k];
+    clearance = SegmentClearance(colliders, head, x);
+    ++stats->contact_link_steps;
+  }
+  stats->least_clearance = std::fmin(stats->least_clearance, clearance * inv_length);
+  return contact;
+}
+
+// The colliders a sweep from the new head `head` may meet (NearColliders over the chain's length).
+template <int Dim>
+const std::vector<Collider>& SweepColliders(const double* head, const double* lengths, int n,
+                                            const std::vector<Collider>& all,
+                                            const ContactStats& stats) {
   double total = 0.0, longest = 0.0;
   for (int i = 0; i < n; ++i) total += lengths[i], longest = std::fmax(longest, lengths[i]);
   thread_local std::vector<Collider> near;
-  const std::vector<Collider>& colliders =
-      NearColliders<Dim>(head, total * (1.0 + 1e-12), longest, all, *stats, &near);
+  return NearColliders<Dim>(head, total * (1.0 + 1e-12), longest, all, stats, &near);
+}
+
+template <class Rule, int Dim>
+void ContactSweepOf(const double* head, const double* lengths, const double* inv_lengths, int n,
+                    double* pts, const std::vector<Collider>& all, ContactStats* stats) {
+  const std::vector<Collider>& colliders = SweepColliders<Dim>(head, lengths, n, all, *stats);
   double lead_old[Dim], lead_new[Dim];
   for (int k = 0; k < Dim; ++k) {
     lead_old[k] = pts[k];
@@ -59,22 +98,83 @@ void ContactSweepOf(const double* head, const double* lengths, const double* inv
     double tail_old[Dim];
     for (int k = 0; k < Dim; ++k) tail_old[k] = tail[k];
     ApplyScalar<Rule, Dim>(lead_old, lead_new, tail, lengths[i - 1], inv_lengths[i - 1]);
-    const Eigen::Vector3d lead = In3d<Dim>(lead_new);
-    double clearance = SegmentClearance(colliders, lead, In3d<Dim>(tail));
-    if (clearance < -kContactSlack * lengths[i - 1]) {
-      Eigen::Vector3d x;
-      if (!ContactTail(Dim, lead, In3d<Dim>(tail_old), lengths[i - 1], colliders, &x)) {
-        throw InputError("colliders", "leave no room for link " + std::to_string(i) +
-                                          ": every position of point " + std::to_string(i) +
-                                          " at its link's length from point " +
-                                          std::to_string(i - 1) + " lies in a collider");
-      }
-      for (int k = 0; k < Dim; ++k) tail[k] = x[k];
-      clearance = SegmentClearance(colliders, lead, x);
-      ++stats->contact_link_steps;
-    }
-    stats->least_clearance = std::fmin(stats->least_clearance, clearance * inv_lengths[i - 1]);
+    KeepOutside<Dim>(i, lead_new, tail_old, tail, lengths[i - 1], inv_lengths[i - 1], colliders,
+                     stats);
     for (int k = 0; k < Dim; ++k) lead_old[k] = tail_old[k], lead_new[k] = tail[k];
+  }
+}
+
+// Minimum rotation with colliders: every point moves by the head's shift (SweepsMinRotation's
+// operations) until a link meets a collider; that link's tail takes the clear direction nearest
+// its old one, and every later link keeps its old direction from its new leading end (no
+// rotation), unless it too meets a collider.
+template <int Dim>
+void MinRotationContactSweep(const double* head, const double* lengths, const double* inv_lengths,
+                             int n, double* pts, const std::vector<Collider>& all,
+                             ContactStats* stats) {
+  double shift[Dim], lead_old[Dim];
+  for (int k = 0; k < Dim; ++k) {
+    shift[k] = head[k] - pts[k];
+    lead_old[k] = pts[k];
+    pts[k] += shift[k];
+  }
+  const std::vector<Collider>& colliders = SweepColliders<Dim>(pts, lengths, n, all, *stats);
+  bool shifted = true;  // no link of this sweep has met a collider yet
+  for (int i = 1; i <= n; ++i) {
+    double* tail = pts + i * Dim;
+    const double* lead = tail - Dim;
+    double tail_old[Dim], rule[Dim];
+    for (int k = 0; k < Dim; ++k) {
+      tail_old[k] = tail[k];
+      tail[k] = shifted ? tail[k] + shift[k] : lead[k] + (tail_old[k] - lead_old[k]);
+      rule[k] = tail[k];
+    }
+    if (KeepOutside<Dim>(i, lead, rule, tail, lengths[i - 1], inv_lengths[i - 1], colliders,
+                         stats)) {
+      shifted = false;
+    }
+    for (int k = 0; k < Dim; ++k) lead_old[k] = tail_old[k];
+  }
+}
+
+// Minimum joint-angle change with colliders: the first link by the tractrix step (where it would
+// enter a collider, the contact step from its old tail, as the tractrix's), the chain behind it
+// turned rigidly by the rotation R of its direction (MinJointAngle's operations), p_i <- a_new +
+// R (p_i - a_old) with a = point 1. A later link i whose turned position enters a collider takes
+// the clear direction nearest the turned one; R is then composed with the rotation from the
+// turned direction to the new one and a becomes point i: the links behind it keep their joint
+// angles to it.
+template <int Dim>
+void MinJointAngleContactSweep(const double* head, const double* lengths, const double* inv_lengths,
+                               int n, double* pts, const std::vector<Collider>& all,
+                               ContactStats* stats) {
+  using Vec = Eigen::Matrix<double, Dim, 1>;
+  Eigen::Map<Eigen::Matrix<double, Dim, Eigen::Dynamic>> p(pts, Dim, n + 1);
+  const std::vector<Collider>& colliders = SweepColliders<Dim>(head, lengths, n, all, *stats);
+  const Vec head_old = p.col(0), first_old = p.col(1);
+  const Vec head_new = Eigen::Map<const Vec>(head);
+  Vec first_new = first_old;
+  TractrixStep<Dim>(head_old.data(), head_new.data(), first_new.data(), lengths[0], inv_lengths[0]);
+  KeepOutside<Dim>(1, head_new.data(), first_old.data(), first_new.data(), lengths[0],
+                   inv_lengths[0], colliders, stats);
+  const Vec u = first_old - head_old, v = first_new - head_new;
+  Eigen::Matrix<double, Dim, Dim> rotation = RotationBetween<Dim>(u, v);
+  p.col(0) = head_new;
+  p.col(1) = first_new;
+  Vec from = first_old, to = first_new, tail, rule;
+  for (int i = 2; i <= n; ++i) {
+    const Vec tail_old = p.col(i);
+    tail = to + rotation * (p.col(i) - from);
+    rule = tail;
+    const Vec lead = p.col(i - 1);
+    if (KeepOutside<Dim>(i, lead.data(), rule.data(), tail.data(), lengths[i - 1],
+                         inv_lengths[i - 1], colliders, stats)) {
+      const Vec turned = rule - lead, moved = tail - lead;
+      rotation = (RotationBetween<Dim>(turned, moved) * rotation).eval();
+      from = tail_old;
+      to = tail;
+    }
+    p.col(i) = tail;
   }
 }
 
@@ -83,6 +183,18 @@ void ContactSweepOf(const double* head, const double* lengths, const double* inv
 void ContactSweep(Method method, int dim, const double* head, const double* lengths,
                   const double* inv_lengths, int n, double* points,
                   const std::vector<Collider>& colliders, ContactStats* stats) {
+  // The whole-chain rules are no per-link rules of the sweeps engine: swept here link by link.
+  if (method == Method::kMinRotation) {
+    dim == 2 ? MinRotationContactSweep<2>(head, lengths, inv_lengths, n, points, colliders, stats)
+             : MinRotationContactSweep<3>(head, lengths, inv_lengths, n, points, colliders, stats);
+    return;
+  }
+  if (method == Method::kMinJointAngle) {
+    dim == 2
+        ? MinJointAngleContactSweep<2>(head, lengths, inv_lengths, n, points, colliders, stats)
+        : MinJointAngleContactSweep<3>(head, lengths, inv_lengths, n, points, colliders, stats);
+    return;
+  }
   DispatchRule<kSweepsEngine>(method, [&](auto rule) {
     using Rule = decltype(rule);
     dim == 2 ? ContactSweepOf<typename Rule::template Step<2>, 2>(head, lengths, inv_lengths, n,

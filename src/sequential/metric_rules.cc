@@ -14,6 +14,7 @@
 #include <cmath>
 
 #include "chain/denormals.h"
+#include "sequential/joint_rotation.h"
 #include "sequential/link_rules.h"
 #include "sequential/sweep.h"
 #include "sequential/whole_chain.h"
@@ -43,12 +44,7 @@ void JointAngleMotion(const Eigen::Matrix<double, Dim, 1>& head_old,
   *first_new = first_old;
   TractrixStep<Dim>(head_old.data(), head_new.data(), first_new->data(), length, inv_length);
   const Eigen::Matrix<double, Dim, 1> u = first_old - head_old, v = *first_new - head_new;
-  if constexpr (Dim == 2) {
-    *rotation =
-        Eigen::Rotation2Dd(std::atan2(u.x() * v.y() - u.y() * v.x(), u.dot(v))).toRotationMatrix();
-  } else {
-    *rotation = Eigen::Quaterniond::FromTwoVectors(u, v).toRotationMatrix();
-  }
+  *rotation = RotationBetween<Dim>(u, v);
 }
 
 template <int Dim>

@@ -96,10 +96,12 @@ struct ContactStats {
   double least_clearance = std::numeric_limits<double>::infinity();
 };
 
-// One sweep (the leading end to `head`) of a per-link rule (tractrix, ftl) with colliders: each
-// link's rule step, kept where the link stays outside every collider, else replaced by the
-// least-motion position of its trailing end that keeps it outside (contact_sweep.cc). 2D chains
-// lie in the plane z = 0. Throws InputError when the colliders leave a link no room.
+// One sweep (the leading end to `head`) of a sequential rule (tractrix, ftl, min_rotation,
+// min_joint_angle) with colliders: each link's rule step, kept where the link stays outside every
+// collider, else replaced by the least-motion position of its trailing end that keeps it outside
+// (contact_sweep.cc; for min_rotation and min_joint_angle the clear direction nearest the rule's,
+// the links behind then moved relative to it: docs/colliders.md). 2D chains lie in the plane
+// z = 0. Throws InputError when the colliders leave a link no room.
 void ContactSweep(Method method, int dim, const double* head, const double* lengths,
                   const double* inv_lengths, int num_links, double* points,
                   const std::vector<Collider>& colliders, ContactStats* stats);

@@ -17,10 +17,12 @@ using Eigen::Vector3d;
 // r + u (s - r) in [0, 1], minimizing the distance (the convex quadratic in (t, u) on the unit
 // square: its minimum on an edge when the interior one is outside).
 double SegmentSegmentDistance(const Vector3d& p, const Vector3d& q, const Vector3d& r,
-                              const Vector3d& s) {
+                              const Vector3d& s, double* t_out = nullptr, double* u_out = nullptr) {
   const Vector3d d1 = q - p, d2 = s - r, w = p - r;
   const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(w);
   double t = 0.0, u = 0.0;
+  if (t_out != nullptr) *t_out = 0.0;
+  if (u_out != nullptr) *u_out = 0.0;
   if (a == 0.0 && e == 0.0) return w.norm();
   if (a == 0.0) {
     u = std::clamp(f / e, 0.0, 1.0);
@@ -41,6 +43,8 @@ double SegmentSegmentDistance(const Vector3d& p, const Vector3d& q, const Vector
       }
     }
   }
+  if (t_out != nullptr) *t_out = t;
+  if (u_out != nullptr) *u_out = u;
   return (p + t * d1 - (r + u * d2)).norm();
 }
 
@@ -108,6 +112,56 @@ double SegmentClearance(const std::vector<Collider>& colliders, const Vector3d& 
   double least = std::numeric_limits<double>::infinity();
   for (const Collider& c : colliders) least = std::min(least, SegmentClearance(c, a, b));
   return least;
+}
+
+SegmentContact NearestOnSegment(const Collider& c, const Vector3d& a, const Vector3d& b) {
+  SegmentContact contact;
+  const Vector3d ab = b - a;
+  switch (c.shape) {
+    case ColliderShape::kSphere: {
+      const double ab2 = ab.squaredNorm();
+      contact.s = ab2 > 0.0 ? std::clamp((c.pose.translation() - a).dot(ab) / ab2, 0.0, 1.0) : 0.0;
+      break;
+    }
+    case ColliderShape::kCapsule: {
+      const Vector3d axis = c.pose.linear().col(2) * c.half_length;
+      const Vector3d center = c.pose.translation();
+      SegmentSegmentDistance(a, b, center - axis, center + axis, &contact.s);
+      break;
+    }
+    case ColliderShape::kHalfSpace: {
+      const Vector3d up = c.pose.linear().col(2);
+      contact.s = up.dot(b) < up.dot(a) ? 1.0 : 0.0;
+      break;
+    }
+    case ColliderShape::kEllipsoid:
+    case ColliderShape::kCylinder:
+    case ColliderShape::kBox:
+    case ColliderShape::kMesh: {
+      // The signed distance of a convex set is convex along the segment: its slope there, the
+      // normal's component along ab, does not decrease; its zero by bisection to the last bit.
+      const auto slope = [&](double s) { return QuerySurface(c, a + s * ab).normal.dot(ab); };
+      if (slope(0.0) >= 0.0) {
+        contact.s = 0.0;
+      } else if (slope(1.0) <= 0.0) {
+        contact.s = 1.0;
+      } else {
+        double lo = 0.0, hi = 1.0;
+        for (int i = 0; i < 64; ++i) {
+          const double mid = 0.5 * (lo + hi);
+          if (mid <= lo || mid >= hi) break;
+          (slope(mid) < 0.0 ? lo : hi) = mid;
+        }
+        contact.s = 0.5 * (lo + hi);
+      }
+      break;
+    }
+  }
+  const Vector3d p = a + contact.s * ab;
+  const SurfaceQuery at = QuerySurface(c, p);
+  contact.clearance = at.distance;
+  contact.normal = at.normal;
+  return contact;
 }
 
 namespace {

@@ -25,6 +25,20 @@ double SegmentClearance(const Collider& collider, const Eigen::Vector3d& a,
 double SegmentClearance(const std::vector<Collider>& colliders, const Eigen::Vector3d& a,
                         const Eigen::Vector3d& b);
 
+// Where the segment [a, b] comes nearest a convex collider (not a mesh): the parameter `s` of the
+// point a + s (b - a) of least signed distance, that distance (SegmentClearance's value, to the
+// rounding) and the collider's outward normal there (the signed distance's gradient at that
+// point). By the envelope theorem the clearance's gradient is (1 - s) normal in a and s normal in
+// b. Closed form for the sphere, capsule and half-space; else the zero of the distance's slope
+// along the segment (convex: a slope that does not decrease), bisected to the last bit.
+struct SegmentContact {
+  double clearance = 0.0;
+  double s = 0.0;
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+};
+SegmentContact NearestOnSegment(const Collider& collider, const Eigen::Vector3d& a,
+                                const Eigen::Vector3d& b);
+
 // The sequential step of one link with colliders: its leading end is at `head` (already moved,
 // outside every collider); its trailing end was at `tail`. Of the positions x at distance `length`
 // from `head` whose link [head, x] stays outside every collider (to kContactSlack), the one

@@ -1,0 +1,657 @@
+// The overall step with colliders (overall/contact_step.h, docs/colliders.md "The overall
+// method").
+//
+// A sub-problem: minimize the metric f(x) over points 1..n (point 0 the prescribed head) subject
+// to c_i(x) = (|x_i - x_{i-1}|^2 - L_i^2) / (2 L_i) = 0 and, for each collider k, the contact
+// constraints g >= 0:
+//  - point j against collider k: g = the signed distance of x_j (gradient: the outward normal);
+//  - link i against collider k, where its interior comes nearer than both its ends: g = the
+//    least signed distance along the link, reached at x_{i-1} + s (x_i - x_{i-1}) (gradient, by
+//    the envelope theorem: (1 - s) normal in x_{i-1}, s normal in x_i).
+// A link is outside a convex collider exactly when both its ends are and, where its interior
+// comes nearest, that point is: the two kinds together say "no point and no link inside".
+//
+// KKT conditions, with the Lagrangian f + lambda'c - mu'g: grad f + J_c' lambda - J_g' mu = 0,
+// c = 0, and g >= 0, mu >= 0, mu g = 0. The complementarity is met by a primal-dual active set:
+// the contacts with mu - kappa g > 0 are equalities g = 0, the others have mu = 0 (a contact
+// the step would enter has g < 0 and joins; one whose multiplier pulls inward leaves). Each
+// iteration is a Newton step on those equations, a sparse symmetric indefinite system solved by
+// sparse LU; the contacts' curvature enters its Hessian by central differences of their exact
+// gradients.
+
+#include "overall/contact_step.h"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "chain/substep.h"
+#include "overall/objective.h"
+#include "overall/step.h"
+#include "world/contact.h"
+
+namespace flexkin::internal {
+namespace {
+
+using Eigen::Vector3d;
+
+// One contact constraint of the active set (see the top of this file).
+struct Contact {
+  bool link = false;
+  int index = 0;     // point j (1..n) or link i (1..n)
+  int collider = 0;  // k
+  double value = 0.0;
+  double s = 0.0;  // a link's: where along it the contact is
+  Vector3d normal = Vector3d::UnitZ();
+  double multiplier = 0.0;
+};
+
+class ContactSolver {
+ public:
+  ContactSolver(const Eigen::VectorXd& lengths, const Points& old_points,
+                const OverallOptions& options, const std::vector<Collider>& colliders,
+                OverallContactState* state)
+      : lengths_(lengths),
+        old_(old_points),
+        options_(options),
+        colliders_(colliders),
+        state_(*state),
+        n_(static_cast<int>(lengths.size())),
+        dim_(static_cast<int>(old_points.cols())),
+        m_(static_cast<int>(colliders.size())),
+        unknowns_(n_ * dim_),
+        shortest_(lengths.minCoeff()),
+        weight_sum_(WeightSum(options.weights, lengths)) {
+    sink_.dim = dim_;
+    sink_.offset.assign(n_ + 1, -1);
+    for (int j = 1; j <= n_; ++j) sink_.offset[j] = (j - 1) * dim_;
+  }
+
+  // Solves the sub-problem with the head at row 0 of `*x`, from `*x` (outside every collider,
+  // lengths kept). On success `*x` is the solution; else it is left as it was.
+  OverallReport Solve(Points* x);
+
+ private:
+  // The state of the iteration at one configuration.
+  struct Point {
+    Points x;
+    double objective = 0.0;
+    Eigen::VectorXd gradient;   // of the metric
+    Eigen::VectorXd c;          // the length constraints
+    std::vector<Contact> near;  // the contact constraints within a step's reach
+    double violation = 0.0;     // largest |c_i| / L_i
+    double penetration = 0.0;   // sum of max(0, -g) over every contact constraint
+    double least = 0.0;         // least clearance of any point or link, relative to its link
+  };
+
+  Vector3d At(const Points& x, int j) const {
+    return Vector3d(x(j, 0), x(j, 1), dim_ == 3 ? x(j, 2) : 0.0);
+  }
+  double& Multiplier(const Contact& c) {
+    return (c.link ? state_.link_multipliers : state_.point_multipliers)[c.index * m_ + c.collider];
+  }
+
+  // The values at `p->x` (the metric's derivatives into gradient and, if `hessian`, triplets_).
+  void Evaluate(Point* p, bool hessian);
+  // The contact constraints of `x` within reach of a step into `*near` (their multipliers from
+  // the state), and the penetration and least clearance over all of them.
+  // `keep`: the iterate's (not a trial's): a link whose contact moved to its end passes its
+  // multiplier to that end's point.
+  void FindContacts(const Points& x, bool keep, std::vector<Contact>* near, double* penetration,
+                    double* least);
+  // The length constraints' multipliers that best meet stationarity at `p` with the contacts'
+  // multipliers (least squares), into state_.lambda.
+  void StartingMultipliers(const Point& p);
+  Contact Measure(const Contact& contact, const Points& x) const;
+  void AddGradient(const Contact& contact, double scale, Eigen::VectorXd* out) const;
+  double Linearized(const Contact& contact, const Eigen::VectorXd& step) const;
+  // The contact's Hessian times `scale` (central differences of its gradient) into triplets_.
+  void AddCurvature(const Contact& contact, const Points& x, double scale);
+  double Stationarity(const Point& p, Eigen::VectorXd* residual) const;
+  // The step's quadratic model with the contacts of `working` as equalities: the step and the
+  // new multipliers (lambda, then one per working contact) into `*solution`.
+  bool SolveModel(const Point& p, const std::vector<int>& working, Eigen::VectorXd* solution);
+  // The model's solution with its active contacts chosen by a primal active set (a contact whose
+  // multiplier pulls inward leaves; the one the step would enter most joins).
+  bool SolveQp(const Point& p, std::vector<int>* working, Eigen::VectorXd* solution);
+  double Merit(const Point& p, double penalty) const {
+    double sum = 0.0;
+    for (int i = 0; i < n_; ++i) sum += std::fabs(p.c[i]);
+    return p.objective + penalty * (sum + p.penetration);
+  }
+
+  const Eigen::VectorXd& lengths_;
+  const Points& old_;
+  const OverallOptions& options_;
+  const std::vector<Collider>& colliders_;
+  OverallContactState& state_;
+  const int n_, dim_, m_, unknowns_;
+  const double shortest_, weight_sum_;
+  Sink sink_;
+  std::vector<Eigen::Triplet<double>> triplets_;  // the Lagrangian's Hessian at the iterate
+  Eigen::SparseMatrix<double> kkt_;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu_;
+};
+
+Contact ContactSolver::Measure(const Contact& contact, const Points& x) const {
+  Contact out = contact;
+  const Collider& c = colliders_[contact.collider];
+  if (!contact.link) {
+    const SurfaceQuery q = QuerySurface(c, At(x, contact.index));
+    out.value = q.distance;
+    out.normal = q.normal;
+  } else {
+    const Vector3d a = At(x, contact.index - 1), b = At(x, contact.index);
+    const SegmentContact near = NearestOnSegment(c, a, b);
+    out.value = near.clearance;
+    out.s = near.s;
+    out.normal = near.normal;
+    if (dim_ == 2 && near.s > 0.0 && near.s < 1.0) {
+      // Where the interior is nearest, the normal is across the link (exactly so on a smooth
+      // surface). At a corner of the collider's section (a box's) the nearest point's normal
+      // is not defined on the surface; across the link, on the outward side, it is the
+      // gradient of the signed distance from the corner to the link's line.
+      const Vector3d u = (b - a).normalized();
+      const Vector3d across = out.normal - out.normal.dot(u) * u;
+      if (across.norm() > 0.0) out.normal = across.normalized();
+    }
+  }
+  return out;
+}
+
+void ContactSolver::AddGradient(const Contact& contact, double scale, Eigen::VectorXd* out) const {
+  if (!contact.link) {
+    const int row = sink_.offset[contact.index];
+    for (int q = 0; q < dim_; ++q) (*out)[row + q] += scale * contact.normal[q];
+    return;
+  }
+  const int i = contact.index;
+  if (i >= 2) {
+    const int row = sink_.offset[i - 1];
+    for (int q = 0; q < dim_; ++q) (*out)[row + q] += scale * (1.0 - contact.s) * contact.normal[q];
+  }
+  const int row = sink_.offset[i];
+  for (int q = 0; q < dim_; ++q) (*out)[row + q] += scale * contact.s * contact.normal[q];
+}
+
+double ContactSolver::Linearized(const Contact& contact, const Eigen::VectorXd& step) const {
+  double value = contact.value;
+  const auto add = [&](int j, double w) {
+    if (j < 1) return;
+    for (int q = 0; q < dim_; ++q) value += w * contact.normal[q] * step[sink_.offset[j] + q];
+  };
+  if (contact.link) {
+    add(contact.index - 1, 1.0 - contact.s);
+    add(contact.index, contact.s);
+  } else {
+    add(contact.index, 1.0);
+  }
+  return value;
+}
+
+void ContactSolver::AddCurvature(const Contact& contact, const Points& x, double scale) {
+  // The coordinates the contact depends on: its point, or its link's moving ends.
+  int first = contact.index;
+  const int last = contact.index;
+  if (contact.link && contact.index >= 2) first = contact.index - 1;
+  const double h = 1e-6 * shortest_;
+  Points probe = x;
+  Eigen::VectorXd plus = Eigen::VectorXd::Zero(unknowns_), minus = plus;
+  for (int j = first; j <= last; ++j) {
+    for (int q = 0; q < dim_; ++q) {
+      const int col = sink_.offset[j] + q;
+      plus.setZero();
+      minus.setZero();
+      probe(j, q) = x(j, q) + h;
+      AddGradient(Measure(contact, probe), 1.0, &plus);
+      probe(j, q) = x(j, q) - h;
+      AddGradient(Measure(contact, probe), 1.0, &minus);
+      probe(j, q) = x(j, q);
+      for (int r = first; r <= last; ++r) {
+        for (int p = 0; p < dim_; ++p) {
+          const int row = sink_.offset[r] + p;
+          const double d = (plus[row] - minus[row]) / (2.0 * h);
+          // Symmetrized: half here, half at the mirror.
+          triplets_.emplace_back(row, col, 0.5 * scale * d);
+          triplets_.emplace_back(col, row, 0.5 * scale * d);
+        }
+      }
+    }
+  }
+}
+
+void ContactSolver::FindContacts(const Points& x, bool keep, std::vector<Contact>* near,
+                                 double* penetration, double* least) {
+  near->clear();
+  *penetration = 0.0;
+  *least = std::numeric_limits<double>::infinity();
+  // A step moves no point by more than half the shortest link: constraints farther than the
+  // shortest link cannot be reached.
+  const double reach = shortest_;
+  std::vector<double> depth(n_ + 1);
+  for (int k = 0; k < m_; ++k) {
+    const Collider& c = colliders_[k];
+    depth[0] = QuerySurface(c, At(x, 0)).distance;
+    for (int j = 1; j <= n_; ++j) {
+      Contact p;
+      p.index = j;
+      p.collider = k;
+      p = Measure(p, x);
+      depth[j] = p.value;
+      *least = std::fmin(*least, p.value / lengths_[j - 1]);
+      *penetration += std::fmax(0.0, -p.value);
+      p.multiplier = Multiplier(p);
+      if (p.value < reach || p.multiplier > 0.0) near->push_back(p);
+    }
+    // Links whose interior comes nearer than both ends (a link nearest at an end is covered by
+    // that point's constraint).
+    for (int i = 1; i <= n_; ++i) {
+      Contact l;
+      l.link = true;
+      l.index = i;
+      l.collider = k;
+      double& mu = Multiplier(l);
+      const Vector3d a = At(x, i - 1), b = At(x, i);
+      if (mu == 0.0 && QuerySurface(c, 0.5 * (a + b)).distance - 0.5 * lengths_[i - 1] > reach) {
+        continue;
+      }
+      l = Measure(l, x);
+      const bool interior = l.s > 0.0 && l.s < 1.0 &&
+                            l.value < std::fmin(depth[i - 1], depth[i]) - 1e-12 * lengths_[i - 1];
+      if (!interior) {
+        if (keep && mu > 0.0) {  // its end carries it on
+          const int j = l.s >= 0.5 ? i : i - 1;
+          if (j >= 1) state_.point_multipliers[j * m_ + k] += mu;
+        }
+        if (keep) mu = 0.0;
+        continue;
+      }
+      *least = std::fmin(*least, l.value / lengths_[i - 1]);
+      *penetration += std::fmax(0.0, -l.value);
+      l.multiplier = mu;
+      near->push_back(l);
+    }
+  }
+  // Multipliers passed on to a point above: read them again.
+  for (Contact& c : *near) c.multiplier = Multiplier(c);
+}
+
+void ContactSolver::Evaluate(Point* p, bool hessian) {
+  p->gradient = Eigen::VectorXd::Zero(unknowns_);
+  sink_.gradient = p->gradient.data();
+  sink_.hessian = hessian ? &triplets_ : nullptr;
+  sink_.band = nullptr;
+  sink_.form = nullptr;
+  if (hessian) triplets_.clear();
+  p->objective = internal::Evaluate(options_.weights, lengths_, old_, p->x, sink_);
+  p->c.resize(n_);
+  p->violation = 0.0;
+  for (int i = 1; i <= n_; ++i) {
+    const double sq = (p->x.row(i) - p->x.row(i - 1)).squaredNorm();
+    const double l = lengths_[i - 1];
+    p->c[i - 1] = (sq - l * l) / (2.0 * l);
+    p->violation = std::fmax(p->violation, std::fabs(p->c[i - 1]) / l);
+  }
+  FindContacts(p->x, hessian, &p->near, &p->penetration, &p->least);
+}
+
+// The Lagrangian's gradient at `p` with the state's multipliers, into `*residual`; returns the
+// optimality measure (as OverallOptions::optimality_tolerance: relative to the metric's
+// gradient, 0 at the rounding level of the positions).
+double ContactSolver::Stationarity(const Point& p, Eigen::VectorXd* residual) const {
+  *residual = p.gradient;
+  const Eigen::VectorXd& lambda = state_.lambda;
+  for (int i = 1; i <= n_; ++i) {
+    const double f = lambda[i - 1] / lengths_[i - 1];
+    for (int q = 0; q < dim_; ++q) {
+      const double d = f * (p.x(i, q) - p.x(i - 1, q));
+      (*residual)[sink_.offset[i] + q] += d;
+      if (i >= 2) (*residual)[sink_.offset[i - 1] + q] -= d;
+    }
+  }
+  double mu_max = 0.0;
+  for (const Contact& c : p.near) {
+    if (c.multiplier == 0.0) continue;
+    AddGradient(c, -c.multiplier, residual);
+    mu_max = std::fmax(mu_max, std::fabs(c.multiplier));
+  }
+  const double r = residual->cwiseAbs().maxCoeff();
+  const double extent = std::fmax(p.x.cwiseAbs().maxCoeff(), lengths_.maxCoeff());
+  const double kappa = weight_sum_ + (2.0 * lambda.cwiseAbs().maxCoeff() + mu_max) / shortest_;
+  if (r <= 64.0 * std::numeric_limits<double>::epsilon() * extent * kappa) return 0.0;
+  return r / std::fmax(p.gradient.cwiseAbs().maxCoeff(), std::numeric_limits<double>::min());
+}
+
+void ContactSolver::StartingMultipliers(const Point& p) {
+  // J J' lambda = -J (grad f - J_g' mu), J the length constraints' Jacobian (n by unknowns).
+  Eigen::VectorXd force = p.gradient;
+  for (const Contact& c : p.near) {
+    if (c.multiplier != 0.0) AddGradient(c, -c.multiplier, &force);
+  }
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int i = 1; i <= n_; ++i) {
+    for (int q = 0; q < dim_; ++q) {
+      const double d = (p.x(i, q) - p.x(i - 1, q)) / lengths_[i - 1];
+      entries.emplace_back(i - 1, sink_.offset[i] + q, d);
+      if (i >= 2) entries.emplace_back(i - 1, sink_.offset[i - 1] + q, -d);
+    }
+  }
+  Eigen::SparseMatrix<double> jacobian(n_, unknowns_);
+  jacobian.setFromTriplets(entries.begin(), entries.end());
+  const Eigen::SparseMatrix<double> normal = jacobian * jacobian.transpose();
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(normal);
+  Eigen::VectorXd lambda = ldlt.solve(-(jacobian * force));
+  if (ldlt.info() == Eigen::Success && lambda.allFinite()) {
+    state_.lambda = lambda;
+  } else {
+    state_.lambda.setZero(n_);
+  }
+}
+
+bool ContactSolver::SolveModel(const Point& p, const std::vector<int>& working,
+                               Eigen::VectorXd* solution) {
+  const int na = static_cast<int>(working.size());
+  const int size = unknowns_ + n_ + na;
+  std::vector<Eigen::Triplet<double>> entries = triplets_;
+  // Jacobian rows of c_i: D_i / L_i on x_i, -D_i / L_i on x_{i-1}.
+  for (int i = 1; i <= n_; ++i) {
+    const int row = unknowns_ + i - 1;
+    for (int q = 0; q < dim_; ++q) {
+      const double d = (p.x(i, q) - p.x(i - 1, q)) / lengths_[i - 1];
+      entries.emplace_back(row, sink_.offset[i] + q, d);
+      entries.emplace_back(sink_.offset[i] + q, row, d);
+      if (i >= 2) {
+        entries.emplace_back(row, sink_.offset[i - 1] + q, -d);
+        entries.emplace_back(sink_.offset[i - 1] + q, row, -d);
+      }
+    }
+  }
+  // Rows of the working contacts, as -grad g (the system stays symmetric).
+  Eigen::VectorXd column(unknowns_);
+  for (int a = 0; a < na; ++a) {
+    column.setZero();
+    AddGradient(p.near[working[a]], -1.0, &column);
+    const int row = unknowns_ + n_ + a;
+    for (int r = 0; r < unknowns_; ++r) {
+      if (column[r] == 0.0) continue;
+      entries.emplace_back(row, r, column[r]);
+      entries.emplace_back(r, row, column[r]);
+    }
+  }
+  Eigen::VectorXd rhs(size);
+  rhs.head(unknowns_) = -p.gradient;
+  rhs.segment(unknowns_, n_) = -p.c;
+  for (int a = 0; a < na; ++a) rhs[unknowns_ + n_ + a] = p.near[working[a]].value;
+  const size_t base = entries.size();
+  for (const double regularization : {0.0, 1e-12, 1e-9}) {
+    entries.resize(base);
+    if (regularization > 0.0) {
+      for (int r = unknowns_; r < size; ++r) entries.emplace_back(r, r, -regularization);
+    }
+    kkt_.resize(size, size);
+    kkt_.setFromTriplets(entries.begin(), entries.end());
+    lu_.analyzePattern(kkt_);
+    lu_.factorize(kkt_);
+    if (lu_.info() != Eigen::Success) continue;
+    *solution = lu_.solve(rhs);
+    if (lu_.info() == Eigen::Success && solution->allFinite()) return true;
+  }
+  return false;
+}
+
+bool ContactSolver::SolveQp(const Point& p, std::vector<int>* working, Eigen::VectorXd* solution) {
+  // A contact that has left joins again at most twice (no cycling at a corner, whose normal
+  // jumps).
+  std::vector<int> left(p.near.size(), 0);
+  for (;;) {
+    if (!SolveModel(p, *working, solution)) return false;
+    const Eigen::VectorXd step = solution->head(unknowns_);
+    // A working contact whose multiplier pulls inward leaves (the most negative first).
+    int leave = -1;
+    double most = 0.0;
+    for (size_t a = 0; a < working->size(); ++a) {
+      const double mu = (*solution)[unknowns_ + n_ + static_cast<int>(a)];
+      if (mu < most) most = mu, leave = static_cast<int>(a);
+    }
+    if (leave >= 0) {
+      ++left[(*working)[leave]];
+      working->erase(working->begin() + leave);
+      continue;
+    }
+    // The contact the step would enter most joins.
+    int join = -1;
+    double deepest = 0.0;
+    for (size_t b = 0; b < p.near.size(); ++b) {
+      if (left[b] > 2 ||
+          std::find(working->begin(), working->end(), static_cast<int>(b)) != working->end()) {
+        continue;
+      }
+      const Contact& c = p.near[b];
+      const double g = Linearized(c, step) / lengths_[c.index - 1];
+      if (g < -1e-14 && g < deepest) deepest = g, join = static_cast<int>(b);
+    }
+    if (join < 0) return true;
+    working->push_back(join);
+  }
+}
+
+OverallReport ContactSolver::Solve(Points* x_io) {
+  OverallReport report;
+  if (state_.lambda.size() != n_) state_.lambda = Eigen::VectorXd::Zero(n_);
+  const int max_iterations = std::max(options_.max_iterations, 1);
+  Point p, trial;
+  p.x = *x_io;
+  Evaluate(&p, true);
+  StartingMultipliers(p);
+  Eigen::VectorXd residual, solution;
+  std::vector<int> working;
+  bool polished = false;
+  int polish_iteration = -1;
+  Point converged;
+  for (int iteration = 0;; ++iteration) {
+    // Converged: the lengths kept, nothing inside, the contacts with a multiplier on their
+    // surface, and the Lagrangian stationary.
+    double contact_violation = 0.0;
+    for (const Contact& c : p.near) {
+      if (c.multiplier > 0.0) {
+        contact_violation =
+            std::fmax(contact_violation, std::fabs(c.value) / lengths_[c.index - 1]);
+      }
+    }
+    report.objective = p.objective;
+    report.constraint_violation = p.violation;
+    report.optimality = Stationarity(p, &residual);
+    report.iterations = iteration;
+    if (iteration > 0 && p.violation <= options_.constraint_tolerance &&
+        contact_violation <= options_.constraint_tolerance && p.least >= -0.5 * kContactSlack &&
+        report.optimality <= options_.optimality_tolerance) {
+      // One more Newton step takes the lengths to the rounding (it converges quadratically).
+      if (polished || p.violation <= 1e-15) {
+        report.status = OverallStatus::kConverged;
+        break;
+      }
+      polished = true;
+      converged = p;
+    }
+    if (polished && iteration > 0 && iteration == polish_iteration + 1) {
+      // The polishing step did not keep convergence: the converged iterate stands.
+      p = converged;
+      report.status = OverallStatus::kConverged;
+      break;
+    }
+    if (polished && polish_iteration < 0) polish_iteration = iteration;
+    if (iteration >= max_iterations) {
+      report.status = OverallStatus::kMaxIterations;
+      return report;
+    }
+    // The model: the Lagrangian's Hessian with the contacts' curvature.
+    for (int i = 1; i <= n_; ++i) {
+      const double w = state_.lambda[i - 1] / lengths_[i - 1];
+      for (int q = 0; q < dim_; ++q) {
+        const int b = sink_.offset[i] + q;
+        triplets_.emplace_back(b, b, w);
+        if (i >= 2) {
+          const int a = sink_.offset[i - 1] + q;
+          triplets_.emplace_back(a, a, w);
+          triplets_.emplace_back(a, b, -w);
+          triplets_.emplace_back(b, a, -w);
+        }
+      }
+    }
+    working.clear();
+    for (size_t a = 0; a < p.near.size(); ++a) {
+      const Contact& c = p.near[a];
+      if (c.multiplier > 0.0) {
+        AddCurvature(c, p.x, -c.multiplier);
+        working.push_back(static_cast<int>(a));
+      }
+    }
+    if (!SolveQp(p, &working, &solution)) {
+      report.status = OverallStatus::kFailed;
+      return report;
+    }
+    const Eigen::VectorXd step = solution.head(unknowns_);
+    // The step's length: at most half the shortest link for any point; then backtracking on
+    // the l1 merit function (penalty above every multiplier), a full step also taken where it
+    // halves the infeasibility.
+    double longest = 0.0;
+    for (int j = 1; j <= n_; ++j)
+      longest = std::fmax(longest, step.segment(sink_.offset[j], dim_).norm());
+    double alpha = std::fmin(1.0, 0.5 * shortest_ / std::fmax(longest, 1e-300));
+    double penalty = 0.0;
+    for (int i = 0; i < n_; ++i) penalty = std::fmax(penalty, std::fabs(solution[unknowns_ + i]));
+    for (size_t a = 0; a < working.size(); ++a) {
+      penalty = std::fmax(penalty, std::fabs(solution[unknowns_ + n_ + static_cast<int>(a)]));
+    }
+    penalty = 2.0 * penalty + 1e-3 * weight_sum_ * shortest_;
+    const double merit = Merit(p, penalty);
+    double infeasibility = p.penetration;
+    for (int i = 0; i < n_; ++i) infeasibility += std::fabs(p.c[i]);
+    const double slope = p.gradient.dot(step) - penalty * infeasibility;
+    for (int tries = 0;; ++tries) {
+      trial.x = p.x;
+      for (int j = 1; j <= n_; ++j) {
+        for (int q = 0; q < dim_; ++q) trial.x(j, q) += alpha * step[sink_.offset[j] + q];
+      }
+      // (The multipliers the trial's contacts carry are not used: measured again below.)
+      Evaluate(&trial, false);
+      double trial_infeasibility = trial.penetration;
+      for (int i = 0; i < n_; ++i) trial_infeasibility += std::fabs(trial.c[i]);
+      if (Merit(trial, penalty) <= merit + 1e-4 * alpha * std::fmin(slope, 0.0) ||
+          (tries == 0 && trial_infeasibility <= 0.5 * infeasibility) || tries >= 30) {
+        break;
+      }
+      alpha *= 0.5;
+    }
+    // The multipliers: lambda and the working contacts' move by alpha toward the model's; every
+    // other contact's is 0.
+    state_.lambda += alpha * (solution.segment(unknowns_, n_) - state_.lambda);
+    for (const Contact& c : p.near) Multiplier(c) = 0.0;
+    for (size_t a = 0; a < working.size(); ++a) {
+      const Contact& c = p.near[working[a]];
+      Multiplier(c) =
+          c.multiplier + alpha * (solution[unknowns_ + n_ + static_cast<int>(a)] - c.multiplier);
+    }
+    p.x = trial.x;
+    Evaluate(&p, true);
+  }
+  *x_io = p.x;
+  return report;
+}
+
+// Every link of `x` outside every collider (to kContactSlack of its length); the least clearance
+// relative to its link into `*least`, and the links within 1e-9 of their length of a collider
+// (in contact) into `*touching`.
+bool Clear(const Points& x, const Eigen::VectorXd& lengths, const std::vector<Collider>& colliders,
+           double* least, int* touching) {
+  const int dim = static_cast<int>(x.cols());
+  const auto at = [&](int j) { return Vector3d(x(j, 0), x(j, 1), dim == 3 ? x(j, 2) : 0.0); };
+  *least = std::numeric_limits<double>::infinity();
+  *touching = 0;
+  for (Eigen::Index i = 1; i <= lengths.size(); ++i) {
+    const double clearance = SegmentClearance(colliders, at(i - 1), at(i)) / lengths[i - 1];
+    *least = std::fmin(*least, clearance);
+    if (clearance <= 1e-9) ++*touching;
+  }
+  return *least >= -kContactSlack;
+}
+
+}  // namespace
+
+void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& head,
+                        const OverallOptions& options, const std::vector<Collider>& colliders,
+                        Points* points, OverallWorkspace* workspace, OverallContactState* state,
+                        OverallReport* report, ContactStats* stats) {
+  const int n = static_cast<int>(lengths.size());
+  const int dim = static_cast<int>(points->cols());
+  const size_t pairs = static_cast<size_t>(n + 1) * colliders.size();
+  if (state->point_multipliers.size() != pairs) {
+    state->point_multipliers.assign(pairs, 0.0);
+    state->link_multipliers.assign(pairs, 0.0);
+  }
+  // The step without colliders, kept where it ends clear.
+  state->free = *points;
+  OverallStepUnchecked(lengths, head, options, &state->free, workspace, report);
+  double least = 0.0;
+  int touching = 0;
+  if (Clear(state->free, lengths, colliders, &least, &touching)) {
+    stats->contact_link_steps += touching;
+    *points = state->free;
+    stats->least_clearance = std::fmin(stats->least_clearance, least);
+    std::fill(state->point_multipliers.begin(), state->point_multipliers.end(), 0.0);
+    std::fill(state->link_multipliers.begin(), state->link_multipliers.end(), 0.0);
+    return;
+  }
+  // Continuation in head sub-steps of at most half the shortest link, each from the sequential
+  // contact step (tractrix) of the last one's solution.
+  const Points old = *points;
+  const Eigen::VectorXd from = old.row(0).transpose();
+  const Eigen::VectorXd inv_lengths = lengths.cwiseInverse();
+  const double distance = (head - from).norm();
+  const int sub_steps =
+      std::max(1, static_cast<int>(std::ceil(distance / (0.5 * lengths.minCoeff()))));
+  OverallReport result;
+  result.status = OverallStatus::kConverged;
+  int iterations = 0, fallbacks = 0;
+  Eigen::VectorXd target(dim);
+  ContactStats sweep_stats;
+  for (int s = 1; s <= sub_steps; ++s) {
+    for (int k = 0; k < dim; ++k) target[k] = SubstepHead(from[k], head[k], s, sub_steps);
+    state->start = *points;
+    ContactSweep(Method::kTractrix, dim, target.data(), lengths.data(), inv_lengths.data(), n,
+                 state->start.data(), colliders, &sweep_stats);
+    *points = state->start;
+    ContactSolver solver(lengths, old, options, colliders, state);
+    OverallReport sub = solver.Solve(points);
+    iterations += sub.iterations;
+    if (!sub.converged()) {
+      ++fallbacks;
+      *points = state->start;
+      std::fill(state->point_multipliers.begin(), state->point_multipliers.end(), 0.0);
+      std::fill(state->link_multipliers.begin(), state->link_multipliers.end(), 0.0);
+      result.status = sub.status;
+    }
+    result.objective = sub.objective;
+    result.constraint_violation = std::fmax(result.constraint_violation, sub.constraint_violation);
+    result.optimality = std::fmax(result.optimality, sub.optimality);
+  }
+  if (!Clear(*points, lengths, colliders, &least, &touching))
+    result.status = OverallStatus::kFailed;
+  stats->least_clearance = std::fmin(stats->least_clearance, least);
+  stats->contact_link_steps += touching;
+  result.iterations = iterations;
+  result.moving_points = n;
+  result.start = "continuation in " + std::to_string(sub_steps) +
+                 " head sub-steps with colliders, each from the sequential contact step";
+  if (fallbacks > 0) {
+    result.start += "; " + std::to_string(fallbacks) +
+                    " sub-steps kept the sequential contact step (not converged)";
+  }
+  *report = std::move(result);
+}
+
+}  // namespace flexkin::internal

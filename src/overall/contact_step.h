@@ -1,0 +1,39 @@
+#pragma once
+// The overall step with colliders (docs/colliders.md, "The overall method"): the least motion
+// under a smooth metric that keeps every link's length and keeps every point and every link
+// outside every collider. Where the step without colliders ends clear, it is that step (bit for
+// bit); otherwise the head advances in sub-steps, and each sub-problem, started from the
+// sequential contact step, is solved by Newton's method on its KKT conditions with the contacts
+// chosen by a primal-dual active set.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "flexkin/colliders.h"
+#include "flexkin/overall.h"
+#include "sequential/sweep.h"
+
+namespace flexkin::internal {
+
+// What OverallContactStep keeps from step to step: the contacts' multipliers (a warm start for
+// the next step's active set) and its buffers.
+struct OverallContactState {
+  std::vector<double> point_multipliers;  // (n + 1) by colliders: point j against collider k
+  std::vector<double> link_multipliers;   // (n + 1) by colliders: link i against collider k
+  Eigen::VectorXd lambda;                 // n: the length constraints' multipliers
+  Points start;                           // a sub-step's sequential contact step
+  Points free;                            // the step without colliders
+};
+
+// One overall step of the chain (`lengths`, `*points`) with the head moving to `head`, for
+// options and colliders the caller has checked (RunOptions::Validate: a smooth metric, convex
+// colliders; the chain starts outside them). `*report` tells how it was solved; `*stats` gains the
+// links in contact and the least clearance. Where a sub-problem's Newton iteration does not
+// converge, that sub-step keeps its sequential contact step (outside every collider) and the
+// report says so. Throws InputError where the colliders leave a link no room.
+void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& head,
+                        const OverallOptions& options, const std::vector<Collider>& colliders,
+                        Points* points, OverallWorkspace* workspace, OverallContactState* state,
+                        OverallReport* report, ContactStats* stats);
+
+}  // namespace flexkin::internal

@@ -1,0 +1,252 @@
+// The overall method with colliders (src/overall/contact_step.h, docs/colliders.md "The overall
+// method"): each step the least motion under the metric that keeps the lengths and keeps every
+// point and link outside every collider. Checked: the step against IPOPT on the same constrained
+// minimization (spheres, 2D and 3D, with and without the rotation term), every link of every
+// frame outside each convex shape (sampled along the link, independent of the run's clearances)
+// while the run without it cuts through, the lengths kept, the run that touches nothing bit for
+// bit the run without colliders, and the refusals.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "collider_test_util.h"
+#include "flexkin/chain.h"
+#include "flexkin/colliders.h"
+#include "flexkin/error.h"
+#include "flexkin/leader.h"
+#include "flexkin/run.h"
+#include "overall_contact_peer.h"
+
+namespace flexkin {
+namespace {
+
+using collider_test::At;
+using collider_test::Box;
+using collider_test::CapsuleBetween;
+using collider_test::SampledDistance;
+using collider_test::Sphere;
+using Eigen::Vector3d;
+
+// A rope of `links` links of 0.1 hanging along -y from the origin; its leading end pulled up to
+// (0, 2) and then along -x to (-3, 2) (and along z in 3D), in leader steps of at most `step`:
+// round whatever sits at the corner (docs/colliders.md, examples/rope_round_post.json).
+struct Rope {
+  Chain chain;
+  Points path;
+};
+Rope RopeRoundCorner(int dim, int links, double step) {
+  Rope r;
+  Points p = Points::Zero(links + 1, dim);
+  for (int i = 0; i <= links; ++i) p(i, 1) = -0.1 * i;
+  r.chain = MakeChain(p);
+  Points corners = Points::Zero(2, dim);
+  corners(0, 1) = 2.0;
+  corners(1, 0) = -3.0;
+  corners(1, 1) = 2.0;
+  if (dim == 3) corners(1, 2) = 0.6;
+  r.path = ResamplePath(p.row(0).transpose(), corners, step);
+  return r;
+}
+
+RunOptions OverallOptionsWith(const std::vector<Collider>& colliders, double rotation = 0.0) {
+  RunOptions options;
+  options.method = Method::kOverall;
+  options.overall.weights.squared = 1.0;
+  options.overall.weights.rotation = rotation;
+  options.colliders = colliders;
+  return options;
+}
+
+// The least distance of any link of any frame to `c`, relative to the link (sampled).
+double LeastSampled(const RunResult& result, const Collider& c, int samples = 400) {
+  double least = std::numeric_limits<double>::infinity();
+  for (const Frame& f : result.frames) {
+    const Points p = f.points;
+    for (Eigen::Index i = 1; i < p.rows(); ++i) {
+      least = std::fmin(
+          least, SampledDistance(c, At(p, i - 1), At(p, i), samples) / result.lengths[i - 1]);
+    }
+  }
+  return least;
+}
+
+double LengthError(const RunResult& result) {
+  double worst = 0.0;
+  for (const Frame& f : result.frames) {
+    const Points p = f.points;
+    for (Eigen::Index i = 1; i < p.rows(); ++i) {
+      worst = std::fmax(worst, std::fabs((p.row(i) - p.row(i - 1)).norm() - result.lengths[i - 1]) /
+                                   result.lengths[i - 1]);
+    }
+  }
+  return worst;
+}
+
+TEST(OverallCollidersTest, TheStepIsIpoptsSolutionOfTheSameConstrainedMinimization) {
+  int compared = 0;
+  double worst_distance = 0.0, worst_objective = 0.0;
+  for (int dim : {2, 3}) {
+    for (double rotation : {0.0, 0.5}) {
+      const Rope r = RopeRoundCorner(dim, 16, 0.02);
+      std::vector<Collider> spheres = {Sphere(Vector3d(-0.35, 1.65, dim == 3 ? 0.05 : 0.0), 0.3)};
+      if (dim == 3) spheres.push_back(Sphere(Vector3d(-1.3, 1.8, 0.3), 0.12));
+      RunOptions options = OverallOptionsWith(spheres, rotation);
+      options.substeps = 1;
+      const RunResult result = flexkin::Run(r.chain, r.path, options);
+      ASSERT_EQ(result.overall.failures, 0) << result.overall.first_failure;
+      ASSERT_GT(result.contacts.contact_link_steps, 0);
+      peers::OverallContactProblem problem;
+      problem.lengths = result.lengths;
+      problem.squared = 1.0;
+      problem.rotation = rotation;
+      for (const Collider& c : spheres) problem.spheres.push_back({c.pose.translation(), c.radius});
+      // Every step with a link in contact (within 1e-9 of a sphere), the first 12 of them.
+      int taken = 0;
+      for (size_t f = 1; f < result.frames.size() && taken < 12; ++f) {
+        const Points ours = result.frames[f].points;
+        double nearest = std::numeric_limits<double>::infinity();
+        for (const Collider& c : spheres) {
+          for (Eigen::Index i = 1; i < ours.rows(); ++i) {
+            nearest = std::fmin(nearest, SampledDistance(c, At(ours, i - 1), At(ours, i), 200));
+          }
+        }
+        if (nearest > 1e-9) continue;
+        ++taken;
+        problem.old_points = result.frames[f - 1].points;
+        problem.head = ours.row(0).transpose();
+        // IPOPT from the old configuration (its head moved) and from ours moved by 1e-3 of a
+        // link at every point; its best answer.
+        Eigen::MatrixXd moved_old = problem.old_points;
+        moved_old.row(0) = problem.head.transpose();
+        Eigen::MatrixXd nudged = ours;
+        for (Eigen::Index j = 1; j < nudged.rows(); ++j) {
+          nudged(j, 0) += 1e-4 * std::cos(7.0 * j);
+          nudged(j, 1) += 1e-4 * std::sin(5.0 * j);
+        }
+        double best = std::numeric_limits<double>::infinity();
+        Eigen::MatrixXd best_x;
+        for (const Eigen::MatrixXd& start : {moved_old, nudged}) {
+          Eigen::MatrixXd x;
+          if (!peers::IpoptOverallContact(problem, start, &x)) continue;
+          const double value = peers::OverallContactObjective(problem, x);
+          if (value < best) best = value, best_x = x;
+        }
+        ASSERT_TRUE(std::isfinite(best)) << "IPOPT found no solution at frame " << f;
+        const double value = peers::OverallContactObjective(problem, ours);
+        // Ours is never worse, and it is the same point.
+        EXPECT_LE(value, best + 1e-12 * std::fmax(1.0, best)) << "dim " << dim << " frame " << f;
+        const double distance = (Eigen::MatrixXd(ours) - best_x).cwiseAbs().maxCoeff();
+        EXPECT_LE(distance, 1e-8) << "dim " << dim << " rotation " << rotation << " frame " << f;
+        worst_distance = std::fmax(worst_distance, distance);
+        worst_objective = std::fmax(worst_objective, (value - best) / std::fmax(1.0, best));
+        ++compared;
+      }
+      EXPECT_GE(taken, 4) << "dim " << dim << " rotation " << rotation;
+    }
+  }
+  RecordProperty("steps_compared", compared);
+  RecordProperty("largest_distance_to_ipopt", std::to_string(worst_distance));
+  std::printf(
+      "compared %d contact steps with IPOPT: largest distance %.3g, objective above "
+      "IPOPT's by at most %.3g (relative)\n",
+      compared, worst_distance, worst_objective);
+}
+
+TEST(OverallCollidersTest, EveryConvexShapeKeepsEveryLinkOutsideWhereTheFreeRunCutsThrough) {
+  for (int dim : {2, 3}) {
+    const Rope r = RopeRoundCorner(dim, 24, 0.03);
+    const double z = dim == 3 ? 0.05 : 0.0;
+    Collider ellipsoid;
+    ellipsoid.shape = ColliderShape::kEllipsoid;
+    ellipsoid.pose.translation() = Vector3d(-0.35, 1.65, z);
+    ellipsoid.extents = Vector3d(0.3, 0.2, 0.3);
+    Collider cylinder;
+    cylinder.shape = ColliderShape::kCylinder;
+    cylinder.pose.translation() = Vector3d(-0.35, 1.65, z);
+    cylinder.radius = 0.3;
+    cylinder.half_length = 0.4;
+    const std::vector<std::pair<std::string, Collider>> shapes = {
+        {"sphere", Sphere(Vector3d(-0.35, 1.65, z), 0.3)},
+        {"capsule", CapsuleBetween(Vector3d(-0.45, 1.65, z), Vector3d(-0.25, 1.6, z), 0.25)},
+        {"ellipsoid", ellipsoid},
+        {"cylinder", cylinder},
+        {"box", Box(Vector3d(-0.35, 1.65, z), Vector3d(0.3, 0.3, 0.3))},
+    };
+    const RunResult free = flexkin::Run(r.chain, r.path, OverallOptionsWith({}));
+    for (const auto& [name, c] : shapes) {
+      SCOPED_TRACE(name + " " + std::to_string(dim) + "D");
+      EXPECT_LT(LeastSampled(free, c, 50), -0.1) << "the free run does not cut through";
+      const RunResult result = flexkin::Run(r.chain, r.path, OverallOptionsWith({c}));
+      EXPECT_GE(LeastSampled(result, c, 100), -1e-12);
+      EXPECT_LE(LengthError(result), 1e-13);
+      EXPECT_GT(result.contacts.contact_link_steps, 0);
+      EXPECT_GE(result.contacts.least_clearance, -1e-12);
+      // Smooth surfaces: every sub-step converged. A box's or cylinder's edges may leave a
+      // sub-step on its sequential contact step (reported), never inside.
+      const bool smooth = name == "sphere" || name == "capsule" || name == "ellipsoid";
+      if (smooth) EXPECT_EQ(result.overall.failures, 0) << result.overall.first_failure;
+      std::printf(
+          "%s %dD: %lld of %lld sub-steps converged, %lld link steps in contact, least "
+          "clearance %.3g, length error %.3g\n",
+          name.c_str(), dim, (long long)(result.overall.solves - result.overall.failures),
+          (long long)result.overall.solves, (long long)result.contacts.contact_link_steps,
+          result.contacts.least_clearance, LengthError(result));
+    }
+  }
+}
+
+TEST(OverallCollidersTest, ARunThatTouchesNothingIsTheRunWithoutCollidersBitForBit) {
+  for (int dim : {2, 3}) {
+    for (double rotation : {0.0, 0.5}) {
+      const Rope r = RopeRoundCorner(dim, 20, 0.05);
+      const RunResult free = flexkin::Run(r.chain, r.path, OverallOptionsWith({}, rotation));
+      const RunResult far = flexkin::Run(
+          r.chain, r.path, OverallOptionsWith({Sphere(Vector3d(40, 40, 0), 1.0)}, rotation));
+      ASSERT_EQ(free.frames.size(), far.frames.size());
+      for (size_t f = 0; f < free.frames.size(); ++f) {
+        ASSERT_EQ(Points(free.frames[f].points), Points(far.frames[f].points)) << f;
+      }
+      EXPECT_EQ(free.metrics.l2_per_step, far.metrics.l2_per_step);
+      EXPECT_EQ(far.contacts.contact_link_steps, 0);
+    }
+  }
+}
+
+TEST(OverallCollidersTest, TheL2MetricAndMeshesAreRefusedByName) {
+  const Rope r = RopeRoundCorner(2, 10, 0.1);
+  RunOptions options = OverallOptionsWith({Sphere(Vector3d(-0.35, 1.65, 0), 0.3)});
+  options.overall.weights.l2 = 1.0;
+  options.overall.weights.squared = 0.0;
+  try {
+    flexkin::Run(r.chain, r.path, options);
+    FAIL() << "the L2 metric with colliders was not refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("overall.weights.l2"), std::string::npos) << e.what();
+  }
+  RunOptions mesh = OverallOptionsWith({});
+  Collider m;
+  m.shape = ColliderShape::kMesh;
+  std::vector<Problem> problems;
+  MeshVertices vertices(4, 3);
+  vertices << 5, 5, 5, 6, 5, 5, 5, 6, 5, 5, 5, 6;
+  MeshTriangles triangles(4, 3);
+  triangles << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3;
+  m.mesh = MakeColliderMesh(vertices, triangles, "", "mesh", &problems);
+  ASSERT_TRUE(m.mesh) << problems.size();
+  mesh.colliders = {m};
+  Points p3 = Points::Zero(4, 3);
+  for (int i = 0; i <= 3; ++i) p3(i, 1) = -0.1 * i;
+  try {
+    flexkin::Run(MakeChain(p3), Points(Points::Constant(1, 3, 0.01)), mesh);
+    FAIL() << "a mesh with the overall method was not refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("colliders[0].shape"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace flexkin
