@@ -2,8 +2,8 @@
 // "Colliders"): after every step no link capsule lies inside a collider beyond 1e-12 of its
 // length, measured here by the test's own distance computation (not the library's), the base is
 // held and the lengths kept, while the same path without the colliders cuts into them; colliders
-// that nothing reaches change no bit; starts and targets inside colliders, bad colliders and arms
-// with joint axes are refused by name.
+// that nothing reaches change no bit; starts and targets inside colliders, bad colliders, and
+// pointing or method fixed_point with colliders on arms with joint axes are refused by name.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -117,6 +117,23 @@ bool PlaceObstacle(const ArmModel& model, const Points& path, const ArmTrajector
   return false;
 }
 
+// A round collider of radius 0.3 (a capsule: half length 0.5 along z) that the free run's middle
+// links cut 0.1 into (PlaceObstacle), into `*obstacle`; how deep the free run cuts into it,
+// relative to a link, into `*free_least`.
+void ObstacleInTheWay(const ArmModel& model, const Points& path, const ArmTrajectory& free,
+                      ColliderShape shape, Collider* obstacle, double* free_least) {
+  obstacle->shape = shape;
+  obstacle->radius = 0.3;
+  if (shape == ColliderShape::kCapsule) obstacle->half_length = 0.5;  // along z
+  Eigen::Vector3d centre;
+  ASSERT_TRUE(PlaceObstacle(model, path, free, obstacle->radius + 0.05, 0.1, &centre));
+  obstacle->pose.translation() = centre;
+  *free_least = std::numeric_limits<double>::infinity();
+  for (const ArmStepReport& step : free.steps) {
+    *free_least = std::min(*free_least, RelativeClearance(model, step.state.points, {*obstacle}));
+  }
+}
+
 struct Case {
   int dim;
   ColliderShape shape;
@@ -140,18 +157,9 @@ TEST_P(ArmColliders, NoLinkEntersAndTheBaseIsHeld) {
   ASSERT_EQ(free.unreached, 0);
 
   Collider obstacle;
-  obstacle.shape = param.shape;
-  obstacle.radius = 0.3;
-  if (param.shape == ColliderShape::kCapsule) obstacle.half_length = 0.5;  // along z
-  Eigen::Vector3d centre;
-  ASSERT_TRUE(PlaceObstacle(model, path, free, obstacle.radius + 0.05, 0.1, &centre));
-  obstacle.pose.translation() = centre;
+  double free_least = 0.0;
+  ObstacleInTheWay(model, path, free, param.shape, &obstacle, &free_least);
   options.colliders = {obstacle};
-
-  double free_least = std::numeric_limits<double>::infinity();
-  for (const ArmStepReport& step : free.steps) {
-    free_least = std::min(free_least, RelativeClearance(model, step.state.points, {obstacle}));
-  }
   EXPECT_LT(free_least, -0.05) << "the free run should cut into the obstacle";
 
   const ArmTrajectory run = TrackPath(model, path, options);
@@ -277,12 +285,66 @@ TEST(ArmCollidersRefused, StartTargetBadColliderAndJointAxes) {
   m = MessageOf([&] { TrackPath(model, path, options); });
   EXPECT_NE(m.find("link_radii[0]"), std::string::npos) << m;
 
+  // Arms with joint axes take colliders with method newton and position targets.
   const ArmModel snake = scenes::RevoluteSnake(8);
   Points p3(1, 3);
   p3.row(0) = ForwardKinematics(snake, snake.initial).row(8);
-  m = MessageOf([&] { TrackPath(snake, p3, options); });
-  EXPECT_NE(m.find("colliders"), std::string::npos) << m;
+  ArmOptions pointing = options;
+  pointing.pointing.enabled = true;
+  pointing.pointing.axis = Eigen::Vector3d::UnitZ();
+  pointing.pointing.direction = Eigen::Vector3d::UnitX();
+  m = MessageOf([&] { TrackPath(snake, p3, pointing); });
+  EXPECT_NE(m.find("pointing"), std::string::npos) << m;
   EXPECT_NE(m.find("joint axes"), std::string::npos) << m;
+  ArmOptions fixed_point = options;
+  fixed_point.method = FixedBaseMethod::kFixedPoint;
+  m = MessageOf([&] { TrackPath(snake, p3, fixed_point); });
+  EXPECT_NE(m.find("method"), std::string::npos) << m;
+}
+
+// An arm with joint axes (the pitch/yaw snake) tracking a circle with a collider in the way of
+// its free motion: the joint-space step with the capsules' clearances as constraints
+// (src/arm/joint_space_contact.h). Every link outside after every step, measured by the test's
+// own distances; the base held, the lengths kept, the targets reached.
+TEST(ArmCollidersJointAxes, NoLinkEntersAndTheTargetsAreReached) {
+  for (const ColliderShape shape : {ColliderShape::kSphere, ColliderShape::kCapsule}) {
+    SCOPED_TRACE(ColliderShapeName(shape));
+    ArmModel model = scenes::RevoluteSnake(12);
+    model.link_radii = Eigen::VectorXd::Constant(12, 0.05);
+    const Points path = CircleOfTargets(model, 2.0, 60, CircleTilt::kRising);
+    ArmOptions options;
+    const ArmTrajectory free = TrackPath(model, path, options);
+    ASSERT_EQ(free.unreached, 0);
+    Collider obstacle;
+    double free_least = 0.0;
+    ObstacleInTheWay(model, path, free, shape, &obstacle, &free_least);
+    options.colliders = {obstacle};
+    EXPECT_LT(free_least, -0.05) << "the free run should cut into the obstacle";
+
+    const ArmTrajectory run = TrackPath(model, path, options);
+    const double scale = model.link_lengths.mean();
+    const Points start = ForwardKinematics(model, model.initial);
+    int contact_steps = 0;
+    for (size_t s = 0; s < run.steps.size(); ++s) {
+      const ArmStepReport& step = run.steps[s];
+      const Points& p = step.state.points;
+      EXPECT_GE(RelativeClearance(model, p, {obstacle}), -1e-12) << "step " << s;
+      EXPECT_EQ(At(p, 0), At(start, 0)) << "step " << s;
+      for (int k = 0; k < model.num_links(); ++k) {
+        EXPECT_NEAR((At(p, k + 1) - At(p, k)).norm(), model.link_lengths[k], 1e-12);
+      }
+      contact_steps += step.contact ? 1 : 0;
+    }
+    EXPECT_GT(contact_steps, 0);
+    EXPECT_EQ(run.unreached, 0) << "blocked " << run.blocked_steps;
+    EXPECT_LE(run.max_ee_error, 1e-10 * scale);
+    EXPECT_GE(run.min_clearance, -1e-12 * scale);
+    std::printf(
+        "joint axes, %s: free run %.3g deep; %d contact steps, %d not reached, least "
+        "clearance %.3g, largest miss %.3g\n",
+        ColliderShapeName(shape), -free_least, contact_steps, run.unreached, run.min_clearance,
+        run.max_ee_error);
+  }
 }
 
 // Robot scenario files: every bad value named by its JSON pointer.

@@ -247,19 +247,24 @@ struct ArmOptions {
   // equal legs along the end effector's straight move, each taking time_step, as keep every joint
   // within its limit (ArmStepReport::velocity_legs). 0: limits ignored.
   double time_step = 0.0;
-  // Things in the world the arm's links stay outside of (docs/robots.md, "Colliders"): planar and
-  // spherical arms (the tractrix sweep) only; arms with joint axes refuse them. Each link is a
-  // capsule of ArmModel::link_radii about its axis. Where a step's free result (the step without
-  // colliders) keeps every link outside, it is that result bit for bit; otherwise the step is
-  // solved again by the sweep in which every link whose tractrix step would enter a collider takes
-  // the contact step instead (the least motion of its trailing end that keeps it outside). A 2D
-  // arm lies in the plane z = 0. Empty: none.
+  // Things in the world the arm's links stay outside of (docs/robots.md, "Colliders"). Each link
+  // is a capsule of ArmModel::link_radii about its axis. Where a step's free result (the step
+  // without colliders) keeps every link outside, it is that result bit for bit; otherwise, for
+  // planar and spherical arms, the step is solved again by the sweep in which every link whose
+  // tractrix step would enter a collider takes the contact step instead (the least motion of its
+  // trailing end that keeps it outside); for arms with joint axes (method newton, no pointing,
+  // convex colliders), by the joint-space step with the capsules' clearances as constraints. A 2D
+  // arm lies in the plane z = 0. Keyframed colliders (Collider::motion) move with time in leader
+  // steps: TrackPath's step toward path row i spans [i, i + 1], each sub-step of its sweep at its
+  // own time, the result checked where they are at i + 1 (docs/robots.md, "Colliders"). Empty:
+  // none.
   std::vector<Collider> colliders;
   // Every problem (empty if valid), each naming its member ("max_iterations").
   Problems Validate() const;
   // The problems of these options on `model` besides Validate's: pointing needs joint axes, and
   // method fixed_point takes only revolute joints across links of positive length within
-  // [-pi, pi] and no pointing; colliders need an arm without joint axes.
+  // [-pi, pi] and no pointing; colliders on an arm with joint axes need method newton, no
+  // pointing and convex shapes.
   Problems ValidateFor(const ArmModel& model) const;
 };
 
@@ -341,9 +346,12 @@ struct ArmStepReport {
 // model.base. Every link keeps its length (the points are rebuilt from the joint angles), every
 // joint stays within its limits, and nothing is NaN: an unreachable target gives the nearest
 // configuration the method finds and reached = false. Throws InputError on an invalid model,
-// options, state or target.
+// options, state or target. `time` (leader steps) places keyframed colliders (Collider::motion):
+// the step spans [time, time + 1], as TrackPath's step toward path row i spans [i, i + 1]
+// (docs/colliders.md, "Moving colliders"); the state must be outside them at `time`.
 ArmStepReport ArmStep(const ArmModel& model, const ArmState& state,
-                      const Eigen::Ref<const Eigen::VectorXd>& target, const ArmOptions& options);
+                      const Eigen::Ref<const Eigen::VectorXd>& target, const ArmOptions& options,
+                      double time = 0.0);
 
 struct ArmTrajectory {
   // One per path point from the plain TrackPath; empty from TrackPath with a sink (the steps went

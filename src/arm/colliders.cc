@@ -28,6 +28,13 @@ double LinkRadius(const ArmModel& model, int k) {
 
 }  // namespace
 
+const std::vector<Collider>& CollidersNow(const std::vector<Collider>& colliders, double time,
+                                          std::vector<Collider>* storage) {
+  if (!AnyMoves(colliders)) return colliders;
+  *storage = CollidersAt(colliders, time);
+  return *storage;
+}
+
 double SweepSkin(const ArmModel& model, const ArmOptions& options) {
   return std::max(2.0 * options.tolerance, 1e-8) * model.link_lengths.mean();
 }
@@ -66,18 +73,23 @@ double ArmClearance(const ArmModel& model, const Points& points,
 }
 
 void CheckArmOutside(const ArmModel& model, const Points& points,
-                     const std::vector<Collider>& colliders, const std::string& field) {
+                     const std::vector<Collider>& colliders, const std::string& field,
+                     double time) {
   if (colliders.empty()) return;
   double relative = 0.0;
   int link = 0, collider = 0;
-  ArmClearance(model, points, colliders, &relative, &link, &collider);
+  std::vector<Collider> storage;
+  ArmClearance(model, points, CollidersNow(colliders, time, &storage), &relative, &link, &collider);
   if (relative >= -kArmContactSlack) return;
   const double depth = -relative * model.link_lengths[link - 1];
+  const std::string when = colliders[collider].motion
+                               ? " at time " + FormatNumber(time) + " of its motion"
+                               : std::string();
   throw InputError(field, "link " + std::to_string(link) + " (points " + std::to_string(link - 1) +
                               " to " + std::to_string(link) +
                               ", base first) lies inside collider " + std::to_string(collider) +
-                              " (" + ColliderShapeName(colliders[collider].shape) + ") by " +
-                              FormatNumber(depth) +
+                              " (" + ColliderShapeName(colliders[collider].shape) + ")" + when +
+                              " by " + FormatNumber(depth) +
                               " (length unit, its capsule's radius included); expected a start "
                               "with every link outside every collider");
 }
@@ -91,6 +103,7 @@ void CheckTargetOutside(const ArmModel& model, const ArmOptions& options,
   Eigen::Vector3d t = Eigen::Vector3d::Zero();
   t.head(target.size()) = target;
   for (size_t c = 0; c < options.colliders.size(); ++c) {
+    if (options.colliders[c].motion) continue;  // blocks the steps where it is on the target
     const double d = QuerySurface(options.colliders[c], t).distance - r;
     if (d < skin) {
       throw InputError(field, "the target " + FormatPoint(target) + " lies inside collider " +

@@ -16,6 +16,25 @@ namespace flexkin::arm_internal {
 // as `collided`: the 1e-12 of a link.
 constexpr double kArmContactSlack = 1e-12;
 
+// The time a step (or a leg of one) spans, in leader steps, for keyframed colliders
+// (Collider::motion; docs/colliders.md, "Moving colliders"): TrackPath's step toward path row i
+// spans [i, i + 1], so the state after it (frame i + 1) is at time i + 1; sub-step j of m of a
+// sweep is at start + (end - start) j / m (i + j / m for a whole step, as in chain runs).
+struct StepWindow {
+  double start = 0.0, end = 1.0;
+  // Sub-step j (1-based) of m.
+  double Substep(int j, int m) const {
+    return j == m ? end : start + (end - start) * (double(j) / double(m));
+  }
+  // Leg `leg` (1-based) of `legs` equal legs; the last ends where this window does.
+  StepWindow Leg(int leg, int legs) const { return {Substep(leg - 1, legs), Substep(leg, legs)}; }
+};
+
+// `colliders` where their motions have them at `time` (ColliderAt): `colliders` themselves where
+// none moves, otherwise *storage, filled.
+const std::vector<Collider>& CollidersNow(const std::vector<Collider>& colliders, double time,
+                                          std::vector<Collider>* storage);
+
 // The colliders as the sweep's contact step sees them: each grown by the arm's largest link
 // radius (exact for a uniform arm, conservative for thinner links) and by a skin (SweepSkin).
 std::vector<Collider> SweepColliders(const ArmModel& model, const ArmOptions& options);
@@ -36,12 +55,16 @@ double ArmClearance(const ArmModel& model, const Points& points,
                     int* collider = nullptr);
 
 // Throws InputError (field `field`) naming the link, the collider (by index) and the depth if a
-// link capsule of `points` lies inside a collider beyond kArmContactSlack of its length.
+// link capsule of `points` lies inside a collider, where its motion has it at `time`, beyond
+// kArmContactSlack of its length.
 void CheckArmOutside(const ArmModel& model, const Points& points,
-                     const std::vector<Collider>& colliders, const std::string& field);
+                     const std::vector<Collider>& colliders, const std::string& field,
+                     double time = 0.0);
 
 // Throws InputError (field `field`) if `target` lies inside a collider grown by the end
 // effector's link radius and the sweep's skin (the end effector could not be put there).
+// Keyframed colliders are not checked: one that comes onto a target blocks the steps where it
+// is there (ArmStepReport::blocked).
 void CheckTargetOutside(const ArmModel& model, const ArmOptions& options,
                         const Eigen::VectorXd& target, const std::string& field);
 

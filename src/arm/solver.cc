@@ -23,6 +23,7 @@
 #include "arm/colliders.h"
 #include "arm/internal.h"
 #include "arm/joint_space.h"
+#include "arm/joint_space_contact.h"
 #include "arm/revolute.h"
 #include "arm/sweep.h"
 #include "flexkin/arm.h"
@@ -42,6 +43,7 @@ constexpr int kFarIterations = 20;
 
 using Vec = arm_internal::SmallVec;
 using Mat = arm_internal::SmallMat;
+using arm_internal::StepWindow;
 using arm_internal::Sweeper;
 
 // Where a solver ended: the best sweep it found.
@@ -381,12 +383,6 @@ Problems ArmOptions::Validate() const {
   for (size_t c = 0; c < colliders.size(); ++c) {
     const Problems bad = CheckCollider(colliders[c], "colliders[" + std::to_string(c) + "]");
     problems.insert(problems.end(), bad.begin(), bad.end());
-    if (colliders[c].motion) {
-      problems.emplace_back("colliders[" + std::to_string(c) + "].motion",
-                            "is not supported for fixed-base arms yet; keyframed colliders are "
-                            "for chain runs (docs/colliders.md, \"Moving colliders\")",
-                            "a motion", "a collider without \"motion\"");
-    }
   }
   if (pointing.enabled) {
     auto unit_vector = [&](const Eigen::Vector3d& v, const char* name) {
@@ -431,13 +427,26 @@ Problems ArmOptions::ValidateFor(const ArmModel& model) const {
                           "within [-pi, pi] and no pointing; expected \"newton\"");
   }
   if (!colliders.empty() && model.has_axes()) {
-    problems.emplace_back(
-        "colliders",
-        "has " + std::to_string(colliders.size()) +
-            " colliders, which arms with joint axes (URDF arms, joint_axes) do not take yet: "
-            "colliders are supported for planar arms (revolute joints about z, including URDF arms "
-            "that read as planar) and spatial arms with spherical joints (the tractrix sweep); "
-            "expected no colliders for this arm");
+    // Arms with joint axes keep their capsules outside in the joint-space step
+    // (src/arm/joint_space_contact.h): method newton, position targets, convex colliders.
+    if (method != FixedBaseMethod::kNewton) {
+      problems.emplace_back("method",
+                            "colliders with an arm with joint axes need method \"newton\" (the "
+                            "joint-space step keeps the links outside); expected \"newton\"");
+    }
+    if (pointing.enabled) {
+      problems.emplace_back("pointing",
+                            "is not combined with colliders yet for arms with joint axes: the "
+                            "joint-space step among colliders tracks the end effector's position; "
+                            "expected pointing off with colliders");
+    }
+    for (size_t c = 0; c < colliders.size(); ++c) {
+      if (colliders[c].shape == ColliderShape::kMesh) {
+        problems.emplace_back("colliders[" + std::to_string(c) + "].shape",
+                              "a mesh is not taken by arms with joint axes yet (their step needs "
+                              "a convex collider's smooth clearance); expected a convex shape");
+      }
+    }
   }
   return problems;
 }
@@ -482,6 +491,22 @@ ArmStepReport Report(const ArmModel& model, const Eigen::VectorXd& target, doubl
   return report;
 }
 
+// The report of a joint-space solve of an arm with joint axes: the solver's joint values and
+// their points, the end effector's miss as base_error. (The solve's angle residual is kept.)
+ArmStepReport AxisReport(const ArmModel& model, const Eigen::VectorXd& target, double tol,
+                         arm_internal::JointSpaceSolve&& solved) {
+  ArmStepReport report;
+  report.base_error = solved.residual;
+  report.iterations = solved.iterations;
+  report.converged = solved.converged;
+  report.limited = solved.limited;
+  report.passes = solved.passes;
+  report.state.angles.angle = std::move(solved.angles);
+  report.state.points = std::move(solved.points);
+  MeasureReach(model, target, tol, &report);
+  return report;
+}
+
 // The joint-space solve from `state` (src/arm/joint_space.h); base_error is the end effector's
 // miss, sweeps 0. Arms with joint axes keep the solver's joint values (their points are its
 // forward kinematics); the others read their angles from the points, as the sweep's steps do.
@@ -492,15 +517,9 @@ ArmStepReport JointSpaceStep(const arm_internal::JointSpacePlan& plan, const Arm
       plan, state, target, tol, options.max_iterations, options.restarts, options.pointing);
   ArmStepReport report;
   if (model.has_axes()) {
-    report.base_error = solved.residual;
-    report.iterations = solved.iterations;
-    report.converged = solved.converged;
-    report.limited = solved.limited;
-    report.passes = solved.passes;
-    report.state.angles.angle = std::move(solved.angles);
-    report.state.points = std::move(solved.points);
-    MeasureReach(model, target, tol, &report);
-    if (options.pointing.enabled) report.pointing_error = solved.angle_residual;
+    const double angle_residual = solved.angle_residual;
+    report = AxisReport(model, target, tol, std::move(solved));
+    if (options.pointing.enabled) report.pointing_error = angle_residual;
   } else {
     const SolveResult result{std::move(solved.points), solved.residual, solved.iterations,
                              solved.converged,         solved.limited,  {}};
@@ -549,9 +568,9 @@ ArmOptions LegOptions(const ArmModel& model, const ArmState& state, const Eigen:
 template <class Step>
 ArmStepReport VelocityLimitedStep(const ArmModel& model, const ArmState& state,
                                   const Eigen::VectorXd& target, const ArmOptions& options,
-                                  const Step& step) {
+                                  const StepWindow& window, const Step& step) {
   constexpr int kMaxVelocityRounds = 8, kMaxVelocityLegs = 100000;
-  ArmStepReport report = step(state, target, options);
+  ArmStepReport report = step(state, target, options, window);
   report.velocity_legs = 1;
   report.velocity_ratio =
       VelocityRatio(model, state.angles.angle, report.state.angles.angle, options.time_step);
@@ -566,7 +585,8 @@ ArmStepReport VelocityLimitedStep(const ArmModel& model, const ArmState& state,
     for (int leg = 1; leg <= legs; ++leg) {
       const Eigen::VectorXd goal =
           leg == legs ? target : Eigen::VectorXd(from + (target - from) * (double(leg) / legs));
-      leg_report = step(leg_state, goal, LegOptions(model, state, target, options, leg, legs));
+      leg_report = step(leg_state, goal, LegOptions(model, state, target, options, leg, legs),
+                        window.Leg(leg, legs));
       AddCost(leg_report, &cost);
       ratio = std::max(ratio, VelocityRatio(model, leg_state.angles.angle,
                                             leg_report.state.angles.angle, options.time_step));
@@ -585,12 +605,12 @@ ArmStepReport VelocityLimitedStep(const ArmModel& model, const ArmState& state,
 
 // The tractrix sweep's step (planar and spherical arms), solved by Newton or the fixed point.
 // With `contact` (src/arm/colliders.h), the sweep takes the contact step where a link would enter
-// a collider.
+// a collider, keyframed ones where they are at each sub-step's time in `window`.
 ArmStepReport SweepStep(const ArmModel& model, const ArmState& state, const Eigen::VectorXd& target,
-                        double tol, const ArmOptions& options,
-                        const std::vector<Collider>* contact = nullptr) {
+                        double tol, const ArmOptions& options, const std::vector<Collider>* contact,
+                        const StepWindow& window) {
   const int n = model.num_links();
-  Sweeper sweeper(model, state.points, target, options.substeps, contact);
+  Sweeper sweeper(model, state.points, target, options.substeps, contact, window);
   const SolveResult solved =
       options.method == FixedBaseMethod::kNewton
           ? SolveNewton(&sweeper, model, target - state.points.row(n).transpose(), options, tol,
@@ -613,10 +633,11 @@ void SetCost(const ArmStepReport& from, ArmStepReport* to) {
 
 // The move from the end effector to `target` tracked along its straight line in `legs` equal
 // legs, each a sweep step with the base held, as TrackPath would track that line. Stops at the
-// first leg not reached (reached = false; its error is then the leg's). Costs of all legs.
+// first leg not reached (reached = false; its error is then the leg's). Costs of all legs. Each
+// leg spans its share of `window`.
 ArmStepReport LegsStep(const ArmModel& model, const ArmState& state, const Eigen::VectorXd& target,
                        int legs, double tol, const ArmOptions& options,
-                       const std::vector<Collider>* contact) {
+                       const std::vector<Collider>* contact, const StepWindow& window) {
   const Eigen::VectorXd from = state.points.row(model.num_links()).transpose();
   ArmStepReport report, cost;
   ArmState leg_state = state;
@@ -624,7 +645,7 @@ ArmStepReport LegsStep(const ArmModel& model, const ArmState& state, const Eigen
   for (int leg = 1; leg <= legs; ++leg) {
     const Eigen::VectorXd goal =
         leg == legs ? target : Eigen::VectorXd(from + (target - from) * (double(leg) / legs));
-    report = SweepStep(model, leg_state, goal, tol, options, contact);
+    report = SweepStep(model, leg_state, goal, tol, options, contact, window.Leg(leg, legs));
     AddCost(report, &cost);
     if (!report.reached) break;
     leg_state = report.state;
@@ -643,27 +664,53 @@ void CheckOptionsForModel(const ArmModel& model, const ArmOptions& options) {
 
 ArmStepReport SweptStep(const arm_internal::JointSpacePlan& plan, const ArmState& state,
                         const Eigen::VectorXd& target, const ArmOptions& options,
-                        const std::vector<Collider>* contact);
+                        const std::vector<Collider>* contact, const StepWindow& window);
+
+// `report` (a step among `colliders`, where they are at the step's end) with its clearance
+// measured; where a link is still inside a collider (no solve kept them all outside), the arm held
+// where it was (`blocked`, not reached; a keyframed collider that came onto it may leave it
+// inside: the clearance says by how much).
+ArmStepReport KeptOutside(const ArmModel& model, const ArmState& state,
+                          const Eigen::VectorXd& target, const ArmOptions& options,
+                          const std::vector<Collider>& colliders, ArmStepReport report) {
+  double relative = 0.0;
+  report.clearance = arm_internal::ArmClearance(model, report.state.points, colliders, &relative);
+  if (relative >= -arm_internal::kArmContactSlack) return report;
+  ArmStepReport held = report;
+  held.state = state;
+  held.state.memory = ArmSolverMemory();
+  held.reached = false;
+  held.blocked = true;
+  MeasureReach(model, target, options.tolerance * model.link_lengths.mean(), &held);
+  held.reached = false;
+  held.clearance = arm_internal::ArmClearance(model, state.points, colliders, &relative);
+  return held;
+}
 
 // The step among colliders (planar and spherical arms): the free step where it leaves every link
 // outside (then it is the step without colliders, bit for bit), else the step again with contact
-// steps in the sweep. The clearance after it is measured either way.
+// steps in the sweep. The clearance after it is measured either way, against the colliders where
+// they are at the end of `window` (keyframed ones: in the sweep, at each sub-step's time).
 ArmStepReport ContactStep(const arm_internal::JointSpacePlan& plan, const ArmState& state,
-                          const Eigen::VectorXd& target, const ArmOptions& options) {
+                          const Eigen::VectorXd& target, const ArmOptions& options,
+                          const StepWindow& window) {
   const ArmModel& model = plan.model();
   double relative = 0.0;
-  ArmStepReport free = SweptStep(plan, state, target, options, nullptr);
-  free.clearance =
-      arm_internal::ArmClearance(model, free.state.points, options.colliders, &relative);
+  std::vector<Collider> posed;
+  const std::vector<Collider>& colliders =
+      arm_internal::CollidersNow(options.colliders, window.end, &posed);
+  ArmStepReport free = SweptStep(plan, state, target, options, nullptr, window);
+  free.clearance = arm_internal::ArmClearance(model, free.state.points, colliders, &relative);
   if (relative >= -arm_internal::kArmContactSlack) return free;
   const std::vector<Collider> grown = arm_internal::SweepColliders(model, options);
-  ArmStepReport report = SweptStep(plan, state, target, options, &grown);
+  ArmStepReport report = SweptStep(plan, state, target, options, &grown, window);
   AddCost(free, &report);
   // Contact makes F piecewise smooth: where Newton finds no root, the same straight move in
   // 2, 4 and 8 legs (each leg's Newton starts nearer its root).
   for (int legs = 2; !report.reached && legs <= kContactLegs; legs *= 2) {
-    ArmStepReport legged = LegsStep(model, state, target, legs,
-                                    options.tolerance * model.link_lengths.mean(), options, &grown);
+    ArmStepReport legged =
+        LegsStep(model, state, target, legs, options.tolerance * model.link_lengths.mean(), options,
+                 &grown, window);
     AddCost(report, &legged);
     legged.legs = std::max(legged.legs, report.legs);
     // The legs stop at the first leg not reached, with that leg's error: measured to the target.
@@ -676,27 +723,41 @@ ArmStepReport ContactStep(const arm_internal::JointSpacePlan& plan, const ArmSta
     report = std::move(legged);
   }
   report.contact = true;
-  report.clearance =
-      arm_internal::ArmClearance(model, report.state.points, options.colliders, &relative);
-  if (relative < -arm_internal::kArmContactSlack) {
-    // No solve keeps every link outside: the arm is held where it was.
-    ArmStepReport held = report;
-    held.state = state;
-    held.state.memory = ArmSolverMemory();
-    held.reached = false;
-    held.blocked = true;
-    MeasureReach(model, target, options.tolerance * model.link_lengths.mean(), &held);
-    held.reached = false;
-    held.clearance = arm_internal::ArmClearance(model, state.points, options.colliders, &relative);
-    return held;
-  }
-  return report;
+  return KeptOutside(model, state, target, options, colliders, std::move(report));
+}
+
+// The step among colliders of an arm with joint axes (method newton): the free joint-space step
+// where it leaves every link outside (then it is that step, bit for bit), else the joint-space
+// step with the capsules' clearances as constraints (src/arm/joint_space_contact.h). Keyframed
+// colliders: where they are at the end of `window` (the step has no sub-steps).
+ArmStepReport AxisContactStep(const arm_internal::JointSpacePlan& plan, const ArmState& state,
+                              const Eigen::VectorXd& target, const ArmOptions& options,
+                              const StepWindow& window) {
+  const ArmModel& model = plan.model();
+  const double tol = options.tolerance * model.link_lengths.mean();
+  double relative = 0.0;
+  std::vector<Collider> posed;
+  const std::vector<Collider>& colliders =
+      arm_internal::CollidersNow(options.colliders, window.end, &posed);
+  ArmStepReport free = JointSpaceStep(plan, state, target, tol, options);
+  free.clearance = arm_internal::ArmClearance(model, free.state.points, colliders, &relative);
+  if (relative >= -arm_internal::kArmContactSlack) return free;
+  arm_internal::JointSpaceSolve solved;
+  arm_internal::SolveJointSpaceContact(plan, state.angles.angle, target, colliders, tol,
+                                       arm_internal::kArmContactSlack, options.max_iterations,
+                                       &solved);
+  ArmStepReport report = AxisReport(model, target, tol, std::move(solved));
+  report.joint_space = true;
+  AddCost(free, &report);
+  report.contact = true;
+  return KeptOutside(model, state, target, options, colliders, std::move(report));
 }
 
 // ArmStep on a checked model (prepared in `plan`), options, state and target, without velocity
-// limits.
+// limits, over `window` (keyframed colliders).
 ArmStepReport StepUnlimited(const arm_internal::JointSpacePlan& plan, const ArmState& state,
-                            const Eigen::VectorXd& target, const ArmOptions& options) {
+                            const Eigen::VectorXd& target, const ArmOptions& options,
+                            const StepWindow& window) {
   const ArmModel& model = plan.model();
   const int n = model.num_links();
   const double scale = model.link_lengths.mean();
@@ -711,14 +772,17 @@ ArmStepReport StepUnlimited(const arm_internal::JointSpacePlan& plan, const ArmS
     // Method newton: the weighted minimum-norm joint motion from the last angles
     // (src/arm/joint_space.cc says why not the sweep). Out of reach, it ends at the nearest
     // configuration its joints give (a straight arm is not one in general).
+    if (newton && !options.colliders.empty()) {
+      return AxisContactStep(plan, state, target, options, window);
+    }
     if (newton) return JointSpaceStep(plan, state, target, tol, options);
     arm_internal::RevoluteSweeper sweeper(model, state, target, options.substeps);
     const SolveResult solved = SolveFixedPointRevolute(&sweeper, options, tol);
     return Report(model, target, tol, solved, sweeper.sweeps(),
                   sweeper.sweeps());  // 1 sweep a pass
   }
-  if (!options.colliders.empty()) return ContactStep(plan, state, target, options);
-  return SweptStep(plan, state, target, options, nullptr);
+  if (!options.colliders.empty()) return ContactStep(plan, state, target, options, window);
+  return SweptStep(plan, state, target, options, nullptr, window);
 }
 
 // The step of a planar or spherical arm (the tractrix sweep, then the legs and the joint-space
@@ -727,7 +791,7 @@ ArmStepReport StepUnlimited(const arm_internal::JointSpacePlan& plan, const ArmS
 // outside the colliders.
 ArmStepReport SweptStep(const arm_internal::JointSpacePlan& plan, const ArmState& state,
                         const Eigen::VectorXd& target, const ArmOptions& options,
-                        const std::vector<Collider>* contact) {
+                        const std::vector<Collider>* contact, const StepWindow& window) {
   const ArmModel& model = plan.model();
   const int n = model.num_links();
   const double scale = model.link_lengths.mean();
@@ -756,11 +820,11 @@ ArmStepReport SweptStep(const arm_internal::JointSpacePlan& plan, const ArmState
   const int legs = static_cast<int>(std::ceil((target - from).norm() / (kLegLength * scale)));
   ArmOptions first = options;
   if (legs > 1 && newton) first.max_iterations = std::min(options.max_iterations, kFarIterations);
-  ArmStepReport report = SweepStep(model, state, target, tol, first, contact);
+  ArmStepReport report = SweepStep(model, state, target, tol, first, contact, window);
   if (report.reached || !newton) return report;
   // The sweep found no root. (1) A far move: the same straight line in legs.
   if (legs > 1) {
-    ArmStepReport legged = LegsStep(model, state, target, legs, tol, options, contact);
+    ArmStepReport legged = LegsStep(model, state, target, legs, tol, options, contact, window);
     AddCost(report, &legged);
     if (legged.reached) return legged;
     SetCost(legged, &report);
@@ -770,42 +834,51 @@ ArmStepReport SweptStep(const arm_internal::JointSpacePlan& plan, const ArmState
   ArmStepReport fallback = JointSpaceStep(plan, state, target, tol, options);
   AddCost(report, &fallback);
   double relative = 0.0;
+  std::vector<Collider> posed;
   const bool fallback_clear =
       contact == nullptr ||
-      (arm_internal::ArmClearance(model, fallback.state.points, options.colliders, &relative),
+      (arm_internal::ArmClearance(model, fallback.state.points,
+                                  arm_internal::CollidersNow(options.colliders, window.end, &posed),
+                                  &relative),
        relative >= -arm_internal::kArmContactSlack);
   if (fallback_clear && (fallback.reached || fallback.ee_error < report.ee_error)) return fallback;
   SetCost(fallback, &report);
   return report;
 }
 
-// ArmStep on a checked model (prepared in `plan`), options, state and target.
+// ArmStep on a checked model (prepared in `plan`), options, state and target, over `window`
+// (keyframed colliders; velocity legs split it as they split the move).
 ArmStepReport StepChecked(const arm_internal::JointSpacePlan& plan, const ArmState& state,
-                          const Eigen::VectorXd& target, const ArmOptions& options) {
+                          const Eigen::VectorXd& target, const ArmOptions& options,
+                          const StepWindow& window) {
   const ArmModel& model = plan.model();
   if (options.time_step > 0.0 && model.max_velocity.size() == model.num_links()) {
-    return VelocityLimitedStep(
-        model, state, target, options,
-        [&](const ArmState& from, const Eigen::VectorXd& goal, const ArmOptions& leg_options) {
-          return StepUnlimited(plan, from, goal, leg_options);
-        });
+    return VelocityLimitedStep(model, state, target, options, window,
+                               [&](const ArmState& from, const Eigen::VectorXd& goal,
+                                   const ArmOptions& leg_options, const StepWindow& leg_window) {
+                                 return StepUnlimited(plan, from, goal, leg_options, leg_window);
+                               });
   }
-  return StepUnlimited(plan, state, target, options);
+  return StepUnlimited(plan, state, target, options, window);
 }
 
 }  // namespace
 
 ArmStepReport ArmStep(const ArmModel& model, const ArmState& state,
-                      const Eigen::Ref<const Eigen::VectorXd>& target_in,
-                      const ArmOptions& options) {
+                      const Eigen::Ref<const Eigen::VectorXd>& target_in, const ArmOptions& options,
+                      double time) {
   arm_internal::CheckModel(model);
   CheckOptions(options);
   CheckOptionsForModel(model, options);
   const Eigen::VectorXd target = target_in;
   CheckState(model, state, target);
-  arm_internal::CheckArmOutside(model, state.points, options.colliders, "state.points");
+  if (!std::isfinite(time)) {
+    throw InputError("time", "value " + FormatNumber(time) + " is not a finite number");
+  }
+  arm_internal::CheckArmOutside(model, state.points, options.colliders, "state.points", time);
   arm_internal::CheckTargetOutside(model, options, target, "target");
-  return StepChecked(arm_internal::JointSpacePlan(model), state, target, options);
+  return StepChecked(arm_internal::JointSpacePlan(model), state, target, options,
+                     StepWindow{time, time + 1.0});
 }
 
 std::string ArmStepReport::BriefReport() const {
@@ -853,7 +926,8 @@ ArmTrajectory TrackPath(const ArmModel& model, const Points& path, const ArmOpti
   // The last step's state is the next step's start: two reports, swapped after each step.
   ArmStepReport last;
   last.state = InitialState(model);
-  arm_internal::CheckArmOutside(model, last.state.points, options.colliders, "initial");
+  // Keyframed colliders where their motions have them at time 0.
+  arm_internal::CheckArmOutside(model, last.state.points, options.colliders, "initial", 0.0);
   for (int i = 0; i < path.rows(); ++i) {
     arm_internal::CheckTargetOutside(model, options, path.row(i).transpose(),
                                      "path[" + std::to_string(i) + "]");
@@ -861,7 +935,9 @@ ArmTrajectory TrackPath(const ArmModel& model, const Points& path, const ArmOpti
   const arm_internal::JointSpacePlan plan(model);  // for every step
   for (int i = 0; i < path.rows(); ++i) {
     const Eigen::VectorXd target = path.row(i).transpose();
-    ArmStepReport step = StepChecked(plan, last.state, target, options);
+    // Step i spans leader step i + 1: time i to i + 1 (docs/colliders.md, "Moving colliders").
+    ArmStepReport step =
+        StepChecked(plan, last.state, target, options, StepWindow{double(i), double(i + 1)});
     trajectory.max_ee_error = std::max(trajectory.max_ee_error, step.ee_error);
     trajectory.max_base_error = std::max(trajectory.max_base_error, step.base_error);
     trajectory.unreached += step.reached ? 0 : 1;

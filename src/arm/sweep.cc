@@ -23,7 +23,7 @@ bool HasAvx2Fma() {
 }
 
 Sweeper::Sweeper(const ArmModel& model, const Points& start, const Eigen::VectorXd& target,
-                 int substeps, const std::vector<Collider>* colliders)
+                 int substeps, const std::vector<Collider>* colliders, const StepWindow& window)
     : model_(model),
       start_(start),
       target_(target),
@@ -37,6 +37,12 @@ Sweeper::Sweeper(const ArmModel& model, const Points& start, const Eigen::Vector
   for (int j = 0; j < n_; ++j) inv_lengths_[j] = 1.0 / model.link_lengths[j];
   lanes_[0].resize(n_ + 1, dim_);
   fast_ = !has_limits_ && colliders_ == nullptr && HasAvx2Fma();
+  if (colliders_ != nullptr && AnyMoves(*colliders_)) {
+    posed_.reserve(substeps_);
+    for (int s = 1; s <= substeps_; ++s) {
+      posed_.push_back(CollidersAt(*colliders_, window.Substep(s, substeps_)));
+    }
+  }
 }
 
 SmallVec Sweeper::FastLanes(int lanes, const double* u, double* points0) {
@@ -195,6 +201,7 @@ void Sweeper::Run(double* const* lanes, bool* limited_out) {
     for (int k = 0; k < Dim; ++k) from[l][k] = lanes[l][n * Dim + k];
   }
   for (int s = 1; s <= substeps_; ++s) {
+    const std::vector<Collider>* colliders = posed_.empty() ? colliders_ : &posed_[s - 1];
     for (int l = 0; l < K; ++l) {
       double* head = lanes[l] + n * Dim;
       for (int k = 0; k < Dim; ++k) {
@@ -211,7 +218,7 @@ void Sweeper::Run(double* const* lanes, bool* limited_out) {
         internal::TractrixStep<Dim>(head_old[l], tail + Dim, tail, lengths[j - 1],
                                     inv_lengths[j - 1]);
         if (has_limits_) limited[l] |= Limit(lanes[l], j);
-        if (colliders_ != nullptr) Contact<Dim>(lanes[l], j, tail_old);
+        if (colliders != nullptr) Contact<Dim>(*colliders, lanes[l], j, tail_old);
         for (int k = 0; k < Dim; ++k) head_old[l][k] = tail_old[k];
       }
     }
@@ -220,7 +227,8 @@ void Sweeper::Run(double* const* lanes, bool* limited_out) {
 }
 
 template <int Dim>
-void Sweeper::Contact(double* p, int j, const double* tail_old) {
+void Sweeper::Contact(const std::vector<Collider>& colliders, double* p, int j,
+                      const double* tail_old) {
   Eigen::Vector3d head = Eigen::Vector3d::Zero(), tail = head, old = head;
   for (int k = 0; k < Dim; ++k) {
     head[k] = p[j * Dim + k];
@@ -228,11 +236,11 @@ void Sweeper::Contact(double* p, int j, const double* tail_old) {
     old[k] = tail_old[k];
   }
   const double length = model_.link_lengths[j - 1];
-  if (internal::SegmentClearance(*colliders_, head, tail) >= -internal::kContactSlack * length) {
+  if (internal::SegmentClearance(colliders, head, tail) >= -internal::kContactSlack * length) {
     return;  // the rule's step stands
   }
   Eigen::Vector3d x;
-  if (!internal::ContactTail(Dim, head, old, length, *colliders_, &x)) {
+  if (!internal::ContactTail(Dim, head, old, length, colliders, &x)) {
     wedged_ = true;
     return;
   }

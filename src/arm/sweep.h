@@ -14,6 +14,7 @@
 #include <array>
 #include <vector>
 
+#include "arm/colliders.h"
 #include "arm/internal.h"
 #include "flexkin/arm.h"
 
@@ -26,9 +27,10 @@ class Sweeper {
   // `start` (n+1 by dim, base first) must outlive the sweeper. With `colliders` (grown by the
   // link radius and the skin: src/arm/colliders.h; must outlive the sweeper), every link whose
   // tractrix step (and limits) would put it into one takes the contact step instead, in every
-  // lane (the generic loop: the AVX2 lanes are not used).
+  // lane (the generic loop: the AVX2 lanes are not used). Keyframed ones are placed by their
+  // motions at each sub-step's time in `window` (StepWindow::Substep).
   Sweeper(const ArmModel& model, const Points& start, const Eigen::VectorXd& target, int substeps,
-          const std::vector<Collider>* colliders = nullptr);
+          const std::vector<Collider>* colliders = nullptr, const StepWindow& window = {});
 
   // F(u) (dim); leaves the swept points in points().
   SmallVec Evaluate(const SmallVec& u);
@@ -69,10 +71,10 @@ class Sweeper {
   // Puts link j (points j-1, j of `p`) back into the limits of joint j and, for the base link, of
   // joint 0, turning it about point j. Returns whether it moved.
   bool Limit(double* p, int j) const;
-  // Link j (points j-1, j of `p`) out of the colliders: where it enters one, its trailing end is
+  // Link j (points j-1, j of `p`) out of `colliders`: where it enters one, its trailing end is
   // moved from `tail_old` by the contact step (world/contact.h).
   template <int Dim>
-  void Contact(double* p, int j, const double* tail_old);
+  void Contact(const std::vector<Collider>& colliders, double* p, int j, const double* tail_old);
   // The AVX2 sweeps of `lanes` translations (u: lanes by dim); copy 0's points into `points0`,
   // the lanes' F into fast_bases_ (lanes by dim). Returns lane 0's F.
   SmallVec FastLanes(int lanes, const double* u, double* points0);
@@ -88,6 +90,8 @@ class Sweeper {
   std::vector<double> inv_lengths_;
   std::array<Points, kMaxLanes> lanes_;
   const std::vector<Collider>* colliders_;
+  // With keyframed colliders: *colliders_ at the time of each sub-step (empty otherwise).
+  std::vector<std::vector<Collider>> posed_;
   bool limited_ = false, wedged_ = false;
   int sweeps_ = 0, passes_ = 0, contacts_ = 0;
 };

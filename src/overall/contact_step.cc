@@ -140,21 +140,34 @@ class ContactSolver {
 Contact ContactSolver::Measure(const Contact& contact, const Points& x) const {
   Contact out = contact;
   const Collider& c = colliders_[contact.collider];
+  // A box's edges and a cylinder's rims: on or inside the surface there the normal is a face's,
+  // not the gradient of the distance to the edge, which turns by up to a right angle across it.
+  // Measured again a hair outside (1e-6 of a link along the normal), where it is the direction
+  // from the edge: on a face the same normal, at an edge the one across it.
+  const bool edged = c.shape == ColliderShape::kBox || c.shape == ColliderShape::kCylinder;
+  const double hair = 1e-6 * lengths_[contact.index - 1];
   if (!contact.link) {
-    const SurfaceQuery q = QuerySurface(c, At(x, contact.index));
+    const Vector3d p = At(x, contact.index);
+    const SurfaceQuery q = QuerySurface(c, p);
     out.value = q.distance;
     out.normal = q.normal;
+    if (edged && q.distance < hair) {
+      out.normal = QuerySurface(c, p + (hair - q.distance) * q.normal).normal;
+    }
   } else {
     const Vector3d a = At(x, contact.index - 1), b = At(x, contact.index);
     const SegmentContact near = NearestOnSegment(c, a, b);
     out.value = near.clearance;
     out.s = near.s;
     out.normal = near.normal;
+    if (edged && near.clearance < hair) {
+      const Vector3d shift = (hair - near.clearance) * near.normal;
+      out.normal = NearestOnSegment(c, a + shift, b + shift).normal;
+    }
     if (dim_ == 2 && near.s > 0.0 && near.s < 1.0) {
       // Where the interior is nearest, the normal is across the link (exactly so on a smooth
-      // surface). At a corner of the collider's section (a box's) the nearest point's normal
-      // is not defined on the surface; across the link, on the outward side, it is the
-      // gradient of the signed distance from the corner to the link's line.
+      // surface, and at a corner of the collider's section the gradient of the signed distance
+      // from the corner to the link's line).
       const Vector3d u = (b - a).normalized();
       const Vector3d across = out.normal - out.normal.dot(u) * u;
       if (across.norm() > 0.0) out.normal = across.normalized();
@@ -541,7 +554,11 @@ OverallReport ContactSolver::Solve(Points* x_io) {
       Evaluate(&trial, false);
       double trial_infeasibility = trial.penetration;
       for (int i = 0; i < n_; ++i) trial_infeasibility += std::fabs(trial.c[i]);
-      if (Merit(trial, penalty) <= merit + 1e-4 * alpha * std::fmin(slope, 0.0) ||
+      // (A full step that changes the merit only at its rounding is taken: near the solution
+      // the step's own gain is below it.)
+      const double trial_merit = Merit(trial, penalty);
+      if (trial_merit <= merit + 1e-4 * alpha * std::fmin(slope, 0.0) ||
+          (tries == 0 && trial_merit <= merit + 1e-13 * std::fabs(merit)) ||
           (tries == 0 && trial_infeasibility <= 0.5 * infeasibility) || tries >= 30) {
         break;
       }
