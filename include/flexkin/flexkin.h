@@ -20,6 +20,7 @@
 #include "flexkin/chain.h"           // Chain, Points, MakeChain
 #include "flexkin/colliders.h"       // colliders: spheres, capsules, boxes, ... and their geometry
 #include "flexkin/curves.h"          // generated initial curves: line, parabola, arc, helix
+#include "flexkin/dynamics.h"        // dynamic chains: inertia, gravity and three projections
 #include "flexkin/error.h"           // Problem, Problems, InputError
 #include "flexkin/groom.h"           // groom scenarios (strands on a moving body) and their runs
 #include "flexkin/leader.h"          // leader paths: pulls, resampling

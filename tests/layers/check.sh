@@ -13,7 +13,7 @@ declare -A header_layer=(
   [colliders]=world
   [link_step]=sequential [propagate]=sequential
   [overall]=overall
-  [run]=run [frames]=run
+  [run]=run [frames]=run [dynamics]=dynamics
   [arm]=arm [strands]=strands [groom]=groom [strand_file]=io
   [scenario]=io [result_io]=io [robot_scenario]=io [scenario_kind]=io [any_scenario]=scenario
   [flexkin]=umbrella
@@ -27,12 +27,13 @@ declare -A allowed=(
   [sequential]="chain world"
   [overall]="chain world sequential"
   [run]="chain world sequential overall"
+  [dynamics]="chain world sequential overall"
   [arm]="chain world sequential"
   [strands]="chain world sequential"
   [io]="chain world sequential overall run arm strands"
   [groom]="chain world sequential overall run arm io strands"
   [scenario]="chain world sequential overall run arm io strands groom"
-  [umbrella]="chain world sequential overall run arm strands io groom scenario"
+  [umbrella]="chain world sequential overall run dynamics arm strands io groom scenario"
   [render]="chain world sequential overall run arm io strands groom"
   [viewer]="chain world sequential overall run arm io strands groom"
   [gltf]="chain world sequential overall run arm io render"
