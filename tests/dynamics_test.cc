@@ -214,6 +214,23 @@ TEST(DynamicsTest, TheTipsPathConvergesAsSubStepsShrink) {
   }
 }
 
+TEST(DynamicsTest, APendulumInWindSettlesWhereDragAndGravityBalance) {
+  // A point on a link in air moving at w with drag rate c: at rest the link lies along
+  // g + c w, at atan(c |w| / g) from the vertical.
+  Points p(2, 2);
+  p << 0.0, 0.0, 0.0, -1.0;
+  const Chain chain = MakeChain(p);
+  for (const Projection projection : kAll) {
+    DynamicOptions o = Options(projection, 2);
+    o.damping = 2.0;
+    o.wind = Eigen::Vector2d(5.0, 0.0);
+    const DynamicResult r = SimulateChain(chain, Still(1200), o);  // 20 s
+    const Points& last = r.frames.back();
+    const double angle = std::atan2(last(1, 0), -last(1, 1));
+    EXPECT_NEAR(angle, std::atan(2.0 * 5.0 / kG), 1e-8) << ProjectionName(projection);
+  }
+}
+
 TEST(DynamicsTest, BadOptionsAreRefusedByName) {
   Points p(2, 2);
   p << 0, 0, 1, 0;
@@ -226,6 +243,9 @@ TEST(DynamicsTest, BadOptionsAreRefusedByName) {
   o = Options(Projection::kOverall, 1);
   o.damping = -1.0;
   EXPECT_EQ(o.ValidateFor(2).front().field, "damping");
+  o = Options(Projection::kOverall, 1);
+  o.wind = Eigen::Vector3d(1, 0, 0);
+  EXPECT_EQ(o.ValidateFor(2).front().field, "wind");
   o = Options(Projection::kOverall, 1);
   o.frame_rate = 0.0;
   EXPECT_EQ(o.ValidateFor(2).front().field, "frame_rate");

@@ -60,9 +60,12 @@ struct DynamicOptions {
   Projection projection = Projection::kOverall;
   // Gravity (length units per s^2), in the chain's dimension (2 or 3 entries).
   Eigen::VectorXd gravity;
-  // Linear damping rate (1/s): each sub-step's predicted velocity is v + h (g - damping v).
-  // 0: none.
+  // Linear damping rate (1/s), the drag of the air: each sub-step's predicted velocity is
+  // v + h (g + damping (wind - v)). 0: none.
   double damping = 0.0;
+  // The air's velocity (uniform, constant), in the chain's dimension; empty: still air. It acts
+  // through the damping: without damping the wind does nothing.
+  Eigen::VectorXd wind;
   // Frames per second (the driven end's path has one row per frame) and sub-steps per frame.
   double frame_rate = 60.0;
   int substeps = 1;

@@ -19,6 +19,12 @@ Problems DynamicOptions::ValidateFor(int dim) const {
         "gravity", "has " + std::to_string(gravity.size()) + " finite entries or fewer; expected " +
                        std::to_string(dim) + " finite numbers (the chain's dimension)");
   }
+  if (wind.size() != 0 && (wind.size() != dim || !wind.allFinite())) {
+    problems.emplace_back("wind", "has " + std::to_string(wind.size()) +
+                                      " entries or one that is not finite; expected none (still "
+                                      "air) or " +
+                                      std::to_string(dim) + " finite numbers (a velocity)");
+  }
   if (!(damping >= 0.0 && std::isfinite(damping))) {
     problems.push_back(
         Problem::Invalid("damping", FormatNumber(damping), "a finite number >= 0 (1/s)"));
@@ -179,6 +185,9 @@ DynamicResult SimulateChain(const Chain& chain, const Points& root_path,
   inverse_mass.tail(n) = mass.tail(n).cwiseInverse();
   const double h = 1.0 / (options.frame_rate * options.substeps);
   const Eigen::RowVectorXd g = options.gravity.transpose();
+  const Eigen::RowVectorXd air = options.wind.size() == dim
+                                     ? Eigen::RowVectorXd(options.wind.transpose())
+                                     : Eigen::RowVectorXd::Zero(dim);
   Projector projector(lengths, dim, options);
 
   Points x = chain.points, x_old, p(n + 1, dim), projected(n + 1, dim);
@@ -209,7 +218,8 @@ DynamicResult SimulateChain(const Chain& chain, const Points& root_path,
         p(0, k) = internal::SubstepHead(from[k], root_path(f, k), s, options.substeps);
       }
       for (int j = 1; j <= n; ++j) {
-        const Eigen::RowVectorXd predicted = v.row(j) + h * (g - options.damping * v.row(j));
+        const Eigen::RowVectorXd predicted =
+            v.row(j) + h * (g + options.damping * (air - v.row(j)));
         p.row(j) = x.row(j) + h * predicted;
       }
       switch (options.projection) {
