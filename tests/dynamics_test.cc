@@ -100,8 +100,8 @@ TEST(DynamicsTest, APendulumKeepsTheExactPeriodUnderShakeAndLosesItUnderTheOther
 
 // The discrete hanging chain's linearized modes: n links of length L / n, masses by length (the
 // last point half), tension in link i g times the mass below it. Small sideways motion u:
-// M u'' = -K u, K tridiagonal. Returns the angular frequencies, ascending, and the first mode.
-Eigen::VectorXd DiscreteModes(int n, double length, Eigen::VectorXd* first) {
+// M u'' = -K u, K tridiagonal. Returns the angular frequencies, ascending, and the modes (columns).
+Eigen::VectorXd DiscreteModes(int n, double length, Eigen::MatrixXd* modes) {
   const double l = length / n;
   Eigen::VectorXd m = Eigen::VectorXd::Constant(n, l);
   m[n - 1] = 0.5 * l;
@@ -119,18 +119,15 @@ Eigen::VectorXd DiscreteModes(int n, double length, Eigen::VectorXd* first) {
     }
   }
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(k, Eigen::MatrixXd(m.asDiagonal()));
-  *first = eig.eigenvectors().col(0);
+  *modes = eig.eigenvectors();
   return eig.eigenvalues().cwiseSqrt();
 }
 
-TEST(DynamicsTest, AHangingChainSwingsAtItsFirstMode) {
-  const int n = 32;
-  const double length = 1.0;
-  Eigen::VectorXd mode;
-  const Eigen::VectorXd omega = DiscreteModes(n, length, &mode);
-  const double bernoulli = 0.5 * 2.404825557695773 * std::sqrt(kG / length);
-  // Released from the first mode's shape, 0.01 of the length at its widest: each link turned by
-  // the mode's slope, so the lengths are exact.
+// The chain of n links of total length `length` released from the shape of mode `k` (0-based) of
+// its linearized motion, 0.01 of the length at its widest: each link turned by the mode's slope,
+// so the lengths are exact.
+Chain ChainInMode(int n, double length, const Eigen::MatrixXd& modes, int k) {
+  Eigen::VectorXd mode = modes.col(k);
   mode *= 0.01 * length / mode.cwiseAbs().maxCoeff();
   Points p = Points::Zero(n + 1, 2);
   for (int j = 1; j <= n; ++j) {
@@ -139,60 +136,100 @@ TEST(DynamicsTest, AHangingChainSwingsAtItsFirstMode) {
     p(j, 0) = p(j - 1, 0) + (length / n) * std::sin(angle);
     p(j, 1) = p(j - 1, 1) - (length / n) * std::cos(angle);
   }
-  const Chain chain = MakeChain(p);
-  for (const Projection projection : kAll) {
-    const DynamicResult r = SimulateChain(chain, Still(600), Options(projection, 4));
-    std::vector<double> x;
-    for (const Points& f : r.frames) x.push_back(f(n, 0));
-    const double measured = 2.0 * M_PI / Period(x, 1.0 / 60.0);
-    std::printf(
-        "hanging chain, %d links, %s: omega_1 %.5f, discrete %.5f (%.2e), Bernoulli %.5f "
-        "(%.2e); energy %.6g -> %.6g\n",
-        n, ProjectionName(projection), measured, omega[0],
-        std::fabs(measured - omega[0]) / omega[0], bernoulli,
-        std::fabs(measured - bernoulli) / bernoulli, r.energy[0], r.energy.tail(1)[0]);
-    const double error = std::fabs(measured - omega[0]) / omega[0];
-    if (projection == Projection::kOverall || projection == Projection::kShake) {
-      EXPECT_LT(error, 1e-3) << ProjectionName(projection);
-    } else {
-      // The sequential projections' velocity correction stiffens the chain: the known fault of
-      // DFTL, shared by the tractrix projection that needs the same correction.
-      EXPECT_GT(error, 5e-2) << ProjectionName(projection);
+  return MakeChain(p);
+}
+
+TEST(DynamicsTest, AHangingChainSwingsAtItsFirstThreeModes) {
+  const double length = 1.0;
+  // The zeros of J0: Bernoulli's omega_k = (a_k / 2) sqrt(g / L).
+  const double zeros[3] = {2.404825557695773, 5.520078110286311, 8.653727912911013};
+  for (const int n : {32, 64, 128}) {
+    Eigen::MatrixXd modes;
+    const Eigen::VectorXd omega = DiscreteModes(n, length, &modes);
+    for (int k = 0; k < 3; ++k) {
+      const double bernoulli = 0.5 * zeros[k] * std::sqrt(kG / length);
+      // The discrete chain's modes are Bernoulli's to within its discretization.
+      EXPECT_LT(std::fabs(omega[k] - bernoulli) / bernoulli, 32.0 / (n * n) + 1e-3);
+      if (n != 64 && k > 0) continue;  // modes 2 and 3 on 64 links
+      const Chain chain = ChainInMode(n, length, modes, k);
+      for (const Projection projection : kAll) {
+        // SHAKE is explicit: 128 links at 60 Hz need 16 sub-steps to be within its stability
+        // limit (with 4 it falls back to the overall projection: below).
+        const int substeps = projection == Projection::kShake && n == 128 ? 16 : 4;
+        const DynamicResult r = SimulateChain(chain, Still(600), Options(projection, substeps));
+        if (projection == Projection::kShake) EXPECT_EQ(r.failures, 0) << n << " links";
+        std::vector<double> x;
+        for (const Points& f : r.frames) x.push_back(f(n, 0));
+        const double measured = 2.0 * M_PI / Period(x, 1.0 / 60.0);
+        const double error = std::fabs(measured - omega[k]) / omega[k];
+        std::printf(
+            "hanging chain, %d links, mode %d, %s: omega %.5f, discrete %.5f (%.2e), Bernoulli "
+            "%.5f (%.2e); energy %.6g -> %.6g\n",
+            n, k + 1, ProjectionName(projection), measured, omega[k], error, bernoulli,
+            std::fabs(measured - bernoulli) / bernoulli, r.energy[0], r.energy.tail(1)[0]);
+        if (projection == Projection::kShake || projection == Projection::kOverall) {
+          EXPECT_LT(error, k == 0 ? 1e-3 : 5e-3) << n << " links, mode " << k + 1;
+        } else if (k == 0) {
+          // The sequential projections' velocity correction stiffens the chain: the known fault
+          // of DFTL, shared by the tractrix projection that needs the same correction.
+          EXPECT_GT(error, 5e-2) << ProjectionName(projection);
+        }
+        EXPECT_LE(r.max_relative_length_error, 1e-12);
+      }
     }
-    EXPECT_LE(r.max_relative_length_error, 1e-12);
   }
-  // The discrete chain's first mode is Bernoulli's to within its discretization.
-  EXPECT_LT(std::fabs(omega[0] - bernoulli) / bernoulli, 1e-2);
+  // Past SHAKE's stability limit (128 links, 4 sub-steps at 60 Hz) its sub-steps are projected by
+  // the overall projection and counted; the run stays finite and keeps its lengths.
+  Eigen::MatrixXd modes;
+  DiscreteModes(128, length, &modes);
+  const DynamicResult past =
+      SimulateChain(ChainInMode(128, length, modes, 0), Still(60), Options(Projection::kShake, 4));
+  EXPECT_GT(past.failures, 0);
+  EXPECT_TRUE(past.energy.allFinite());
+  EXPECT_LE(past.max_relative_length_error, 1e-12);
 }
 
 TEST(DynamicsTest, EnergyDriftsLittleWithoutDampingAndFallsWithIt) {
-  Points p(9, 2);
+  Points p = Points::Zero(9, 2);
   for (int j = 0; j <= 8; ++j) p(j, 0) = 0.125 * j, p(j, 1) = 0.0;  // released from horizontal
   const Chain chain = MakeChain(p);
   for (const Projection projection : kAll) {
-    DynamicOptions o = Options(projection, 4);
+    DynamicOptions o = Options(projection, 16);
     const DynamicResult free = SimulateChain(chain, Still(600), o);
-    std::printf("rope from horizontal, %s: energy %.6g -> %.6g over 10 s\n",
-                ProjectionName(projection), free.energy[0], free.energy.tail(1)[0]);
+    std::printf(
+        "rope from horizontal, %s: energy %.6g -> %.6g over 10 s (largest change %.3g, %d "
+        "sub-steps past SHAKE's limit)\n",
+        ProjectionName(projection), free.energy[0], free.energy.tail(1)[0],
+        (free.energy.array() - free.energy[0]).abs().maxCoeff(), free.failures);
     if (projection == Projection::kShake) {
-      // Symplectic: the energy stays within 5% of the fall's scale (m g L / 2 = 4.9), measured
-      // with the velocities over the sub-step (lagging half a step).
-      EXPECT_LT((free.energy.array() - free.energy[0]).abs().maxCoeff(), 0.25);
+      // Symplectic: at 16 sub-steps the energy stays within 1% of the fall's scale
+      // (m g L / 2 = 4.9) in every frame (0.79 at 4 sub-steps, when the tail cracks).
+      EXPECT_LT((free.energy.array() - free.energy[0]).abs().maxCoeff(), 0.05);
     } else {
       // The nearest-point projections dissipate: most of the fall's energy is gone in 10 s.
       EXPECT_LT(free.energy.tail(1)[0], -2.0);
     }
     o.damping = 0.5;
     const DynamicResult damped = SimulateChain(chain, Still(600), o);
+    int rises = 0;
     for (Eigen::Index f = 1; f < damped.energy.size(); ++f) {
-      EXPECT_LE(damped.energy[f], damped.energy[f - 1] + 1e-12) << ProjectionName(projection);
+      rises += damped.energy[f] > damped.energy[f - 1] + 1e-12;
+    }
+    std::printf("  with damping 0.5 /s: energy -> %.6g, rising in %d of 600 frames\n",
+                damped.energy.tail(1)[0], rises);
+    if (projection == Projection::kOverall || projection == Projection::kShake) {
+      EXPECT_EQ(rises, 0) << ProjectionName(projection);  // falls in every frame
+    } else {
+      // DFTL's velocity correction adds energy in some frames (a fault the issue names), and the
+      // tractrix projection's, the same correction, with it.
+      EXPECT_GT(rises, 0) << ProjectionName(projection);
     }
     EXPECT_LT(damped.energy.tail(1)[0], free.energy.tail(1)[0]);
   }
 }
 
 TEST(DynamicsTest, TheTipsPathConvergesAsSubStepsShrink) {
-  Points p(9, 2);
+  Points p = Points::Zero(9, 2);
   for (int j = 0; j <= 8; ++j) p(j, 0) = 0.125 * j;
   const Chain chain = MakeChain(p);
   for (const Projection projection : kAll) {

@@ -19,6 +19,8 @@
 //  - shake: the correction along the links' directions at the start of the sub-step (SHAKE,
 //    Ryckaert et al. 1977: with the inertial prediction, Verlet's method with constraints,
 //    symplectic), its n multipliers by Newton's method on the lengths (a tridiagonal system).
+//    Explicit: stable for sub-steps shorter than about 2 / the chain's highest frequency (long
+//    chains need more sub-steps); a sub-step past it is projected by `overall` and counted.
 // Velocities are the positions' change over the sub-step. Kinematic runs (flexkin/run.h) are
 // unchanged by this.
 
@@ -84,12 +86,13 @@ struct DynamicResult {
   // Frame f (0 .. frames): the points after f frames (row-major n+1 by dim each).
   std::vector<Points> frames;
   // The energy at each frame: kinetic (1/2 sum m |v|^2) plus potential (-sum m g . x), masses
-  // as DynamicOptions::mass_by_length says with the unit of mass such that the free points' total
-  // is 1.
+  // as DynamicOptions::mass_by_length says, the free points' total 1. Taken at the middle of the
+  // frame's last sub-step: v is that sub-step's mean velocity, x the mean of its two positions.
   Eigen::VectorXd energy;
   double max_relative_length_error = 0.0;  // over every frame
-  // Projections "overall" and "shake": sub-steps whose Newton solve did not converge (the overall
-  // one then keeps the tractrix projection, the shake one its last iterate).
+  // Projections "overall" and "shake": sub-steps whose Newton solve did not converge (overall
+  // then keeps the tractrix projection; shake, past its stability limit, takes the overall
+  // projection for that sub-step).
   int failures = 0;
 };
 

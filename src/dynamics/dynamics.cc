@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "chain/substep.h"
@@ -117,13 +118,17 @@ class Projector {
       for (int i = 1; i <= n; ++i) {
         const Eigen::RowVectorXd d = x->row(i) - x->row(i - 1);
         f[i] = d.squaredNorm() - lengths_[i - 1] * lengths_[i - 1];
-        worst = std::fmax(worst, std::fabs(f[i]) / (lengths_[i - 1] * lengths_[i - 1]));
+        // |D|^2 - L^2 at the rounding of the positions: 2 |D| (eps |x|) each way.
+        const double level = 8.0 * std::numeric_limits<double>::epsilon() * lengths_[i - 1] *
+                             (x->row(i).cwiseAbs().maxCoeff() +
+                              x->row(i - 1).cwiseAbs().maxCoeff() + lengths_[i - 1]);
+        worst = std::fmax(worst, std::fabs(f[i]) / level);
         // d D_i / d lambda_{i-1}, lambda_i, lambda_{i+1}.
         lower[i] = i >= 2 ? 2.0 * d.dot(-w(i - 1) * d_old.row(i - 1)) : 0.0;
         diag[i] = 2.0 * d.dot((w(i) + w(i - 1)) * d_old.row(i));
         upper[i] = i < n ? 2.0 * d.dot(-w(i) * d_old.row(i + 1)) : 0.0;
       }
-      if (worst <= 1e-15) return true;
+      if (worst <= 1.0) return true;  // every length at the rounding of the positions
       // The tridiagonal solve (Thomas), J delta = -f.
       for (int i = 2; i <= n; ++i) {
         const double m = lower[i] / diag[i - 1];
@@ -193,9 +198,13 @@ DynamicResult SimulateChain(const Chain& chain, const Points& root_path,
   Points x = chain.points, x_old, p(n + 1, dim), projected(n + 1, dim);
   Points v = Points::Zero(n + 1, dim);
   DynamicResult result;
+  // The velocity is the last sub-step's mean: the energy is taken at that sub-step's middle, the
+  // potential at the mean of its two positions (second order, as the velocity).
   const auto energy = [&]() {
     double e = 0.0;
-    for (int j = 1; j <= n; ++j) e += mass[j] * (0.5 * v.row(j).squaredNorm() - g.dot(x.row(j)));
+    for (int j = 1; j <= n; ++j) {
+      e += mass[j] * (0.5 * v.row(j).squaredNorm() - 0.5 * g.dot(x.row(j) + x_old.row(j)));
+    }
     return e;
   };
   const auto measure_lengths = [&]() {
@@ -208,6 +217,7 @@ DynamicResult SimulateChain(const Chain& chain, const Points& root_path,
   const Eigen::Index frames = root_path.rows();
   result.frames.reserve(frames + 1);
   result.frames.push_back(x);
+  x_old = x;
   result.energy.resize(frames + 1);
   result.energy[0] = energy();
   for (Eigen::Index f = 0; f < frames; ++f) {
@@ -233,7 +243,13 @@ DynamicResult SimulateChain(const Chain& chain, const Points& root_path,
           projector.FollowTheLeader(p, &projected);
           break;
         case Projection::kShake:
-          if (!projector.Shake(x_old, p, inverse_mass, &projected)) ++result.failures;
+          // SHAKE's forces are those of the sub-step's start: past its stability limit (a step
+          // longer than about 2 / the chain's highest frequency) its lengths have no solution.
+          // That sub-step is then projected by the overall projection, which always has one.
+          if (!projector.Shake(x_old, p, inverse_mass, &projected)) {
+            ++result.failures;
+            projector.Overall(p, &projected);
+          }
           break;
       }
       x = projected;
