@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "flexkin/chain.h"
+#include "flexkin/colliders.h"
 #include "flexkin/error.h"
 #include "flexkin/vocabulary.h"
 
@@ -68,18 +69,38 @@ struct DynamicOptions {
   // The air's velocity (uniform, constant), in the chain's dimension; empty: still air. It acts
   // through the damping: without damping the wind does nothing.
   Eigen::VectorXd wind;
+  // A keyframed wind: the air's velocity at given times (seconds from the run's start, frame f at
+  // f / frame_rate; strictly increasing), linear between keys and held before the first and after
+  // the last. When given it replaces `wind`. See WindAt.
+  struct WindKey {
+    double time = 0.0;
+    Eigen::VectorXd velocity;  // the chain's dimension
+  };
+  std::vector<WindKey> wind_keys;
   // Frames per second (the driven end's path has one row per frame) and sub-steps per frame.
   double frame_rate = 60.0;
   int substeps = 1;
   // The points' masses: false, every free point the same mass; true, each point the mass of
   // half of each link it touches (a uniform density along the chain: the last point half).
   bool mass_by_length = true;
+  // Given masses of the free points 1 .. n (n entries, each finite and > 0; single chains only,
+  // SimulateChain): they replace mass_by_length. Only their ratios matter (normalized to a total
+  // of 1, as the others).
+  Eigen::VectorXd masses;
+  // Colliders the free points and links stay outside of (flexkin/colliders.h, docs/colliders.md):
+  // static, or placed by their keyframed motion at each sub-step's time (seconds from the run's
+  // start). Single chains (SimulateChain); the strand engine takes StrandOptions' colliders.
+  std::vector<Collider> colliders;
   // The sequential projections' (dftl, tractrix) velocity correction factor s (0 to 1; Mueller
   // et al. suggest about 0.9).
   double dftl_damping = 0.9;
 
-  // Every problem (empty if valid), each naming its member ("gravity", "substeps").
+  // Every problem (empty if valid), each naming its member ("gravity", "substeps",
+  // "wind_keys[2].time", "masses[4]"). `masses` is checked by SimulateChain against the chain.
   Problems ValidateFor(int dim) const;
+  // The air's velocity at `time` (seconds from the run's start): the keyframed wind where given,
+  // else `wind`, else zero; `dim` entries.
+  Eigen::VectorXd WindAt(double time, int dim) const;
 };
 
 struct DynamicResult {

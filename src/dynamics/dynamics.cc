@@ -26,6 +26,28 @@ Problems DynamicOptions::ValidateFor(int dim) const {
                                       "air) or " +
                                       std::to_string(dim) + " finite numbers (a velocity)");
   }
+  for (size_t i = 0; i < wind_keys.size(); ++i) {
+    const std::string at = "wind_keys[" + std::to_string(i) + "]";
+    const WindKey& key = wind_keys[i];
+    if (!std::isfinite(key.time) || (i > 0 && !(key.time > wind_keys[i - 1].time))) {
+      problems.push_back(Problem::Invalid(at + ".time", FormatNumber(key.time),
+                                          i > 0 ? "a finite time after the previous key's (" +
+                                                      FormatNumber(wind_keys[i - 1].time) + " s)"
+                                                : "a finite time (s)"));
+    }
+    if (key.velocity.size() != dim || !key.velocity.allFinite()) {
+      problems.emplace_back(at + ".velocity",
+                            "has " + std::to_string(key.velocity.size()) +
+                                " entries or one that is not finite; expected " +
+                                std::to_string(dim) + " finite numbers (a velocity)");
+    }
+  }
+  for (Eigen::Index i = 0; i < masses.size(); ++i) {
+    if (!(masses[i] > 0.0 && std::isfinite(masses[i]))) {
+      problems.push_back(Problem::Invalid("masses[" + std::to_string(i) + "]",
+                                          FormatNumber(masses[i]), "a finite number > 0"));
+    }
+  }
   if (!(damping >= 0.0 && std::isfinite(damping))) {
     problems.push_back(
         Problem::Invalid("damping", FormatNumber(damping), "a finite number >= 0 (1/s)"));
@@ -42,6 +64,18 @@ Problems DynamicOptions::ValidateFor(int dim) const {
         Problem::Invalid("dftl_damping", FormatNumber(dftl_damping), "a number in [0, 1]"));
   }
   return problems;
+}
+
+Eigen::VectorXd DynamicOptions::WindAt(double time, int dim) const {
+  if (wind_keys.empty()) return wind.size() == dim ? wind : Eigen::VectorXd::Zero(dim);
+  if (time <= wind_keys.front().time) return wind_keys.front().velocity;
+  if (time >= wind_keys.back().time) return wind_keys.back().velocity;
+  size_t i = 1;
+  while (wind_keys[i].time < time) ++i;
+  const WindKey& a = wind_keys[i - 1];
+  const WindKey& b = wind_keys[i];
+  const double u = (time - a.time) / (b.time - a.time);
+  return (1.0 - u) * a.velocity + u * b.velocity;
 }
 
 namespace {
