@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,9 @@ struct StrandFileHeader {
   // groom's scalp among them unless it said "scalp_collider": false), and those fixed in the
   // world. Written only when there are any.
   std::vector<Collider> body_colliders, world_colliders;
+  // Dynamic strands (StrandOptions::dynamics): the projection, gravity, damping and wind (a
+  // constant wind; keyframed wind is not written). Written as "dynamics" only when set.
+  std::optional<DynamicOptions> dynamics;
 
   int num_strands() const { return static_cast<int>(offsets.empty() ? 0 : offsets.size() - 1); }
   int64_t num_points() const { return offsets.empty() ? 0 : offsets.back(); }
@@ -93,6 +97,11 @@ struct StrandRunReport {
   // to its length (StrandContacts; +inf: none came near). Written only with colliders.
   int64_t contact_link_steps = 0;
   double least_clearance = std::numeric_limits<double>::infinity();
+  // Dynamic strands: the strands' energy at each recorded frame (StrandDynamics::energy; frame 0
+  // NaN, written null), the overall projection's non-converged strand sub-steps and its contact
+  // sub-steps. Written only for dynamic strands.
+  std::vector<double> energy;
+  int64_t failures = 0, contact_substeps = 0;
 };
 
 class StrandFileWriter {

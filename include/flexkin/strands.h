@@ -22,6 +22,7 @@
 
 #include "flexkin/chain.h"
 #include "flexkin/colliders.h"
+#include "flexkin/dynamics.h"
 #include "flexkin/error.h"
 #include "flexkin/propagate.h"
 
@@ -51,6 +52,21 @@ struct StrandOptions {
   // translation linearly), so that the roots stay on the body at every sub-step.
   std::vector<Collider> colliders;
   std::vector<Collider> body_colliders;
+  // Dynamic strands (docs/dynamics.md, "Strands"): when set, the strands have inertia. Each
+  // sub-step the pinned points go to the body's pose at the sub-step's time (slerp and linear
+  // between the frames' poses; roots given as points move linearly), the free points are
+  // predicted inertially (velocity, gravity, damping, wind) and put back to their lengths by the
+  // projection (overall, tractrix or dftl; shake is for single chains), exactly as SimulateChain
+  // does for one chain: with one pinned point and no collider, each strand's frames are those of
+  // SimulateChain of its chain with the root's path, bit for bit on the scalar engine and to
+  // about 1e-14 relative on the SIMD ones. `method` is not used. The sub-steps are `substeps`
+  // (dynamics->substeps must be 1 or equal to it); a frame lasts 1 / dynamics->frame_rate;
+  // keyframed wind is read at the sub-step's middle (seconds from the batch's making); given
+  // masses are for single chains. With colliders, a link the projection would leave inside one
+  // takes the nearest clear direction (tractrix, dftl: ContactTail from its new leading end,
+  // nearest the projection's own position; overall: the strand's sub-step is projected by the
+  // tractrix projection with contacts, counted in StrandDynamics::contact_substeps).
+  std::optional<DynamicOptions> dynamics;
 
   // Problems with fields "method", "substeps", "pinned", "threads", "colliders[i]...",
   // "body_colliders[i]...".
@@ -94,6 +110,20 @@ std::optional<StrandInside> FindStrandInside(const std::vector<Points>& strands,
                                              const StrandOptions& options, const BodyPose& rest,
                                              double time = 0.0);
 
+// What the dynamics did (StrandBatch::dynamics()), from the batch's making on.
+struct StrandDynamics {
+  // The strands' total energy after the last frame: each strand's free points weigh 1 together
+  // (as DynamicResult::energy, there for one chain), kinetic plus potential (-m g . x), at the
+  // middle of the frame's last sub-step. NaN before the first frame.
+  double energy = std::numeric_limits<double>::quiet_NaN();
+  // Overall projection: strand sub-steps whose Newton solve did not converge (they keep the
+  // tractrix projection).
+  int64_t failures = 0;
+  // Overall projection with colliders: strand sub-steps projected by the tractrix projection
+  // with contacts because the overall one left a link inside a collider.
+  int64_t contact_substeps = 0;
+};
+
 namespace internal {
 struct StrandBatchImpl;
 }
@@ -121,6 +151,8 @@ class StrandBatch {
   const char* engine() const;
   // What the colliders did so far (zeros and +inf without colliders).
   StrandContacts contacts() const;
+  // What the dynamics did (options().dynamics set; defaults otherwise).
+  StrandDynamics dynamics() const;
 
   // Strand `strand`'s points now, (n_i + 1) by dim. Throws InputError ("strand") out of range.
   Points strand(int strand) const;

@@ -60,6 +60,7 @@ StrandFileHeader MakeStrandFileHeader(const GroomScenario& scenario) {
   h.scalp = scenario.scalp;
   h.body_colliders = scenario.options.body_colliders;
   h.world_colliders = scenario.options.colliders;
+  h.dynamics = scenario.options.dynamics;
   return h;
 }
 
@@ -72,8 +73,10 @@ StrandRunReport RunGroom(const GroomScenario& scenario, StrandFileWriter* writer
                     motion.TimeOf(0));
   // The batch keeps the pinned points in body coordinates, q = R^T (p - t), which the pose maps
   // back to p only to rounding: one step to the same pose settles them (a move of a few ulps),
-  // so that frame 0 is what a body that stays there keeps, bit for bit.
-  StepStrands(&batch, start);
+  // so that frame 0 is what a body that stays there keeps, bit for bit. (Not for dynamic strands,
+  // for which a step is a frame of their motion: their frame 0 is the grown shape.)
+  const bool dynamic = scenario.options.dynamics.has_value();
+  if (!dynamic) StepStrands(&batch, start);
   const StrandFileHeader header = MakeStrandFileHeader(scenario);
 
   StrandRunReport report;
@@ -85,6 +88,7 @@ StrandRunReport RunGroom(const GroomScenario& scenario, StrandFileWriter* writer
   Points strand;
   auto record = [&](int64_t f, const BodyPose& pose) {
     if (writer != nullptr) writer->Add(f, motion.TimeOf(f), pose, batch);
+    if (dynamic) report.energy.push_back(batch.dynamics().energy);
     Eigen::Index k = 0;
     for (int i = 0; i < batch.size(); ++i) {
       batch.CopyStrand(i, &strand);
@@ -114,6 +118,8 @@ StrandRunReport RunGroom(const GroomScenario& scenario, StrandFileWriter* writer
   report.seconds = std::chrono::duration<double>(stepping).count();
   report.contact_link_steps = batch.contacts().contact_link_steps;
   report.least_clearance = batch.contacts().least_clearance;
+  report.failures = batch.dynamics().failures;
+  report.contact_substeps = batch.dynamics().contact_substeps;
   return report;
 }
 

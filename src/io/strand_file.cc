@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "flexkin/error.h"
+#include "flexkin/vocabulary.h"
 #include "io/atomic_file.h"
 #include "io/colliders_json.h"
 #include "io/json_file.h"
@@ -120,10 +121,33 @@ std::string GroomJson(const StrandFileHeader& h, const StrandRunReport& report) 
       j[key] = array;
     }
   }
+  if (h.dynamics) {
+    const DynamicOptions& d = *h.dynamics;
+    const auto vector = [](const Eigen::VectorXd& v) {
+      nlohmann::json a = nlohmann::json::array();
+      for (Eigen::Index k = 0; k < v.size(); ++k) a.push_back(v[k]);
+      return a;
+    };
+    j["dynamics"] = {{"projection", ProjectionName(d.projection)},
+                     {"gravity", vector(d.gravity)},
+                     {"damping", d.damping},
+                     {"mass", d.mass_by_length ? "by_length" : "uniform"},
+                     {"dftl_damping", d.dftl_damping}};
+    if (d.wind.size() != 0) j["dynamics"]["wind"] = vector(d.wind);
+  }
   j["report"] = {{"max_length_error", report.max_length_error},
                  {"seconds", report.seconds},
                  {"engine", report.engine},
                  {"threads", report.threads}};
+  if (h.dynamics) {
+    nlohmann::json energy = nlohmann::json::array();
+    for (double e : report.energy) {
+      energy.push_back(std::isfinite(e) ? nlohmann::json(e) : nlohmann::json(nullptr));
+    }
+    j["report"]["energy"] = energy;
+    j["report"]["failures"] = report.failures;
+    j["report"]["contact_substeps"] = report.contact_substeps;
+  }
   if (colliders) {
     j["report"]["contact_link_steps"] = report.contact_link_steps;
     // +inf (no link came near a collider) has no JSON number: null.
@@ -381,6 +405,47 @@ StrandFileReader::StrandFileReader(const std::string& path) : impl_(std::make_un
     if (least != report.end() && !least->is_null()) {
       r.report.least_clearance = Get<double>(report, "least_clearance");
     }
+  }
+  if (const auto it = j.find("dynamics"); it != j.end()) {
+    DynamicOptions d;
+    const std::string name = Get<std::string>(*it, "projection");
+    const NamedValue<Projection>* entry = FindName<Projection>(name);
+    if (entry == nullptr) {
+      throw InputError("groom.json/dynamics/projection",
+                       "is \"" + name + "\", not a projection; not " + std::string(kFileKind));
+    }
+    d.projection = entry->value;
+    const auto vector = [&](const char* key) {
+      const std::vector<double> v = Get<std::vector<double>>(*it, key);
+      if (static_cast<int>(v.size()) != h.dim) {
+        throw InputError(std::string("groom.json/dynamics/") + key,
+                         "has " + std::to_string(v.size()) + " numbers, not the file's dim " +
+                             std::to_string(h.dim) + "; not " + std::string(kFileKind));
+      }
+      return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(v.data(), h.dim));
+    };
+    d.gravity = vector("gravity");
+    if (it->contains("wind")) d.wind = vector("wind");
+    d.damping = Get<double>(*it, "damping");
+    d.mass_by_length = Get<std::string>(*it, "mass") == "by_length";
+    d.dftl_damping = Get<double>(*it, "dftl_damping");
+    d.frame_rate = h.fps;
+    h.dynamics = d;
+    const nlohmann::json energy = Get<nlohmann::json>(report, "energy");
+    if (!energy.is_array()) {
+      throw InputError("groom.json/report/energy",
+                       "is not an array; not " + std::string(kFileKind));
+    }
+    for (const nlohmann::json& e : energy) {
+      if (!e.is_null() && !e.is_number()) {
+        throw InputError("groom.json/report/energy",
+                         "has " + e.dump() + ", not a number; not " + std::string(kFileKind));
+      }
+      r.report.energy.push_back(e.is_null() ? std::numeric_limits<double>::quiet_NaN()
+                                            : e.get<double>());
+    }
+    r.report.failures = Get<int64_t>(report, "failures");
+    r.report.contact_substeps = Get<int64_t>(report, "contact_substeps");
   }
   r.report.max_length_error = Get<double>(report, "max_length_error");
   r.report.seconds = Get<double>(report, "seconds");

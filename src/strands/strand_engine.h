@@ -68,7 +68,35 @@ using StrandSphereSweepFn = void (*)(Method method, int dim, int n, int head, co
                                      double* points, const StrandSphere& sphere, uint8_t* contact,
                                      int* fallback);
 
+// Dynamic strands (flexkin/strands.h `dynamics`): one sub-step of one block, in two stages.
+// Stage 1: the pinned points 0 .. head are at the sub-step's end in x (their start in x_old), the
+// free points head + 1 .. n at its start in x and x_old with velocities v; afterwards p holds the
+// inertial prediction (the pinned points' new places) and x its sequential projection (tractrix
+// or dftl). Stage 2: v becomes (x - x_old) / h, with Mueller et al.'s correction
+// -s (x_{j+1} - p_{j+1}) / h where `correct`. The operations are SimulateChain's.
+struct DynamicLaneStep {
+  int n = 0, head = 0;
+  bool tractrix = true;  // else dftl
+  bool correct = true;   // stage 2: the sequential projections' velocity correction
+  double h = 0.0, damping = 0.0, dftl_damping = 0.0;
+  double gravity[3] = {}, wind[3] = {};
+  const double* lengths = nullptr;
+  const double* inv_lengths = nullptr;
+  double *x = nullptr, *x_old = nullptr, *p = nullptr, *v = nullptr;
+  // Stage 1 on the SIMD engines, if set: the sequential projection's contact step against this
+  // sphere in the lanes (as StrandSphereSweepFn's), link i of lane j flagged in
+  // contact[i * kStrandLanes + j] (1 where it took it, else 0) and fallback[j] lowered to the first
+  // link the closed form could not step. The scalar engine leaves every contact to its caller.
+  const StrandSphere* sphere = nullptr;
+  uint8_t* contact = nullptr;
+  int* fallback = nullptr;
+};
+using StrandDynamicFn = void (*)(int dim, const DynamicLaneStep& q, int stage);
+void StrandDynamicScalar(int dim, const DynamicLaneStep& q, int stage);
+
 #if FLEXKIN_HAVE_WAVEFRONT
+void StrandDynamicAvx2(int dim, const DynamicLaneStep& q, int stage);
+void StrandDynamicAvx512(int dim, const DynamicLaneStep& q, int stage);
 // The lanes in SIMD registers (strands_isa.cc, compiled per instruction set); equal to the
 // reference up to the vector exp's rounding, as the wavefront engine.
 void StrandSweepsAvx2(Method method, int dim, int n, int head, int num_sweeps, const double* heads,

@@ -17,9 +17,11 @@
 #include "chain/denormals.h"
 #include "chain/simd.h"
 #include "chain/substep.h"
+#include "overall/newton.h"
 #include "sequential/link_rules.h"
 #include "sequential/rule_table.h"
 #include "sequential/sweep.h"
+#include "strands/dynamic_lanes.h"
 #include "strands/strand_engine.h"
 #include "world/contact.h"
 
@@ -214,6 +216,22 @@ struct ContactScratch {
   std::string error;  // the first contact step that found no room
 };
 
+// Per thread: what the dynamic sub-steps need, made once (the overall projection's solver state
+// made for each sub-chain length when first met).
+struct DynamicScratch {
+  AlignedDoubles x_old, predicted;  // a block's points at the sub-step's start; the prediction
+  std::vector<double> pin_from;     // the pinned points at the frame's start (dim x L each)
+  struct Overall {
+    Eigen::VectorXd lengths;
+    Points p, x;
+    Eigen::VectorXd weights;  // the points' masses, the largest free one 1 (SimulateChain's)
+    OverallOptions options;
+    NewtonBuffers buffers;
+  };
+  std::vector<std::unique_ptr<Overall>> overall;  // by the sub-chain's link count
+  int64_t failures = 0, contact_substeps = 0;
+};
+
 }  // namespace
 
 struct StrandBatchImpl {
@@ -256,6 +274,30 @@ struct StrandBatchImpl {
   std::vector<ContactScratch> contact;  // per thread
   StrandContacts contacts;
 
+  // Dynamics (options.dynamics): the velocities (laid out as the points), the points' masses
+  // ((n + 1) x L per block, the free points' total 1 per lane), per thread scratch, per block the
+  // energy of the last frame, and per frame the pinned points' poses and the wind at each
+  // sub-step's start.
+  bool dynamic = false;
+  AlignedDoubles velocity, mass;
+  std::vector<size_t> mass_offset;
+  std::vector<DynamicScratch> dynamic_scratch;
+  std::vector<double> block_energy;
+  std::vector<BodyPose> dynamic_poses;
+  std::vector<Eigen::Vector3d> winds;
+  int64_t substeps_done = 0;
+  StrandDynamicFn dynamic_step = StrandDynamicScalar;
+  StrandDynamics dynamics_report;
+  void StepBlockDynamic(int b, int thread);
+  // The pinned points of block b at sub-step s of S, into rows 0 .. pinned - 1 of `pts`.
+  void PinnedAt(const Block& block, int s, const double* from, double* pts) const;
+  // Before a dynamic frame: the pinned points' poses (`pose` null: roots given as points) and the
+  // wind at each sub-step; after it: the energy and the threads' counts.
+  void BeginDynamicFrame(const BodyPose* pose);
+  void EndDynamicFrame();
+  void ContactLane(const Block& block, int lane, int first, int s, const DynamicScratch& ds,
+                   double* pts, ContactScratch* cs);
+
   void StepBlock(int b, double* scratch_heads);
   void StepBlockWithColliders(int b, double* scratch_heads, ContactScratch* cs);
   // The pinned points of a block at the frame's end: all but the last into the points, the last
@@ -278,7 +320,9 @@ struct StrandBatchImpl {
   static void Job(void* self, int t) {
     auto* impl = static_cast<StrandBatchImpl*>(self);
     for (int b = impl->first_block[t]; b < impl->first_block[t + 1]; ++b) {
-      if (impl->has_colliders) {
+      if (impl->dynamic) {
+        impl->StepBlockDynamic(b, t);
+      } else if (impl->has_colliders) {
         impl->StepBlockWithColliders(b, impl->scratch[t].data(), &impl->contact[t]);
       } else {
         impl->StepBlock(b, impl->scratch[t].data());
@@ -680,6 +724,29 @@ Problems StrandOptions::Validate() const {
   };
   check(colliders, "colliders");
   check(body_colliders, "body_colliders");
+  if (dynamics) {
+    if (dynamics->projection == Projection::kShake) {
+      problems.push_back(Problem::Invalid("dynamics.projection", "\"shake\"",
+                                          "\"overall\", \"tractrix\" or \"dftl\" (shake is for "
+                                          "single chains, SimulateChain)"));
+    }
+    if (dynamics->masses.size() != 0) {
+      problems.emplace_back("dynamics.masses",
+                            "are given; given masses are for single chains (SimulateChain): a "
+                            "strand's masses are uniform or by length (mass_by_length)");
+    }
+    if (dynamics->substeps != 1 && dynamics->substeps != substeps) {
+      problems.push_back(Problem::Invalid("dynamics.substeps", std::to_string(dynamics->substeps),
+                                          "1 or the strands' substeps (" +
+                                              std::to_string(substeps) +
+                                              "), which the strand engine takes"));
+    }
+    if (!dynamics->colliders.empty()) {
+      problems.emplace_back("dynamics.colliders",
+                            "are given; the strand engine takes its colliders from "
+                            "\"colliders\" and \"body_colliders\"");
+    }
+  }
   return problems;
 }
 
@@ -768,6 +835,257 @@ void StrandBatchImpl::PlaceColliders(const BodyPose* frame_pose) {
 
 }  // namespace internal
 
+namespace internal {
+
+void StrandDynamicScalar(int dim, const DynamicLaneStep& q, int stage) {
+  const auto step = [](auto dim_tag) {
+    constexpr int Dim = decltype(dim_tag)::value;
+    return [](const double* lead_old, const double* lead_new, double* tail, const double* len,
+              const double* inv) { TractrixStep<Dim>(lead_old, lead_new, tail, *len, *inv); };
+  };
+  // Contacts: left to the caller (StepBlockDynamic's ContactLane).
+  const auto no_contact = [](const double*, double*, int, int) {};
+  dim == 2 ? DynamicBlock<double, 2>(q, stage, step(std::integral_constant<int, 2>()), no_contact)
+           : DynamicBlock<double, 3>(q, stage, step(std::integral_constant<int, 3>()), no_contact);
+}
+
+void StrandBatchImpl::BeginDynamicFrame(const BodyPose* frame_pose) {
+  const int S = options.substeps;
+  const DynamicOptions& dyn = *options.dynamics;
+  for (int s = 1; s <= S; ++s) {
+    if (frame_pose != nullptr) {
+      dynamic_poses[s - 1] =
+          s < S ? Between(last_pose, *frame_pose, static_cast<double>(s) / S, dim) : *frame_pose;
+    }
+    // The wind at the sub-step's middle (seconds from the batch's making), as SimulateChain.
+    const Eigen::VectorXd wind =
+        dyn.WindAt((static_cast<double>(substeps_done) + (s - 0.5)) / (dyn.frame_rate * S), dim);
+    winds[s - 1].setZero();
+    for (int k = 0; k < dim; ++k) winds[s - 1][k] = wind[k];
+  }
+}
+
+void StrandBatchImpl::EndDynamicFrame() {
+  substeps_done += options.substeps;
+  double energy = 0.0;
+  for (double e : block_energy) energy += e;  // in block order: the same for any thread count
+  dynamics_report.energy = energy;
+  for (DynamicScratch& ds : dynamic_scratch) {
+    dynamics_report.failures += ds.failures;
+    dynamics_report.contact_substeps += ds.contact_substeps;
+    ds.failures = ds.contact_substeps = 0;
+  }
+}
+
+void StrandBatchImpl::PinnedAt(const Block& block, int s, const double* from, double* pts) const {
+  const int S = options.substeps;
+  for (int j = 0; j < block.pinned; ++j) {
+    for (int k = 0; k < dim; ++k) {
+      double* out = pts + (j * dim + k) * L;
+      for (int lane = 0; lane < L; ++lane) {
+        if (pose != nullptr) {
+          const double* q = body.data() + block.body + (j * dim) * L + lane;
+          out[lane] = FromBody(dynamic_poses[s - 1], dim, k, q, L);
+        } else {
+          // The root moves linearly to its point; the other pinned points translate with it.
+          const double root = roots[block.source[lane] * roots_stride + k];
+          const double at = SubstepHead(from[k * L + lane], root, s, S);
+          out[lane] = j == 0 ? at : from[(j * dim + k) * L + lane] + (at - from[k * L + lane]);
+        }
+      }
+    }
+  }
+}
+
+// A lane whose projection left link `first` (or a later one) inside a collider: projected again
+// from that link on, link by link, each link that would enter one taking the nearest clear
+// direction (ContactTail). The overall projection's lanes are projected again from the first free
+// link by the tractrix projection.
+void StrandBatchImpl::ContactLane(const Block& block, int lane, int first, int s,
+                                  const DynamicScratch& ds, double* pts, ContactScratch* cs) {
+  const Projection projection = options.dynamics->projection;
+  const int head = block.pinned - 1;
+  const double* p = ds.predicted.data();
+  const double* block_lengths = lengths.data() + block.lengths;
+  const double* block_inv = inv_lengths.data() + block.lengths;
+  const std::vector<Collider>& all = placed[s - 1];
+  if (projection == Projection::kOverall) first = head + 1;
+  const auto at = [&](const double* base, int i) {
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    for (int k = 0; k < dim; ++k) x[k] = base[(i * dim + k) * L + lane];
+    return x;
+  };
+  for (int i = first; i <= block.n; ++i) {
+    const double length = block_lengths[(i - 1) * L + lane];
+    const Eigen::Vector3d lead = at(pts, i - 1);
+    const Eigen::Vector3d pi = at(p, i);
+    Eigen::Vector3d x;
+    if (projection == Projection::kDftl) {
+      x = lead + (length / (pi - lead).norm()) * (pi - lead);
+    } else {
+      const Eigen::Vector3d lead_p = at(p, i - 1);
+      x = lead_p + (length / (pi - lead_p).norm()) * (pi - lead_p);
+      double tail[3] = {x[0], x[1], x[2]};
+      const double inv = block_inv[(i - 1) * L + lane];
+      dim == 2 ? TractrixStep<2>(lead_p.data(), lead.data(), tail, length, inv)
+               : TractrixStep<3>(lead_p.data(), lead.data(), tail, length, inv);
+      x = Eigen::Vector3d(tail[0], tail[1], tail[2]);
+    }
+    const double clearance = SegmentClearance(all, lead, x);
+    if (clearance < -kContactSlack * length) {
+      Eigen::Vector3d clear;
+      if (ContactTail(dim, lead, projection == Projection::kDftl ? pi : x, length, all, &clear)) {
+        x = clear;
+        ++cs->stats.contact_link_steps;
+      } else if (cs->error.empty()) {
+        cs->error = "strands[" + std::to_string(block.source[lane]) + "]: link " +
+                    std::to_string(i) +
+                    " finds no direction clear of the colliders (its leading end is wedged "
+                    "between them)";
+      }
+    }
+    cs->stats.least_clearance =
+        std::min(cs->stats.least_clearance, SegmentClearance(all, lead, x) / length);
+    for (int k = 0; k < dim; ++k) pts[(i * dim + k) * L + lane] = x[k];
+  }
+}
+
+// One frame of one block with dynamics: sub-step by sub-step, the pinned points placed, the
+// prediction and its projection (dynamic_lanes.h; the overall projection lane by lane by the
+// overall method's Newton solver), the colliders' contacts, the velocities; the block's energy
+// after the last sub-step.
+void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
+  const Block& block = blocks[b];
+  const DynamicOptions& dyn = *options.dynamics;
+  const int S = options.substeps;
+  const int head = block.pinned - 1;
+  const int n = block.n;
+  DynamicScratch& ds = dynamic_scratch[thread];
+  double* pts = points.data() + block.points;
+  const size_t size = static_cast<size_t>(n + 1) * dim * L;
+  const size_t pinned_size = static_cast<size_t>(block.pinned) * dim * L;
+  std::copy(pts, pts + pinned_size, ds.pin_from.data());
+  DynamicLaneStep q;
+  q.n = n;
+  q.head = head;
+  q.tractrix = dyn.projection != Projection::kDftl;
+  q.correct = dyn.projection != Projection::kOverall;
+  q.h = 1.0 / (dyn.frame_rate * S);
+  q.damping = dyn.damping;
+  q.dftl_damping = dyn.dftl_damping;
+  for (int k = 0; k < dim; ++k) q.gravity[k] = dyn.gravity[k];
+  q.lengths = lengths.data() + block.lengths;
+  q.inv_lengths = inv_lengths.data() + block.lengths;
+  q.x = pts;
+  q.x_old = ds.x_old.data();
+  q.p = ds.predicted.data();
+  q.v = velocity.data() + block.points;
+  const SubnormalsAsZero subnormals;
+  ContactScratch* cs = has_colliders ? &contact[thread] : nullptr;
+  for (int s = 1; s <= S; ++s) {
+    std::copy(pts, pts + size, ds.x_old.data());
+    PinnedAt(block, s, ds.pin_from.data(), pts);
+    for (int k = 0; k < dim; ++k) q.wind[k] = winds[s - 1][k];
+    // The SIMD engines take the contact step against a lone sphere (a scalp) in the lanes.
+    const bool in_lanes = cs != nullptr && dynamic_step != StrandDynamicScalar &&
+                          dyn.projection != Projection::kOverall && lone_sphere[s - 1];
+    q.sphere = in_lanes ? &spheres[s - 1] : nullptr;
+    if (in_lanes) {
+      q.contact = cs->contact_flags.data();
+      q.fallback = cs->fallback.data();
+      std::fill(cs->fallback.begin(), cs->fallback.end(), n + 1);
+    }
+    dynamic_step(dim, q, 1);
+    if (dyn.projection == Projection::kOverall) {
+      // Lane by lane: the sub-chain from the last pinned point, Newton from the tractrix
+      // projection, as SimulateChain's overall projection.
+      const int m = n - head;
+      if (ds.overall.size() <= static_cast<size_t>(m)) ds.overall.resize(m + 1);
+      if (!ds.overall[m]) {
+        auto o = std::make_unique<DynamicScratch::Overall>();
+        o->lengths.resize(m);
+        o->p.resize(m + 1, dim);
+        o->x.resize(m + 1, dim);
+        o->weights.resize(m + 1);
+        o->options.weights.squared = 1.0;
+        o->buffers.Reserve(m, dim, o->options.weights);
+        ds.overall[m] = std::move(o);
+      }
+      DynamicScratch::Overall& o = *ds.overall[m];
+      for (int lane = 0; lane < L; ++lane) {
+        if (lane > 0 && block.source[lane] == block.source[0]) break;  // padding lanes
+        for (int i = 0; i < m; ++i) o.lengths[i] = q.lengths[(head + i) * L + lane];
+        const double* mass_of = mass.data() + mass_offset[b];
+        for (int i = 0; i <= m; ++i) o.weights[i] = mass_of[(head + i) * L + lane];
+        o.weights /= o.weights.tail(m).maxCoeff();
+        for (int i = 0; i <= m; ++i) {
+          for (int k = 0; k < dim; ++k) {
+            const size_t at = static_cast<size_t>((head + i) * dim + k) * L + lane;
+            o.p(i, k) = q.p[at];
+            o.x(i, k) = pts[at];
+          }
+        }
+        NewtonSolver solver(o.lengths, o.p, o.options, m, 0.0, &o.buffers);
+        o.buffers.sink.point_weights = o.weights.data();
+        if (!solver.Solve(&o.x).converged()) {
+          ++ds.failures;
+          continue;  // the lane keeps the tractrix projection
+        }
+        for (int i = 1; i <= m; ++i) {
+          for (int k = 0; k < dim; ++k) {
+            pts[static_cast<size_t>((head + i) * dim + k) * L + lane] = o.x(i, k);
+          }
+        }
+      }
+    }
+    if (cs != nullptr) {
+      std::fill(cs->least.begin(), cs->least.end(), std::numeric_limits<double>::infinity());
+      std::fill(cs->first_enter.begin(), cs->first_enter.end(), n + 1);
+      std::fill(cs->near.begin(), cs->near.end(), 0);
+      CheckLanes(measure_bounds, dim, n, head, pts, q.lengths, q.inv_lengths, placed[s - 1],
+                 bounds[s - 1], cs->clearances.data(), cs->least.data(), cs->first_enter.data(),
+                 cs->near.data());
+      for (int lane = 0; lane < L; ++lane) {
+        int first = cs->first_enter[lane];
+        if (in_lanes) {
+          // The lanes' own contact steps stand up to the first link projected again.
+          first = std::min(first, cs->fallback[lane]);
+          for (int i = head + 1; i < first && i <= n; ++i) {
+            cs->stats.contact_link_steps += cs->contact_flags[i * L + lane];
+          }
+        }
+        if (first > n) {
+          cs->stats.least_clearance = std::min(cs->stats.least_clearance, cs->least[lane]);
+          continue;
+        }
+        if (dyn.projection == Projection::kOverall) ++ds.contact_substeps;
+        ContactLane(block, lane, first, s, ds, pts, cs);
+      }
+    }
+    dynamic_step(dim, q, 2);
+  }
+  // The energy at the middle of the last sub-step, each lane's free points weighing 1.
+  double energy = 0.0;
+  const double* mass_of = mass.data() + mass_offset[b];
+  for (int lane = 0; lane < L; ++lane) {
+    if (lane > 0 && block.source[lane] == block.source[0]) break;
+    double e = 0.0;
+    for (int i = head + 1; i <= n; ++i) {
+      double kinetic = 0.0, height = 0.0;
+      for (int k = 0; k < dim; ++k) {
+        const size_t at = static_cast<size_t>(i * dim + k) * L + lane;
+        kinetic += q.v[at] * q.v[at];
+        height += dyn.gravity[k] * (pts[at] + ds.x_old.data()[at]);
+      }
+      e += mass_of[i * L + lane] * (0.5 * kinetic - 0.5 * height);
+    }
+    energy += e;
+  }
+  block_energy[b] = energy;
+}
+
+}  // namespace internal
+
 namespace {
 
 // Refuses strands that start inside a collider, naming the strand, the point or link, the
@@ -819,6 +1137,11 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
   }
   if (count > 0) ValidatePose(rest, m.dim);
   const int dim = m.dim;
+  if (options.dynamics && count > 0) {
+    Problems problems = options.dynamics->ValidateFor(dim);
+    for (Problem& p : problems) p.field = "dynamics." + p.field;
+    ThrowIfAny(problems);
+  }
   m.links.resize(count);
   for (int i = 0; i < count; ++i) m.links[i] = static_cast<int>(strands[i].rows()) - 1;
   // Strands of one link count side by side, in the order given.
@@ -906,6 +1229,50 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
   }
   m.pool = std::make_unique<internal::WorkerPool>(threads);
   m.last_pose = rest;
+  if (options.dynamics && count > 0) {
+    m.dynamic = true;
+    const DynamicOptions& dyn = *options.dynamics;
+    m.velocity = internal::AlignedDoubles(num_points);
+    size_t num_mass = 0;
+    for (const auto& block : m.blocks) {
+      m.mass_offset.push_back(num_mass);
+      num_mass += static_cast<size_t>(block.n + 1) * L;
+    }
+    m.mass = internal::AlignedDoubles(num_mass);
+    int most_links = 0, most_pinned = 1;
+    for (size_t b = 0; b < m.blocks.size(); ++b) {
+      const internal::Block& block = m.blocks[b];
+      most_links = std::max(most_links, block.n);
+      most_pinned = std::max(most_pinned, block.pinned);
+      const double* len = m.lengths.data() + block.lengths;
+      double* mass = m.mass.data() + m.mass_offset[b];
+      for (int lane = 0; lane < L; ++lane) {
+        // As SimulateChain (the same operations): half of each link a point touches (or 1), the
+        // free points' total 1.
+        Eigen::VectorXd mj = Eigen::VectorXd::Zero(block.n + 1);
+        for (int j = 1; j <= block.n; ++j) {
+          mj[j] = dyn.mass_by_length
+                      ? 0.5 * (len[(j - 1) * L + lane] + (j < block.n ? len[j * L + lane] : 0.0))
+                      : 1.0;
+        }
+        mj /= mj.sum();
+        for (int j = 1; j <= block.n; ++j) mass[j * L + lane] = mj[j];
+      }
+    }
+    m.dynamic_scratch.resize(threads);
+    for (auto& ds : m.dynamic_scratch) {
+      ds.x_old = internal::AlignedDoubles(static_cast<size_t>(most_links + 1) * dim * L);
+      ds.predicted = internal::AlignedDoubles(static_cast<size_t>(most_links + 1) * dim * L);
+      ds.pin_from.resize(static_cast<size_t>(most_pinned) * dim * L);
+    }
+    m.block_energy.assign(m.blocks.size(), 0.0);
+    m.dynamic_poses.resize(options.substeps);
+    m.winds.resize(options.substeps);
+#if FLEXKIN_HAVE_WAVEFRONT
+    if (std::string(m.engine) == "avx512") m.dynamic_step = internal::StrandDynamicAvx512;
+    if (std::string(m.engine) == "avx2") m.dynamic_step = internal::StrandDynamicAvx2;
+#endif
+  }
   m.has_colliders = !options.colliders.empty() || !options.body_colliders.empty();
   if (m.has_colliders && count > 0) {
     const int S = options.substeps;
@@ -991,6 +1358,7 @@ int StrandBatch::num_links(int strand) const {
 const StrandOptions& StrandBatch::options() const { return impl_->options; }
 const char* StrandBatch::engine() const { return impl_->engine; }
 StrandContacts StrandBatch::contacts() const { return impl_->contacts; }
+StrandDynamics StrandBatch::dynamics() const { return impl_->dynamics_report; }
 
 void StrandBatch::CopyStrand(int strand, Points* out) const {
   using internal::L;
@@ -1025,10 +1393,12 @@ void StepStrands(StrandBatch* batch, const BodyPose& pose, double time) {
   m.roots = nullptr;
   m.frame_time = time;
   if (m.has_colliders) m.PlaceColliders(&pose);
+  if (m.dynamic) m.BeginDynamicFrame(&pose);
   m.pool->Run(internal::StrandBatchImpl::Job, &m);
   m.pose = nullptr;
   m.last_pose = pose;
   m.last_time = time;
+  if (m.dynamic) m.EndDynamicFrame();
   m.GatherContacts();
 }
 
@@ -1050,8 +1420,10 @@ void StepStrands(StrandBatch* batch, const Eigen::Ref<const Points>& roots) {
   m.roots = roots.data();
   m.roots_stride = roots.outerStride();
   m.pose = nullptr;
+  if (m.dynamic) m.BeginDynamicFrame(nullptr);
   m.pool->Run(internal::StrandBatchImpl::Job, &m);
   m.roots = nullptr;
+  if (m.dynamic) m.EndDynamicFrame();
   m.GatherContacts();
 }
 
@@ -1064,20 +1436,24 @@ bool SetStrandEngine(StrandBatch* batch, const char* name) {
   StrandSweepsFn fn = nullptr;
   StrandSphereSweepFn sphere = nullptr;
   StrandBoundsFn bounds = StrandBoundsScalar;
+  StrandDynamicFn dynamic = StrandDynamicScalar;
   if (engine == "scalar") fn = StrandSweepsScalar;
 #if FLEXKIN_HAVE_WAVEFRONT
   if (engine == "avx2" && CpuSimd().avx2_fma) {
     fn = StrandSweepsAvx2;
     sphere = StrandSphereSweepAvx2;
     bounds = StrandBoundsAvx2;
+    dynamic = StrandDynamicAvx2;
   }
   if (engine == "avx512" && CpuSimd().avx512) {
     fn = StrandSweepsAvx512;
     sphere = StrandSphereSweepAvx512;
     bounds = StrandBoundsAvx512;
+    dynamic = StrandDynamicAvx512;
   }
 #endif
   if (fn == nullptr) return false;
+  batch->impl().dynamic_step = dynamic;
   batch->impl().sweeps = fn;
   batch->impl().sphere_sweep = sphere;
   batch->impl().measure_bounds = bounds;

@@ -12,6 +12,7 @@
 #include "sequential/link_rules.h"
 #include "sequential/rule_table.h"
 #include "sequential/wavefront.h"
+#include "strands/dynamic_lanes.h"
 #include "strands/strand_engine.h"
 
 namespace flexkin::internal {
@@ -20,11 +21,13 @@ namespace flexkin::internal {
 #define FLEXKIN_STRAND_ENTRY StrandSweepsAvx2
 #define FLEXKIN_SPHERE_ENTRY StrandSphereSweepAvx2
 #define FLEXKIN_BOUNDS_ENTRY StrandBoundsAvx2
+#define FLEXKIN_DYNAMIC_ENTRY StrandDynamicAvx2
 using Arch = xsimd::fma3<xsimd::avx2>;
 #elif FLEXKIN_ISA == 3
 #define FLEXKIN_STRAND_ENTRY StrandSweepsAvx512
 #define FLEXKIN_SPHERE_ENTRY StrandSphereSweepAvx512
 #define FLEXKIN_BOUNDS_ENTRY StrandBoundsAvx512
+#define FLEXKIN_DYNAMIC_ENTRY StrandDynamicAvx512
 using Arch = xsimd::avx512f;
 #else
 #error "FLEXKIN_ISA must be 2 or 3"
@@ -300,6 +303,49 @@ void FLEXKIN_STRAND_ENTRY(Method method, int dim, int n, int head, int num_sweep
              : BlockSweeps<typename Rule::template Step<3, BatchExp>, 3>(
                    n, head, num_sweeps, heads, lengths, inv_lengths, points);
   });
+}
+
+void FLEXKIN_DYNAMIC_ENTRY(int dim, const DynamicLaneStep& q, int stage) {
+  using B = xsimd::batch<double, Arch>;
+  constexpr int W = B::size;
+  constexpr int L = kStrandLanes;
+  const auto run = [&](auto dim_tag) {
+    constexpr int Dim = decltype(dim_tag)::value;
+    const auto step = [](const B* lead_old, const B* lead_new, B* tail, const double* len,
+                         const double* inv) {
+      B old[Dim];
+      for (int k = 0; k < Dim; ++k) old[k] = tail[k];
+      RuleStep<TractrixRule<Dim, BatchExp>, B, Dim>(lead_old, lead_new, old, len, inv, tail);
+    };
+    // The sphere's contact step in the lanes: where the projected link enters the sphere, the
+    // clear direction nearest the projection's (ContactTail's, in closed form).
+    const auto contact = [&](const B* lead, B* out, int i, int lane0) {
+      if (q.sphere == nullptr) return;
+      B c[Dim];
+      for (int k = 0; k < Dim; ++k) c[k] = B(q.sphere->center[k]);
+      const B r(q.sphere->radius), slack(q.sphere->slack);
+      const B length = B::load_aligned(q.lengths + static_cast<size_t>(i - 1) * L + lane0);
+      B step[Dim];
+      for (int k = 0; k < Dim; ++k) step[k] = out[k] - lead[k];
+      const auto enter = SphereClearance<B, Dim>(lead, step, c, r) < -slack * length;
+      alignas(64) double entered[W], failed[W];
+      xsimd::select(enter, B(1.0), B(0.0)).store_aligned(entered);
+      if (xsimd::any(enter)) {
+        B candidate[Dim], moved[Dim];
+        for (int k = 0; k < Dim; ++k) candidate[k] = out[k];
+        typename B::batch_bool_type bad;
+        SphereContact<B, Dim>(lead, candidate, length, c, r, slack, moved, &bad);
+        for (int k = 0; k < Dim; ++k) out[k] = xsimd::select(enter, moved[k], out[k]);
+        xsimd::select(enter & bad, B(1.0), B(0.0)).store_aligned(failed);
+        for (int j = 0; j < W; ++j) {
+          if (failed[j] != 0.0 && q.fallback[lane0 + j] > i) q.fallback[lane0 + j] = i;
+        }
+      }
+      for (int j = 0; j < W; ++j) q.contact[i * L + lane0 + j] = entered[j] != 0.0;
+    };
+    DynamicBlock<B, Dim>(q, stage, step, contact);
+  };
+  dim == 2 ? run(std::integral_constant<int, 2>()) : run(std::integral_constant<int, 3>());
 }
 
 }  // namespace flexkin::internal

@@ -29,17 +29,17 @@ declare -A allowed=(
   [run]="chain world sequential overall"
   [dynamics]="chain world sequential overall"
   [arm]="chain world sequential"
-  [strands]="chain world sequential"
-  [io]="chain world sequential overall run arm strands"
+  [strands]="chain world sequential overall dynamics"
+  [io]="chain world sequential overall run dynamics arm strands"
   [groom]="chain world sequential overall run arm io strands"
-  [scenario]="chain world sequential overall run arm io strands groom"
+  [scenario]="chain world sequential overall run dynamics arm io strands groom"
   [umbrella]="chain world sequential overall run dynamics arm strands io groom scenario"
   [render]="chain world sequential overall run arm io strands groom"
   [viewer]="chain world sequential overall run arm io strands groom"
   [gltf]="chain world sequential overall run arm io render"
   [urdf]="chain world sequential overall run arm io"
   [draw]="chain world sequential overall run arm io strands groom render viewer gltf"
-  [apps]="chain world sequential overall run arm io strands groom scenario render viewer gltf urdf draw"
+  [apps]="chain world sequential overall run dynamics arm io strands groom scenario render viewer gltf urdf draw"
 )
 
 layer_of_path() {  # a file of the tree -> its layer
