@@ -34,6 +34,7 @@
 
 #include "flexkin/any_scenario.h"
 #include "flexkin/arm.h"
+#include "flexkin/dynamics.h"
 #include "flexkin/error.h"
 #include "flexkin/groom.h"
 #include "flexkin/propagate.h"
@@ -87,7 +88,8 @@ int ExitInterrupted() {
 }
 
 struct RunArgs {
-  std::string scenario, output, csv, method, report = "brief", max_output_size, precision;
+  std::string scenario, output, csv, method, report = "brief", max_output_size, precision,
+                                             projection;
   int substeps = 0, record_every = 0, max_substeps = 0, threads = 0;
   double tolerance = 0.0;
   bool quiet = false, no_link_angles = false;
@@ -95,7 +97,7 @@ struct RunArgs {
   CLI::Option *substeps_opt = nullptr, *record_every_opt = nullptr, *max_substeps_opt = nullptr,
               *tolerance_opt = nullptr, *method_opt = nullptr, *threads_opt = nullptr,
               *precision_opt = nullptr, *csv_opt = nullptr, *no_link_angles_opt = nullptr,
-              *report_opt = nullptr;
+              *report_opt = nullptr, *projection_opt = nullptr;
 };
 
 // Progress on stderr, rewritten in place; only used when stderr is a terminal.
@@ -107,16 +109,20 @@ void ShowProgress(int64_t done, int64_t total) {
 }
 
 // Applies the command-line overrides to the scenario's options; throws InputError naming the
-// option (or the scenario field it conflicts with).
-void ApplyOverrides(const RunArgs& args, flexkin::RunOptions* options) {
-  if (*args.method_opt) options->method = flexkin::ParseMethod(args.method, "--method");
-  if (*args.substeps_opt) options->substeps = args.substeps;
+// option (or the scenario field it conflicts with). `dynamic`: a dynamic chain's, whose --substeps
+// went to its "dynamics" (ApplyDynamicOverrides) and which takes --record-every and
+// --no-link-angles only.
+void ApplyOverrides(const RunArgs& args, flexkin::RunOptions* options, bool dynamic = false) {
+  if (*args.method_opt && !dynamic) {
+    options->method = flexkin::ParseMethod(args.method, "--method");
+  }
+  if (*args.substeps_opt && !dynamic) options->substeps = args.substeps;
   if (*args.record_every_opt) options->record_every = args.record_every;
   if (args.no_link_angles) options->link_angles = false;
-  if (*args.tolerance_opt) options->tolerance = args.tolerance;
-  if (*args.max_substeps_opt) {
+  if (*args.tolerance_opt && !dynamic) options->tolerance = args.tolerance;
+  if (*args.max_substeps_opt && !dynamic) {
     options->max_substeps = args.max_substeps;
-  } else if (*args.substeps_opt && options->max_substeps < options->substeps) {
+  } else if (*args.substeps_opt && !dynamic && options->max_substeps < options->substeps) {
     options->max_substeps = options->substeps;  // a large --substeps raises the default cap
   }
   const flexkin::Problems problems = options->Validate();
@@ -135,6 +141,35 @@ void ApplyOverrides(const RunArgs& args, flexkin::RunOptions* options) {
   throw flexkin::InputError(located);
 }
 
+// A dynamic chain scenario ("dynamics", docs/dynamics.md): --substeps and --projection set its
+// sub-steps per frame and its projection; the options of kinematic runs it has no use for are
+// refused by name.
+void ApplyDynamicOverrides(const RunArgs& args, flexkin::Scenario* scenario) {
+  const std::pair<CLI::Option*, const char*> unsupported[] = {
+      {args.method_opt, "--method"},
+      {args.tolerance_opt, "--tolerance"},
+      {args.max_substeps_opt, "--max-substeps"}};
+  for (const auto& [option, name] : unsupported) {
+    if (*option) {
+      throw flexkin::InputError(flexkin::Problem(
+          name, std::string("is not used with a dynamic chain scenario (") + args.scenario +
+                    " has \"dynamics\", docs/dynamics.md); choose its projection with "
+                    "--projection and its sub-steps per frame with --substeps"));
+    }
+  }
+  flexkin::DynamicOptions& d = *scenario->dynamics;
+  if (*args.projection_opt) {
+    d.projection = flexkin::ParseName<flexkin::Projection>(args.projection, "--projection");
+  }
+  if (*args.substeps_opt) {
+    if (args.substeps < 1) {
+      throw flexkin::InputError(flexkin::Problem::Invalid(
+          "--substeps", std::to_string(args.substeps), "an integer >= 1 (sub-steps per frame)"));
+    }
+    d.substeps = args.substeps;
+  }
+}
+
 // The --method help, from the library's vocabulary: every method with its one-line summary.
 std::string MethodHelp() {
   std::string help = "Overrides the scenario's method:";
@@ -143,6 +178,16 @@ std::string MethodHelp() {
   }
   help += "\nOf a robot scenario:";
   for (const auto& entry : flexkin::Vocabulary<flexkin::FixedBaseMethod>::kEntries) {
+    help += std::string("\n  ") + entry.name + ": " + entry.summary;
+  }
+  return help;
+}
+
+// The --projection help, from the library's vocabulary.
+std::string ProjectionHelp() {
+  std::string help =
+      "Dynamic chain and groom scenarios (\"dynamics\"): overrides dynamics/projection:";
+  for (const auto& entry : flexkin::Vocabulary<flexkin::Projection>::kEntries) {
     help += std::string("\n  ") + entry.name + ": " + entry.summary;
   }
   return help;
@@ -220,6 +265,7 @@ int RunGroom(const RunArgs& args, flexkin::AnyScenario scenario) {
   if (*args.substeps_opt) g.substeps = args.substeps;
   if (*args.record_every_opt) g.record_every = args.record_every;
   if (*args.threads_opt) g.threads = args.threads;
+  if (*args.projection_opt) g.projection = args.projection;
   const std::pair<CLI::Option*, const char*> unsupported[] = {
       {args.csv_opt, "--csv"},
       {args.tolerance_opt, "--tolerance"},
@@ -254,6 +300,7 @@ int RunRobot(const RunArgs& args, flexkin::AnyScenario scenario) {
   if (*args.method_opt) r.method = args.method;
   const std::pair<CLI::Option*, const char*> unsupported[] = {
       {args.substeps_opt, "--substeps"},
+      {args.projection_opt, "--projection"},
       {args.tolerance_opt, "--tolerance"},
       {args.max_substeps_opt, "--max-substeps"},
       {args.record_every_opt, "--record-every"},
@@ -285,7 +332,19 @@ int RunCommand(const RunArgs& args) {
   }
   flexkin::Scenario& scenario = *any.chain;
   const flexkin::ResultFileFormat format = flexkin::ResultFileFormatOfPath(args.output, "-o");
-  ApplyOverrides(args, &scenario.options);
+  if (scenario.dynamics) {
+    ApplyDynamicOverrides(args, &scenario);
+    ApplyOverrides(args, &scenario.options, /*dynamic=*/true);
+  } else {
+    if (*args.projection_opt) {
+      throw flexkin::InputError(
+          flexkin::Problem("--projection",
+                           "is an option of dynamic chain scenarios (\"dynamics\", "
+                           "docs/dynamics.md); " +
+                               args.scenario + " has no \"dynamics\""));
+    }
+    ApplyOverrides(args, &scenario.options);
+  }
   CheckOutputSize(args, scenario, format);
   flexkin::cli::CheckOutputDirectory(args.output);
   if (!args.csv.empty()) flexkin::cli::CheckOutputDirectory(args.csv);
@@ -344,7 +403,8 @@ void PrintChainOutput(const flexkin::Scenario& scenario) {
   using flexkin::cli::FormatBytes;
   std::cout << "output: " << e.frames << " frames (recording every "
             << scenario.options.record_every << " of " << scenario.leader_steps.rows()
-            << " leader steps); result about " << FormatBytes(e.json_bytes) << " as .json, "
+            << (scenario.dynamics ? " frames of the dynamic chain" : " leader steps")
+            << "); result about " << FormatBytes(e.json_bytes) << " as .json, "
             << FormatBytes(e.npz_bytes) << " as .npz; --csv about " << FormatBytes(e.csv_bytes)
             << "; keeping every frame in memory (Run without a sink) about "
             << FormatBytes(e.recorder_bytes) << "\n";
@@ -394,8 +454,10 @@ int Main(int argc, char** argv) {
   args.csv_opt = run->add_option("--csv", args.csv,
                                  "Also write the recorded frames (a robot's joint angles) as CSV");
   args.method_opt = run->add_option("--method", args.method, MethodHelp());
-  args.substeps_opt =
-      run->add_option("--substeps", args.substeps, "Sub-steps per leader step (>= 1)");
+  args.substeps_opt = run->add_option(
+      "--substeps", args.substeps,
+      "Sub-steps per leader step (>= 1); of a dynamic chain, per frame (its dynamics/substeps)");
+  args.projection_opt = run->add_option("--projection", args.projection, ProjectionHelp());
   args.tolerance_opt = run->add_option(
       "--tolerance", args.tolerance,
       "Automatic sub-steps: largest distance to the continuous motion (length unit); 0 = off");

@@ -34,6 +34,7 @@ void ApplyOverrides(const GroomRunArgs& args, GroomScenario* s) {
   }
   GroomOverrides overrides;
   overrides.method = args.method;
+  overrides.projection = args.projection;
   overrides.precision = args.precision;
   overrides.substeps = args.substeps;
   overrides.threads = args.threads;
@@ -97,14 +98,18 @@ int RunGroomCommand(const GroomRunArgs& args, AnyScenario any) {
       }).strands;
   if (!args.quiet) {
     const int64_t frames = scenario.motion.num_frames();
+    // Dynamic strands: "dynamic, projection overall"; else the method.
+    const std::string how = header.dynamics ? std::string("dynamic, projection ") +
+                                                  ProjectionName(header.dynamics->projection)
+                                            : header.method;
     char line[512];
     std::snprintf(line, sizeof line,
                   "%s: %d strands, %lld points, %lld frames (%lld recorded, %s); %s on %s x %d "
                   "thread%s: %.3f ms per frame; largest link-length error %.2g\n",
                   out.c_str(), header.num_strands(), static_cast<long long>(header.num_points()),
                   static_cast<long long>(frames), static_cast<long long>(header.num_frames),
-                  PrecisionName(header.float32), header.method.c_str(), report.engine.c_str(),
-                  report.threads, report.threads == 1 ? "" : "s",
+                  PrecisionName(header.float32), how.c_str(), report.engine.c_str(), report.threads,
+                  report.threads == 1 ? "" : "s",
                   frames > 1 ? 1e3 * report.seconds / static_cast<double>(frames - 1) : 0.0,
                   report.max_length_error);
     std::cout << line;

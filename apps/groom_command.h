@@ -13,7 +13,7 @@ namespace flexkin::cli {
 
 struct GroomRunArgs {
   std::string scenario, output, max_output_size;
-  std::optional<std::string> method, precision;
+  std::optional<std::string> method, precision, projection;
   std::optional<int> substeps, record_every, threads;
   // Options of chain runs that have no meaning for a groom ("--csv"), refused by name.
   std::string unsupported;

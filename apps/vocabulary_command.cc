@@ -4,6 +4,7 @@
 
 #include "flexkin/arm.h"
 #include "flexkin/curves.h"
+#include "flexkin/dynamics.h"
 #include "flexkin/gltf.h"
 #include "flexkin/overall.h"
 #include "flexkin/propagate.h"
@@ -52,6 +53,10 @@ void PrintVocabulary(std::ostream& out) {
                        "The keys of `\"objective\"` in a scenario file (method `overall`) and of "
                        "`\"overall\"/\"objective\"` in a result file (`ObjectiveTerm`, "
                        "flexkin/overall.h).");
+  Table<Projection>(out, "Projections",
+                    "`\"dynamics\"/\"projection\"` of a dynamic chain scenario, `flexkin run "
+                    "--projection`: how a dynamic chain's links are put back to their lengths "
+                    "(`Projection`, flexkin/dynamics.h; docs/dynamics.md).");
   Table<FixedBaseMethod>(out, "Fixed-base methods",
                          "`\"solver\"/\"method\"` of a robot scenario file, `flexkin robot "
                          "--method` (`FixedBaseMethod`, flexkin/arm.h).");

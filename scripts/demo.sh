@@ -19,6 +19,9 @@ echo "== closed form and comparisons"
 "$build/examples/fig06_compare" examples/fig06_parabola_multi_step.json \
   examples/fig06_parabola_single_step.json examples/fig06_parabola_overall_multi_step.json \
   examples/fig06_parabola_overall_single_step.json
+echo "== dynamic chains: the physics checks' numbers and plots (docs/dynamics.md)"
+"$build/examples/dynamics_plots" out/dynamics
+/usr/bin/python3 scripts/dynamics_plots.py out/dynamics
 echo "== robot arm with a fixed base (docs/robots.md)"
 "$flexkin" robot examples/robot_planar_8link.json -o out/robot_planar_8link.json \
   --csv out/robot_planar_8link_joints.csv
@@ -50,6 +53,15 @@ mkdir -p out/groom_head_readme
 # What the hair did, read back with numpy alone (no flexkin): the motion dying out toward the
 # tips, and every link's length.
 /usr/bin/python3 examples/python/hair_numpy.py out/groom_head.npz
+echo "== hair with inertia and gravity (docs/dynamics.md, \"Strands\"): it falls from its grown"
+echo "   shape onto the scalp, swings when the head turns and nods, settles when it stops"
+"$flexkin" run examples/groom_head_gravity.json -o out/groom_head_gravity.npz
+"$flexkin" render out/groom_head_gravity.npz -o out --formats png,mp4,html --quiet
+# The energy and the tips' paths, then the same with the overall projection (about 40 s).
+/usr/bin/python3 examples/python/hair_dynamics_plot.py out/groom_head_gravity.npz
+"$flexkin" run examples/groom_head_gravity.json -o out/groom_head_gravity_overall.npz \
+  --projection overall
+/usr/bin/python3 examples/python/hair_dynamics_plot.py out/groom_head_gravity_overall.npz
 echo "== colliders (docs/colliders.md): a rope round a post, a thick rope across a floor and round"
 echo "   a post, a rope pushed aside by a passing ball (a keyframed collider), a snake threading"
 echo "   20 pegs (follow_path and tractrix)"
@@ -57,6 +69,10 @@ for name in rope_round_post rope_post_floor rope_swept snake_pegs snake_pegs_tra
   "$flexkin" run "examples/$name.json" -o "out/$name.json"
   "$flexkin" render "out/$name.json" -o out --formats png,mp4,html --quiet
 done
+echo "== a dynamic chain (docs/dynamics.md): a rope of 40 links released from horizontal, its"
+echo "   first point held, falling under gravity (overall projection, 3 s at 60 fps)"
+"$flexkin" run examples/rope_fall.json -o out/rope_fall.json
+"$flexkin" render out/rope_fall.json -o out --formats png,mp4,html --quiet
 echo "== figures, plots, animations, viewers and glTF (docs/rendering.md)"
 for result in out/fig*.json; do
   "$flexkin" render "$result" -o out --formats svg,png,pdf,plots,mp4,gif,html,glb --quiet

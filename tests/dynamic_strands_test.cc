@@ -6,11 +6,14 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "flexkin/dynamics.h"
+#include "flexkin/groom.h"
+#include "flexkin/strand_file.h"
 #include "flexkin/strands.h"
 #include "strands/strand_engine.h"
 #include "world/contact.h"
@@ -296,6 +299,106 @@ TEST(DynamicStrands, RefusesByName) {
   EXPECT_EQ(field_of(options), "dynamics.damping");
   options.dynamics = Dynamics(3, Projection::kOverall);
   EXPECT_EQ(field_of(options), "none");
+}
+
+}  // namespace
+}  // namespace flexkin
+
+namespace flexkin {
+namespace {
+
+// A small dynamic groom: strands given point by point, a body that turns.
+std::string GroomText(const std::string& dynamics, const std::string& extra = "") {
+  return R"({"strands": [{"points": [[0, 0, 1], [0, 0.05, 1.05], [0, 0.1, 1.1], [0, 0.15, 1.15]]},
+                         {"points": [[1, 0, 0], [1.05, 0, 0.05], [1.1, 0, 0.1]]}],
+             "motion": {"fps": 30, "keyframes": [{"time": 0}, {"time": 1, "rotation":
+                        {"axis": [0, 0, 1], "angle_deg": 40}}]},
+             "colliders": [{"shape": "sphere", "center": [0, 0, 0], "radius": 0.9}],
+             "substeps": 2, "dynamics": )" +
+         dynamics + extra + "}";
+}
+
+std::vector<std::string> Fields(const Problems& problems) {
+  std::vector<std::string> fields;
+  for (const Problem& p : problems) fields.push_back(p.field);
+  return fields;
+}
+
+TEST(DynamicGroom, ReadsTheDynamicsAndTakesFpsAndSubsteps) {
+  const GroomScenario s = ParseGroomText(GroomText(
+      R"({"projection": "dftl", "gravity": [0, 0, -9.81], "damping": 0.5, "wind": [1, 0, 0],
+          "mass": "uniform", "dftl_damping": 0.8})"));
+  ASSERT_TRUE(s.options.dynamics.has_value());
+  const DynamicOptions& d = *s.options.dynamics;
+  EXPECT_EQ(d.projection, Projection::kDftl);
+  EXPECT_EQ(d.gravity, Eigen::Vector3d(0, 0, -9.81));
+  EXPECT_EQ(d.damping, 0.5);
+  EXPECT_EQ(d.wind, Eigen::Vector3d(1, 0, 0));
+  EXPECT_FALSE(d.mass_by_length);
+  EXPECT_EQ(d.dftl_damping, 0.8);
+  EXPECT_EQ(d.frame_rate, 30.0);  // the motion's fps
+  EXPECT_EQ(d.substeps, 2);       // the groom's substeps
+  EXPECT_NE(GroomSummary(s).find("dynamic, projection dftl"), std::string::npos);
+}
+
+TEST(DynamicGroom, NamesEveryProblemByPointer) {
+  const auto fields = [](const std::string& dynamics, const std::string& extra = "") {
+    return Fields(ValidateGroomText(GroomText(dynamics, extra)));
+  };
+  using V = std::vector<std::string>;
+  EXPECT_EQ(fields(R"({"projection": "overall"})"), V{"/dynamics/gravity"});
+  EXPECT_EQ(fields(R"({"gravity": [0, -9.81]})"), V{"/dynamics/gravity"});
+  EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "projection": "shake"})"),
+            V{"/dynamics/projection"});
+  EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "projection": "overal"})"),
+            V{"/dynamics/projection"});
+  EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "frame_rate": 60})"), V{"/dynamics/frame_rate"});
+  EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "substeps": 4})"), V{"/dynamics/substeps"});
+  EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "mass": [1, 2, 3]})"), V{"/dynamics/mass"});
+  EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "damping": -1})"), V{"/dynamics/damping"});
+  EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "dftl_damping": 2})"),
+            V{"/dynamics/dftl_damping"});
+  EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "wind_keys": [{"time": 1, "velocity": [1, 0, 0]},
+                                                               {"time": 0.5, "velocity": [0, 0, 0]}]})"),
+            V{"/dynamics/wind_keys/1/time"});
+  EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "gust": 1})"), V{"/dynamics/gust"});
+  EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81]})", R"(, "method": "ftl")"), V{"/method"});
+  EXPECT_EQ(fields(R"([0, 0, -9.81])"), V{"/dynamics"});
+}
+
+// The groom run: frame by frame the batch stepped directly, the energy in the report and back
+// from the file.
+TEST(DynamicGroom, RunIsTheBatchSteppedFrameByFrame) {
+  const GroomScenario s = ParseGroomText(GroomText(R"({"projection": "overall",
+      "gravity": [0, 0, -9.81], "damping": 0.5, "wind_keys": [{"time": 0, "velocity": [0, 0, 0]},
+      {"time": 0.5, "velocity": [2, 0, 0]}]})"));
+  const std::string path = ::testing::TempDir() + "dynamic_groom.npz";
+  const StrandRunReport report = RunGroomToFile(s, path);
+  StrandFileReader file(path);
+  ASSERT_TRUE(file.header().dynamics.has_value());
+  EXPECT_EQ(file.header().dynamics->projection, Projection::kOverall);
+  EXPECT_EQ(file.report().energy.size(), report.energy.size());
+  EXPECT_EQ(static_cast<int64_t>(report.energy.size()), file.header().num_frames);
+  EXPECT_TRUE(std::isnan(file.report().energy[0]));
+  for (size_t f = 1; f < report.energy.size(); ++f) {
+    EXPECT_EQ(file.report().energy[f], report.energy[f]);
+  }
+  // The same strands stepped by hand: the batch at the first pose, one StepStrands a frame.
+  StrandBatch batch(s.strands, s.options, s.motion.PoseAt(0), s.motion.TimeOf(0));
+  for (int64_t f = 1; f < s.motion.num_frames(); ++f) {
+    StepStrands(&batch, s.motion.PoseAt(f), s.motion.TimeOf(f));
+  }
+  StrandFrame frame, last;
+  while (file.Next(&frame)) last = frame;
+  for (int i = 0; i < batch.size(); ++i) {
+    const Points p = batch.strand(i);
+    for (Eigen::Index j = 0; j < p.rows(); ++j) {
+      const Eigen::Index row = file.header().offsets[i] + j;
+      for (int k = 0; k < 3; ++k) EXPECT_NEAR(last.points(row, k), p(j, k), 1e-6);  // float32
+    }
+  }
+  EXPECT_EQ(report.energy.back(), batch.dynamics().energy);
+  std::remove(path.c_str());
 }
 
 }  // namespace

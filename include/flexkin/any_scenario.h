@@ -75,6 +75,19 @@ struct ScenarioRunReport {
   std::string BriefReport() const;
 };
 
+// A chain scenario (flexkin/scenario.h) into `files` (and `also`, if not null, e.g. arrays), as
+// RunScenarioToFiles runs one and Python's run_scenario: a kinematic one by RunToFiles (Run with
+// `scenario.options`), a dynamic one ("dynamics", docs/dynamics.md) by SimulateChain from the
+// chain at rest, its first point on `leader_steps` (one row per frame), every frame's points
+// handed on as the frames of a run (step f: frame f; the initial frame, every
+// `options.record_every`-th and the last; no link angles), with RunResult::dynamics (the energy
+// at every frame) and the metrics measured between frames. A dynamic run is computed whole
+// before its frames are written; `options.progress` is called before and while they are.
+// Throws InputError for what DynamicScenarioProblems or RunOptions::Validate finds (by the
+// scenario file's JSON pointer), and what the run and the writers throw; nothing is written then.
+RunResult RunChainScenario(const Scenario& scenario, const RunFiles& files,
+                           FrameSink* also = nullptr);
+
 // The one call that runs a valid scenario of any kind into its files, each streamed while the run
 // goes and renamed into place only when complete (RunToFiles, RunGroomToFile, TrackToFiles): the
 // command line's `flexkin run` and Python's run_scenario(output=) call it, so a kind added here

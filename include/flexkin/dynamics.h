@@ -115,6 +115,9 @@ struct DynamicResult {
   // then keeps the tractrix projection; shake, past its stability limit, takes the overall
   // projection for that sub-step).
   int failures = 0;
+  // Sub-steps in which a collider moved a point (DynamicOptions::colliders): the projection left
+  // a point or link inside one and the contact step put it out (docs/dynamics.md, "Colliders").
+  int contact_substeps = 0;
 };
 
 // Simulates `chain` from rest (its points, velocities 0) with point 0 at `root_path` row f at frame

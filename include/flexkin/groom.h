@@ -98,6 +98,8 @@ bool IsGroomFile(const std::string& path);
 // the scenario's; unset ones keep the file's.
 struct GroomOverrides {
   std::optional<std::string> method;  // "tractrix" or "ftl": the strand engine's methods
+  // Dynamic strands' projection ("overall", "tractrix", "dftl"); refused without "dynamics".
+  std::optional<std::string> projection;
   std::optional<int> substeps, pinned, threads;
   std::optional<int64_t> record_every;   // >= 1
   std::optional<std::string> precision;  // "float32" or "float64"

@@ -163,6 +163,19 @@ struct OverallRunReport {
   std::string first_failure;          // "leader step s, sub-step j: <report>" of the first failure
 };
 
+// What a dynamic chain did (a chain scenario's "dynamics": SimulateChain, flexkin/dynamics.h,
+// docs/dynamics.md); `enabled` false for every kinematic run.
+struct DynamicRunReport {
+  bool enabled = false;
+  std::string projection;   // "overall", "tractrix", "dftl" or "shake"
+  double frame_rate = 0.0;  // frames per second: frame f (leader step f) at f / frame_rate s
+  int substeps = 0;         // sub-steps per frame
+  // The energy at every frame of the run, 0 .. num_steps, recorded or not (DynamicResult::energy:
+  // kinetic plus potential, the free points' masses summing to 1).
+  Eigen::VectorXd energy;
+  int64_t failures = 0;  // sub-steps whose projection's Newton solve did not converge
+};
+
 struct RunResult {
   Method method = Method::kTractrix;
   Eigen::VectorXd lengths;  // the link lengths, fixed at the start
@@ -174,11 +187,12 @@ struct RunResult {
   Eigen::VectorXd final_link_angles;
   Metrics metrics;
   AccuracyReport accuracy;
-  OverallRunReport overall;  // method "overall" only
-  ContactReport contacts;    // with colliders only
-  PathReport path;           // method "follow_path" only
-  ObjectiveWeights weights;  // the overall method's metric (method "overall" only)
-  double seconds = 0.0;      // wall time of the computation
+  OverallRunReport overall;   // method "overall" only
+  ContactReport contacts;     // with colliders only
+  PathReport path;            // method "follow_path" only
+  DynamicRunReport dynamics;  // a dynamic chain only (a scenario's "dynamics")
+  ObjectiveWeights weights;   // the overall method's metric (method "overall" only)
+  double seconds = 0.0;       // wall time of the computation
 
   // One line: method, steps, length error, L2 total, accuracy.
   std::string BriefReport() const;

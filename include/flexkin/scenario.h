@@ -1,9 +1,11 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "flexkin/chain.h"
+#include "flexkin/dynamics.h"
 #include "flexkin/run.h"
 
 namespace flexkin {
@@ -18,7 +20,20 @@ struct Scenario {
   Chain chain;
   Points leader_steps;  // m by dim, m >= 1: the targets from "leader", not including the start
   RunOptions options;   // "method", "leader/substeps", "record/every", "accuracy/..."
+  // "dynamics" (docs/scenario-format.md, docs/dynamics.md): a dynamic chain, its first point
+  // driven along `leader_steps`, one row per frame (SimulateChain's root_path), the others moved
+  // by inertia, gravity and the air. Its colliders are `options.colliders` (times in frames, as
+  // leader steps), its frames recorded as `options.record_every` says. nullopt: a kinematic run.
+  std::optional<DynamicOptions> dynamics;
 };
+
+// What a scenario with "dynamics" cannot take, each named by the JSON pointer of the scenario
+// file where it is set ("/method", "/leader/substeps", "/accuracy/tolerance", "/colliders/0"):
+// a method other than "tractrix", sub-steps of the leader (the frame's are
+// "dynamics/substeps"), accuracy control and mesh colliders. Empty for a kinematic scenario. The
+// parser and the run (RunChainScenario) check it; options changed after parsing (the command line,
+// Python) are checked by the run.
+Problems DynamicScenarioProblems(const Scenario& scenario);
 
 // Checks the JSON text of a scenario and builds the scenario. Throws InputError whose field() is
 // the JSON pointer of the first problem and whose what() is "pointer: message", e.g.
@@ -63,7 +78,9 @@ const OptionLocation* FindOptionLocation(const std::string& field);
 // A problem of RunOptions::Validate with its field as the scenario file's JSON pointer.
 Problem InScenarioFile(Problem problem);
 
-// One line: "2D, 20 links (total length 5), 5 leader steps, method tractrix, 1 sub-step".
+// One line: "2D, 20 links (total length 5), 5 leader steps, method tractrix, 1 sub-step"; with
+// "dynamics": "2D, 40 links (total length 1), dynamic: 180 frames at 60 fps (3 s), projection
+// overall, 4 sub-steps, gravity [0, -9.81], masses by length".
 std::string ScenarioSummary(const Scenario& scenario);
 
 }  // namespace flexkin

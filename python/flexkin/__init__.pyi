@@ -114,6 +114,9 @@ class StrandRunReport:
     seconds: float
     engine: str
     threads: int
+    energy: List[float]  # dynamic strands: per recorded frame (frame 0 NaN)
+    failures: int
+    contact_substeps: int
 
 class OverallReport:
     status: str
@@ -162,6 +165,7 @@ class Result:
     scenario: str
     dim: int
     num_links: int
+    dynamics: Optional[Dict[str, Any]]  # a dynamic chain's: projection, ..., energy; else None
     def brief_report(self) -> str: ...
     def full_report(self) -> str: ...
     def write(self, path: PathLike) -> None: ...
@@ -515,7 +519,7 @@ def run_strands(strands: Sequence[ArrayLike], poses: ArrayLike, *,
                 rest: PoseArg = None) -> Float64Array: ...  # (F', S, n+1, dim)
 
 def run_groom(scenario: Union[PathLike, dict], output: PathLike, *, method: Optional[str] = None,
-              substeps: Optional[int] = None, pinned: Optional[int] = None,
+              projection: Optional[str] = None, substeps: Optional[int] = None, pinned: Optional[int] = None,
               threads: Optional[int] = None, record_every: Optional[int] = None,
               precision: Optional[str] = None,
               progress: Optional[Callable[[int, int], object]] = None) -> StrandRunReport: ...

@@ -57,8 +57,8 @@ int IntOverride(py::handle value, const char* name) {
 }
 
 StrandRunReport RunGroomTo(GroomSource source, PathLike output, OptionalStr method,
-                           OptionalInt substeps, OptionalInt pinned, OptionalInt threads,
-                           OptionalInt record_every, OptionalStr precision,
+                           OptionalStr projection, OptionalInt substeps, OptionalInt pinned,
+                           OptionalInt threads, OptionalInt record_every, OptionalStr precision,
                            ProgressCallback progress) {
   GroomScenario s = GroomArg(source);
   // Checked by the library as `flexkin run`'s options are (ApplyGroomOverrides, flexkin/groom.h).
@@ -70,6 +70,7 @@ StrandRunReport RunGroomTo(GroomSource source, PathLike output, OptionalStr meth
     return py::cast<std::string>(value);
   };
   if (!method.is_none()) overrides.method = text(method, "method");
+  if (!projection.is_none()) overrides.projection = text(projection, "projection");
   if (!precision.is_none()) overrides.precision = text(precision, "precision");
   if (!substeps.is_none()) overrides.substeps = IntOverride(substeps, "substeps");
   if (!pinned.is_none()) overrides.pinned = IntOverride(pinned, "pinned");
@@ -108,20 +109,30 @@ What a groom run did (flexkin.run_groom; also in the strand file's groom.json "r
       .Member("engine", &StrandRunReport::engine,
               "The strand engine that ran: 'avx512', 'avx2' or 'scalar'.")
       .Member("threads", &StrandRunReport::threads, "Threads that stepped the strands.")
+      .Member("energy", &StrandRunReport::energy,
+              "Dynamic strands: the strands' energy at each recorded frame (each strand's free "
+              "points weighing 1; frame 0 NaN); empty for kinematic strands.")
+      .Member("failures", &StrandRunReport::failures,
+              "Dynamic strands, overall projection: strand sub-steps whose Newton solve did not "
+              "converge (they kept the tractrix projection).")
+      .Member("contact_substeps", &StrandRunReport::contact_substeps,
+              "Dynamic strands, overall projection: strand sub-steps projected with contacts by "
+              "the tractrix projection.")
       .Finish();
 
   m.def("run_groom", &RunGroomTo, py::arg("scenario"), py::arg("output"), py::kw_only(),
-        py::arg("method") = py::none(), py::arg("substeps") = py::none(),
-        py::arg("pinned") = py::none(), py::arg("threads") = py::none(),
-        py::arg("record_every") = py::none(), py::arg("precision") = py::none(),
-        py::arg("progress") = py::none(),
+        py::arg("method") = py::none(), py::arg("projection") = py::none(),
+        py::arg("substeps") = py::none(), py::arg("pinned") = py::none(),
+        py::arg("threads") = py::none(), py::arg("record_every") = py::none(),
+        py::arg("precision") = py::none(), py::arg("progress") = py::none(),
         "Runs a groom scenario (a path to a groom file or a dict of its JSON form, "
         "docs/groom-format.md) and writes the strand file `output` (.npz; read it with "
         "numpy.load: points (F, P, dim), offsets, frames, times, body_rotation, "
         "body_translation, link_lengths, groom.json; docs/strands.md), as `flexkin run` does, "
         "bit for bit. The keyword arguments override the scenario's method ('tractrix' or "
-        "'ftl'), substeps, pinned, threads, record_every and precision ('float32' or "
-        "'float64'). The file is written whole or not at all; Ctrl-C or an exception from "
+        "'ftl'), projection (dynamic strands: 'overall', 'tractrix' or 'dftl'), substeps, "
+        "pinned, threads, record_every and precision ('float32' or 'float64'). The file is written "
+        "whole or not at all; Ctrl-C or an exception from "
         "progress(done, total) stops the run and leaves no file. Returns a StrandRunReport.");
   m.def(
       "groom_summary", [](GroomSource scenario) { return GroomSummary(GroomArg(scenario)); },

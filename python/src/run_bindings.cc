@@ -139,6 +139,31 @@ Result RunToArrays(const Chain& chain, const Points& leader_steps, RunOptions op
   return result;
 }
 
+// A chain scenario: a kinematic one as RunToArrays runs it; a dynamic one ("dynamics",
+// docs/dynamics.md) through the library's one call for chain scenarios (RunChainScenario), its
+// frames kept for the Result.
+Result RunScenarioToArrays(const Scenario& s, py::object progress, const RunFiles& files) {
+  if (!s.dynamics) {
+    return RunToArrays(s.chain, s.leader_steps, s.options, std::move(progress), s.name, files);
+  }
+  Result result;
+  result.file.dim = s.chain.dim();
+  result.file.scenario_name = s.name;
+  result.file.colliders = s.options.colliders;
+  Scenario run = s;
+  ProgressHook hook(std::move(progress));
+  hook.Install(&run.options.progress);
+  try {
+    py::gil_scoped_release release;
+    FrameRecorder recorder;
+    result.file.result = RunChainScenario(run, files, &recorder);
+    result.file.result.frames = std::move(recorder.frames);
+  } catch (const StopRun&) {
+    hook.Rethrow();
+  }
+  return result;
+}
+
 Scenario ScenarioArg(ScenarioSource scenario) {
   if (py::isinstance<Scenario>(scenario)) return py::cast<Scenario>(scenario);
   if (py::isinstance<py::dict>(scenario))
@@ -320,8 +345,7 @@ py::object RunAnyScenario(ScenarioSource scenario, ProgressCallback progress, Op
   }
   if (chain != nullptr) {
     if (!files.result.empty()) ResultFileFormatOfPath(files.result, "output");
-    return py::cast(RunToArrays(chain->chain, chain->leader_steps, chain->options,
-                                std::move(progress), chain->name, files));
+    return py::cast(RunScenarioToArrays(*chain, std::move(progress), files));
   }
   // Every other kind runs into its files.
   if (files.result.empty()) {
@@ -409,6 +433,22 @@ The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
       .def_property_readonly(
           "substeps", [](const Result& r) { return r.file.result.accuracy.substeps; },
           "Sub-steps per leader step used (accuracy.substeps).")
+      .def_property_readonly(
+          "dynamics",
+          [](const Result& r) -> py::object {
+            const DynamicRunReport& d = r.file.result.dynamics;
+            if (!d.enabled) return py::none();
+            py::dict out;
+            out["projection"] = d.projection;
+            out["frame_rate"] = d.frame_rate;
+            out["substeps"] = d.substeps;
+            out["failures"] = d.failures;
+            out["energy"] = ToArray(d.energy);
+            return std::move(out);
+          },
+          "A dynamic chain's (a scenario's \"dynamics\", docs/dynamics.md): a dict with "
+          "projection, frame_rate, substeps, failures and energy ((num_steps + 1,) float64, the "
+          "energy at every frame); None for a kinematic run.")
       .def_property_readonly(
           "dim", [](const Result& r) { return r.file.dim; }, "2 or 3.")
       .def_property_readonly(

@@ -72,7 +72,8 @@ class GroomParser : public json_internal::JsonReader {
     if (!ExpectObject(root, "", kRootExpected)) return s;
     CheckKeys(root, "",
               {"$schema", "name", "description", "groom", "strands", "motion", "method", "substeps",
-               "pinned", "threads", "record", "colliders", "world_colliders", "scalp_collider"});
+               "pinned", "threads", "record", "colliders", "world_colliders", "scalp_collider",
+               "dynamics"});
     for (const char* key : {"$schema", "name", "description"}) {
       if (const json* v = Find(root, key)) {
         if (const auto text = String(*v, std::string("/") + key)) {
@@ -107,6 +108,19 @@ class GroomParser : public json_internal::JsonReader {
       motion = ParseMotion(*m, "/motion", dim);
     }
     ParseOptions(root, &s);
+    if (const json* d = Find(root, "dynamics")) {
+      s.options.dynamics = ReadDynamics(*d, "/dynamics", dim, 0, /*strands=*/true);
+      if (s.options.dynamics) {
+        s.options.dynamics->substeps = s.options.substeps;
+        if (motion) s.options.dynamics->frame_rate = motion->fps;
+      }
+      if (root.contains("method")) {
+        Add("/method",
+            "is not used with \"dynamics\" (dynamic strands are moved by inertia and "
+            "\"dynamics/projection\"); remove \"method\"",
+            root["method"].dump(), "no \"method\"");
+      }
+    }
     bool scalp_collider = true;
     if (const json* v = Find(root, "scalp_collider")) {
       if (!v->is_boolean()) {
@@ -538,8 +552,28 @@ void ApplyGroomOverrides(const GroomOverrides& overrides, bool command_line,
     return "--" + field;
   };
   StrandOptions& o = scenario->options;
-  if (overrides.method) o.method = ParseStrandMethod(*overrides.method, name("method"));
-  if (overrides.substeps) o.substeps = *overrides.substeps;
+  if (overrides.method) {
+    if (o.dynamics) {
+      throw InputError(name("method"),
+                       "is not used by dynamic strands (the scenario has \"dynamics\"): they "
+                       "are moved by inertia and the projection; give " +
+                           name("projection") + " instead");
+    }
+    o.method = ParseStrandMethod(*overrides.method, name("method"));
+  }
+  if (overrides.projection) {
+    if (!o.dynamics) {
+      throw InputError(name("projection"),
+                       "is for dynamic strands; the scenario has no \"dynamics\" (its strands "
+                       "are kinematic: " +
+                           name("method") + " chooses their link rule)");
+    }
+    o.dynamics->projection = ParseName<Projection>(*overrides.projection, name("projection"));
+  }
+  if (overrides.substeps) {
+    o.substeps = *overrides.substeps;
+    if (o.dynamics) o.dynamics->substeps = o.substeps;
+  }
   if (overrides.pinned) o.pinned = *overrides.pinned;
   if (overrides.threads) o.threads = *overrides.threads;
   if (overrides.record_every) {
@@ -616,9 +650,23 @@ std::string GroomSummary(const GroomScenario& s) {
   out += std::string("), ") + std::to_string(frames) + (frames == 1 ? " frame" : " frames") +
          " at " + fps + " fps (" + seconds + " s, " + std::to_string(keys) +
          (keys == 1 ? " keyframe, " : " keyframes, ") +
-         (s.motion.interpolation == KeyframeInterpolation::kLinear ? "linear" : "smooth") +
-         "), method " + MethodName(s.options.method) + ", " + std::to_string(s.options.substeps) +
+         (s.motion.interpolation == KeyframeInterpolation::kLinear ? "linear" : "smooth") + "), " +
+         (s.options.dynamics
+              ? std::string("dynamic, projection ") + ProjectionName(s.options.dynamics->projection)
+              : std::string("method ") + MethodName(s.options.method)) +
+         ", " + std::to_string(s.options.substeps) +
          (s.options.substeps == 1 ? " sub-step" : " sub-steps");
+  if (s.options.dynamics) {
+    const DynamicOptions& d = *s.options.dynamics;
+    char text[40];
+    out += ", gravity [";
+    for (Eigen::Index k = 0; k < d.gravity.size(); ++k) {
+      std::snprintf(text, sizeof text, k == 0 ? "%.4g" : ", %.4g", d.gravity[k]);
+      out += text;
+    }
+    std::snprintf(text, sizeof text, "], damping %.4g /s", d.damping);
+    out += text;
+  }
   if (s.options.pinned != 1) out += ", " + std::to_string(s.options.pinned) + " pinned points";
   // Frames 0, e, 2e, ... and the last: as a chain run records its leader steps.
   const int64_t recorded = frames == 0 ? 0 : CountRecordedFrames(frames - 1, s.record_every);

@@ -16,6 +16,7 @@
 
 #include "flexkin/chain.h"
 #include "flexkin/colliders.h"
+#include "flexkin/dynamics.h"
 #include "flexkin/error.h"
 
 namespace flexkin::json_internal {
@@ -90,6 +91,14 @@ class JsonReader {
   std::optional<std::pair<std::vector<BodyKeyframe>, KeyframeInterpolation>> ReadKeyframes(
       const json& motion, const std::string& ptr, int dim, const char* time_unit,
       int64_t max_keyframes);
+
+  // "dynamics" (io/dynamics_json.cc; docs/scenario-format.md and docs/groom-format.md): the
+  // options of a dynamic chain of `num_links` links (0: not known), or, `strands`, of dynamic
+  // strands, which take no "frame_rate" or "substeps" (a groom's are its motion's fps and its
+  // "substeps"), no per-point masses and no "shake". dim 0: the dimension is not known (read,
+  // checked as far as it goes, nothing returned). Null where a problem was added.
+  std::optional<DynamicOptions> ReadDynamics(const json& v, const std::string& ptr, int dim,
+                                             int num_links, bool strands);
 
   // Reads obj[key] with `get` into *out if it is there (and valid); Require also reports a
   // missing key.

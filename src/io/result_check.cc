@@ -80,6 +80,18 @@ std::optional<Problem> ResultSummaryProblem(const RunResult& r) {
   for (const auto& [name, v] : vectors) {
     if (auto problem = NonFinite(*v, name)) return problem;
   }
+  if (r.dynamics.enabled) {
+    if (auto problem = NonFinite(r.dynamics.energy, "dynamics.energy")) return problem;
+    if (r.dynamics.energy.size() != r.num_steps + 1) {
+      return Problem("dynamics.energy", "has " + std::to_string(r.dynamics.energy.size()) +
+                                            " values; expected " + std::to_string(r.num_steps + 1) +
+                                            " (one per frame, 0 to num_steps)");
+    }
+    if (!(std::isfinite(r.dynamics.frame_rate) && r.dynamics.frame_rate > 0.0)) {
+      return Problem::Invalid("dynamics.frame_rate", FormatNumber(r.dynamics.frame_rate),
+                              "a finite number > 0");
+    }
+  }
   const std::pair<const char*, double> numbers[] = {
       {"metrics.l2_total", m.l2_total},
       {"metrics.l2_weighted_total", m.l2_weighted_total},

@@ -124,6 +124,23 @@ void ReadResultSummary(const json& j, const ResultArrays* arrays, ResultFile* ou
     r.overall.optimality = ReadNumber(Member(o, "/overall", "optimality"), "/overall/optimality");
   }
 
+  if (const auto it = j.find("dynamics"); it != j.end()) {
+    const json& d = *it;
+    DynamicRunReport& report = r.dynamics;
+    report.enabled = true;
+    const json& projection = Member(d, "/dynamics", "projection");
+    if (!projection.is_string()) {
+      throw InputError("/dynamics/projection", "value " + Show(projection) + " is not a string");
+    }
+    report.projection = projection.get<std::string>();
+    report.frame_rate = ReadNumber(Member(d, "/dynamics", "frame_rate"), "/dynamics/frame_rate");
+    report.substeps =
+        static_cast<int>(ReadInteger(Member(d, "/dynamics", "substeps"), "/dynamics/substeps", 1));
+    report.failures = ReadInteger(Member(d, "/dynamics", "failures"), "/dynamics/failures", 0);
+    report.energy =
+        ReadVector(Member(d, "/dynamics", "energy"), "/dynamics/energy", r.num_steps + 1);
+  }
+
   const json& metrics = Member(j, "", "metrics");
   Metrics& m = r.metrics;
   m.l2_total = ReadNumber(Member(metrics, "/metrics", "l2_total"), "/metrics/l2_total");

@@ -253,6 +253,17 @@ void AppendResultSummaryJson(const RunResult& result, bool with_arrays, std::str
     AppendJsonDouble(o.optimality, &t);
     t += ", \"first_failure\": " + JsonString(o.first_failure) + "},\n";
   }
+  // A dynamic chain's (docs/dynamics.md): its energy, one number a frame, also in an npz's
+  // result.json (small beside the frames).
+  if (result.dynamics.enabled) {
+    const DynamicRunReport& d = result.dynamics;
+    t += "\"dynamics\": {\"projection\": " + JsonString(d.projection) + ", \"frame_rate\": ";
+    AppendJsonDouble(d.frame_rate, &t);
+    t += ", \"substeps\": " + std::to_string(d.substeps) +
+         ", \"failures\": " + std::to_string(d.failures) + ",\n\"energy\": ";
+    AppendVector(d.energy, &t);
+    t += "},\n";
+  }
   t += "\"metrics\": {";
   const std::pair<const char*, double> totals[] = {
       {"l2_total", m.l2_total},

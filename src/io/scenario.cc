@@ -19,7 +19,7 @@ Scenario Parser::Parse(const json& root) {
   if (!ExpectObject(root, "", "an object with \"curve\" and \"leader\"")) return s;
   CheckKeys(root, "",
             {"$schema", "name", "description", "curve", "leader", "method", "objective", "solver",
-             "record", "accuracy", "colliders", "link_radius"});
+             "record", "accuracy", "colliders", "link_radius", "dynamics"});
   for (const char* key : {"$schema", "name", "description"}) {
     if (const json* v = Find(root, key)) {
       if (const auto text = String(*v, std::string("/") + key)) {
@@ -48,6 +48,10 @@ Scenario Parser::Parse(const json& root) {
                                "an object: {\"path\": [...]} or {\"pull\": [...], \"steps\": n}")) {
     steps = ParseLeader(*l, "/leader", chain ? &*chain : nullptr, &s.options);
   }
+  std::optional<DynamicOptions> dynamics;
+  if (const json* d = Find(root, "dynamics")) {
+    dynamics = ParseDynamics(*d, "/dynamics", chain ? &*chain : nullptr);
+  }
   // A large "substeps" raises the default cap rather than contradicting it.
   if (!max_substeps_given)
     s.options.max_substeps = std::max(s.options.max_substeps, s.options.substeps);
@@ -58,6 +62,8 @@ Scenario Parser::Parse(const json& root) {
   }
   s.chain = std::move(*chain);
   s.leader_steps = std::move(*steps);
+  s.dynamics = std::move(dynamics);
+  for (Problem& p : DynamicScenarioProblems(s)) problems.push_back(std::move(p));
   return s;
 }
 
@@ -153,11 +159,41 @@ std::string ScenarioSummary(const Scenario& scenario) {
   char total[40];
   std::snprintf(total, sizeof total, "%.6g", c.lengths.sum());
   std::string out = std::to_string(c.dim()) + "D, " + std::to_string(c.num_links()) +
-                    (c.num_links() == 1 ? " link" : " links") + " (total length " + total + "), " +
-                    std::to_string(scenario.leader_steps.rows()) +
-                    (scenario.leader_steps.rows() == 1 ? " leader step" : " leader steps") +
-                    ", method " + MethodName(o.method) + ", " + std::to_string(o.substeps) +
-                    (o.substeps == 1 ? " sub-step" : " sub-steps");
+                    (c.num_links() == 1 ? " link" : " links") + " (total length " + total + "), ";
+  if (scenario.dynamics) {
+    const DynamicOptions& d = *scenario.dynamics;
+    const auto number = [](const char* fmt, double x) {
+      char text[40];
+      std::snprintf(text, sizeof text, fmt, x);
+      return std::string(text);
+    };
+    const auto vector = [&number](const Eigen::VectorXd& v) {
+      std::string text = "[";
+      for (Eigen::Index k = 0; k < v.size(); ++k) text += (k ? ", " : "") + number("%.6g", v[k]);
+      return text + "]";
+    };
+    const Eigen::Index frames = scenario.leader_steps.rows();
+    out += "dynamic: " + std::to_string(frames) + (frames == 1 ? " frame" : " frames") + " at " +
+           number("%.6g", d.frame_rate) + " fps (" +
+           number("%.6g", static_cast<double>(frames) / d.frame_rate) + " s), projection " +
+           ProjectionName(d.projection) + ", " + std::to_string(d.substeps) +
+           (d.substeps == 1 ? " sub-step" : " sub-steps") + ", gravity " + vector(d.gravity);
+    if (d.damping > 0.0) out += ", damping " + number("%.6g", d.damping) + " /s";
+    if (!d.wind_keys.empty()) {
+      out += ", wind in " + std::to_string(d.wind_keys.size()) + " keys";
+    } else if (d.wind.size() > 0) {
+      out += ", wind " + vector(d.wind);
+    }
+    out += d.masses.size() > 0 ? ", masses given"
+           : d.mass_by_length  ? ", masses by length"
+                               : ", uniform masses";
+    if (o.record_every != 1) out += ", recording every " + std::to_string(o.record_every);
+    return out;
+  }
+  out += std::to_string(scenario.leader_steps.rows()) +
+         (scenario.leader_steps.rows() == 1 ? " leader step" : " leader steps") + ", method " +
+         MethodName(o.method) + ", " + std::to_string(o.substeps) +
+         (o.substeps == 1 ? " sub-step" : " sub-steps");
   if (o.tolerance > 0.0) {
     char tol[40];
     std::snprintf(tol, sizeof tol, "%.3g", o.tolerance);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "flexkin/curves.h"
+#include "flexkin/dynamics.h"
 #include "flexkin/error.h"
 #include "flexkin/leader.h"
 #include "flexkin/scenario.h"
@@ -58,6 +59,10 @@ class Parser : public json_internal::JsonReader {
   std::optional<Points> ParseLeader(const json& v, const std::string& ptr, const Chain* chain,
                                     RunOptions* options);
   void ParseOptions(const json& root, RunOptions* options);
+  // "dynamics" (scenario_dynamics.cc): the options of a dynamic chain; `chain` null if the curve
+  // was not valid (then its dimension is not known and the chain-dependent checks are skipped).
+  std::optional<DynamicOptions> ParseDynamics(const json& v, const std::string& ptr,
+                                              const Chain* chain);
   std::optional<Collider> ParseCollider(const json& v, const std::string& ptr, int dim);
   void ParseMesh(const json& v, const std::string& ptr, Collider* collider);
 

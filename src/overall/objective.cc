@@ -74,7 +74,8 @@ double Evaluate(const ObjectiveWeights& w, const Eigen::VectorXd& lengths, const
   if (w.squared > 0.0 || w.squared_weighted > 0.0) {
     for (int j = 1; j <= n; ++j) {
       const double arc = 0.5 * (length[j - 1] + (j < n ? length[j] : 0.0));
-      const double s = w.squared + w.squared_weighted * arc;
+      const double s = sink.point_weights != nullptr ? sink.point_weights[j]
+                                                     : w.squared + w.squared_weighted * arc;
       double sq = 0.0;
       for (int k = 0; k < dim; ++k) {
         d[k] = xs[j * dim + k] - olds[j * dim + k];

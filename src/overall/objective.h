@@ -35,6 +35,10 @@ struct Sink {
   // squared and rotation metrics and of the constraints, couple neighbours only.)
   double* identity_diagonal = nullptr;
   double* identity_below = nullptr;
+  // If set (n + 1 entries, [0] unused): the squared metric's weight of each point j instead of
+  // squared + squared_weighted (L_j + L_{j+1}) / 2 (a dynamic chain's masses, dynamics.cc; the
+  // squared or squared_weighted weight must be > 0 for the term to be evaluated).
+  const double* point_weights = nullptr;
 
   bool WantsHessian() const { return band != nullptr || form != nullptr || hessian != nullptr; }
   void Gradient(int j, const double* g, double scale) const {

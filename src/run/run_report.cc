@@ -20,6 +20,19 @@ std::string Format(const char* fmt, double x) {
 
 std::string RunResult::BriefReport() const {
   std::ostringstream out;
+  if (dynamics.enabled) {
+    out << "dynamic, projection " << dynamics.projection << ": " << lengths.size() << " links, "
+        << num_steps << " frames at " << Format("%.6g", dynamics.frame_rate) << " fps x "
+        << dynamics.substeps << " sub-steps, max relative length error "
+        << Format("%.3g", metrics.max_relative_length_error);
+    if (dynamics.energy.size() > 0) {
+      out << ", energy " << Format("%.6g", dynamics.energy[0]) << " at the start, "
+          << Format("%.6g", dynamics.energy[dynamics.energy.size() - 1]) << " at the end";
+    }
+    if (dynamics.failures > 0) out << ", " << dynamics.failures << " sub-steps' solves failed";
+    out << ", " << Format("%.3g", seconds) << " s";
+    return out.str();
+  }
   out << MethodName(method) << ": " << lengths.size() << " links, " << num_steps
       << " leader steps x " << accuracy.substeps << " sub-steps, max relative length error "
       << Format("%.3g", metrics.max_relative_length_error) << ", L2 total "

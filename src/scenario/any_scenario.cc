@@ -1,10 +1,15 @@
 #include "flexkin/any_scenario.h"
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
+#include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
+#include "flexkin/dynamics.h"
 #include "groom/groom_reader.h"
 #include "io/json_file.h"
 #include "io/scenario_kinds.h"
@@ -85,7 +90,133 @@ bool EndsWith(const std::string& s, const std::string& end) {
   return s.size() >= end.size() && s.compare(s.size() - end.size(), end.size(), end) == 0;
 }
 
+// The colliders of a dynamic chain: a scenario's, their keyframe times turned from frames (leader
+// steps) into seconds, grown by the links' radius (RunOptions::link_radius, as Run grows them).
+std::vector<Collider> DynamicColliders(const RunOptions& options, double frame_rate) {
+  std::vector<Collider> colliders = options.colliders;
+  for (Collider& c : colliders) {
+    c.margin += options.link_radius;
+    if (c.motion) {
+      auto motion = std::make_shared<ColliderMotion>(*c.motion);
+      for (BodyKeyframe& k : motion->keyframes) k.time /= frame_rate;
+      c.motion = std::move(motion);
+    }
+  }
+  return colliders;
+}
+
+// The metrics of a dynamic chain's frames, measured from frame to frame (its sub-steps are not
+// seen): per frame the points' distances moved, plain and weighted by arc length, and each
+// point's path.
+Metrics FrameMetrics(const Chain& chain, const std::vector<Points>& frames,
+                     double max_relative_length_error) {
+  const Eigen::Index n = chain.num_links(), steps = static_cast<Eigen::Index>(frames.size()) - 1;
+  Eigen::VectorXd weight = Eigen::VectorXd::Zero(n + 1);
+  weight.head(n) += 0.5 * chain.lengths;
+  weight.tail(n) += 0.5 * chain.lengths;
+  Metrics m;
+  m.l2_per_step = Eigen::VectorXd::Zero(steps);
+  m.l2_weighted_per_step = Eigen::VectorXd::Zero(steps);
+  m.path_length = Eigen::VectorXd::Zero(n + 1);
+  for (Eigen::Index f = 1; f <= steps; ++f) {
+    const Points& a = frames[static_cast<size_t>(f - 1)];
+    const Points& b = frames[static_cast<size_t>(f)];
+    for (Eigen::Index j = 0; j <= n; ++j) {
+      const double d = (b.row(j) - a.row(j)).norm();
+      m.l2_per_step[f - 1] += d;
+      m.l2_weighted_per_step[f - 1] += weight[j] * d;
+      m.path_length[j] += d;
+    }
+  }
+  m.l2_total = m.l2_per_step.sum();
+  m.l2_weighted_total = m.l2_weighted_per_step.sum();
+  m.max_relative_length_error = max_relative_length_error;
+  return m;
+}
+
+// A dynamic chain (Scenario::dynamics) into its files: SimulateChain, then the frames.
+RunResult RunDynamicChain(const Scenario& s, const RunOptions& options, const RunFiles& files,
+                          FrameSink* also) {
+  Scenario checked;  // DynamicScenarioProblems of these options (the command line's, Python's)
+  checked.dynamics = s.dynamics;
+  checked.options.method = options.method;
+  checked.options.substeps = options.substeps;
+  checked.options.tolerance = options.tolerance;
+  checked.options.colliders = options.colliders;
+  ThrowIfAny(DynamicScenarioProblems(checked));
+  if (const Problems problems = options.Validate(); !problems.empty()) {
+    throw InputError(InScenarioFile(problems.front()));
+  }
+  DynamicOptions dynamics = *s.dynamics;
+  dynamics.colliders = DynamicColliders(options, dynamics.frame_rate);
+  const Eigen::Index frames = s.leader_steps.rows();
+  // The files are opened first: a path that cannot be written fails before the run.
+  std::optional<ResultFileWriter> writer;
+  std::vector<FrameSink*> sinks;
+  if (!files.result.empty()) {
+    sinks.push_back(&writer.emplace(files.result, ResultFileFormatOfPath(files.result),
+                                    MakeResultHeader(s.chain, options, s.name)));
+  }
+  std::optional<FramesCsvWriter> csv;
+  if (!files.csv.empty()) sinks.push_back(&csv.emplace(files.csv, s.chain.dim()));
+  if (also != nullptr) sinks.push_back(also);
+  FrameFanOut sink(sinks);
+  if (options.progress) options.progress(0, frames);
+
+  const auto start = std::chrono::steady_clock::now();
+  DynamicResult run;
+  try {
+    run = SimulateChain(s.chain, s.leader_steps, dynamics);
+  } catch (const InputError& e) {  // the driven end in a collider: named in the scenario's terms
+    Problem p = e.problem();
+    if (p.field.rfind("root_path[", 0) == 0) {
+      const int64_t frame = std::stoll(p.field.substr(10)) + 1;
+      p.message = "frame " + std::to_string(frame) + ": " + p.message;
+      p.field = "/leader";
+    }
+    throw InputError(p);
+  }
+  RunResult result;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.method = options.method;
+  result.lengths = s.chain.lengths;
+  result.num_steps = frames;
+  result.accuracy.substeps = dynamics.substeps;
+  result.accuracy.order = 0;  // no accuracy control
+  result.metrics = FrameMetrics(s.chain, run.frames, run.max_relative_length_error);
+  result.contacts.num_colliders = static_cast<int>(dynamics.colliders.size());
+  DynamicRunReport& report = result.dynamics;
+  report.enabled = true;
+  report.projection = ProjectionName(dynamics.projection);
+  report.frame_rate = dynamics.frame_rate;
+  report.substeps = dynamics.substeps;
+  report.energy = run.energy;
+  report.failures = run.failures;
+
+  const Eigen::VectorXd no_angles;
+  for (Eigen::Index f = 0; f <= frames; ++f) {
+    if (f % options.record_every != 0 && f != frames) continue;
+    sink.Add(f, run.frames[static_cast<size_t>(f)], no_angles);
+    ++result.recorded_frames;
+    if (options.progress && f > 0 && f % 256 == 0) options.progress(f, frames);
+  }
+  if (writer) writer->Commit(result);
+  if (csv) csv->Commit();
+  if (options.progress) options.progress(frames, frames);
+  return result;
+}
+
+RunResult RunChain(const Scenario& s, const RunOptions& options, const RunFiles& files,
+                   FrameSink* also) {
+  if (s.dynamics) return RunDynamicChain(s, options, files, also);
+  return RunToFiles(s.chain, s.leader_steps, options, s.name, files, also);
+}
+
 }  // namespace
+
+RunResult RunChainScenario(const Scenario& scenario, const RunFiles& files, FrameSink* also) {
+  return RunChain(scenario, scenario.options, files, also);
+}
 
 std::string ScenarioRunReport::BriefReport() const {
   switch (kind) {
@@ -111,11 +242,9 @@ ScenarioRunReport RunScenarioToFiles(const AnyScenario& scenario, const Scenario
   report.kind = scenario.kind;
   switch (scenario.kind) {
     case ScenarioKind::kChain: {
-      const Scenario& s = *scenario.chain;
-      RunOptions options = s.options;
+      RunOptions options = scenario.chain->options;
       if (progress) options.progress = progress;
-      report.chain =
-          RunToFiles(s.chain, s.leader_steps, options, s.name, {outputs.output, outputs.csv});
+      report.chain = RunChain(*scenario.chain, options, {outputs.output, outputs.csv}, nullptr);
       break;
     }
     case ScenarioKind::kGroom: {

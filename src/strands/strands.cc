@@ -295,8 +295,8 @@ struct StrandBatchImpl {
   // wind at each sub-step; after it: the energy and the threads' counts.
   void BeginDynamicFrame(const BodyPose* pose);
   void EndDynamicFrame();
-  void ContactLane(const Block& block, int lane, int first, int s, const DynamicScratch& ds,
-                   double* pts, ContactScratch* cs);
+  void ContactLane(const Block& block, int lane, int first, int s, DynamicScratch& ds, double* pts,
+                   ContactScratch* cs);
 
   void StepBlock(int b, double* scratch_heads);
   void StepBlockWithColliders(int b, double* scratch_heads, ContactScratch* cs);
@@ -902,10 +902,10 @@ void StrandBatchImpl::PinnedAt(const Block& block, int s, const double* from, do
 // direction (ContactTail). The overall projection's lanes are projected again from the first free
 // link by the tractrix projection.
 void StrandBatchImpl::ContactLane(const Block& block, int lane, int first, int s,
-                                  const DynamicScratch& ds, double* pts, ContactScratch* cs) {
+                                  DynamicScratch& ds, double* pts, ContactScratch* cs) {
   const Projection projection = options.dynamics->projection;
   const int head = block.pinned - 1;
-  const double* p = ds.predicted.data();
+  double* p = ds.predicted.data();
   const double* block_lengths = lengths.data() + block.lengths;
   const double* block_inv = inv_lengths.data() + block.lengths;
   const std::vector<Collider>& all = placed[s - 1];
@@ -935,8 +935,12 @@ void StrandBatchImpl::ContactLane(const Block& block, int lane, int first, int s
     if (clearance < -kContactSlack * length) {
       Eigen::Vector3d clear;
       if (ContactTail(dim, lead, projection == Projection::kDftl ? pi : x, length, all, &clear)) {
+        SettleTail(dim, lead, length, all, &clear);
         x = clear;
         ++cs->stats.contact_link_steps;
+        // A point a collider placed takes no DFTL velocity correction (its correction is the
+        // contact's, not the link's): its prediction is made its place.
+        for (int k = 0; k < dim; ++k) p[(i * dim + k) * L + lane] = x[k];
       } else if (cs->error.empty()) {
         cs->error = "strands[" + std::to_string(block.source[lane]) + "]: link " +
                     std::to_string(i) +
@@ -1051,7 +1055,12 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
           // The lanes' own contact steps stand up to the first link projected again.
           first = std::min(first, cs->fallback[lane]);
           for (int i = head + 1; i < first && i <= n; ++i) {
-            cs->stats.contact_link_steps += cs->contact_flags[i * L + lane];
+            if (!cs->contact_flags[i * L + lane]) continue;
+            ++cs->stats.contact_link_steps;
+            for (int k = 0; k < dim; ++k) {
+              const size_t at = static_cast<size_t>(i * dim + k) * L + lane;
+              ds.predicted.data()[at] = pts[at];
+            }
           }
         }
         if (first > n) {

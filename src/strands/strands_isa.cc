@@ -161,9 +161,14 @@ void SphereContact(const B* h, const B* old, const B& length, const B* c, const 
   const B cos_a = xsimd::select(on_surface, B(0.0), xsimd::select(reach, tangent / D, cos_far));
   B du(0.0);
   for (int k = 0; k < Dim; ++k) du += d0[k] * u[k];
-  B w[Dim], wn(0.0);
+  B w[Dim], wn(0.0), wu(0.0);
+  for (int k = 0; k < Dim; ++k) w[k] = d0[k] - du * u[k];
+  // Again (Gram-Schmidt twice): where the old direction points nearly at the centre, w is small
+  // and its first pass leaves it off the perpendicular by eps / |w|, which would change the
+  // link's length by as much.
+  for (int k = 0; k < Dim; ++k) wu += w[k] * u[k];
   for (int k = 0; k < Dim; ++k) {
-    w[k] = d0[k] - du * u[k];
+    w[k] -= wu * u[k];
     wn += w[k] * w[k];
   }
   wn = xsimd::sqrt(wn);

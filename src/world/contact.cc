@@ -438,4 +438,19 @@ bool ContactTail(int dim, const Vector3d& head, const Vector3d& tail, double len
   return true;
 }
 
+void SettleTail(int dim, const Vector3d& head, double length,
+                const std::vector<Collider>& colliders, Vector3d* tail) {
+  Vector3d lifted = *tail;
+  for (const Collider& c : colliders) {
+    const SurfaceQuery q = QuerySurface(c, lifted);
+    if (q.distance < 0.0 && q.distance > -1e-9 * length) lifted -= q.distance * q.normal;
+  }
+  if (lifted == *tail) return;
+  lifted = head + (length / (lifted - head).norm()) * (lifted - head);
+  if (dim == 2) lifted.z() = 0.0;
+  if (SegmentClearance(colliders, head, lifted) >= SegmentClearance(colliders, head, *tail)) {
+    *tail = lifted;
+  }
+}
+
 }  // namespace flexkin::internal

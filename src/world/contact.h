@@ -49,4 +49,12 @@ SegmentContact NearestOnSegment(const Collider& collider, const Eigen::Vector3d&
 bool ContactTail(int dim, const Eigen::Vector3d& head, const Eigen::Vector3d& tail, double length,
                  const std::vector<Collider>& colliders, Eigen::Vector3d* x);
 
+// ContactTail leaves the tail where the link meets the collider to within its slack, or, from a
+// head inside by a hair (the last link's contact step), within twice the head's depth: along a
+// chain lying on a surface, link after link, that depth would double each link. So a tail inside
+// a collider by no more than rounding (1e-9 of its link) is put on the surface along its normal
+// and back at its link's length from `head`, where that leaves the link no less clear.
+void SettleTail(int dim, const Eigen::Vector3d& head, double length,
+                const std::vector<Collider>& colliders, Eigen::Vector3d* tail);
+
 }  // namespace flexkin::internal
