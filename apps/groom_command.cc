@@ -98,10 +98,7 @@ int RunGroomCommand(const GroomRunArgs& args, AnyScenario any) {
       }).strands;
   if (!args.quiet) {
     const int64_t frames = scenario.motion.num_frames();
-    // Dynamic strands: "dynamic, projection overall"; else the method.
-    const std::string how = header.dynamics ? std::string("dynamic, projection ") +
-                                                  ProjectionName(header.dynamics->projection)
-                                            : header.method;
+    const std::string how = StrandMotionName(header);  // "dynamic, projection dftl", "tractrix"
     char line[512];
     std::snprintf(line, sizeof line,
                   "%s: %d strands, %lld points, %lld frames (%lld recorded, %s); %s on %s x %d "

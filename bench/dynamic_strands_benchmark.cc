@@ -5,7 +5,7 @@
 // run is the kinematic strand engine (tractrix) on the same strands, scalp and motion. Before
 // the timer the hair falls for 60 frames, so that it lies on the scalp as it does in use (most
 // strands touch it). Counters: contact link steps per frame, the overall projection's
-// non-converged strand sub-steps per frame.
+// non-converged strand sub-steps per frame. *NoScalp: the same without the scalp collider.
 // Run: build/bench/dynamic_strands_benchmark --benchmark_repetitions=5
 //        --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
@@ -53,13 +53,13 @@ BodyPose ShakePose(int64_t frame) {
   return pose;
 }
 
-StrandOptions Options(int threads, std::optional<Projection> projection) {
+StrandOptions Options(int threads, std::optional<Projection> projection, bool scalp_collider) {
   StrandOptions options;
   options.threads = threads;
   Collider scalp;
   scalp.shape = ColliderShape::kSphere;
   scalp.radius = 1.0;
-  options.body_colliders = {scalp};
+  if (scalp_collider) options.body_colliders = {scalp};
   if (projection) {
     DynamicOptions d;
     d.projection = *projection;
@@ -71,8 +71,10 @@ StrandOptions Options(int threads, std::optional<Projection> projection) {
   return options;
 }
 
-void Run(benchmark::State& state, std::optional<Projection> projection) {
-  StrandBatch batch(Hair(10000, 32), Options(static_cast<int>(state.range(0)), projection));
+void Run(benchmark::State& state, std::optional<Projection> projection,
+         bool scalp_collider = true) {
+  StrandBatch batch(Hair(10000, 32),
+                    Options(static_cast<int>(state.range(0)), projection, scalp_collider));
   int64_t frame = 0;
   // The hair falls onto the scalp before the timer (the kinematic strands just follow the head).
   for (; frame < 60; ++frame) StepStrands(&batch, ShakePose(frame + 1), (frame + 1) / 60.0);
@@ -97,6 +99,11 @@ void BM_KinematicHair(benchmark::State& state) { Run(state, std::nullopt); }
 void BM_DynamicHairTractrix(benchmark::State& state) { Run(state, Projection::kTractrix); }
 void BM_DynamicHairDftl(benchmark::State& state) { Run(state, Projection::kDftl); }
 void BM_DynamicHairOverall(benchmark::State& state) { Run(state, Projection::kOverall); }
+// Without the scalp (the hair falls through where the head is): the projections' own cost.
+void BM_DynamicHairTractrixNoScalp(benchmark::State& state) {
+  Run(state, Projection::kTractrix, false);
+}
+void BM_DynamicHairDftlNoScalp(benchmark::State& state) { Run(state, Projection::kDftl, false); }
 
 #define FLEXKIN_HAIR_BENCHMARK(name) \
   BENCHMARK(name)->Arg(1)->Arg(2)->Iterations(60)->Unit(benchmark::kMillisecond)->UseRealTime()
@@ -104,6 +111,8 @@ FLEXKIN_HAIR_BENCHMARK(BM_KinematicHair);
 FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairTractrix);
 FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairDftl);
 FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairOverall);
+FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairTractrixNoScalp);
+FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairDftlNoScalp);
 
 }  // namespace
 }  // namespace flexkin

@@ -77,6 +77,10 @@ struct StrandFileHeader {
   int64_t num_points() const { return offsets.empty() ? 0 : offsets.back(); }
 };
 
+// How the strands of a file moved, for titles and reports: "dynamic, projection dftl" for dynamic
+// strands, else the method ("tractrix").
+std::string StrandMotionName(const StrandFileHeader& header);
+
 // One recorded frame.
 struct StrandFrame {
   int64_t frame = 0;  // frame number of the motion

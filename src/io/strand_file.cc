@@ -542,4 +542,9 @@ bool IsStrandFile(const std::string& path) {
   }
 }
 
+std::string StrandMotionName(const StrandFileHeader& header) {
+  if (!header.dynamics) return header.method;
+  return std::string("dynamic, projection ") + ProjectionName(header.dynamics->projection);
+}
+
 }  // namespace flexkin

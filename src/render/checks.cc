@@ -32,6 +32,12 @@ std::string MainTitle(const ResultFile& file, const std::string& title) {
 std::string RunSummary(const ResultFile& file) {
   const RunResult& r = file.result;
   const long long n = r.lengths.size();
+  if (r.dynamics.enabled) {
+    // A dynamic chain: its projection, and its leader steps are frames.
+    return "dynamic, projection " + r.dynamics.projection + " \u00b7 " + std::to_string(file.dim) +
+           "D \u00b7 " + std::to_string(n) + (n == 1 ? " link" : " links") + " \u00b7 " +
+           std::to_string(r.num_steps) + (r.num_steps == 1 ? " frame" : " frames");
+  }
   return std::string(MethodName(r.method)) + " \u00b7 " + std::to_string(file.dim) + "D \u00b7 " +
          std::to_string(n) + (n == 1 ? " link" : " links") + " \u00b7 " +
          std::to_string(r.num_steps) + (r.num_steps == 1 ? " leader step" : " leader steps");

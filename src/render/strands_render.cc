@@ -102,7 +102,7 @@ Drawing Prepare(const StrandFileReader& reader, const StrandsRenderOptions& opti
   }
   char fps[32];
   std::snprintf(fps, sizeof fps, "%g", h.fps);
-  d.subtitle = h.method + " \u00b7 " + Thousands(s) + (s == 1 ? " strand" : " strands");
+  d.subtitle = StrandMotionName(h) + " \u00b7 " + Thousands(s) + (s == 1 ? " strand" : " strands");
   if (drawn < s) d.subtitle += " (" + Thousands(drawn) + " drawn)";
   d.subtitle += " \u00b7 " + std::to_string(min_links) +
                 (min_links == max_links ? "" : "\u2013" + std::to_string(max_links)) +

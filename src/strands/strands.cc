@@ -1073,22 +1073,31 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
     }
     dynamic_step(dim, q, 2);
   }
-  // The energy at the middle of the last sub-step, each lane's free points weighing 1.
-  double energy = 0.0;
+  // The energy at the middle of the last sub-step, each lane's free points weighing 1 (summed
+  // lane by lane, the lanes in the inner loop).
+  double lane_energy[L] = {};
   const double* mass_of = mass.data() + mass_offset[b];
-  for (int lane = 0; lane < L; ++lane) {
-    if (lane > 0 && block.source[lane] == block.source[0]) break;
-    double e = 0.0;
-    for (int i = head + 1; i <= n; ++i) {
-      double kinetic = 0.0, height = 0.0;
-      for (int k = 0; k < dim; ++k) {
-        const size_t at = static_cast<size_t>(i * dim + k) * L + lane;
-        kinetic += q.v[at] * q.v[at];
-        height += dyn.gravity[k] * (pts[at] + ds.x_old.data()[at]);
+  const double* x_old = ds.x_old.data();
+  for (int i = head + 1; i <= n; ++i) {
+    double kinetic[L] = {}, height[L] = {};
+    for (int k = 0; k < dim; ++k) {
+      const double* v = q.v + static_cast<size_t>(i * dim + k) * L;
+      const double* x = pts + static_cast<size_t>(i * dim + k) * L;
+      const double* xo = x_old + static_cast<size_t>(i * dim + k) * L;
+      const double g = dyn.gravity[k];
+      for (int lane = 0; lane < L; ++lane) {
+        kinetic[lane] += v[lane] * v[lane];
+        height[lane] += g * (x[lane] + xo[lane]);
       }
-      e += mass_of[i * L + lane] * (0.5 * kinetic - 0.5 * height);
     }
-    energy += e;
+    for (int lane = 0; lane < L; ++lane) {
+      lane_energy[lane] += mass_of[i * L + lane] * (0.5 * kinetic[lane] - 0.5 * height[lane]);
+    }
+  }
+  double energy = 0.0;
+  for (int lane = 0; lane < L; ++lane) {
+    if (lane > 0 && block.source[lane] == block.source[0]) break;  // padding lanes
+    energy += lane_energy[lane];
   }
   block_energy[b] = energy;
 }

@@ -201,7 +201,7 @@ nlohmann::json Facts(const StrandFileReader& reader) {
       {"dim", h.dim},
       {"file_strands", h.num_strands()},
       {"file_frames", h.num_frames},
-      {"method", h.method},
+      {"method", StrandMotionName(h)},
       {"fps", h.fps},
       {"substeps", h.substeps},
       {"scalp",
