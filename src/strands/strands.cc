@@ -931,12 +931,13 @@ void StrandBatchImpl::ContactLane(const Block& block, int lane, int first, int s
                : TractrixStep<3>(lead_p.data(), lead.data(), tail, length, inv);
       x = Eigen::Vector3d(tail[0], tail[1], tail[2]);
     }
-    const double clearance = SegmentClearance(all, lead, x);
+    double clearance = SegmentClearance(all, lead, x);
     if (clearance < -kContactSlack * length) {
       Eigen::Vector3d clear;
       if (ContactTail(dim, lead, projection == Projection::kDftl ? pi : x, length, all, &clear)) {
         SettleTail(dim, lead, length, all, &clear);
         x = clear;
+        clearance = SegmentClearance(all, lead, x);  // measured again only where it moved
         ++cs->stats.contact_link_steps;
         // A point a collider placed takes no DFTL velocity correction (its correction is the
         // contact's, not the link's): its prediction is made its place.
@@ -948,8 +949,7 @@ void StrandBatchImpl::ContactLane(const Block& block, int lane, int first, int s
                     "between them)";
       }
     }
-    cs->stats.least_clearance =
-        std::min(cs->stats.least_clearance, SegmentClearance(all, lead, x) / length);
+    cs->stats.least_clearance = std::min(cs->stats.least_clearance, clearance / length);
     for (int k = 0; k < dim; ++k) pts[(i * dim + k) * L + lane] = x[k];
   }
 }
