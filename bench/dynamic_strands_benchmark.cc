@@ -6,6 +6,11 @@
 // the timer the hair falls for 60 frames, so that it lies on the scalp as it does in use (most
 // strands touch it). Counters: contact link steps per frame, the overall projection's
 // non-converged strand sub-steps per frame. *NoScalp: the same without the scalp collider.
+// BM_EqualTime/projection/substeps: the same scene (2 threads) with 1 to 8 sub-steps a frame, and
+// beside the time (outside the timer) the accuracy those sub-steps give each projection: the
+// hanging chain's first mode (32 links, 10 s at 60 Hz, SimulateChain: each strand's operations)
+// against the discrete chain's own, and the energy drift per second of an 8-link rope released
+// from horizontal without damping (10 s at 60 Hz; the free points' mass 1, g 9.81, length 1).
 // Run: build/bench/dynamic_strands_benchmark --benchmark_repetitions=5
 //        --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
@@ -15,6 +20,8 @@
 #include <random>
 #include <vector>
 
+#include "chain_physics.h"
+#include "flexkin/dynamics.h"
 #include "flexkin/strands.h"
 
 namespace flexkin {
@@ -53,7 +60,8 @@ BodyPose ShakePose(int64_t frame) {
   return pose;
 }
 
-StrandOptions Options(int threads, std::optional<Projection> projection, bool scalp_collider) {
+StrandOptions Options(int threads, std::optional<Projection> projection, bool scalp_collider,
+                      int substeps = 1) {
   StrandOptions options;
   options.threads = threads;
   Collider scalp;
@@ -67,14 +75,16 @@ StrandOptions Options(int threads, std::optional<Projection> projection, bool sc
     d.damping = 1.0;
     d.frame_rate = 60.0;
     options.dynamics = d;
+    options.substeps = substeps;
   }
   return options;
 }
 
-void Run(benchmark::State& state, std::optional<Projection> projection,
-         bool scalp_collider = true) {
+void Run(benchmark::State& state, std::optional<Projection> projection, bool scalp_collider = true,
+         int threads = 0, int substeps = 1) {
   StrandBatch batch(Hair(10000, 32),
-                    Options(static_cast<int>(state.range(0)), projection, scalp_collider));
+                    Options(threads > 0 ? threads : static_cast<int>(state.range(0)), projection,
+                            scalp_collider, substeps));
   int64_t frame = 0;
   // The hair falls onto the scalp before the timer (the kinematic strands just follow the head).
   for (; frame < 60; ++frame) StepStrands(&batch, ShakePose(frame + 1), (frame + 1) / 60.0);
@@ -104,6 +114,41 @@ void BM_DynamicHairTractrixNoScalp(benchmark::State& state) {
   Run(state, Projection::kTractrix, false);
 }
 void BM_DynamicHairDftlNoScalp(benchmark::State& state) { Run(state, Projection::kDftl, false); }
+void BM_DynamicHairOverallNoScalp(benchmark::State& state) {
+  Run(state, Projection::kOverall, false);
+}
+
+// The accuracy of `projection` with `substeps` a frame (see the top): the hanging chain's first
+// mode's relative error, and the rope's energy drift per second.
+void Accuracy(Projection projection, int substeps, double* mode_error, double* drift) {
+  namespace phys = testing_physics;
+  const int n = 32;
+  Eigen::MatrixXd modes;
+  const Eigen::VectorXd omega = phys::DiscreteModes(n, 1.0, &modes);
+  const DynamicResult hanging =
+      SimulateChain(phys::ChainInMode(n, 1.0, modes, 0), Points::Zero(600, 2),
+                    phys::Options(projection, substeps));
+  std::vector<double> x;
+  for (const Points& f : hanging.frames) x.push_back(f(n, 0));
+  *mode_error = std::fabs(2.0 * M_PI / phys::Period(x, 1.0 / 60.0) - omega[0]) / omega[0];
+  Points rope = Points::Zero(9, 2);
+  for (int j = 0; j <= 8; ++j) rope(j, 0) = j / 8.0;
+  const DynamicResult fall =
+      SimulateChain(MakeChain(rope), Points::Zero(600, 2), phys::Options(projection, substeps));
+  *drift = (fall.energy[fall.energy.size() - 1] - fall.energy[0]) / 10.0;
+}
+
+void BM_EqualTime(benchmark::State& state) {
+  const auto projection = static_cast<Projection>(state.range(0));
+  const int substeps = static_cast<int>(state.range(1));
+  Run(state, projection, true, 2, substeps);
+  double mode_error = 0.0, drift = 0.0;
+  Accuracy(projection, substeps, &mode_error, &drift);
+  state.counters["hanging_mode_error"] = mode_error;
+  state.counters["energy_drift_per_s"] = drift;
+  state.SetLabel(std::string(ProjectionName(projection)) + " " + std::to_string(substeps) +
+                 " sub-steps");
+}
 
 #define FLEXKIN_HAIR_BENCHMARK(name) \
   BENCHMARK(name)->Arg(1)->Arg(2)->Iterations(60)->Unit(benchmark::kMillisecond)->UseRealTime()
@@ -113,6 +158,21 @@ FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairDftl);
 FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairOverall);
 FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairTractrixNoScalp);
 FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairDftlNoScalp);
+FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairOverallNoScalp);
+BENCHMARK(BM_EqualTime)
+    ->Args({static_cast<int>(Projection::kOverall), 1})
+    ->Args({static_cast<int>(Projection::kOverall), 2})
+    ->Args({static_cast<int>(Projection::kTractrix), 1})
+    ->Args({static_cast<int>(Projection::kTractrix), 2})
+    ->Args({static_cast<int>(Projection::kTractrix), 4})
+    ->Args({static_cast<int>(Projection::kTractrix), 8})
+    ->Args({static_cast<int>(Projection::kDftl), 1})
+    ->Args({static_cast<int>(Projection::kDftl), 2})
+    ->Args({static_cast<int>(Projection::kDftl), 4})
+    ->Args({static_cast<int>(Projection::kDftl), 8})
+    ->Iterations(60)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace flexkin

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "chain/substep.h"
-#include "overall/newton.h"
+#include "dynamics/least_constraint.h"
 #include "sequential/link_rules.h"
 #include "world/contact.h"
 
@@ -111,12 +111,10 @@ class Projector {
       : lengths_(lengths),
         inv_lengths_(lengths.cwiseInverse()),
         n_(static_cast<int>(lengths.size())),
-        dim_(dim) {
-    // The squared metric with every point weighted by its mass (the largest 1: the solver's
-    // measure of optimality takes the weights' scale from it): the least mass-weighted motion.
-    overall_.weights.squared = 1.0;
-    weights_ = mass / mass.tail(n_).maxCoeff();
-    buffers_.Reserve(n_, dim_, overall_.weights);
+        dim_(dim),
+        mass_(mass),
+        work_(internal::LeastConstraintWork(dim, n_)),
+        multipliers_(n_ + 1, 0.0) {
     contact_.assign(n_ + 1, 0);
   }
 
@@ -184,18 +182,24 @@ class Projector {
     return false;
   }
 
-  // The least mass-weighted correction: Newton on the overall problem measured from `p` (the
-  // squared metric, point j weighted by its mass), from the tractrix projection. False if it did
-  // not converge (`x` then holds that projection).
+  // The least mass-weighted correction: Newton on the overall problem measured from `p` (point j
+  // weighted by its mass; dynamics/least_constraint.h), from the tractrix projection and the last
+  // call's multipliers. False if it did not converge (`x` then holds that projection).
   bool Overall(const Points& p, Points* x) {
     Tractrix(p, x);
-    start_ = *x;
-    internal::NewtonSolver solver(lengths_, p, overall_, n_, 0.0, &buffers_);
-    buffers_.sink.point_weights = weights_.data();
-    const OverallReport report = solver.Solve(x);
-    if (report.converged()) return true;
-    *x = start_;
-    return false;
+    internal::LeastConstraintProblem problem;
+    problem.n = n_;
+    problem.head = 0;
+    problem.p = p.data();
+    problem.x = x->data();
+    problem.mass = mass_.data();
+    problem.lengths = lengths_.data();
+    problem.inv_lengths = inv_lengths_.data();
+    problem.work = work_.data();
+    problem.multipliers = multipliers_.data();
+    const double ok = dim_ == 2 ? internal::SolveLeastConstraint<double, 2>(problem)
+                                : internal::SolveLeastConstraint<double, 3>(problem);
+    return ok != 0.0;
   }
 
   // Whether every link of `x` lies outside every one of `colliders` (to kContactSlack of its
@@ -299,10 +303,9 @@ class Projector {
   const Eigen::VectorXd& lengths_;
   const Eigen::VectorXd inv_lengths_;
   const int n_, dim_;
-  OverallOptions overall_;
-  Eigen::VectorXd weights_;
-  internal::NewtonBuffers buffers_;
-  Points start_;
+  const Eigen::VectorXd mass_;
+  std::vector<double> work_;
+  std::vector<double> multipliers_;  // the overall projection's last, where the next starts
   std::vector<char> contact_;
 };
 

@@ -12,31 +12,12 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "dynamics/least_constraint.h"
 #include "sequential/link_rules.h"
 #include "strands/strand_engine.h"
 
 namespace flexkin::internal {
 namespace {
-
-// Loads and stores of one lane (double) or of B::size lanes (a batch) at `p`.
-inline double LoadLanes(const double* p, double) { return *p; }
-inline void StoreLanes(double value, double* p) { *p = value; }
-template <class B>
-inline B LoadLanes(const double* p, B) {
-  return B::load_aligned(p);
-}
-template <class B>
-inline void StoreLanes(const B& value, double* p) {
-  value.store_aligned(p);
-}
-template <class B>
-constexpr int LanesOf() {
-  if constexpr (std::is_same_v<B, double>) {
-    return 1;
-  } else {
-    return static_cast<int>(B::size);
-  }
-}
 
 // The prediction of the free points (SimulateChain: p = x + h (v + h (g + c (w - v)))).
 template <class B, int Dim>
@@ -126,8 +107,29 @@ inline void VelocitiesLanes(const DynamicLaneStep& q, int lane0, bool correct) {
   }
 }
 
-// The whole block (lanes 0 .. kStrandLanes) for stage 1 (PredictLanes, ProjectLanes) or 2
-// (VelocitiesLanes, corrected for the sequential projections where q.correct).
+// The overall projection of the lanes (dynamics/least_constraint.h), from their tractrix
+// projection in q.x: q.converged[lane] 1 where it converged, else 0 (that lane keeps the tractrix
+// projection).
+template <class B, int Dim>
+inline void OverallLanes(const DynamicLaneStep& q, int lane0) {
+  LeastConstraintProblem problem;
+  problem.n = q.n;
+  problem.head = q.head;
+  problem.stride = kStrandLanes;
+  problem.p = q.p + lane0;
+  problem.x = q.x + lane0;
+  problem.mass = q.mass + lane0;
+  problem.lengths = q.lengths + lane0;
+  problem.inv_lengths = q.inv_lengths + lane0;
+  problem.work = q.work + lane0;
+  problem.multipliers = q.multipliers + lane0;
+  if (q.ignore != nullptr) problem.ignore = q.ignore + lane0;
+  StoreLanes(SolveLeastConstraint<B, Dim>(problem), q.converged + lane0);
+}
+
+// The whole block (lanes 0 .. kStrandLanes) for stage 1 (PredictLanes, ProjectLanes), 2
+// (VelocitiesLanes, corrected for the sequential projections where q.correct) or 3
+// (OverallLanes).
 template <class B, int Dim, class Step, class Contact>
 inline void DynamicBlock(const DynamicLaneStep& q, int stage, Step&& tractrix_step,
                          Contact&& contact) {
@@ -135,6 +137,8 @@ inline void DynamicBlock(const DynamicLaneStep& q, int stage, Step&& tractrix_st
     if (stage == 1) {
       PredictLanes<B, Dim>(q, lane0);
       ProjectLanes<B, Dim>(q, lane0, tractrix_step, contact);
+    } else if (stage == 3) {
+      OverallLanes<B, Dim>(q, lane0);
     } else {
       VelocitiesLanes<B, Dim>(q, lane0, q.correct);
     }

@@ -68,12 +68,14 @@ using StrandSphereSweepFn = void (*)(Method method, int dim, int n, int head, co
                                      double* points, const StrandSphere& sphere, uint8_t* contact,
                                      int* fallback);
 
-// Dynamic strands (flexkin/strands.h `dynamics`): one sub-step of one block, in two stages.
+// Dynamic strands (flexkin/strands.h `dynamics`): one sub-step of one block, in stages.
 // Stage 1: the pinned points 0 .. head are at the sub-step's end in x (their start in x_old), the
 // free points head + 1 .. n at its start in x and x_old with velocities v; afterwards p holds the
 // inertial prediction (the pinned points' new places) and x its sequential projection (tractrix
 // or dftl). Stage 2: v becomes (x - x_old) / h, with Mueller et al.'s correction
-// -s (x_{j+1} - p_{j+1}) / h where `correct`. The operations are SimulateChain's.
+// -s (x_{j+1} - p_{j+1}) / h where `correct`. Stage 3 (between them, for the overall projection):
+// x becomes the overall projection of p (dynamics/least_constraint.h) where it converges. The
+// operations are SimulateChain's.
 struct DynamicLaneStep {
   int n = 0, head = 0;
   bool tractrix = true;  // else dftl
@@ -90,6 +92,14 @@ struct DynamicLaneStep {
   const StrandSphere* sphere = nullptr;
   uint8_t* contact = nullptr;
   int* fallback = nullptr;
+  // Stage 3, the overall projection (from the tractrix projection in x): the points' masses (point
+  // i of lane j at i * kStrandLanes + j), the solver's scratch (LeastConstraintWork(dim, n) *
+  // kStrandLanes, aligned) and, per lane, 1 where it converged, else 0.
+  const double* mass = nullptr;
+  double* work = nullptr;
+  double* multipliers = nullptr;   // the links' (as mass), kept from sub-step to sub-step
+  const double* ignore = nullptr;  // per lane: 1 where the overall projection is not wanted
+  double* converged = nullptr;
 };
 using StrandDynamicFn = void (*)(int dim, const DynamicLaneStep& q, int stage);
 void StrandDynamicScalar(int dim, const DynamicLaneStep& q, int stage);

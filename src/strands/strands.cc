@@ -17,7 +17,6 @@
 #include "chain/denormals.h"
 #include "chain/simd.h"
 #include "chain/substep.h"
-#include "overall/newton.h"
 #include "sequential/link_rules.h"
 #include "sequential/rule_table.h"
 #include "sequential/sweep.h"
@@ -221,14 +220,10 @@ struct ContactScratch {
 struct DynamicScratch {
   AlignedDoubles x_old, predicted;  // a block's points at the sub-step's start; the prediction
   std::vector<double> pin_from;     // the pinned points at the frame's start (dim x L each)
-  struct Overall {
-    Eigen::VectorXd lengths;
-    Points p, x;
-    Eigen::VectorXd weights;  // the points' masses, the largest free one 1 (SimulateChain's)
-    OverallOptions options;
-    NewtonBuffers buffers;
-  };
-  std::vector<std::unique_ptr<Overall>> overall;  // by the sub-chain's link count
+  AlignedDoubles work;              // the overall projection's (LeastConstraintWork)
+  AlignedDoubles sequential;  // the overall projection's start (with the lanes' contact steps)
+  alignas(64) double converged[kStrandLanes];  // its lanes' outcome
+  alignas(64) double ignore[kStrandLanes];     // its lanes not wanted (1)
   int64_t failures = 0, contact_substeps = 0;
 };
 
@@ -277,9 +272,10 @@ struct StrandBatchImpl {
   // Dynamics (options.dynamics): the velocities (laid out as the points), the points' masses
   // ((n + 1) x L per block, the free points' total 1 per lane), per thread scratch, per block the
   // energy of the last frame, and per frame the pinned points' poses and the wind at each
-  // sub-step's start.
+  // sub-step's start; the overall projection's multipliers (as the masses), where the next
+  // sub-step's Newton starts.
   bool dynamic = false;
-  AlignedDoubles velocity, mass;
+  AlignedDoubles velocity, mass, multipliers;
   std::vector<size_t> mass_offset;
   std::vector<DynamicScratch> dynamic_scratch;
   std::vector<double> block_energy;
@@ -984,6 +980,10 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
   q.x_old = ds.x_old.data();
   q.p = ds.predicted.data();
   q.v = velocity.data() + block.points;
+  q.mass = mass.data() + mass_offset[b];
+  if (multipliers.size() > 0) q.multipliers = multipliers.data() + mass_offset[b];
+  q.work = ds.work.data();
+  q.converged = ds.converged;
   const SubnormalsAsZero subnormals;
   ContactScratch* cs = has_colliders ? &contact[thread] : nullptr;
   for (int s = 1; s <= S; ++s) {
@@ -991,8 +991,8 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
     PinnedAt(block, s, ds.pin_from.data(), pts);
     for (int k = 0; k < dim; ++k) q.wind[k] = winds[s - 1][k];
     // The SIMD engines take the contact step against a lone sphere (a scalp) in the lanes.
-    const bool in_lanes = cs != nullptr && dynamic_step != StrandDynamicScalar &&
-                          dyn.projection != Projection::kOverall && lone_sphere[s - 1];
+    const bool in_lanes =
+        cs != nullptr && dynamic_step != StrandDynamicScalar && lone_sphere[s - 1];
     q.sphere = in_lanes ? &spheres[s - 1] : nullptr;
     if (in_lanes) {
       q.contact = cs->contact_flags.data();
@@ -1000,58 +1000,74 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
       std::fill(cs->fallback.begin(), cs->fallback.end(), n + 1);
     }
     dynamic_step(dim, q, 1);
-    if (dyn.projection == Projection::kOverall) {
-      // Lane by lane: the sub-chain from the last pinned point, Newton from the tractrix
-      // projection, as SimulateChain's overall projection.
-      const int m = n - head;
-      if (ds.overall.size() <= static_cast<size_t>(m)) ds.overall.resize(m + 1);
-      if (!ds.overall[m]) {
-        auto o = std::make_unique<DynamicScratch::Overall>();
-        o->lengths.resize(m);
-        o->p.resize(m + 1, dim);
-        o->x.resize(m + 1, dim);
-        o->weights.resize(m + 1);
-        o->options.weights.squared = 1.0;
-        o->buffers.Reserve(m, dim, o->options.weights);
-        ds.overall[m] = std::move(o);
+    // Lanes whose points are the sequential projection's with the lanes' contact steps: every
+    // lane for the sequential projections; for the overall one, the lanes where that projection
+    // touched the sphere (the overall projection knows no colliders: it is solved for the others,
+    // and a lane it leaves inside a collider is put back to the sequential projection too).
+    const bool overall = dyn.projection == Projection::kOverall;
+    const auto padding = [&](int lane) {
+      return lane > 0 && block.source[lane] == block.source[0];
+    };
+    bool sequential[L];
+    std::fill(sequential, sequential + L, in_lanes && !overall);
+    const auto restore = [&](int lane) {
+      for (int i = head + 1; i <= n; ++i) {
+        for (int k = 0; k < dim; ++k) {
+          const size_t at = static_cast<size_t>(i * dim + k) * L + lane;
+          pts[at] = ds.sequential.data()[at];
+        }
       }
-      DynamicScratch::Overall& o = *ds.overall[m];
-      for (int lane = 0; lane < L; ++lane) {
-        if (lane > 0 && block.source[lane] == block.source[0]) break;  // padding lanes
-        for (int i = 0; i < m; ++i) o.lengths[i] = q.lengths[(head + i) * L + lane];
-        const double* mass_of = mass.data() + mass_offset[b];
-        for (int i = 0; i <= m; ++i) o.weights[i] = mass_of[(head + i) * L + lane];
-        o.weights /= o.weights.tail(m).maxCoeff();
-        for (int i = 0; i <= m; ++i) {
-          for (int k = 0; k < dim; ++k) {
-            const size_t at = static_cast<size_t>((head + i) * dim + k) * L + lane;
-            o.p(i, k) = q.p[at];
-            o.x(i, k) = pts[at];
-          }
+      sequential[lane] = true;
+    };
+    if (overall) {
+      bool all_touched = in_lanes;
+      if (in_lanes) {
+        for (int lane = 0; lane < L; ++lane) {
+          bool touched = cs->fallback[lane] <= n;
+          for (int i = head + 1; i <= n && !touched; ++i) touched = cs->contact_flags[i * L + lane];
+          sequential[lane] = touched;
+          all_touched = all_touched && touched;
         }
-        NewtonSolver solver(o.lengths, o.p, o.options, m, 0.0, &o.buffers);
-        o.buffers.sink.point_weights = o.weights.data();
-        if (!solver.Solve(&o.x).converged()) {
-          ++ds.failures;
-          continue;  // the lane keeps the tractrix projection
+      }
+      if (!all_touched) {
+        // The overall projection from the tractrix projection, in the lanes; a lane where it does
+        // not converge keeps the tractrix projection.
+        if (in_lanes) std::copy(pts, pts + size, ds.sequential.data());
+        for (int lane = 0; lane < L; ++lane) ds.ignore[lane] = sequential[lane] ? 1.0 : 0.0;
+        q.ignore = ds.ignore;
+        dynamic_step(dim, q, 3);
+        for (int lane = 0; lane < L && !padding(lane); ++lane) {
+          if (!sequential[lane] && ds.converged[lane] == 0.0) ++ds.failures;
         }
-        for (int i = 1; i <= m; ++i) {
-          for (int k = 0; k < dim; ++k) {
-            pts[static_cast<size_t>((head + i) * dim + k) * L + lane] = o.x(i, k);
-          }
+        for (int lane = 0; lane < L; ++lane) {
+          if (sequential[lane]) restore(lane);
         }
       }
     }
     if (cs != nullptr) {
-      std::fill(cs->least.begin(), cs->least.end(), std::numeric_limits<double>::infinity());
-      std::fill(cs->first_enter.begin(), cs->first_enter.end(), n + 1);
-      std::fill(cs->near.begin(), cs->near.end(), 0);
-      CheckLanes(measure_bounds, dim, n, head, pts, q.lengths, q.inv_lengths, placed[s - 1],
-                 bounds[s - 1], cs->clearances.data(), cs->least.data(), cs->first_enter.data(),
-                 cs->near.data());
+      const auto check = [&]() {
+        std::fill(cs->least.begin(), cs->least.end(), std::numeric_limits<double>::infinity());
+        std::fill(cs->first_enter.begin(), cs->first_enter.end(), n + 1);
+        std::fill(cs->near.begin(), cs->near.end(), 0);
+        CheckLanes(measure_bounds, dim, n, head, pts, q.lengths, q.inv_lengths, placed[s - 1],
+                   bounds[s - 1], cs->clearances.data(), cs->least.data(), cs->first_enter.data(),
+                   cs->near.data());
+      };
+      check();
+      if (in_lanes && overall) {
+        bool any = false;
+        for (int lane = 0; lane < L; ++lane) {
+          if (sequential[lane] || cs->first_enter[lane] > n) continue;
+          restore(lane);
+          any = true;
+        }
+        if (any) check();
+        for (int lane = 0; lane < L && !padding(lane); ++lane)
+          ds.contact_substeps += sequential[lane];
+      }
       for (int lane = 0; lane < L; ++lane) {
         int first = cs->first_enter[lane];
-        if (in_lanes) {
+        if (sequential[lane]) {
           // The lanes' own contact steps stand up to the first link projected again.
           first = std::min(first, cs->fallback[lane]);
           for (int i = head + 1; i < first && i <= n; ++i) {
@@ -1067,7 +1083,7 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
           cs->stats.least_clearance = std::min(cs->stats.least_clearance, cs->least[lane]);
           continue;
         }
-        if (dyn.projection == Projection::kOverall) ++ds.contact_substeps;
+        if (overall && !sequential[lane] && !padding(lane)) ++ds.contact_substeps;
         ContactLane(block, lane, first, s, ds, pts, cs);
       }
     }
@@ -1257,6 +1273,9 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
       num_mass += static_cast<size_t>(block.n + 1) * L;
     }
     m.mass = internal::AlignedDoubles(num_mass);
+    if (dyn.projection == Projection::kOverall) {
+      m.multipliers = internal::AlignedDoubles(num_mass);  // 0: the first sub-step's start
+    }
     int most_links = 0, most_pinned = 1;
     for (size_t b = 0; b < m.blocks.size(); ++b) {
       const internal::Block& block = m.blocks[b];
@@ -1282,6 +1301,10 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
       ds.x_old = internal::AlignedDoubles(static_cast<size_t>(most_links + 1) * dim * L);
       ds.predicted = internal::AlignedDoubles(static_cast<size_t>(most_links + 1) * dim * L);
       ds.pin_from.resize(static_cast<size_t>(most_pinned) * dim * L);
+      if (dyn.projection == Projection::kOverall) {
+        ds.work = internal::AlignedDoubles(internal::LeastConstraintWork(dim, most_links) * L);
+        ds.sequential = internal::AlignedDoubles(static_cast<size_t>(most_links + 1) * dim * L);
+      }
     }
     m.block_energy.assign(m.blocks.size(), 0.0);
     m.dynamic_poses.resize(options.substeps);
