@@ -19,6 +19,7 @@
 #include "flexkin/gltf.h"
 #include "flexkin/render.h"
 #include "flexkin/result_io.h"
+#include "flexkin/robot_scenario.h"
 #include "flexkin/scenario.h"
 #include "flexkin/viewer.h"
 #include "io/colliders_json.h"
@@ -106,6 +107,27 @@ bool IsColliderColor(const Rgb8& c) {
   return std::abs(c.r - std::lround(255 * want.r)) <= 2 &&
          std::abs(c.g - std::lround(255 * want.g)) <= 2 &&
          std::abs(c.b - std::lround(255 * want.b)) <= 2;
+}
+
+// The pixels of a PNG in the colliders' colour.
+int ColliderPixels(const std::string& png) {
+  int count = 0;
+  cairo_surface_t* s = cairo_image_surface_create_from_png(png.c_str());
+  if (cairo_surface_status(s) == CAIRO_STATUS_SUCCESS) {
+    cairo_surface_flush(s);
+    const unsigned char* data = cairo_image_surface_get_data(s);
+    for (int y = 0; y < cairo_image_surface_get_height(s); ++y) {
+      for (int x = 0; x < cairo_image_surface_get_width(s); ++x) {
+        uint32_t word;
+        std::memcpy(&word, data + y * cairo_image_surface_get_stride(s) + 4 * x, 4);
+        count +=
+            IsColliderColor({static_cast<int>((word >> 16) & 255),
+                             static_cast<int>((word >> 8) & 255), static_cast<int>(word & 255)});
+      }
+    }
+  }
+  cairo_surface_destroy(s);
+  return count;
 }
 
 // The rope dragged round its post, run into a result file through the one call.
@@ -490,6 +512,39 @@ TEST(ResultColliders, DrawFileEveryStillFormat) {
   const std::vector<std::string> written = DrawFile(dir.Path("rope.json"), options);
   EXPECT_GE(written.size(), 7u);
   EXPECT_NE(ReadFile(dir.Path("out/rope.gltf")).find("collider_0"), std::string::npos);
+}
+
+// A robot trajectory's colliders (docs/robot-format.md): the file carries them as the scenario
+// gave them, reads them back, and its figure and viewer draw them as a chain run's; without them
+// the figure has none of their colour.
+TEST(ResultColliders, RobotTrajectoryCarriesAndDrawsItsColliders) {
+  TempDir dir;
+  const RobotScenario scenario = ParseRobotScenarioText(
+      R"({"format": "flexkin-robot", "arm": {"links": 16, "link_length": 0.1},
+          "colliders": [{"shape": "sphere", "center": [0.8, 0.3], "radius": 0.1},
+                        {"shape": "box", "center": [0.2, 0.9], "half_extents": [0.2, 0.1]}],
+          "path": {"type": "line", "to": [1.2, 0.6], "steps": 40}})");
+  TrackToFiles(scenario, dir.Path("arm.json"), "");
+  RobotTrajectoryFile t = ReadRobotTrajectoryFile(dir.Path("arm.json"));
+  ASSERT_EQ(t.colliders.size(), 2u);
+  EXPECT_EQ(t.colliders[0].shape, ColliderShape::kSphere);
+  EXPECT_EQ(t.colliders[0].radius, 0.1);
+  EXPECT_EQ(t.colliders[0].pose.translation(), Eigen::Vector3d(0.8, 0.3, 0.0));
+  EXPECT_EQ(t.colliders[1].shape, ColliderShape::kBox);
+  EXPECT_EQ(RobotTrajectoryAsResult(t).colliders.size(), 2u);
+  FigureOptions options;
+  options.width = 480;
+  options.show_legend = false;
+  WriteSnapshotFigure(t, options, dir.Path("arm.png"));
+  const int drawn = ColliderPixels(dir.Path("arm.png"));
+  EXPECT_GT(drawn, 100);
+  WriteViewerHtml(t, ViewerOptions(), dir.Path("arm.html"));
+  const std::string html = ReadFile(dir.Path("arm.html"));
+  EXPECT_NE(html.find("\"colliders\":[{\"shape\": \"sphere\""), std::string::npos);
+  t.colliders.clear();
+  WriteSnapshotFigure(t, options, dir.Path("bare.png"));
+  EXPECT_EQ(ColliderPixels(dir.Path("bare.png")), 0);
+  std::printf("robot trajectory figure: %d pixels in the colliders' colour\n", drawn);
 }
 
 }  // namespace

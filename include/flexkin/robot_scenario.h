@@ -219,6 +219,9 @@ struct RobotTrajectoryFile {
   int64_t unreached = 0;      // "summary": steps not reached, largest end-effector error,
   double max_ee_error = 0.0;  // wall time of the tracking (s)
   double seconds = 0.0;
+  // "colliders" (as the scenario gave them; a keyframed one's times in steps: the state of step s
+  // where its motion has it at time s), none if the file has none.
+  std::vector<Collider> colliders;
 };
 
 // Whether the file at `path` is a robot trajectory: JSON whose top-level "format" is
@@ -239,7 +242,8 @@ RobotTrajectoryFile RobotTrajectoryFromText(const std::string& json_text);
 // effector first as a chain's leading end and the base last; the link lengths the largest
 // distance of each pair of neighbouring points over the states (prismatic joints change it; 1 for
 // a pair that never parts); the metrics' path lengths and L2 per step from the states (no length
-// error: the arm keeps its own). Throws InputError for a trajectory without states or of
+// error: the arm keeps its own), and the trajectory's colliders, which the pictures, animations and
+// viewer then draw as a chain run's. Throws InputError for a trajectory without states or of
 // mismatched shapes.
 ResultFile RobotTrajectoryAsResult(const RobotTrajectoryFile& trajectory);
 

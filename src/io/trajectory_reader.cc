@@ -10,6 +10,7 @@
 
 #include "flexkin/error.h"
 #include "flexkin/robot_scenario.h"
+#include "io/colliders_json.h"
 #include "io/json_checked.h"
 #include "io/json_file.h"
 
@@ -76,6 +77,11 @@ RobotTrajectoryFile TrajectoryFromJson(const json& j) {
   t.method = method.get<std::string>();
   t.link_lengths = Vector(Member(j, "", "link_lengths"), "/link_lengths", -1);
   t.base = Vector(Member(j, "", "base"), "/base", t.dim);
+  if (const auto it = j.find("colliders"); it != j.end()) {
+    Problems problems;
+    t.colliders = ReadCollidersJson(*it, "/colliders", t.dim, &problems);
+    ThrowIfAny(problems);
+  }
 
   t.states.push_back(StatePoints(Member(j, "", "initial"), "/initial", 0, t.dim));
   const Eigen::Index rows = t.states.front().rows();
@@ -183,6 +189,7 @@ ResultFile RobotTrajectoryAsResult(const RobotTrajectoryFile& t) {
   ResultFile file;
   file.dim = t.dim;
   file.scenario_name = t.scenario_name;
+  file.colliders = t.colliders;
   RunResult& r = file.result;
   r.num_steps = static_cast<int64_t>(t.states.size()) - 1;
   r.seconds = t.seconds;
