@@ -72,7 +72,7 @@ done
 echo "== a dynamic chain (docs/dynamics.md): a rope of 40 links released from horizontal, its"
 echo "   first point held, falling under gravity (overall projection, 3 s at 60 fps)"
 "$flexkin" run examples/rope_fall.json -o out/rope_fall.json
-"$flexkin" render out/rope_fall.json -o out --formats png,mp4,html --quiet
+"$flexkin" render out/rope_fall.json -o out --formats png,plots,mp4,html --quiet
 echo "== figures, plots, animations, viewers and glTF (docs/rendering.md)"
 for result in out/fig*.json; do
   "$flexkin" render "$result" -o out --formats svg,png,pdf,plots,mp4,gif,html,glb --quiet

@@ -17,6 +17,7 @@
 #include "flexkin/any_scenario.h"
 #include "flexkin/dynamics.h"
 #include "flexkin/error.h"
+#include "flexkin/render.h"
 #include "flexkin/result_io.h"
 #include "flexkin/scenario.h"
 #include "io/json_file.h"
@@ -395,6 +396,26 @@ TEST_F(DynamicRunTest, RopeFallExampleFalls) {
   EXPECT_LT(last(40, 1), -0.5);
 }
 
+// The energy plot (docs/rendering.md, "Plots"): drawn for a dynamic run; a kinematic one is refused
+// naming the plot, nothing written.
+TEST_F(DynamicRunTest, EnergyPlotIsForDynamicRuns) {
+  const AnyScenario any = ReadScenarioFile(Example("rope_fall.json"));
+  ASSERT_TRUE(any.valid()) << AllText(any.problems);
+  RunScenarioToFiles(any, {Path("rope.npz"), ""});
+  ResultFile file = ReadResultFile(Path("rope.npz"));
+  WritePlot(file, PlotKind::kEnergy, PlotOptions(), Path("energy.svg"));
+  EXPECT_GT(std::filesystem::file_size(Path("energy.svg")), 1000u);
+  file.result.dynamics = DynamicRunReport();
+  try {
+    WritePlot(file, PlotKind::kEnergy, PlotOptions(), Path("kinematic.svg"));
+    ADD_FAILURE() << "a kinematic run's energy plot was drawn";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "plot");
+    EXPECT_NE(std::string(e.what()).find("dynamic runs"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(Path("kinematic.svg")));
+}
+
 class DynamicCliTest : public test_util::TempDirTest {
  protected:
   CliResult Cli(const std::string& args) { return RunCli(kCli, dir_, args); }
@@ -431,6 +452,11 @@ TEST_F(DynamicCliTest, RunValidateRenderAndOverrides) {
   ASSERT_EQ(render.exit_code, 0) << render.err;
   EXPECT_TRUE(std::filesystem::exists(Path("out")));
   EXPECT_FALSE(std::filesystem::is_empty(Path("out")));
+  // Its plots include the energy.
+  render = Cli("render rope.json -o plots --formats plots --quiet");
+  ASSERT_EQ(render.exit_code, 0) << render.err;
+  EXPECT_TRUE(std::filesystem::exists(Path("plots/rope_energy.svg")));
+  EXPECT_TRUE(std::filesystem::exists(Path("plots/rope_energy.png")));
 
   // --projection and --substeps set the dynamics; --record-every records fewer frames.
   r = Cli("run " + example +

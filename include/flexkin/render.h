@@ -112,6 +112,8 @@ enum class PlotKind {
                  // against the leader step, coloured by link index: the alignment
   kLengthError,  // "length_error": largest relative link-length error of each recorded frame
                  // against the leader step, log scale (FrameLengthErrors)
+  kEnergy,       // "energy": a dynamic run's energy (dynamics.energy) at every frame against the
+                 // time in seconds; dynamic chains only
 };
 template <>
 struct Vocabulary<PlotKind> {
@@ -120,6 +122,7 @@ struct Vocabulary<PlotKind> {
       {PlotKind::kPathLength, "path_length", "distance travelled by each point against its index"},
       {PlotKind::kLinkAngles, "link_angles", "each link's angle to the pull against the step"},
       {PlotKind::kLengthError, "length_error", "largest relative link-length error per frame"},
+      {PlotKind::kEnergy, "energy", "a dynamic run's energy against the time"},
   };
 };
 inline const char* PlotKindName(PlotKind kind) { return NameOf(kind); }

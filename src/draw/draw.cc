@@ -44,6 +44,7 @@ void Plots(const Output& o) {
       if (o.options.note) o.options.note("no link_angles plot: the leading end never moves");
       continue;
     }
+    if (kind == PlotKind::kEnergy && !o.drawing->result.result.dynamics.enabled) continue;
     for (const char* extension : {".svg", ".png"}) {
       const std::string path = o.options.base + "_" + name + extension;
       o.Write(path, [&] { internal::WritePlot(*o.drawing, kind, o.options.plot, path); });

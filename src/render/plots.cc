@@ -1,4 +1,5 @@
-// WritePlot: path length per point, link angles over time, link-length error over time.
+// WritePlot: path length per point, link angles over time, link-length error over time, a dynamic
+// run's energy over time.
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -197,6 +198,55 @@ void LengthErrorPlot(render::Canvas* canvas, const ResultFile& file) {
   render::DrawText(cr, axes.plot().right() - 6 * ui, axes.Y(worst) - 5 * ui, buf, note);
 }
 
+// The energy at every frame (recorded or not) against the time, frame f at f / frame_rate; a
+// dashed line at the start's energy.
+void EnergyPlot(render::Canvas* canvas, const ResultFile& file) {
+  const DynamicRunReport& d = file.result.dynamics;
+  if (!d.enabled) {
+    throw InputError("plot",
+                     "value \"energy\" is not valid for this result: it is drawn for "
+                     "dynamic runs (a chain scenario with \"dynamics\") only");
+  }
+  const Eigen::VectorXd& e = d.energy;
+  if (e.size() < 1 || !e.allFinite() || !(d.frame_rate > 0.0)) {
+    throw InputError("dynamics.energy", "has " + std::to_string(e.size()) +
+                                            " values; expected finite values, one per frame");
+  }
+  cairo_t* cr = canvas->cr();
+  const double ui = canvas->ui();
+  const double t1 = std::max(static_cast<double>(e.size() - 1) / d.frame_rate, 1e-9);
+  double lo = e.minCoeff(), hi = e.maxCoeff();
+  const double pad = std::max(0.06 * (hi - lo), 1e-9 * std::max(1.0, std::fabs(hi)));
+  lo -= pad;
+  hi += pad;
+  Axes axes(PlotArea(*canvas, 0.0), 0.0, t1, lo, hi);
+  axes.Draw(cr, ui, "time (s)", "energy (kinetic + potential, free points' mass 1)");
+  std::vector<double> x(e.size()), y(e.size());
+  for (Eigen::Index f = 0; f < e.size(); ++f) {
+    x[f] = static_cast<double>(f) / d.frame_rate;
+    y[f] = e[f];
+  }
+  cairo_save(cr);
+  axes.Clip(cr);
+  cairo_save(cr);
+  const double dash[] = {6 * ui, 4 * ui};
+  cairo_set_dash(cr, dash, 2, 0.0);
+  render::Line(cr, axes.plot().x, axes.Y(e[0]), axes.plot().right(), axes.Y(e[0]), render::kFinal,
+               1.3 * ui);
+  cairo_restore(cr);
+  StrokePolyline(cr, axes, x, y, render::kMarker, 1.6 * ui);
+  cairo_restore(cr);
+  render::TextStyle note;
+  note.size = 11.5 * ui;
+  note.color = render::kFinal;
+  note.halign = render::Align::kEnd;
+  note.valign = render::Align::kEnd;
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%s projection, %d sub-steps: %.4g at the start, %.4g at the end",
+                d.projection.c_str(), d.substeps, e[0], e[e.size() - 1]);
+  render::DrawText(cr, axes.plot().right() - 6 * ui, axes.plot().y + 18 * ui, buf, note);
+}
+
 }  // namespace
 
 void WritePlot(const ResultFile& file, PlotKind kind, const PlotOptions& options,
@@ -212,7 +262,7 @@ void internal::WritePlot(const CheckedDrawing& drawing, PlotKind kind, const Plo
   const ImageFormat format = ImageFormatFromPath(path);
   render::Canvas canvas(format, options.width, options.height);
   static const char* kTitles[] = {"Path length of each point", "Angle of each link to the pull",
-                                  "Link-length error"};
+                                  "Link-length error", "Energy"};
   const std::string title = options.title.empty() ? kTitles[static_cast<int>(kind)] : options.title;
   render::DrawTitle(canvas.cr(), canvas.ui(), canvas.width(), title,
                     render::MainTitle(file, "") + " \u00b7 " + render::RunSummary(file));
@@ -225,6 +275,9 @@ void internal::WritePlot(const CheckedDrawing& drawing, PlotKind kind, const Plo
       break;
     case PlotKind::kLengthError:
       LengthErrorPlot(&canvas, file);
+      break;
+    case PlotKind::kEnergy:
+      EnergyPlot(&canvas, file);
       break;
   }
   render::SaveCanvas(&canvas, path);

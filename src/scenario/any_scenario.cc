@@ -13,6 +13,7 @@
 #include "groom/groom_reader.h"
 #include "io/json_file.h"
 #include "io/scenario_kinds.h"
+#include "run/sweep_pipeline.h"
 
 namespace flexkin {
 namespace {
@@ -111,9 +112,7 @@ std::vector<Collider> DynamicColliders(const RunOptions& options, double frame_r
 Metrics FrameMetrics(const Chain& chain, const std::vector<Points>& frames,
                      double max_relative_length_error) {
   const Eigen::Index n = chain.num_links(), steps = static_cast<Eigen::Index>(frames.size()) - 1;
-  Eigen::VectorXd weight = Eigen::VectorXd::Zero(n + 1);
-  weight.head(n) += 0.5 * chain.lengths;
-  weight.tail(n) += 0.5 * chain.lengths;
+  const Eigen::VectorXd weight = internal::ArcLengthWeights(chain.lengths);
   Metrics m;
   m.l2_per_step = Eigen::VectorXd::Zero(steps);
   m.l2_weighted_per_step = Eigen::VectorXd::Zero(steps);
