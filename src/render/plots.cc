@@ -45,6 +45,26 @@ std::pair<double, double> StepRange(const RunResult& r) {
   return b > a ? std::make_pair(a, b) : std::make_pair(a - 0.5, a + 0.5);
 }
 
+// A dashed red line across the plot at value y (the caller has clipped to the axes).
+void DashedLevel(cairo_t* cr, const Axes& axes, double ui, double y) {
+  cairo_save(cr);
+  const double dash[] = {6 * ui, 4 * ui};
+  cairo_set_dash(cr, dash, 2, 0.0);
+  render::Line(cr, axes.plot().x, axes.Y(y), axes.plot().right(), axes.Y(y), render::kFinal,
+               1.3 * ui);
+  cairo_restore(cr);
+}
+
+// A note in red, its bottom right corner at (x, y).
+void Note(cairo_t* cr, double ui, double x, double y, const char* text) {
+  render::TextStyle note;
+  note.size = 11.5 * ui;
+  note.color = render::kFinal;
+  note.halign = render::Align::kEnd;
+  note.valign = render::Align::kEnd;
+  render::DrawText(cr, x, y, text, note);
+}
+
 void PathLengthPlot(render::Canvas* canvas, const ResultFile& file) {
   const Eigen::VectorXd& length = file.result.metrics.path_length;
   const Eigen::Index points = file.result.lengths.size() + 1;
@@ -175,27 +195,17 @@ void LengthErrorPlot(render::Canvas* canvas, const ResultFile& file) {
   axes.Clip(cr);
   // The worst over every leader step (recorded or not), from the result's metrics.
   const double worst = std::max(r.metrics.max_relative_length_error, kErrorFloor);
-  cairo_save(cr);
-  const double dash[] = {6 * ui, 4 * ui};
-  cairo_set_dash(cr, dash, 2, 0.0);
-  render::Line(cr, axes.plot().x, axes.Y(worst), axes.plot().right(), axes.Y(worst), render::kFinal,
-               1.3 * ui);
-  cairo_restore(cr);
+  DashedLevel(cr, axes, ui, worst);
   StrokePolyline(cr, axes, x, y, render::kMarker, 1.1 * ui);
   if (x.size() <= 200) {
     for (size_t f = 0; f < x.size(); ++f)
       render::Disc(cr, axes.X(x[f]), axes.Y(y[f]), 2.4 * ui, render::kMarker);
   }
   cairo_restore(cr);
-  render::TextStyle note;
-  note.size = 11.5 * ui;
-  note.color = render::kFinal;
-  note.halign = render::Align::kEnd;
-  note.valign = render::Align::kEnd;
   char buf[96];
   std::snprintf(buf, sizeof buf, "worst over every leader step: %.2e",
                 r.metrics.max_relative_length_error);
-  render::DrawText(cr, axes.plot().right() - 6 * ui, axes.Y(worst) - 5 * ui, buf, note);
+  Note(cr, ui, axes.plot().right() - 6 * ui, axes.Y(worst) - 5 * ui, buf);
 }
 
 // The energy at every frame (recorded or not) against the time, frame f at f / frame_rate; a
@@ -228,23 +238,13 @@ void EnergyPlot(render::Canvas* canvas, const ResultFile& file) {
   }
   cairo_save(cr);
   axes.Clip(cr);
-  cairo_save(cr);
-  const double dash[] = {6 * ui, 4 * ui};
-  cairo_set_dash(cr, dash, 2, 0.0);
-  render::Line(cr, axes.plot().x, axes.Y(e[0]), axes.plot().right(), axes.Y(e[0]), render::kFinal,
-               1.3 * ui);
-  cairo_restore(cr);
+  DashedLevel(cr, axes, ui, e[0]);
   StrokePolyline(cr, axes, x, y, render::kMarker, 1.6 * ui);
   cairo_restore(cr);
-  render::TextStyle note;
-  note.size = 11.5 * ui;
-  note.color = render::kFinal;
-  note.halign = render::Align::kEnd;
-  note.valign = render::Align::kEnd;
   char buf[160];
   std::snprintf(buf, sizeof buf, "%s projection, %d sub-steps: %.4g at the start, %.4g at the end",
                 d.projection.c_str(), d.substeps, e[0], e[e.size() - 1]);
-  render::DrawText(cr, axes.plot().right() - 6 * ui, axes.plot().y + 18 * ui, buf, note);
+  Note(cr, ui, axes.plot().right() - 6 * ui, axes.plot().y + 18 * ui, buf);
 }
 
 }  // namespace
