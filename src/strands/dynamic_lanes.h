@@ -89,16 +89,22 @@ inline void ProjectLanes(const DynamicLaneStep& q, int lane0, Step&& tractrix_st
 }
 
 // The velocities of the free points: the change over the sub-step, and for the sequential
-// projections Mueller et al.'s correction v_j -= s (x_{j+1} - p_{j+1}) / h.
+// projections Mueller et al.'s correction v_j -= s (x_{j+1} - p_{j+1}) / h (`correct`; else, if
+// q.correct_lanes is set, in the lanes where it is 1).
 template <class B, int Dim>
 inline void VelocitiesLanes(const DynamicLaneStep& q, int lane0, bool correct) {
   constexpr int L = kStrandLanes;
-  const B h(q.h), s(q.dftl_damping);
+  const B h(q.h);
+  const B s = correct ? B(q.dftl_damping)
+              : q.correct_lanes != nullptr
+                  ? B(q.dftl_damping) * LoadLanes(q.correct_lanes + lane0, B())
+                  : B(0.0);
+  const bool any = correct || q.correct_lanes != nullptr;
   for (int i = q.head + 1; i <= q.n; ++i) {
     for (int k = 0; k < Dim; ++k) {
       const size_t at = static_cast<size_t>(i * Dim + k) * L + lane0;
       B vel = (LoadLanes(q.x + at, B()) - LoadLanes(q.x_old + at, B())) / h;
-      if (correct && i < q.n) {
+      if (any && i < q.n) {
         const size_t next = at + static_cast<size_t>(Dim) * L;
         vel = vel - (s * (LoadLanes(q.x + next, B()) - LoadLanes(q.p + next, B()))) / h;
       }

@@ -99,6 +99,9 @@ struct DynamicLaneStep {
   double* work = nullptr;
   double* multipliers = nullptr;   // the links' (as mass), kept from sub-step to sub-step
   const double* ignore = nullptr;  // per lane: 1 where the overall projection is not wanted
+  // Stage 2 without `correct`: per lane, 1 where the velocities take the correction (the overall
+  // projection's lanes that took the tractrix projection with contacts), else 0.
+  const double* correct_lanes = nullptr;
   double* converged = nullptr;
 };
 using StrandDynamicFn = void (*)(int dim, const DynamicLaneStep& q, int stage);

@@ -224,6 +224,7 @@ struct DynamicScratch {
   AlignedDoubles sequential;  // the overall projection's start (with the lanes' contact steps)
   alignas(64) double converged[kStrandLanes];  // its lanes' outcome
   alignas(64) double ignore[kStrandLanes];     // its lanes not wanted (1)
+  alignas(64) double corrected[kStrandLanes];  // its lanes that took the sequential one (1)
   int64_t failures = 0, contact_substeps = 0;
 };
 
@@ -1084,7 +1085,14 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
           continue;
         }
         if (overall && !sequential[lane] && !padding(lane)) ++ds.contact_substeps;
+        if (overall) sequential[lane] = true;  // ContactLane's projection is the tractrix one
         ContactLane(block, lane, first, s, ds, pts, cs);
+      }
+      if (overall) {
+        // A lane that took the tractrix projection with contacts takes its velocity correction
+        // too (without it that projection gains energy: docs/dynamics.md).
+        for (int lane = 0; lane < L; ++lane) ds.corrected[lane] = sequential[lane] ? 1.0 : 0.0;
+        q.correct_lanes = ds.corrected;
       }
     }
     dynamic_step(dim, q, 2);
