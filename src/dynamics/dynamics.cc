@@ -461,16 +461,22 @@ DynamicResult SimulateChain(const Chain& chain, const Points& root_path,
       }
       const std::vector<Collider>& now = moving ? placed : colliders;
       bool contact = false;
+      // Whether an overall projection did not converge (its tractrix start kept, which then takes
+      // the tractrix projection's velocity correction: without it that projection gains energy).
+      bool fell_back = false;
       // The overall and SHAKE projections of a prediction `q`.
       const auto project = [&](const Points& q, Points* out) {
         if (options.projection == Projection::kOverall) {
-          if (!projector.Overall(q, out)) ++result.failures;
+          if (!projector.Overall(q, out)) {
+            ++result.failures;
+            fell_back = true;
+          }
         } else if (!projector.Shake(x_old, q, inverse_mass, out)) {
           // SHAKE's forces are those of the sub-step's start: past its stability limit (a step
           // longer than about 2 / the chain's highest frequency) its lengths have no solution.
           // That sub-step is then projected by the overall projection, which always has one.
           ++result.failures;
-          projector.Overall(q, out);
+          if (!projector.Overall(q, out)) fell_back = true;
         }
       };
       switch (options.projection) {
@@ -516,7 +522,7 @@ DynamicResult SimulateChain(const Chain& chain, const Points& root_path,
       result.contact_substeps += contact;
       x = projected;
       v = (x - x_old) / h;
-      if (sequential) {
+      if (sequential || fell_back) {
         // Mueller et al. 2012, eq. (9): v_j += s (-d_{j+1}) / h, d = the correction x - p; not
         // of a point a collider placed (its correction is the contact's, not the link's).
         for (int j = 1; j < n; ++j) {

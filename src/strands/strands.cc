@@ -1010,6 +1010,7 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
       return lane > 0 && block.source[lane] == block.source[0];
     };
     bool sequential[L];
+    bool failed[L] = {};  // the overall projection did not converge: the tractrix one kept
     std::fill(sequential, sequential + L, in_lanes && !overall);
     const auto restore = [&](int lane) {
       for (int i = head + 1; i <= n; ++i) {
@@ -1037,8 +1038,9 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
         for (int lane = 0; lane < L; ++lane) ds.ignore[lane] = sequential[lane] ? 1.0 : 0.0;
         q.ignore = ds.ignore;
         dynamic_step(dim, q, 3);
-        for (int lane = 0; lane < L && !padding(lane); ++lane) {
-          if (!sequential[lane] && ds.converged[lane] == 0.0) ++ds.failures;
+        for (int lane = 0; lane < L; ++lane) {
+          failed[lane] = !sequential[lane] && ds.converged[lane] == 0.0;
+          if (failed[lane] && !padding(lane)) ++ds.failures;
         }
         for (int lane = 0; lane < L; ++lane) {
           if (sequential[lane]) restore(lane);
@@ -1088,12 +1090,18 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
         if (overall) sequential[lane] = true;  // ContactLane's projection is the tractrix one
         ContactLane(block, lane, first, s, ds, pts, cs);
       }
-      if (overall) {
-        // A lane that took the tractrix projection with contacts takes its velocity correction
-        // too (without it that projection gains energy: docs/dynamics.md).
-        for (int lane = 0; lane < L; ++lane) ds.corrected[lane] = sequential[lane] ? 1.0 : 0.0;
-        q.correct_lanes = ds.corrected;
+    }
+    if (overall) {
+      // A lane that kept or took the tractrix projection (with contacts, or where the overall one
+      // did not converge) takes its velocity correction too (without it that projection gains
+      // energy: docs/dynamics.md).
+      bool any = false;
+      for (int lane = 0; lane < L; ++lane) {
+        const bool tractrix = (cs != nullptr && sequential[lane]) || failed[lane];
+        ds.corrected[lane] = tractrix ? 1.0 : 0.0;
+        any = any || tractrix;
       }
+      q.correct_lanes = any ? ds.corrected : nullptr;
     }
     dynamic_step(dim, q, 2);
   }
