@@ -128,13 +128,9 @@ void Accuracy(Projection projection, int substeps, double* mode_error, double* d
   const DynamicResult hanging =
       SimulateChain(phys::ChainInMode(n, 1.0, modes, 0), Points::Zero(600, 2),
                     phys::Options(projection, substeps));
-  std::vector<double> x;
-  for (const Points& f : hanging.frames) x.push_back(f(n, 0));
-  *mode_error = std::fabs(2.0 * M_PI / phys::Period(x, 1.0 / 60.0) - omega[0]) / omega[0];
-  Points rope = Points::Zero(9, 2);
-  for (int j = 0; j <= 8; ++j) rope(j, 0) = j / 8.0;
+  *mode_error = std::fabs(phys::SwingOmega(hanging, n) - omega[0]) / omega[0];
   const DynamicResult fall =
-      SimulateChain(MakeChain(rope), Points::Zero(600, 2), phys::Options(projection, substeps));
+      SimulateChain(phys::Horizontal(8), Points::Zero(600, 2), phys::Options(projection, substeps));
   *drift = (fall.energy[fall.energy.size() - 1] - fall.energy[0]) / 10.0;
 }
 

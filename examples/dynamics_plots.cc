@@ -24,9 +24,11 @@ namespace {
 using flexkin::testing_physics::ChainInMode;
 using flexkin::testing_physics::DiscreteModes;
 using flexkin::testing_physics::EllipticK;
+using flexkin::testing_physics::Horizontal;
 using flexkin::testing_physics::kG;
 using flexkin::testing_physics::Options;
 using flexkin::testing_physics::Period;
+using flexkin::testing_physics::SwingOmega;
 
 using flexkin::Chain;
 using flexkin::DynamicOptions;
@@ -38,12 +40,6 @@ const Projection kAll[] = {Projection::kOverall, Projection::kShake, Projection:
                            Projection::kDftl};
 
 Points Still(int frames) { return Points::Zero(frames, 2); }
-
-Chain Horizontal(int links) {
-  Points p = Points::Zero(links + 1, 2);
-  for (int j = 0; j <= links; ++j) p(j, 0) = static_cast<double>(j) / links;
-  return flexkin::MakeChain(p);
-}
 
 FILE* Open(const std::string& path) {
   FILE* file = std::fopen(path.c_str(), "w");
@@ -96,9 +92,7 @@ int main(int argc, char** argv) {
       const int substeps = projection == Projection::kShake && n == 128 ? 16 : 4;
       const DynamicResult r =
           flexkin::SimulateChain(chain, Still(600), Options(projection, substeps));
-      std::vector<double> x;
-      for (const Points& f : r.frames) x.push_back(f(n, 0));
-      const double measured = 2.0 * M_PI / Period(x, 1.0 / 60.0);
+      const double measured = SwingOmega(r, n);
       std::fprintf(file, "%d,1,%s,%d,%.9f,%.9f,%.6e\n", n, flexkin::ProjectionName(projection),
                    substeps, measured, omega[0], std::fabs(measured - omega[0]) / omega[0]);
     }

@@ -80,6 +80,22 @@ inline Chain ChainInMode(int n, double length, const Eigen::MatrixXd& modes, int
   return MakeChain(p);
 }
 
+// A rope of `links` equal links and length 1 lying along x from the origin (released from
+// horizontal).
+inline Chain Horizontal(int links) {
+  Points p = Points::Zero(links + 1, 2);
+  for (int j = 0; j <= links; ++j) p(j, 0) = static_cast<double>(j) / links;
+  return MakeChain(p);
+}
+
+// The angular frequency at which point `point` of a run at 60 frames per second swings sideways
+// (along x): 2 pi over the mean period of its x.
+inline double SwingOmega(const DynamicResult& r, int point) {
+  std::vector<double> x;
+  for (const Points& f : r.frames) x.push_back(f(point, 0));
+  return 2.0 * M_PI / Period(x, 1.0 / 60.0);
+}
+
 // A 2D dynamic chain's options: the projection, gravity -kG along y, `substeps` per frame.
 inline DynamicOptions Options(Projection projection, int substeps) {
   DynamicOptions o;

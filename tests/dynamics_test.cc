@@ -30,9 +30,11 @@ namespace {
 using testing_physics::ChainInMode;
 using testing_physics::DiscreteModes;
 using testing_physics::EllipticK;
+using testing_physics::Horizontal;
 using testing_physics::kG;
 using testing_physics::Options;
 using testing_physics::Period;
+using testing_physics::SwingOmega;
 
 // The driven end held at the origin for `frames` frames.
 Points Still(int frames) { return Points::Zero(frames, 2); }
@@ -96,9 +98,7 @@ TEST(DynamicsTest, AHangingChainSwingsAtItsFirstThreeModes) {
         const int substeps = projection == Projection::kShake && n == 128 ? 16 : 4;
         const DynamicResult r = SimulateChain(chain, Still(600), Options(projection, substeps));
         if (projection == Projection::kShake) EXPECT_EQ(r.failures, 0) << n << " links";
-        std::vector<double> x;
-        for (const Points& f : r.frames) x.push_back(f(n, 0));
-        const double measured = 2.0 * M_PI / Period(x, 1.0 / 60.0);
+        const double measured = SwingOmega(r, n);
         const double error = std::fabs(measured - omega[k]) / omega[k];
         std::printf(
             "hanging chain, %d links, mode %d, %s: omega %.5f, discrete %.5f (%.2e), Bernoulli "
@@ -128,9 +128,7 @@ TEST(DynamicsTest, AHangingChainSwingsAtItsFirstThreeModes) {
 }
 
 TEST(DynamicsTest, EnergyDriftsLittleWithoutDampingAndFallsWithIt) {
-  Points p = Points::Zero(9, 2);
-  for (int j = 0; j <= 8; ++j) p(j, 0) = 0.125 * j, p(j, 1) = 0.0;  // released from horizontal
-  const Chain chain = MakeChain(p);
+  const Chain chain = Horizontal(8);
   for (const Projection projection : kAll) {
     DynamicOptions o = Options(projection, 16);
     const DynamicResult free = SimulateChain(chain, Still(600), o);
@@ -167,9 +165,7 @@ TEST(DynamicsTest, EnergyDriftsLittleWithoutDampingAndFallsWithIt) {
 }
 
 TEST(DynamicsTest, TheTipsPathConvergesAsSubStepsShrink) {
-  Points p = Points::Zero(9, 2);
-  for (int j = 0; j <= 8; ++j) p(j, 0) = 0.125 * j;
-  const Chain chain = MakeChain(p);
+  const Chain chain = Horizontal(8);
   for (const Projection projection : kAll) {
     std::vector<Points> tips;
     for (const int substeps : {1, 2, 4, 8, 64}) {

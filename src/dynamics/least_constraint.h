@@ -210,7 +210,8 @@ B SolveLeastConstraint(const LeastConstraintProblem& pr) {
   // Converged: the step's largest part r (of its link's length) small enough that what is left,
   // at most r times the ratio r / (the step before), is below 1e-12; or r below 1e-13; or below
   // 1e-10 and no longer shrinking (the rounding's level, far from the origin).
-  B done = pr.ignore ? LoadLanes(pr.ignore, B()) : B(0.0), previous(0.0);
+  const B ignored = pr.ignore ? LoadLanes(pr.ignore, B()) : B(0.0);
+  B done = ignored, previous(0.0);
   for (int iteration = 0; iteration < pr.max_iterations; ++iteration) {
     // From the free end: the cost-to-go of the points beyond point i - 1 as a function of its
     // step w, 1/2 w' A w + b' w, link by link. Where the multipliers leave a link's sub-problem
@@ -312,7 +313,6 @@ B SolveLeastConstraint(const LeastConstraintProblem& pr) {
   // The lengths restored to rounding from the held points; a lane that did not converge back at
   // its start.
   const auto ok = done != B(0.0);
-  const auto ignored = pr.ignore ? LoadLanes(pr.ignore, B()) != B(0.0) : done != done;
   for (int i = head + 1; i <= n; ++i) {
     B d[Dim], dd(0.0);
     for (int k = 0; k < Dim; ++k) {
@@ -329,7 +329,7 @@ B SolveLeastConstraint(const LeastConstraintProblem& pr) {
       // (An ignored lane's kept as they were.)
       double* const at = pr.multipliers + static_cast<size_t>(i) * st;
       const B result = SelectLanes(ok, LoadLanes(W + FLEXKIN_LC_SLOT(i, kLambda), B()), B(0.0));
-      StoreLanes(pr.ignore ? SelectLanes(ignored, LoadLanes(at, B()), result) : result, at);
+      StoreLanes(SelectLanes(ignored != B(0.0), LoadLanes(at, B()), result), at);
     }
   }
 #undef FLEXKIN_LC_PT

@@ -218,9 +218,14 @@ void EnergyPlot(render::Canvas* canvas, const ResultFile& file) {
                      "dynamic runs (a chain scenario with \"dynamics\") only");
   }
   const Eigen::VectorXd& e = d.energy;
-  if (e.size() < 1 || !e.allFinite() || !(d.frame_rate > 0.0)) {
+  if (e.size() < 1 || !e.allFinite()) {
     throw InputError("dynamics.energy", "has " + std::to_string(e.size()) +
-                                            " values; expected finite values, one per frame");
+                                            " values, or one not finite; expected finite values, "
+                                            "one per frame");
+  }
+  if (!(d.frame_rate > 0.0) || !std::isfinite(d.frame_rate)) {
+    throw InputError("dynamics.frame_rate", "value " + std::to_string(d.frame_rate) +
+                                                " is not valid; expected a positive number");
   }
   cairo_t* cr = canvas->cr();
   const double ui = canvas->ui();

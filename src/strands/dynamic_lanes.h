@@ -10,7 +10,6 @@
 
 #include <cmath>
 #include <cstdint>
-#include <type_traits>
 
 #include "dynamics/least_constraint.h"
 #include "sequential/link_rules.h"
