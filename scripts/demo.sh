@@ -57,7 +57,7 @@ echo "== hair with inertia and gravity (docs/dynamics.md, \"Strands\"): it falls
 echo "   shape onto the scalp, swings when the head turns and nods, settles when it stops"
 "$flexkin" run examples/groom_head_gravity.json -o out/groom_head_gravity.npz
 "$flexkin" render out/groom_head_gravity.npz -o out --formats png,mp4,html --quiet
-# The energy and the tips' paths, then the same with the overall projection (about 40 s).
+# The energy and the tips' paths, then the same with the overall projection (about 10 s).
 /usr/bin/python3 examples/python/hair_dynamics_plot.py out/groom_head_gravity.npz
 "$flexkin" run examples/groom_head_gravity.json -o out/groom_head_gravity_overall.npz \
   --projection overall

@@ -3,9 +3,11 @@
 // length, measured here by the test's own distance computation (not the library's), the base is
 // held and the lengths kept, while the same path without the colliders cuts into them; colliders
 // that nothing reaches change no bit; starts and targets inside colliders, bad colliders, and
-// pointing or method fixed_point with colliders on arms with joint axes are refused by name.
+// method fixed_point with colliders on arms with joint axes is refused by name; arms with joint
+// axes keep their capsules outside with position targets and with pointing.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -19,6 +21,7 @@
 #include "flexkin/error.h"
 #include "flexkin/robot_scenario.h"
 #include "flexkin/urdf.h"
+#include "mesh_test_util.h"
 #include "scenes/scenes.h"
 
 namespace flexkin {
@@ -285,17 +288,10 @@ TEST(ArmCollidersRefused, StartTargetBadColliderAndJointAxes) {
   m = MessageOf([&] { TrackPath(model, path, options); });
   EXPECT_NE(m.find("link_radii[0]"), std::string::npos) << m;
 
-  // Arms with joint axes take colliders with method newton and position targets.
+  // Arms with joint axes take colliders with method newton.
   const ArmModel snake = scenes::RevoluteSnake(8);
   Points p3(1, 3);
   p3.row(0) = ForwardKinematics(snake, snake.initial).row(8);
-  ArmOptions pointing = options;
-  pointing.pointing.enabled = true;
-  pointing.pointing.axis = Eigen::Vector3d::UnitZ();
-  pointing.pointing.direction = Eigen::Vector3d::UnitX();
-  m = MessageOf([&] { TrackPath(snake, p3, pointing); });
-  EXPECT_NE(m.find("pointing"), std::string::npos) << m;
-  EXPECT_NE(m.find("joint axes"), std::string::npos) << m;
   ArmOptions fixed_point = options;
   fixed_point.method = FixedBaseMethod::kFixedPoint;
   m = MessageOf([&] { TrackPath(snake, p3, fixed_point); });
@@ -345,6 +341,136 @@ TEST(ArmCollidersJointAxes, NoLinkEntersAndTheTargetsAreReached) {
         ColliderShapeName(shape), -free_least, contact_steps, run.unreached, run.min_clearance,
         run.max_ee_error);
   }
+}
+
+// The same snake pointing its tool axis (along a direction 0.3 rad from where it starts, or at a
+// point) while it tracks the circle round an obstacle in the way of the free motion: every link
+// outside after every step (the test's own distances), the targets reached but for two steps
+// where the local step stalls against the obstacle, and the tool axis, from the tool frame at the
+// step's joint values, on its goal to 1e-8 rad where the target is reached.
+TEST(ArmCollidersJointAxes, PointingRoundAnObstacle) {
+  for (const bool look_at : {false, true}) {
+    SCOPED_TRACE(look_at ? "looking at a point" : "pointing along a direction");
+    ArmModel model = scenes::RevoluteSnake(12);
+    model.link_radii = Eigen::VectorXd::Constant(12, 0.05);
+    const Points path = CircleOfTargets(model, 2.0, 60, CircleTilt::kRising);
+    const ToolPose tool = ToolPoseAt(model, model.initial);
+    const Eigen::Vector3d axis0 = tool.rotation.col(0);
+    ArmOptions options;
+    options.pointing.enabled = true;
+    options.pointing.axis = Eigen::Vector3d::UnitX();
+    options.pointing.angle_tolerance = 1e-9;
+    const Eigen::Vector3d across = axis0.unitOrthogonal();
+    const Eigen::Vector3d direction = Eigen::AngleAxisd(0.1, across) * axis0;
+    if (look_at) {
+      options.pointing.look_at = true;
+      options.pointing.point = tool.position + 100.0 * direction;
+    } else {
+      options.pointing.direction = direction;
+    }
+    const auto goal_of = [&](const Eigen::Vector3d& end) {
+      return look_at ? Eigen::Vector3d((options.pointing.point - end).normalized()) : direction;
+    };
+    const ArmTrajectory free = TrackPath(model, path, options);
+    ASSERT_EQ(free.unreached, 0);
+    Collider obstacle;
+    double free_least = 0.0;
+    ObstacleInTheWay(model, path, free, ColliderShape::kSphere, &obstacle, &free_least);
+    options.colliders = {obstacle};
+    EXPECT_LT(free_least, -0.05) << "the free run should cut into the obstacle";
+
+    const ArmTrajectory run = TrackPath(model, path, options);
+    int contact_steps = 0, not_reached = 0;
+    double worst_angle = 0.0, worst_miss = 0.0;
+    for (size_t s = 0; s < run.steps.size(); ++s) {
+      const ArmStepReport& step = run.steps[s];
+      EXPECT_GE(RelativeClearance(model, step.state.points, {obstacle}), -1e-12) << "step " << s;
+      contact_steps += step.contact ? 1 : 0;
+      if (!step.reached) {
+        ++not_reached;
+        worst_miss = std::max(worst_miss, step.ee_error);
+        continue;
+      }
+      const ToolPose at = ToolPoseAt(model, step.state.angles);
+      const Eigen::Vector3d pointed = at.rotation.col(0), wanted = goal_of(at.position);
+      const double angle = std::atan2(pointed.cross(wanted).norm(), pointed.dot(wanted));
+      worst_angle = std::max(worst_angle, angle);
+      EXPECT_LE(angle, 1e-8) << "step " << s;
+      EXPECT_NEAR(step.pointing_error, angle, 1e-9) << "step " << s;
+    }
+    EXPECT_GT(contact_steps, 0);
+    // Measured: 2 of the 60 steps end short of the target (pointing along: misses of 7e-4 and
+    // 9e-4 of a link, the arm pressed against the obstacle where the local step stalls;
+    // looking at: 5e-10 and 3e-7), reported as not reached, the arm outside; the next steps
+    // reach theirs again (docs/robots.md, "Colliders").
+    EXPECT_LE(not_reached, 2);
+    EXPECT_EQ(run.unreached, not_reached);
+    EXPECT_EQ(run.blocked_steps, 0);
+    EXPECT_LE(worst_miss, 1e-3 * model.link_lengths.mean());
+    std::printf(
+        "joint axes, pointing%s: free run %.3g deep; %d contact steps, %d not reached (largest "
+        "miss %.3g), least clearance %.3g, largest pointing error %.3g rad\n",
+        look_at ? " (look at)" : "", -free_least, contact_steps, not_reached, worst_miss,
+        run.min_clearance, worst_angle);
+  }
+}
+
+// The snake round a triangle mesh: the ball of the test above tessellated (24 round, 12 rings;
+// its vertices on the sphere), in the way of the free motion. Every link's capsule outside the
+// mesh after every step, by the test's own brute force over every triangle (mesh_test_util.h:
+// the side by the winding number, the distance by dense sampling along the link), the targets
+// reached.
+TEST(ArmCollidersJointAxes, NoLinkEntersAMesh) {
+  ArmModel model = scenes::RevoluteSnake(12);
+  model.link_radii = Eigen::VectorXd::Constant(12, 0.05);
+  const Points path = CircleOfTargets(model, 2.0, 60, CircleTilt::kRising);
+  const ArmTrajectory free = TrackPath(model, path, ArmOptions());
+  ASSERT_EQ(free.unreached, 0);
+  Collider ball;
+  double free_least = 0.0;
+  ObstacleInTheWay(model, path, free, ColliderShape::kSphere, &ball, &free_least);
+  std::vector<std::pair<double, double>> profile;
+  for (int i = 0; i <= 12; ++i) {
+    const double a = M_PI * i / 12;
+    profile.emplace_back(ball.radius * std::sin(a), ball.radius * std::cos(a));
+  }
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = ball.pose.translation();
+  const Collider mesh = mesh_test::MeshCollider(mesh_test::Lathe(profile, 24), pose);
+  const mesh_test::World world = mesh_test::Placed(mesh);
+  ArmOptions options;
+  options.colliders = {mesh};
+  const ArmTrajectory run = TrackPath(model, path, options);
+  int contact_steps = 0;
+  double least = std::numeric_limits<double>::infinity();
+  for (size_t s = 0; s < run.steps.size(); ++s) {
+    const ArmStepReport& step = run.steps[s];
+    contact_steps += step.contact ? 1 : 0;
+    const Points& p = step.state.points;
+    for (int k = 0; k < model.num_links(); ++k) {
+      const Eigen::Vector3d a = At(p, k), b = At(p, k + 1);
+      // Links that cannot come within 0.1 of the ball the mesh lies in are not measured.
+      const Eigen::Vector3d c = ball.pose.translation();
+      const double t = std::clamp((c - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+      if ((a + t * (b - a) - c).norm() > ball.radius + 0.1) continue;
+      bool inside = false;
+      for (int i = 0; i <= 40 && !inside; ++i) {
+        inside = mesh_test::Winding(world, a + (i / 40.0) * (b - a)) > 0.5;
+      }
+      const double clearance =
+          (inside ? -1.0 : mesh_test::BruteSegmentDistance(world, a, b)) - model.link_radii[k];
+      least = std::min(least, clearance / model.link_lengths[k]);
+      EXPECT_GE(clearance, -1e-12 * model.link_lengths[k]) << "step " << s << " link " << k;
+    }
+  }
+  EXPECT_GT(contact_steps, 0);
+  EXPECT_EQ(run.unreached, 0) << "blocked " << run.blocked_steps;
+  EXPECT_LE(run.max_ee_error, 1e-10 * model.link_lengths.mean());
+  std::printf(
+      "joint axes, mesh (%d triangles): %d contact steps, %lld not reached, least clearance %.3g "
+      "(brute force %.3g), largest miss %.3g\n",
+      static_cast<int>(mesh.mesh->triangles.rows()), contact_steps,
+      static_cast<long long>(run.unreached), run.min_clearance, least, run.max_ee_error);
 }
 
 // Robot scenario files: every bad value named by its JSON pointer.

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 #include <string>
@@ -216,6 +217,46 @@ PostScene Post(int links) {
   }
   scene.colliders = {Sphere(Vector3d(-0.35, 1.65, 0.0), 0.3)};
   return scene;
+}
+
+// A link nearly parallel to a capsule's axis (hair hanging along a neck), one end inside by a
+// hair: its clearance is no more than either end's own distance, however small the angle (the
+// closest points of nearly parallel segments are ill-conditioned; once the segment's clearance
+// came out 1e-8 of the link above its end's depth, and a chain lying on the neck got wedged).
+TEST(ContactTest, ALinkAlongACapsuleIsNoClearerThanItsEnds) {
+  Collider capsule;
+  capsule.shape = ColliderShape::kCapsule;
+  capsule.radius = 0.05;
+  capsule.half_length = 0.105;
+  capsule.pose.translation() = Eigen::Vector3d(0.0, 0.0, -0.195);  // from z -0.09 to -0.3
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  double worst = -std::numeric_limits<double>::infinity();
+  for (int trial = 0; trial < 2000; ++trial) {
+    const double length = 0.006;
+    const double around = M_PI * u(rng);
+    const Eigen::Vector3d radial(std::cos(around), std::sin(around), 0.0);
+    const Eigen::Vector3d tangent(-radial.y(), radial.x(), 0.0);
+    // Tilts from 1e-16 to 1e-2 rad, toward the axis or away, and a little sideways.
+    const double tilt = std::pow(10.0, -16.0 + 14.0 * (0.5 + 0.5 * u(rng))) * (u(rng) < 0 ? -1 : 1);
+    Eigen::Vector3d dir = Eigen::Vector3d(0.0, 0.0, -1.0) + tilt * radial + 0.1 * tilt * tangent;
+    dir.normalize();
+    const Eigen::Vector3d a =
+        Eigen::Vector3d(0.0, 0.0, -0.15 + 0.05 * u(rng)) + (0.05 + 1e-9 * u(rng)) * radial;
+    const Eigen::Vector3d b = a + length * dir;
+    const double ends =
+        std::min(QuerySurface(capsule, a).distance, QuerySurface(capsule, b).distance);
+    const double clearance = internal::SegmentClearance(capsule, a, b);
+    worst = std::max(worst, (clearance - ends) / length);
+    EXPECT_LE(clearance, ends + 1e-15 * length) << "trial " << trial << " tilt " << tilt;
+    // and no lower than any point of the link is (sampled)
+    double sampled = ends;
+    for (int k = 1; k < 100; ++k) {
+      sampled = std::min(sampled, QuerySurface(capsule, a + (k / 100.0) * (b - a)).distance);
+    }
+    EXPECT_GE(clearance, sampled - 1e-15 * length) << "trial " << trial;
+  }
+  std::printf("the segment's clearance above its ends': at most %.2e of the link\n", worst);
 }
 
 TEST(ContactTest, ARunThatNeverTouchesAColliderIsTheRunWithout) {

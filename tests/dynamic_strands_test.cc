@@ -158,6 +158,85 @@ INSTANTIATE_TEST_SUITE_P(Dynamics, EveryProjection,
                                                               Projection::kDftl),
                                             ::testing::Values(2, 3), ::testing::Values(1, 3)));
 
+// Given masses: each strand with its own masses (or the batch's one profile) is SimulateChain of
+// its chain with those masses, bit for bit on the scalar engine and to 1e-12 over 10 frames on the
+// SIMD ones; the overall projection weighs its motion by them, so they change the result.
+TEST(DynamicStrands, GivenMassesAreEachStrandsSimulateChainMasses) {
+  const Case c = MakeCase(3, 21, 40);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0.2, 3.0);
+  StrandOptions options;
+  options.dynamics = Dynamics(3, Projection::kOverall);
+  options.masses.resize(c.strands.size());
+  for (size_t s = 0; s < c.strands.size(); ++s) {
+    if (s % 4 == 3) continue;  // this one by length, as the others say
+    options.masses[s] = Eigen::VectorXd(c.strands[s].rows() - 1);
+    for (Eigen::Index j = 0; j < options.masses[s].size(); ++j) options.masses[s][j] = u(rng);
+  }
+  std::vector<double> expected_energy(c.root_paths[0].rows(), 0.0);
+  std::vector<std::vector<Points>> expected, by_length;
+  for (size_t s = 0; s < c.strands.size(); ++s) {
+    DynamicOptions own = *options.dynamics;
+    own.masses = options.masses[s];
+    const DynamicResult r = SimulateChain(MakeChain(c.strands[s]), c.root_paths[s], own);
+    expected.push_back(r.frames);
+    for (Eigen::Index f = 0; f + 1 < r.energy.size(); ++f) expected_energy[f] += r.energy[f + 1];
+    by_length.push_back(
+        SimulateChain(MakeChain(c.strands[s]), c.root_paths[s], *options.dynamics).frames);
+  }
+  for (const char* engine : {"scalar", "avx2", "avx512"}) {
+    std::vector<double> energy;
+    const auto frames = RunBatch(c, options, engine, &energy);
+    if (frames.empty()) continue;  // no such engine on this CPU
+    SCOPED_TRACE(engine);
+    const bool scalar = std::string(engine) == "scalar";
+    double worst = 0.0, moved = 0.0;
+    for (size_t s = 0; s < frames.size(); ++s) {
+      for (size_t f = 0; f < frames[s].size() && f <= 10; ++f) {
+        worst = std::max(worst, MaxRelativeDifference(frames[s][f], expected[s][f]));
+        if (options.masses[s].size() == 0) {
+          EXPECT_EQ(MaxRelativeDifference(expected[s][f], by_length[s][f]), 0.0);
+        } else {
+          moved = std::max(moved, MaxRelativeDifference(frames[s][f], by_length[s][f]));
+        }
+      }
+    }
+    if (scalar) {
+      EXPECT_EQ(worst, 0.0);
+    } else {
+      EXPECT_LT(worst, 1e-12);
+    }
+    EXPECT_GT(moved, 1e-4);  // the masses matter
+    for (size_t f = 0; f < energy.size(); ++f) {
+      EXPECT_NEAR(energy[f], expected_energy[f], 1e-12 * (1.0 + std::fabs(expected_energy[f])));
+    }
+  }
+  // One profile for every strand of a batch of one link count (dynamics.masses); only the
+  // ratios matter: the profile times 7 gives the same motion to rounding.
+  Case same;
+  for (size_t s = 0; s < c.strands.size(); ++s) {
+    if (c.strands[s].rows() != 7) continue;
+    same.strands.push_back(c.strands[s]);
+    same.root_paths.push_back(c.root_paths[s]);
+  }
+  ASSERT_GE(same.strands.size(), 3u);
+  StrandOptions profile;
+  profile.dynamics = Dynamics(3, Projection::kOverall);
+  profile.dynamics->masses = Eigen::VectorXd::LinSpaced(6, 3.0, 0.5);  // heavy at the root
+  StrandOptions times7 = profile;
+  times7.dynamics->masses *= 7.0;
+  const auto a = RunBatch(same, profile, "scalar", nullptr);
+  const auto b = RunBatch(same, times7, "scalar", nullptr);
+  for (size_t s = 0; s < same.strands.size(); ++s) {
+    const DynamicResult r =
+        SimulateChain(MakeChain(same.strands[s]), same.root_paths[s], *profile.dynamics);
+    for (size_t f = 0; f < a[s].size(); ++f) {
+      EXPECT_EQ(a[s][f], r.frames[f]);
+      EXPECT_LT(MaxRelativeDifference(b[s][f], a[s][f]), 1e-12);
+    }
+  }
+}
+
 // Threads change the speed only: the points and the energy bit for bit.
 TEST(DynamicStrands, ThreadsChangeNothing) {
   const Case c = MakeCase(3, 40, 30);
@@ -286,8 +365,22 @@ TEST(DynamicStrands, RefusesByName) {
   options.dynamics = Dynamics(3, Projection::kShake);
   EXPECT_EQ(field_of(options), "dynamics.projection");
   options.dynamics = Dynamics(3, Projection::kOverall);
-  options.dynamics->masses = Eigen::VectorXd::Ones(3);
+  options.dynamics->masses = Eigen::VectorXd::Ones(4);  // the strand has 3 links
   EXPECT_EQ(field_of(options), "dynamics.masses");
+  options.dynamics = Dynamics(3, Projection::kOverall);
+  options.masses = {Eigen::VectorXd::Ones(2)};
+  EXPECT_EQ(field_of(options), "masses[0]");
+  options.masses = {Eigen::Vector3d(1.0, -1.0, 1.0)};
+  EXPECT_EQ(field_of(options), "masses[0][1]");
+  options.masses = {Eigen::Vector3d(1.0, 1.0, std::nan(""))};
+  EXPECT_EQ(field_of(options), "masses[0][2]");
+  options.masses = {Eigen::Vector3d(1.0, 2.0, 3.0), Eigen::Vector3d(1.0, 2.0, 3.0)};
+  EXPECT_EQ(field_of(options), "masses");  // two entries for one strand
+  options.masses = {Eigen::Vector3d(1.0, 2.0, 3.0)};
+  EXPECT_EQ(field_of(options), "none");
+  options.dynamics.reset();
+  EXPECT_EQ(field_of(options), "masses");  // masses without dynamics
+  options.masses.clear();
   options.dynamics = Dynamics(3, Projection::kOverall);
   options.dynamics->gravity = Eigen::VectorXd::Zero(2);
   EXPECT_EQ(field_of(options), "dynamics.gravity");
@@ -354,7 +447,10 @@ TEST(DynamicGroom, NamesEveryProblemByPointer) {
             V{"/dynamics/projection"});
   EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "frame_rate": 60})"), V{"/dynamics/frame_rate"});
   EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "substeps": 4})"), V{"/dynamics/substeps"});
+  // The given strands have 3 and 2 links: one profile of 3 masses does not fit the second.
   EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "mass": [1, 2, 3]})"), V{"/dynamics/mass"});
+  EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "mass": [1, 2, -3]})"), V{"/dynamics/mass/2"});
+  EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "mass": "heavy"})"), V{"/dynamics/mass"});
   EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "damping": -1})"), V{"/dynamics/damping"});
   EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "dftl_damping": 2})"),
             V{"/dynamics/dftl_damping"});
@@ -364,6 +460,50 @@ TEST(DynamicGroom, NamesEveryProblemByPointer) {
   EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81], "gust": 1})"), V{"/dynamics/gust"});
   EXPECT_EQ(fields(R"({"gravity": [0, 0, -9.81]})", R"(, "method": "ftl")"), V{"/method"});
   EXPECT_EQ(fields(R"([0, 0, -9.81])"), V{"/dynamics"});
+}
+
+// Given masses in a groom file: a strand's own ("/strands/i/masses") and the one profile
+// ("/dynamics/mass") for the strands without their own; each problem by pointer.
+TEST(DynamicGroom, ReadsGivenMasses) {
+  const auto text = [](const std::string& masses0, const std::string& masses1,
+                       const std::string& mass) {
+    return R"({"strands": [{"points": [[0, 0, 1], [0, 0.05, 1.05], [0, 0.1, 1.1]])" + masses0 +
+           R"(}, {"points": [[1, 0, 0], [1.05, 0, 0.05], [1.1, 0, 0.1]])" + masses1 + R"(}],
+             "motion": {"fps": 30, "keyframes": [{"time": 0}, {"time": 1}]},
+             "dynamics": {"gravity": [0, 0, -9.81])" +
+           mass + "}}";
+  };
+  const GroomScenario s = ParseGroomText(text(R"(, "masses": [1, 2])", "", R"(, "mass": [3, 1])"));
+  ASSERT_EQ(s.options.masses.size(), 2u);
+  EXPECT_EQ(s.options.masses[0], Eigen::Vector2d(1, 2));
+  EXPECT_EQ(s.options.masses[1].size(), 0);  // the profile's
+  EXPECT_EQ(s.options.dynamics->masses, Eigen::Vector2d(3, 1));
+  StrandBatch batch(s.strands, s.options);  // the batch takes them
+  // The strand file says so: the profile, and that strands have their own.
+  const std::string path = ::testing::TempDir() + "groom_masses.npz";
+  RunGroomToFile(s, path);
+  {
+    StrandFileReader file(path);
+    ASSERT_TRUE(file.header().dynamics.has_value());
+    EXPECT_EQ(file.header().dynamics->masses, Eigen::Vector2d(3, 1));
+    EXPECT_TRUE(file.header().own_masses);
+  }
+  std::remove(path.c_str());
+  using V = std::vector<std::string>;
+  EXPECT_EQ(Fields(ValidateGroomText(text(R"(, "masses": [1, 2, 3])", "", ""))),
+            V{"/strands/0/masses"});
+  EXPECT_EQ(Fields(ValidateGroomText(text(R"(, "masses": [1, 0])", "", ""))),
+            V{"/strands/0/masses/1"});
+  EXPECT_EQ(Fields(ValidateGroomText(text("", "", R"(, "mass": [1, 2, 3])"))), V{"/dynamics/mass"});
+  const std::string no_dynamics = R"({"strands": [{"points": [[0, 0, 1], [0, 0.05, 1.05]],
+      "masses": [1]}], "motion": {"fps": 30, "keyframes": [{"time": 0}]}})";
+  EXPECT_EQ(Fields(ValidateGroomText(no_dynamics)), V{"/strands/0/masses"});
+  // A grown groom: the profile has one mass per grown link.
+  const std::string grown = R"({"groom": {"scalp": {"shape": "sphere", "radius": 1}, "roots": 4,
+      "links": 3, "link_length": 0.05}, "motion": {"fps": 30, "keyframes": [{"time": 0}]},
+      "dynamics": {"gravity": [0, 0, -9.81], "mass": )";
+  EXPECT_TRUE(ValidateGroomText(grown + "[1, 1, 2]}}").empty());
+  EXPECT_EQ(Fields(ValidateGroomText(grown + "[1, 2]}}")), V{"/dynamics/mass"});
 }
 
 // The groom run: frame by frame the batch stepped directly, the energy in the report and back
@@ -414,7 +554,9 @@ double CapsuleDistance(const Eigen::Vector3d& x, const Eigen::Vector3d& a, const
 }
 
 // Hair falling onto a head with a neck (the crevice where the scalp meets the neck collects it):
-// the sequential projections keep every point and link outside both, measured here by sampling.
+// every projection keeps every point and link outside both, measured here by sampling (the
+// overall one through its contact fallback, which once stopped "wedged" on links lying along the
+// neck: tests/contact_test.cc, ALinkAlongACapsuleIsNoClearerThanItsEnds).
 TEST(DynamicStrands, HairFallsIntoTheCreviceOfScalpAndNeckAndStaysOutside) {
   GrowSpec spec;
   spec.scalp.shape = "sphere";
@@ -434,7 +576,7 @@ TEST(DynamicStrands, HairFallsIntoTheCreviceOfScalpAndNeckAndStaysOutside) {
   neck.half_length = 0.105;
   neck.radius = 0.05;
   const Eigen::Vector3d neck_a(0, 0, -0.09), neck_b(0, 0, -0.3);
-  for (Projection projection : {Projection::kDftl, Projection::kTractrix}) {
+  for (Projection projection : {Projection::kDftl, Projection::kTractrix, Projection::kOverall}) {
     SCOPED_TRACE(ProjectionName(projection));
     StrandOptions options;
     options.pinned = 2;

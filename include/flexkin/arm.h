@@ -252,19 +252,18 @@ struct ArmOptions {
   // without colliders) keeps every link outside, it is that result bit for bit; otherwise, for
   // planar and spherical arms, the step is solved again by the sweep in which every link whose
   // tractrix step would enter a collider takes the contact step instead (the least motion of its
-  // trailing end that keeps it outside); for arms with joint axes (method newton, no pointing,
-  // convex colliders), by the joint-space step with the capsules' clearances as constraints. A 2D
-  // arm lies in the plane z = 0. Keyframed colliders (Collider::motion) move with time in leader
-  // steps: TrackPath's step toward path row i spans [i, i + 1], each sub-step of its sweep at its
-  // own time, the result checked where they are at i + 1 (docs/robots.md, "Colliders"). Empty:
-  // none.
+  // trailing end that keeps it outside); for arms with joint axes (method newton, with
+  // or without pointing), by the joint-space step with the capsules' clearances as
+  // constraints. A 2D arm lies in the plane z = 0. Keyframed colliders (Collider::motion) move with
+  // time in leader steps: TrackPath's step toward path row i spans [i, i + 1], each sub-step of its
+  // sweep at its own time, the result checked where they are at i + 1 (docs/robots.md,
+  // "Colliders"). Empty: none.
   std::vector<Collider> colliders;
   // Every problem (empty if valid), each naming its member ("max_iterations").
   Problems Validate() const;
   // The problems of these options on `model` besides Validate's: pointing needs joint axes, and
   // method fixed_point takes only revolute joints across links of positive length within
-  // [-pi, pi] and no pointing; colliders on an arm with joint axes need method newton, no
-  // pointing and convex shapes.
+  // [-pi, pi] and no pointing; colliders on an arm with joint axes need method newton.
   Problems ValidateFor(const ArmModel& model) const;
 };
 

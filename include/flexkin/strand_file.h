@@ -72,6 +72,9 @@ struct StrandFileHeader {
   // Dynamic strands (StrandOptions::dynamics): the projection, gravity, damping and wind (a
   // constant wind; keyframed wind is not written). Written as "dynamics" only when set.
   std::optional<DynamicOptions> dynamics;
+  // Dynamic strands with their own masses (StrandOptions::masses; not written themselves):
+  // "dynamics": {"own_masses": true}.
+  bool own_masses = false;
 
   int num_strands() const { return static_cast<int>(offsets.empty() ? 0 : offsets.size() - 1); }
   int64_t num_points() const { return offsets.empty() ? 0 : offsets.back(); }

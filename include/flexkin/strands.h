@@ -62,14 +62,22 @@ struct StrandOptions {
   // about 1e-14 relative on the SIMD ones. `method` is not used. The sub-steps are `substeps`
   // (dynamics->substeps must be 1 or equal to it); a frame lasts 1 / dynamics->frame_rate;
   // keyframed wind is read at the sub-step's middle (seconds from the batch's making); given
-  // masses are for single chains. With colliders, a link the projection would leave inside one
-  // takes the nearest clear direction (tractrix, dftl: ContactTail from its new leading end,
-  // nearest the projection's own position; overall: the strand's sub-step is projected by the
-  // tractrix projection with contacts, counted in StrandDynamics::contact_substeps).
+  // masses: `dynamics->masses` (n entries) is every strand's profile, for batches whose strands
+  // all have n links; `masses` below gives strands their own. With colliders, a link the projection
+  // would leave inside one takes the nearest clear direction (tractrix, dftl: ContactTail from its
+  // new leading end, nearest the projection's own position; overall: the strand's sub-step is
+  // projected by the tractrix projection with contacts, counted in
+  // StrandDynamics::contact_substeps).
   std::optional<DynamicOptions> dynamics;
+  // Dynamic strands' own masses: empty, every strand as `dynamics` says (mass_by_length, or the
+  // profile dynamics->masses); else one entry per strand, each empty (that strand as the others)
+  // or one finite mass > 0 per free point 1 .. n_i of that strand. As for SimulateChain only the
+  // ratios matter: each strand's free points weigh 1 in all. Given without dynamics, refused.
+  std::vector<Eigen::VectorXd> masses;
 
   // Problems with fields "method", "substeps", "pinned", "threads", "colliders[i]...",
-  // "body_colliders[i]...".
+  // "body_colliders[i]...", "dynamics...". `masses` is checked against the strands by the batch
+  // ("masses[i][j]", "dynamics.masses").
   Problems Validate() const;
 };
 

@@ -76,14 +76,6 @@ Eigen::Matrix<double, T, 1> SolveNormal(Eigen::Matrix<double, T, T>* a_io,
   return x;
 }
 
-// The rotation vector of the smallest rotation taking unit `from` to unit `to`.
-Vec3 RotationVector(const Vec3& from, const Vec3& to) {
-  const Vec3 axis = from.cross(to);
-  const double s = axis.norm(), c = from.dot(to);
-  if (!(s > 0.0)) return c >= 0.0 ? Vec3::Zero() : Vec3(from.unitOrthogonal() * M_PI);
-  return axis * (std::atan2(s, c) / s);
-}
-
 // What a solve aims at: the end effector's position and, with pointing, the direction the tool
 // axis should take (a unit vector; for look_at, recomputed from the end effector as it moves).
 struct Goal {
@@ -92,11 +84,7 @@ struct Goal {
   Vec3 direction = Vec3::UnitX();                  // unit; pointing along it (not look_at)
   bool look_at = false;
   Vec3 point = Vec3::Zero();  // with look_at
-  Vec3 Direction(const Vec3& end) const {
-    if (!look_at) return direction;
-    const Vec3 d = point - end;
-    return d.squaredNorm() > 0.0 ? Vec3(d.normalized()) : direction;
-  }
+  Vec3 Direction(const Vec3& end) const { return AimedDirection(look_at, point, direction, end); }
 };
 
 // Joints about or along given axes (planar arms embedded with every axis z). The state is the
@@ -536,6 +524,19 @@ ArmModel Embedded(const ArmModel& planar) {
 }
 
 }  // namespace
+
+Vec3 RotationVector(const Vec3& from, const Vec3& to) {
+  const Vec3 axis = from.cross(to);
+  const double s = axis.norm(), c = from.dot(to);
+  if (!(s > 0.0)) return c >= 0.0 ? Vec3::Zero() : Vec3(from.unitOrthogonal() * M_PI);
+  return axis * (std::atan2(s, c) / s);
+}
+
+Vec3 AimedDirection(bool look_at, const Vec3& point, const Vec3& direction, const Vec3& end) {
+  if (!look_at) return direction;
+  const Vec3 d = point - end;
+  return d.squaredNorm() > 0.0 ? Vec3(d.normalized()) : direction;
+}
 
 Eigen::VectorXd InverseJointWeights(const ArmModel& model) {
   const int n = model.num_links();

@@ -23,6 +23,14 @@ namespace flexkin::arm_internal {
 // grows about as d_k, so its share of a step, w_k^-1 (J' lambda)_k, falls off about as 1 / d_k.
 Eigen::VectorXd InverseJointWeights(const ArmModel& model);
 
+// The rotation vector of the smallest rotation taking unit `from` to unit `to`.
+Eigen::Vector3d RotationVector(const Eigen::Vector3d& from, const Eigen::Vector3d& to);
+
+// Where pointing aims the tool axis with the end effector at `end`: the unit `direction`, or,
+// with `look_at`, toward `point` (`direction` where the end is on that point).
+Eigen::Vector3d AimedDirection(bool look_at, const Eigen::Vector3d& point,
+                               const Eigen::Vector3d& direction, const Eigen::Vector3d& end);
+
 // What the joint-space solve needs of a model, prepared once for many steps (TrackPath prepares
 // it for all of its steps, ArmStep for its one): the weights and, for arms with joint axes, the
 // forward kinematics. Holds a reference to the model, which must outlive it.

@@ -1,7 +1,9 @@
 // The joint-space step of an arm with joint axes among colliders (src/arm/joint_space_contact.h).
 //
-// At q, with the end effector's miss r = FK(q) - target and its position Jacobian J, each step is
-// the solution dq of
+// At q, with the end effector's miss r = FK(q) - target and its position Jacobian J (with
+// pointing, r and J also have the free step's three rows of the tool axis' turn to its goal,
+// weighted by pointing.weight mean link lengths per radian: joint_space.cc), each step is the
+// solution dq of
 //   minimize (1/2) dq' W dq  subject to  J dq = -r,  g_a + G_a dq >= 0,  lo <= q + dq <= hi,
 // W the free step's weights (joint_space.h: W^-1 = InverseJointWeights, a prismatic joint in
 // units of the mean link length), g_a the clearance of link l's capsule from collider k (the
@@ -16,6 +18,7 @@
 #include "arm/joint_space_contact.h"
 
 #include <Eigen/Dense>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -36,34 +39,76 @@ struct Inequality {
 
 class ContactDriver {
  public:
-  ContactDriver(const JointSpacePlan& plan, const std::vector<Collider>& colliders, double slack)
+  ContactDriver(const JointSpacePlan& plan, const std::vector<Collider>& colliders, double slack,
+                const ArmOptions::Pointing& pointing)
       : model_(plan.model()),
         fk_(plan.kinematics()),
         colliders_(colliders),
         n_(plan.model().num_links()),
         scale_(plan.model().link_lengths.mean()),
-        slack_(slack) {
+        slack_(slack),
+        rows_(pointing.enabled ? 5 : 3),
+        angle_scale_(pointing.weight * scale_),
+        tool_axis_(pointing.axis.normalized()),
+        point_(pointing.point) {
     weight_.resize(n_);
     for (int k = 0; k < n_; ++k) {
       weight_[k] = model_.prismatic(k) ? 1.0 / (scale_ * scale_) : 1.0 / plan.inverse_weights()[k];
     }
   }
 
-  // Drives `*q` toward `goal` until the miss is at most `tol` with every capsule outside (true),
-  // or no step improves, or `iterations` run out.
-  bool Drive(const Vec3& goal, double tol, int iterations, Eigen::VectorXd* q, int* used);
+  // Drives `*q` toward `goal` (with pointing, the tool axis toward `direction`, or toward the
+  // point looked at where `look_at`) until the miss is at most `tol` and the tool axis' angle at
+  // most `angle_tol`, with every capsule outside (true), or no step improves, or `iterations` run
+  // out.
+  bool Drive(const Vec3& goal, const Vec3& direction, bool look_at, double tol, double angle_tol,
+             int iterations, Eigen::VectorXd* q, int* used);
 
+  // The arm at q: the norm of the miss (with pointing, of the position's and the weighted turn's
+  // rows together) and the capsules' depth inside the colliders.
   double Miss(const Eigen::VectorXd& q, double* depth) {
     Forward(q);
     *depth = Depth();
-    return (End() - goal_).norm();
+    return ResidualNorm();
   }
   const Points& points() const { return points_; }
+  Vec3 End() const { return At(n_); }
+  // The tool axis in the world, and its angle from its goal (rad).
+  Vec3 ToolAxis() const { return frame_ * tool_axis_; }
+  double AngleMiss() const { return RotationVector(ToolAxis(), Direction()).norm(); }
+  double PositionMiss() const { return (End() - goal_).norm(); }
 
  private:
-  void Forward(const Eigen::VectorXd& q) { fk_.Forward(q, &points_, &axes_); }
+  void Forward(const Eigen::VectorXd& q) { fk_.Forward(q, &points_, &axes_, &frame_); }
   Vec3 At(int i) const { return points_.row(i).transpose(); }
-  Vec3 End() const { return At(n_); }
+  Vec3 Direction() const { return AimedDirection(look_at_, point_, direction_, End()); }
+  // The miss: the end effector's, and with pointing the weighted turn that would bring the tool
+  // axis onto its goal (as the free step's, joint_space.cc). That turn is across the tool axis:
+  // its two components on `across` (two unit vectors across the tool axis), so that the rows of
+  // the step's equality are independent.
+  Eigen::VectorXd Residual(const Eigen::Matrix<double, 3, 2>& across) const {
+    Eigen::VectorXd r(rows_);
+    r.head<3>() = End() - goal_;
+    if (rows_ == 5) {
+      r.tail<2>() = -angle_scale_ * across.transpose() * RotationVector(ToolAxis(), Direction());
+    }
+    return r;
+  }
+  // The same norm as Residual's, without the basis.
+  double ResidualNorm() const {
+    const double position = (End() - goal_).squaredNorm();
+    if (rows_ == 3) return std::sqrt(position);
+    const double turn = angle_scale_ * RotationVector(ToolAxis(), Direction()).norm();
+    return std::sqrt(position + turn * turn);
+  }
+  // Two unit vectors across the tool axis, and the miss' Jacobian at the current q (rows_ by n).
+  Eigen::Matrix<double, 3, 2> Across() const {
+    const Vec3 a = ToolAxis(), e1 = a.unitOrthogonal();
+    Eigen::Matrix<double, 3, 2> across;
+    across << e1, a.cross(e1);
+    return across;
+  }
+  void Jacobian(const Eigen::Matrix<double, 3, 2>& across, Eigen::MatrixXd* jacobian) const;
   double Radius(int link) const {
     return model_.link_radii.size() > 0 ? model_.link_radii[link - 1] : 0.0;
   }
@@ -77,7 +122,10 @@ class ContactDriver {
   double Depth() const;
   // The inequalities at the current q: contacts within reach, and the limits.
   void Inequalities(const Eigen::VectorXd& q, std::vector<Inequality>* out) const;
-  bool SolveQp(const Eigen::MatrixXd& jacobian, const Vec3& miss,
+  // The step's quadratic program. `penalty` 0: J dq = -r as equalities; > 0: as the penalty
+  // (penalty / 2) |J dq + r|^2 added to the objective instead (where the linearized equalities and
+  // the constraints held active cannot all be met, the step that comes nearest).
+  bool SolveQp(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& miss, double penalty,
                const std::vector<Inequality>& inequalities, Eigen::VectorXd* dq) const;
 
   const ArmModel& model_;
@@ -85,11 +133,36 @@ class ContactDriver {
   const std::vector<Collider>& colliders_;
   const int n_;
   const double scale_, slack_;
+  const int rows_;  // 3, or 5 with pointing
+  const double angle_scale_;
+  const Vec3 tool_axis_;  // in the last link's frame
+  const Vec3 point_;      // looked at (pointing.look_at)
   Eigen::VectorXd weight_;
-  Vec3 goal_ = Vec3::Zero();
+  Vec3 goal_ = Vec3::Zero(), direction_ = Vec3::UnitX();
+  bool look_at_ = false;
   Points points_;
   Eigen::MatrixXd axes_;
+  Eigen::Matrix3d frame_ = Eigen::Matrix3d::Identity();
 };
+
+void ContactDriver::Jacobian(const Eigen::Matrix<double, 3, 2>& across,
+                             Eigen::MatrixXd* jacobian) const {
+  jacobian->resize(rows_, n_);
+  for (int j = 0; j < n_; ++j) jacobian->col(j).head<3>() = PointRate(n_, j);
+  if (rows_ == 3) return;
+  const Vec3 a_w = ToolAxis(), to_point = point_ - End();
+  // Looking at a point, the goal turns as the end effector moves (joint_space.cc, Propose).
+  const double look = look_at_ && to_point.norm() > 0.0 ? 1.0 / to_point.norm() : 0.0;
+  for (int j = 0; j < n_; ++j) {
+    Vec3 turn = Vec3::Zero();
+    if (!model_.prismatic(j)) {
+      const Vec3 axis = axes_.row(j).transpose();
+      turn = axis - axis.dot(a_w) * a_w;  // the tool axis turns with w x a_w
+    }
+    if (look > 0.0) turn += look * a_w.cross(Vec3(jacobian->col(j).head<3>()));
+    jacobian->col(j).tail<2>() = angle_scale_ * across.transpose() * turn;
+  }
+}
 
 double ContactDriver::Depth() const {
   double depth = 0.0;
@@ -147,26 +220,33 @@ void ContactDriver::Inequalities(const Eigen::VectorXd& q, std::vector<Inequalit
   }
 }
 
-bool ContactDriver::SolveQp(const Eigen::MatrixXd& jacobian, const Vec3& miss,
-                            const std::vector<Inequality>& inequalities,
+bool ContactDriver::SolveQp(const Eigen::MatrixXd& jacobian, const Eigen::VectorXd& miss,
+                            double penalty, const std::vector<Inequality>& inequalities,
                             Eigen::VectorXd* dq) const {
   std::vector<int> working;
   std::vector<int> left(inequalities.size(), 0);
   const double ridge = 1e-14 * weight_.maxCoeff();
+  const int equalities = penalty > 0.0 ? 0 : rows_;
+  const int first = n_ + equalities;  // the inequalities' multipliers
   for (int round = 0; round < 4 * static_cast<int>(inequalities.size()) + 8; ++round) {
     const int m = static_cast<int>(working.size());
-    const int size = n_ + 3 + m;
+    const int size = first + m;
     Eigen::MatrixXd kkt = Eigen::MatrixXd::Zero(size, size);
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(size);
     kkt.topLeftCorner(n_, n_) = weight_.asDiagonal();
-    kkt.block(0, n_, n_, 3) = jacobian.transpose();
-    kkt.block(n_, 0, 3, n_) = jacobian;
-    rhs.segment(n_, 3) = -miss;
+    if (penalty > 0.0) {
+      kkt.topLeftCorner(n_, n_) += penalty * jacobian.transpose() * jacobian;
+      rhs.head(n_) = -penalty * (jacobian.transpose() * miss);
+    } else {
+      kkt.block(0, n_, n_, rows_) = jacobian.transpose();
+      kkt.block(n_, 0, rows_, n_) = jacobian;
+      rhs.segment(n_, rows_) = -miss;
+    }
     for (int a = 0; a < m; ++a) {
       const Inequality& in = inequalities[working[a]];
-      kkt.block(0, n_ + 3 + a, n_, 1) = -in.a.transpose();
-      kkt.block(n_ + 3 + a, 0, 1, n_) = -in.a;
-      rhs[n_ + 3 + a] = -in.b;
+      kkt.block(0, first + a, n_, 1) = -in.a.transpose();
+      kkt.block(first + a, 0, 1, n_) = -in.a;
+      rhs[first + a] = -in.b;
     }
     for (int r = n_; r < size; ++r) kkt(r, r) = -ridge;
     const Eigen::VectorXd solution = kkt.fullPivLu().solve(rhs);
@@ -175,7 +255,7 @@ bool ContactDriver::SolveQp(const Eigen::MatrixXd& jacobian, const Vec3& miss,
     int leave = -1;
     double most = 0.0;
     for (int a = 0; a < m; ++a) {
-      if (solution[n_ + 3 + a] < most) most = solution[n_ + 3 + a], leave = a;
+      if (solution[first + a] < most) most = solution[first + a], leave = a;
     }
     if (leave >= 0) {
       ++left[working[leave]];
@@ -198,21 +278,33 @@ bool ContactDriver::SolveQp(const Eigen::MatrixXd& jacobian, const Vec3& miss,
   return true;
 }
 
-bool ContactDriver::Drive(const Vec3& goal, double tol, int iterations, Eigen::VectorXd* q,
-                          int* used) {
+bool ContactDriver::Drive(const Vec3& goal, const Vec3& direction, bool look_at, double tol,
+                          double angle_tol, int iterations, Eigen::VectorXd* q, int* used) {
   goal_ = goal;
+  direction_ = direction;
+  look_at_ = look_at;
   double depth = 0.0;
   double miss = Miss(*q, &depth);
-  Eigen::MatrixXd jacobian(3, n_);
+  const auto within = [&] {
+    return PositionMiss() <= tol && (rows_ == 3 || AngleMiss() <= angle_tol) && depth == 0.0;
+  };
+  Eigen::MatrixXd jacobian;
   std::vector<Inequality> inequalities;
   Eigen::VectorXd dq(n_), trial(n_);
   for (int it = 0; it < iterations; ++it) {
-    if (miss <= tol && depth == 0.0) return true;
+    if (within()) return true;
     ++*used;
-    const Vec3 r = End() - goal_;
-    for (int j = 0; j < n_; ++j) jacobian.col(j) = PointRate(n_, j);
+    const Eigen::Matrix<double, 3, 2> across = Across();
+    const Eigen::VectorXd r = Residual(across);
+    Jacobian(across, &jacobian);
     Inequalities(*q, &inequalities);
-    if (!SolveQp(jacobian, r, inequalities, &dq)) return false;
+    if (!SolveQp(jacobian, r, 0.0, inequalities, &dq)) return false;
+    // Where the active constraints leave the linearized miss uncancelled (more constraints held
+    // than the joints can meet with it), the step that comes nearest to cancelling it: the miss
+    // as a penalty far above the weights, 1e8 per squared mean link length.
+    if ((jacobian * dq + r).norm() > 1e-6 * r.norm() + 1e-14 * scale_) {
+      if (!SolveQp(jacobian, r, 1e8 / (scale_ * scale_), inequalities, &dq)) return false;
+    }
     // Backtracking on the miss plus the depth inside the colliders.
     const double merit = miss + depth;
     double alpha = 1.0;
@@ -232,42 +324,61 @@ bool ContactDriver::Drive(const Vec3& goal, double tol, int iterations, Eigen::V
     }
     if (!improved) {
       Forward(*q);
-      return miss <= tol && depth == 0.0;
+      return within();
     }
   }
   Forward(*q);
-  return miss <= tol && depth == 0.0;
+  return within();
 }
 
 }  // namespace
 
 void SolveJointSpaceContact(const JointSpacePlan& plan, const Eigen::VectorXd& previous,
                             const Eigen::VectorXd& target, const std::vector<Collider>& colliders,
-                            double tol, double slack, int max_iterations, JointSpaceSolve* out) {
+                            double tol, double slack, int max_iterations,
+                            const ArmOptions::Pointing& pointing, JointSpaceSolve* out) {
   const ArmModel& model = plan.model();
   const double scale = model.link_lengths.mean();
-  ContactDriver driver(plan, colliders, slack);
+  ContactDriver driver(plan, colliders, slack, pointing);
   Eigen::VectorXd q = previous;
   double depth = 0.0;
   driver.Miss(q, &depth);
-  const Vec3 from = driver.points().row(model.num_links()).transpose();
+  const Vec3 from = driver.End();
   Vec3 goal = Vec3::Zero();
   goal.head(target.size()) = target;
   // Legs of at most half a mean link length, as the free step's; each but the last to 1e-3 of a
-  // link.
-  constexpr double kLeg = 0.5, kLegTol = 1e-3;
+  // link. With pointing, the tool axis turns to its goal along the great circle in the same legs,
+  // at most 0.5 rad apart (the free step's legs, joint_space.cc).
+  constexpr double kLeg = 0.5, kLegTol = 1e-3, kLegAngle = 0.5;
   constexpr int kLegIterations = 20;
-  const int legs = std::max(1, static_cast<int>(std::ceil((goal - from).norm() / (kLeg * scale))));
+  int legs = std::max(1, static_cast<int>(std::ceil((goal - from).norm() / (kLeg * scale))));
+  const Vec3 axis_from = driver.ToolAxis();
+  Vec3 turn = Vec3::Zero();
+  if (pointing.enabled) {
+    turn = RotationVector(axis_from, AimedDirection(pointing.look_at, pointing.point,
+                                                    pointing.direction.normalized(), goal));
+    legs = std::max(legs, static_cast<int>(std::ceil(turn.norm() / kLegAngle)));
+  }
   int used = 0;
   bool converged = false;
   for (int leg = 1; leg <= legs; ++leg) {
     const bool last = leg == legs;
-    const Vec3 at = last ? goal : Vec3(from + (goal - from) * (double(leg) / legs));
-    converged = driver.Drive(at, last ? tol : kLegTol * scale,
+    const double t = double(leg) / legs;
+    const Vec3 at = last ? goal : Vec3(from + (goal - from) * t);
+    Vec3 direction = pointing.direction.normalized();
+    if (!last && pointing.enabled) {
+      direction = Eigen::AngleAxisd(t * turn.norm(),
+                                    turn.norm() > 0.0 ? Vec3(turn.normalized()) : Vec3::UnitX()) *
+                  axis_from;
+    }
+    converged = driver.Drive(at, direction, last && pointing.look_at, last ? tol : kLegTol * scale,
+                             last ? pointing.angle_tolerance : kLegAngle,
                              last ? max_iterations : kLegIterations, &q, &used);
   }
   out->angles = q;
-  out->residual = driver.Miss(q, &depth);
+  driver.Miss(q, &depth);
+  out->residual = driver.PositionMiss();
+  out->angle_residual = pointing.enabled ? driver.AngleMiss() : 0.0;
   out->points = driver.points();
   if (model.dim == 2) out->points = Points(out->points.leftCols(2));
   out->iterations = used;

@@ -17,10 +17,14 @@ namespace flexkin::arm_internal {
 
 // From the arm at `previous` (its joint values) toward the end effector at `target` (3), in
 // legs of at most half a mean link length, keeping every link capsule (radius link_radii) outside
-// every collider (convex; ungrown). `out` gets the points, angles, residual, iterations and
-// whether it converged (residual <= tol, no capsule inside beyond `slack` of its link's length).
+// every collider (ungrown; a mesh's clearance linearized at its nearest sample along the link);
+// with `pointing` enabled, the tool axis turned to its goal as the free step turns it (in the same
+// legs, weighted alike). `out` gets the points, angles, residual, angle residual, iterations and
+// whether it converged (residual <= tol, with pointing the angle within pointing.angle_tolerance,
+// no capsule inside beyond `slack` of its link's length).
 void SolveJointSpaceContact(const JointSpacePlan& plan, const Eigen::VectorXd& previous,
                             const Eigen::VectorXd& target, const std::vector<Collider>& colliders,
-                            double tol, double slack, int max_iterations, JointSpaceSolve* out);
+                            double tol, double slack, int max_iterations,
+                            const ArmOptions::Pointing& pointing, JointSpaceSolve* out);
 
 }  // namespace flexkin::arm_internal

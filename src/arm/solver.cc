@@ -428,24 +428,11 @@ Problems ArmOptions::ValidateFor(const ArmModel& model) const {
   }
   if (!colliders.empty() && model.has_axes()) {
     // Arms with joint axes keep their capsules outside in the joint-space step
-    // (src/arm/joint_space_contact.h): method newton, position targets, convex colliders.
+    // (src/arm/joint_space_contact.h): method newton.
     if (method != FixedBaseMethod::kNewton) {
       problems.emplace_back("method",
                             "colliders with an arm with joint axes need method \"newton\" (the "
                             "joint-space step keeps the links outside); expected \"newton\"");
-    }
-    if (pointing.enabled) {
-      problems.emplace_back("pointing",
-                            "is not combined with colliders yet for arms with joint axes: the "
-                            "joint-space step among colliders tracks the end effector's position; "
-                            "expected pointing off with colliders");
-    }
-    for (size_t c = 0; c < colliders.size(); ++c) {
-      if (colliders[c].shape == ColliderShape::kMesh) {
-        problems.emplace_back("colliders[" + std::to_string(c) + "].shape",
-                              "a mesh is not taken by arms with joint axes yet (their step needs "
-                              "a convex collider's smooth clearance); expected a convex shape");
-      }
     }
   }
   return problems;
@@ -745,8 +732,10 @@ ArmStepReport AxisContactStep(const arm_internal::JointSpacePlan& plan, const Ar
   arm_internal::JointSpaceSolve solved;
   arm_internal::SolveJointSpaceContact(plan, state.angles.angle, target, colliders, tol,
                                        arm_internal::kArmContactSlack, options.max_iterations,
-                                       &solved);
+                                       options.pointing, &solved);
+  const double angle_residual = solved.angle_residual;
   ArmStepReport report = AxisReport(model, target, tol, std::move(solved));
+  if (options.pointing.enabled) report.pointing_error = angle_residual;
   report.joint_space = true;
   AddCost(free, &report);
   report.contact = true;

@@ -61,6 +61,7 @@ StrandFileHeader MakeStrandFileHeader(const GroomScenario& scenario) {
   h.body_colliders = scenario.options.body_colliders;
   h.world_colliders = scenario.options.colliders;
   h.dynamics = scenario.options.dynamics;
+  for (const Eigen::VectorXd& m : scenario.options.masses) h.own_masses |= m.size() != 0;
   return h;
 }
 

@@ -169,6 +169,7 @@ class GroomParser : public json_internal::JsonReader {
     } else {
       s.strands = std::move(*strands);
     }
+    CheckMasses(spec ? spec->links : 0, &s);
     // The scalp is a collider too, unless the file says otherwise: the last body collider.
     if (spec && scalp_collider) {
       Collider scalp;
@@ -187,6 +188,46 @@ class GroomParser : public json_internal::JsonReader {
   }
 
  private:
+  // Given masses: the strands' own need "dynamics"; the one profile of "dynamics/mass" needs
+  // every strand without its own to have as many links (`links`: the grown strands', 0 for given
+  // strands).
+  void CheckMasses(int links, GroomScenario* s) {
+    if (!given_masses_.empty()) {
+      if (!s->options.dynamics) {
+        for (size_t i = 0; i < given_masses_.size(); ++i) {
+          if (given_masses_[i].size() == 0) continue;
+          Add("/strands/" + std::to_string(i) + "/masses",
+              "is given without \"dynamics\"; masses are for dynamic strands", "[...]",
+              "no \"masses\", or a \"dynamics\" object");
+          return;
+        }
+      }
+      given_masses_.resize(s->strands.size());
+      s->options.masses = std::move(given_masses_);
+    }
+    if (!s->options.dynamics || s->options.dynamics->masses.size() == 0) return;
+    const Eigen::Index profile = s->options.dynamics->masses.size();
+    const std::string valid = "one number > 0 per free point of every strand";
+    if (links > 0 && links != profile) {
+      Add("/dynamics/mass",
+          "has " + std::to_string(profile) + " numbers; expected " + std::to_string(links) +
+              ", one per free point (the strands grow " + std::to_string(links) + " links)",
+          "[...]", valid);
+      return;
+    }
+    for (size_t i = 0; links == 0 && i < s->strands.size(); ++i) {
+      const Eigen::Index n = s->strands[i].rows() - 1;
+      if (n == profile || (i < s->options.masses.size() && s->options.masses[i].size() != 0)) {
+        continue;
+      }
+      Add("/dynamics/mass",
+          "has " + std::to_string(profile) + " numbers; /strands/" + std::to_string(i) + " has " +
+              std::to_string(n) + " links (give it its own \"masses\")",
+          "[...]", valid);
+      return;
+    }
+  }
+
   // A strand that starts inside a collider (at the first keyframe's pose) is a problem of the
   // collider's entry, naming the root (the strand) and the point.
   void CheckStart(const GroomScenario& s, bool scalp_last) {
@@ -391,11 +432,27 @@ class GroomParser : public json_internal::JsonReader {
     for (size_t i = 0; i < list.size(); ++i) {
       const std::string sp = ptr + "/" + std::to_string(i);
       if (!ExpectObject(list[i], sp, "an object {\"points\": [[x, y, z], ...]}")) continue;
-      CheckKeys(list[i], sp, {"points"});
+      CheckKeys(list[i], sp, {"points", "masses"});
       const json* v = Required(list[i], sp, "points", "an array of at least 2 points");
       if (v == nullptr) continue;
       const auto points = PointList(*v, sp + "/points", *dim, 2, kMaxLinks + 1);
       if (!points) continue;
+      // A dynamic strand's own masses: one per free point (points 1 to n).
+      if (const json* m = Find(list[i], "masses")) {
+        const Eigen::Index n = points->rows() - 1;
+        if (auto masses = NumberList(*m, sp + "/masses", 1, Range::kPositive)) {
+          if (masses->size() != n) {
+            Add(sp + "/masses",
+                "has " + std::to_string(masses->size()) + " numbers; expected " +
+                    std::to_string(n) + ", one per free point (points 1 to " + std::to_string(n) +
+                    " of the strand's " + std::to_string(n + 1) + ")",
+                m->dump(), std::to_string(n) + " numbers > 0");
+          } else {
+            given_masses_.resize(list.size());
+            given_masses_[i] = std::move(*masses);
+          }
+        }
+      }
       if (*dim == 0) *dim = static_cast<int>(points->cols());
       try {
         ValidateChain(MakeChain(*points), "strand");
@@ -496,6 +553,7 @@ class GroomParser : public json_internal::JsonReader {
   }
 
   bool grow_;
+  std::vector<Eigen::VectorXd> given_masses_;  // "/strands/i/masses" (empty: none given)
 
  public:
   std::string directory;  // of mesh colliders' relative files ("": the working directory)

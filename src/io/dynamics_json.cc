@@ -111,7 +111,7 @@ std::optional<DynamicOptions> JsonReader::ReadDynamics(const json& v, const std:
       if (const auto choice = Choice(*m, mp, {"by_length", "uniform"})) {
         d.mass_by_length = *choice == "by_length";
       }
-    } else if (m->is_array() && !strands) {
+    } else if (m->is_array()) {
       if (auto masses = NumberList(*m, mp, 1, Range::kPositive)) {
         if (num_links > 0 && masses->size() != num_links) {
           Add(mp,
@@ -126,11 +126,10 @@ std::optional<DynamicOptions> JsonReader::ReadDynamics(const json& v, const std:
       }
     } else {
       TypeProblem(*m, mp,
-                  strands ? "\"by_length\" (each point half of each link it touches) or "
-                            "\"uniform\" (every free point the same)"
-                          : "\"by_length\" (each point half of each link it touches), "
-                            "\"uniform\" (every free point the same) or an array of one number "
-                            "> 0 per free point (points 1 to n)");
+                  "\"by_length\" (each point half of each link it touches), \"uniform\" "
+                  "(every free point the same) or an array of one number > 0 per free point "
+                  "(points 1 to n" +
+                      std::string(strands ? " of every strand)" : ")"));
     }
   }
   Optional(v, ptr, "dftl_damping", non_negative, &d.dftl_damping);

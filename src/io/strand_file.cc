@@ -131,9 +131,12 @@ std::string GroomJson(const StrandFileHeader& h, const StrandRunReport& report) 
     j["dynamics"] = {{"projection", ProjectionName(d.projection)},
                      {"gravity", vector(d.gravity)},
                      {"damping", d.damping},
-                     {"mass", d.mass_by_length ? "by_length" : "uniform"},
+                     {"mass", d.masses.size() != 0 ? vector(d.masses)
+                              : d.mass_by_length   ? nlohmann::json("by_length")
+                                                   : nlohmann::json("uniform")},
                      {"dftl_damping", d.dftl_damping}};
     if (d.wind.size() != 0) j["dynamics"]["wind"] = vector(d.wind);
+    if (h.own_masses) j["dynamics"]["own_masses"] = true;
   }
   j["report"] = {{"max_length_error", report.max_length_error},
                  {"seconds", report.seconds},
@@ -427,7 +430,14 @@ StrandFileReader::StrandFileReader(const std::string& path) : impl_(std::make_un
     d.gravity = vector("gravity");
     if (it->contains("wind")) d.wind = vector("wind");
     d.damping = Get<double>(*it, "damping");
-    d.mass_by_length = Get<std::string>(*it, "mass") == "by_length";
+    const nlohmann::json mass = Get<nlohmann::json>(*it, "mass");
+    if (mass.is_array()) {
+      const std::vector<double> m = Get<std::vector<double>>(*it, "mass");
+      d.masses = Eigen::Map<const Eigen::VectorXd>(m.data(), static_cast<Eigen::Index>(m.size()));
+    } else {
+      d.mass_by_length = Get<std::string>(*it, "mass") == "by_length";
+    }
+    h.own_masses = it->contains("own_masses") && Get<bool>(*it, "own_masses");
     d.dftl_damping = Get<double>(*it, "dftl_damping");
     d.frame_rate = h.fps;
     h.dynamics = d;

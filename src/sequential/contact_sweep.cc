@@ -40,7 +40,9 @@ const std::vector<Collider>& NearColliders(const double* head, double total, dou
   const Eigen::Vector3d h = In3d<Dim>(head);
   near->clear();
   for (const Collider& c : colliders) {
-    const double beyond = QuerySurface(c, h).distance - total;
+    // A lower bound of the distance: a collider it cannot leave out is kept, which changes no
+    // step (one farther than the chain reaches blocks nothing) and no clearance (measured).
+    const double beyond = DistanceLowerBound(c, h) - total;
     if (!(beyond > 0.0 && beyond / longest >= stats.least_clearance)) near->push_back(c);
   }
   return near->size() == colliders.size() ? colliders : *near;

@@ -173,27 +173,11 @@ ColliderBound BoundOf(const Collider& c) {
       for (int k = 0; k < 3; ++k) b.center[k] += c.margin * up[k];
       break;
     }
-    case ColliderShape::kSphere:
-      b.exact = true;
-      b.radius = c.radius;
-      break;
-    case ColliderShape::kCapsule:
-      b.radius = c.half_length + c.radius;
-      break;
-    case ColliderShape::kCylinder:
-      b.radius = std::hypot(c.half_length, c.radius);
-      break;
-    case ColliderShape::kBox:
-      b.radius = c.extents.norm();
-      break;
-    case ColliderShape::kEllipsoid:
-      b.radius = c.extents.maxCoeff();
-      break;
-    case ColliderShape::kMesh:  // the ball about its frame's origin that holds every vertex
-      b.radius = c.scale * c.mesh->radius;
+    default:
+      b.exact = c.shape == ColliderShape::kSphere;
+      b.radius = BoundingRadius(c);
       break;
   }
-  if (!b.half_space) b.radius += c.margin;
   return b;
 }
 
@@ -727,11 +711,6 @@ Problems StrandOptions::Validate() const {
                                           "\"overall\", \"tractrix\" or \"dftl\" (shake is for "
                                           "single chains, SimulateChain)"));
     }
-    if (dynamics->masses.size() != 0) {
-      problems.emplace_back("dynamics.masses",
-                            "are given; given masses are for single chains (SimulateChain): a "
-                            "strand's masses are uniform or by length (mass_by_length)");
-    }
     if (dynamics->substeps != 1 && dynamics->substeps != substeps) {
       problems.push_back(Problem::Invalid("dynamics.substeps", std::to_string(dynamics->substeps),
                                           "1 or the strands' substeps (" +
@@ -748,6 +727,48 @@ Problems StrandOptions::Validate() const {
 }
 
 namespace {
+
+// Given masses against the strands: dynamics.masses (one profile) needs every strand to have as
+// many links as it has entries; StrandOptions::masses one entry per strand, each empty or one
+// finite mass > 0 per free point of that strand.
+Problems CheckStrandMasses(const std::vector<Points>& strands, const StrandOptions& options) {
+  Problems problems;
+  const Eigen::VectorXd& profile = options.dynamics->masses;
+  const size_t count = strands.size();
+  if (!options.masses.empty() && options.masses.size() != count) {
+    problems.push_back(Problem::Invalid(
+        "masses", std::to_string(options.masses.size()) + " entries",
+        "none or one per strand (" + std::to_string(count) + "), each empty or n_i masses"));
+    return problems;
+  }
+  for (size_t i = 0; i < count; ++i) {
+    const Eigen::Index n = strands[i].rows() - 1;
+    const bool own = !options.masses.empty() && options.masses[i].size() != 0;
+    if (own) {
+      const Eigen::VectorXd& m = options.masses[i];
+      const std::string field = "masses[" + std::to_string(i) + "]";
+      if (m.size() != n) {
+        problems.push_back(Problem::Invalid(
+            field, std::to_string(m.size()) + " entries",
+            std::to_string(n) + ", one per free point of strands[" + std::to_string(i) + "]"));
+        continue;
+      }
+      for (Eigen::Index j = 0; j < n; ++j) {
+        if (!(m[j] > 0.0 && std::isfinite(m[j]))) {
+          problems.push_back(Problem::Invalid(field + "[" + std::to_string(j) + "]",
+                                              FormatNumber(m[j]), "a finite number > 0"));
+        }
+      }
+    } else if (profile.size() != 0 && profile.size() != n) {
+      problems.push_back(Problem::Invalid(
+          "dynamics.masses", std::to_string(profile.size()) + " entries",
+          "one per free point of every strand; strands[" + std::to_string(i) + "] has " +
+              std::to_string(n) + " links (give strands of other link counts their own masses)"));
+      break;
+    }
+  }
+  return problems;
+}
 
 void ValidatePose(const BodyPose& pose, int dim) {
   if (!pose.rotation.allFinite()) throw InputError("pose.rotation", "is not finite");
@@ -1191,6 +1212,11 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
     Problems problems = options.dynamics->ValidateFor(dim);
     for (Problem& p : problems) p.field = "dynamics." + p.field;
     ThrowIfAny(problems);
+    ThrowIfAny(CheckStrandMasses(strands, options));
+  } else if (!options.masses.empty()) {
+    throw InputError("masses",
+                     "are given without dynamics; masses are for dynamic strands "
+                     "(StrandOptions::dynamics)");
   }
   m.links.resize(count);
   for (int i = 0; i < count; ++i) m.links[i] = static_cast<int>(strands[i].rows()) - 1;
@@ -1302,9 +1328,15 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
       for (int lane = 0; lane < L; ++lane) {
         // As SimulateChain (the same operations): half of each link a point touches (or 1), the
         // free points' total 1.
+        // Given masses: the strand's own, else the one profile of dynamics.masses.
+        const int source = block.source[lane];
+        const Eigen::VectorXd& given = options.masses.empty() || options.masses[source].size() == 0
+                                           ? dyn.masses
+                                           : options.masses[source];
         Eigen::VectorXd mj = Eigen::VectorXd::Zero(block.n + 1);
         for (int j = 1; j <= block.n; ++j) {
-          mj[j] = dyn.mass_by_length
+          mj[j] = given.size() == block.n ? given[j - 1]
+                  : dyn.mass_by_length
                       ? 0.5 * (len[(j - 1) * L + lane] + (j < block.n ? len[j * L + lane] : 0.0))
                       : 1.0;
         }

@@ -43,9 +43,28 @@ double SegmentSegmentDistance(const Vector3d& p, const Vector3d& q, const Vector
       }
     }
   }
+  double distance = (p + t * d1 - (r + u * d2)).norm();
+  // Nearly parallel segments (the angle between them below about 0.01): a e - b^2 cancels, and the
+  // (t, u) above may lie anywhere along the flat valley of the distance, by up to the segments'
+  // tilt times their length more than its least value. That least value is then on an edge of
+  // the square (an end against the other segment; the interior is flat to within the rounding),
+  // and each edge's least value is a well-conditioned point-segment distance.
+  if (a > 0.0 && e > 0.0) {
+    const double b = d1.dot(d2);
+    if (a * e - b * b <= 1e-4 * a * e) {
+      const auto edge = [&](double te, double ue) {
+        const double d = (p + te * d1 - (r + ue * d2)).norm();
+        if (d < distance) distance = d, t = te, u = ue;
+      };
+      edge(0.0, std::clamp(f / e, 0.0, 1.0));                // p against [r, s]
+      edge(1.0, std::clamp((f + b) / e, 0.0, 1.0));          // q against [r, s]
+      edge(std::clamp(-d1.dot(w) / a, 0.0, 1.0), 0.0);       // r against [p, q]
+      edge(std::clamp((b - d1.dot(w)) / a, 0.0, 1.0), 1.0);  // s against [p, q]
+    }
+  }
   if (t_out != nullptr) *t_out = t;
   if (u_out != nullptr) *u_out = u;
-  return (p + t * d1 - (r + u * d2)).norm();
+  return distance;
 }
 
 // The minimum of the signed distance along [a, b] by golden-section search (the function is
@@ -114,6 +133,40 @@ double SegmentClearance(const std::vector<Collider>& colliders, const Vector3d& 
   return least;
 }
 
+double BoundingRadius(const Collider& c) {
+  double radius = 0.0;
+  switch (c.shape) {
+    case ColliderShape::kHalfSpace:
+      return 0.0;
+    case ColliderShape::kSphere:
+      radius = c.radius;
+      break;
+    case ColliderShape::kCapsule:
+      radius = c.half_length + c.radius;
+      break;
+    case ColliderShape::kCylinder:
+      radius = std::hypot(c.half_length, c.radius);
+      break;
+    case ColliderShape::kBox:
+      radius = c.extents.norm();
+      break;
+    case ColliderShape::kEllipsoid:
+      radius = c.extents.maxCoeff();
+      break;
+    case ColliderShape::kMesh:  // the ball about its frame's origin that holds every vertex
+      radius = c.scale * c.mesh->radius;
+      break;
+  }
+  return radius + c.margin;
+}
+
+double DistanceLowerBound(const Collider& c, const Vector3d& x) {
+  if (c.shape == ColliderShape::kHalfSpace) {
+    return c.pose.linear().col(2).dot(x - c.pose.translation()) - c.margin;
+  }
+  return (x - c.pose.translation()).norm() - BoundingRadius(c);
+}
+
 SegmentContact NearestOnSegment(const Collider& c, const Vector3d& a, const Vector3d& b) {
   SegmentContact contact;
   const Vector3d ab = b - a;
@@ -140,13 +193,27 @@ SegmentContact NearestOnSegment(const Collider& c, const Vector3d& a, const Vect
     case ColliderShape::kMesh: {
       // The signed distance of a convex set is convex along the segment: its slope there, the
       // normal's component along ab, does not decrease; its zero by bisection to the last bit.
+      // A mesh's need not be: the least of 33 samples along the segment brackets the minimum
+      // bisected (the nearest part of the link to the mesh, to the samples' resolution of its
+      // features; a link that passes two bumps is linearized at the nearer).
       const auto slope = [&](double s) { return QuerySurface(c, a + s * ab).normal.dot(ab); };
-      if (slope(0.0) >= 0.0) {
-        contact.s = 0.0;
-      } else if (slope(1.0) <= 0.0) {
-        contact.s = 1.0;
+      double lo = 0.0, hi = 1.0;
+      if (c.shape == ColliderShape::kMesh) {
+        constexpr int kSamples = 32;
+        int best = 0;
+        double least = std::numeric_limits<double>::infinity();
+        for (int k = 0; k <= kSamples; ++k) {
+          const double d = QuerySurface(c, a + (double(k) / kSamples) * ab).distance;
+          if (d < least) least = d, best = k;
+        }
+        lo = double(std::max(best - 1, 0)) / kSamples;
+        hi = double(std::min(best + 1, kSamples)) / kSamples;
+      }
+      if (slope(lo) >= 0.0) {
+        contact.s = lo;
+      } else if (slope(hi) <= 0.0) {
+        contact.s = hi;
       } else {
-        double lo = 0.0, hi = 1.0;
         for (int i = 0; i < 64; ++i) {
           const double mid = 0.5 * (lo + hi);
           if (mid <= lo || mid >= hi) break;

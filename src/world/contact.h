@@ -21,16 +21,26 @@ constexpr double kContactSlack = 1e-13;
 double SegmentClearance(const Collider& collider, const Eigen::Vector3d& a,
                         const Eigen::Vector3d& b);
 
+// The radius of a ball about the collider's origin (its pose's translation) that holds it, its
+// margin included (0 for a half-space, which no ball holds).
+double BoundingRadius(const Collider& collider);
+
+// A lower bound of QuerySurface(collider, x).distance, cheap: exact for a sphere and a
+// half-space, else the distance to the ball of BoundingRadius (broad phases).
+double DistanceLowerBound(const Collider& collider, const Eigen::Vector3d& x);
+
 // The smallest clearance of [a, b] over `colliders` (+inf for none).
 double SegmentClearance(const std::vector<Collider>& colliders, const Eigen::Vector3d& a,
                         const Eigen::Vector3d& b);
 
-// Where the segment [a, b] comes nearest a convex collider (not a mesh): the parameter `s` of the
-// point a + s (b - a) of least signed distance, that distance (SegmentClearance's value, to the
-// rounding) and the collider's outward normal there (the signed distance's gradient at that
-// point). By the envelope theorem the clearance's gradient is (1 - s) normal in a and s normal in
-// b. Closed form for the sphere, capsule and half-space; else the zero of the distance's slope
-// along the segment (convex: a slope that does not decrease), bisected to the last bit.
+// Where the segment [a, b] comes nearest a collider: the parameter `s` of the point a + s (b - a)
+// of least signed distance, that distance (SegmentClearance's value, to the rounding, for a
+// convex collider) and the collider's outward normal there (the signed distance's gradient at
+// that point). By the envelope theorem the clearance's gradient is (1 - s) normal in a and s
+// normal in b. Closed form for the sphere, capsule and half-space; else the zero of the
+// distance's slope along the segment (convex: a slope that does not decrease), bisected to the
+// last bit; for a mesh (not convex), within the bracket of the least of 33 samples along the
+// segment: a local minimum, the nearest where the mesh's features are coarser than the samples.
 struct SegmentContact {
   double clearance = 0.0;
   double s = 0.0;
