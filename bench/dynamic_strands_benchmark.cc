@@ -1,11 +1,12 @@
 // Dynamic strands (flexkin/strands.h `dynamics`, docs/dynamics.md): 10,000 hair strands of 32
 // links (0.01 to 0.02 each) grown out of a unit-sphere scalp, gravity, air drag 1/s, the scalp as
 // a body collider, one sub-step at 60 frames per second, the head shaken left and right while
-// nodding. Each projection (overall, tractrix, dftl) is timed per frame; the baseline in the same
-// run is the kinematic strand engine (tractrix) on the same strands, scalp and motion. Before
+// nodding. Each projection (overall, shake, tractrix, dftl) is timed per frame; the baseline in the
+// same run is the kinematic strand engine (tractrix) on the same strands, scalp and motion. Before
 // the timer the hair falls for 60 frames, so that it lies on the scalp as it does in use (most
 // strands touch it). Counters: contact link steps per frame, the overall projection's
-// non-converged strand sub-steps per frame. *NoScalp: the same without the scalp collider.
+// non-converged strand sub-steps per frame (SHAKE's: the sub-steps that took the overall
+// projection). *NoScalp: the same without the scalp collider.
 // BM_EqualTime/projection/substeps: the same scene (2 threads) with 1 to 8 sub-steps a frame, and
 // beside the time (outside the timer) the accuracy those sub-steps give each projection: the
 // hanging chain's first mode (32 links, 10 s at 60 Hz, SimulateChain: each strand's operations)
@@ -109,6 +110,7 @@ void BM_KinematicHair(benchmark::State& state) { Run(state, std::nullopt); }
 void BM_DynamicHairTractrix(benchmark::State& state) { Run(state, Projection::kTractrix); }
 void BM_DynamicHairDftl(benchmark::State& state) { Run(state, Projection::kDftl); }
 void BM_DynamicHairOverall(benchmark::State& state) { Run(state, Projection::kOverall); }
+void BM_DynamicHairShake(benchmark::State& state) { Run(state, Projection::kShake); }
 // Without the scalp (the hair falls through where the head is): the projections' own cost.
 void BM_DynamicHairTractrixNoScalp(benchmark::State& state) {
   Run(state, Projection::kTractrix, false);
@@ -117,6 +119,7 @@ void BM_DynamicHairDftlNoScalp(benchmark::State& state) { Run(state, Projection:
 void BM_DynamicHairOverallNoScalp(benchmark::State& state) {
   Run(state, Projection::kOverall, false);
 }
+void BM_DynamicHairShakeNoScalp(benchmark::State& state) { Run(state, Projection::kShake, false); }
 
 // The accuracy of `projection` with `substeps` a frame (see the top): the hanging chain's first
 // mode's relative error, and the rope's energy drift per second.
@@ -152,12 +155,16 @@ FLEXKIN_HAIR_BENCHMARK(BM_KinematicHair);
 FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairTractrix);
 FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairDftl);
 FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairOverall);
+FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairShake);
 FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairTractrixNoScalp);
 FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairDftlNoScalp);
 FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairOverallNoScalp);
+FLEXKIN_HAIR_BENCHMARK(BM_DynamicHairShakeNoScalp);
 BENCHMARK(BM_EqualTime)
     ->Args({static_cast<int>(Projection::kOverall), 1})
     ->Args({static_cast<int>(Projection::kOverall), 2})
+    ->Args({static_cast<int>(Projection::kShake), 1})
+    ->Args({static_cast<int>(Projection::kShake), 2})
     ->Args({static_cast<int>(Projection::kTractrix), 1})
     ->Args({static_cast<int>(Projection::kTractrix), 2})
     ->Args({static_cast<int>(Projection::kTractrix), 4})

@@ -217,6 +217,33 @@ TEST(StrandCollidersTest, FarCollidersChangeNoBit) {
   }
 }
 
+// Colliders out of every strand's reach (a block's leading ends further from their bounds than
+// the strands are long) are not measured: with the scalp's contacts, a batch with three such
+// capsules beside it steps every strand as the scalp alone does, bit for bit, on every engine.
+TEST(StrandCollidersTest, CollidersOutOfReachChangeNoBitBesideContacts) {
+  const std::vector<Points> strands = LyingStrands(40, 3, 12, 5);
+  for (const char* engine : {"scalar", "avx2", "avx512"}) {
+    StrandOptions options;
+    options.body_colliders = {Sphere(Vector3d::Zero(), 1.0)};
+    StrandBatch scalp(strands, options);
+    options.body_colliders.push_back(CapsuleBetween(Vector3d(0, 0, -4), Vector3d(0, 0, -6), 1.0));
+    options.body_colliders.push_back(CapsuleBetween(Vector3d(5, 0, 0), Vector3d(7, 0, 1), 0.5));
+    options.colliders = {CapsuleBetween(Vector3d(0, -5, 0), Vector3d(0, -7, 1), 0.5)};
+    StrandBatch more(strands, options);
+    if (!internal::SetStrandEngine(&scalp, engine)) continue;
+    ASSERT_TRUE(internal::SetStrandEngine(&more, engine));
+    for (int f = 1; f <= 30; ++f) {
+      StepStrands(&scalp, TurningPose(f, 3));
+      StepStrands(&more, TurningPose(f, 3));
+    }
+    EXPECT_GT(more.contacts().contact_link_steps, 100) << engine;
+    EXPECT_EQ(more.contacts().contact_link_steps, scalp.contacts().contact_link_steps) << engine;
+    for (int s = 0; s < scalp.size(); ++s) {
+      ASSERT_TRUE(scalp.strand(s) == more.strand(s)) << engine << " strand " << s;
+    }
+  }
+}
+
 // A strand whose root is moved as a point past a world sphere is the single chain run with the
 // same collider (Run with RunOptions::colliders, the contact sweep), on the scalar engine bit
 // for bit.

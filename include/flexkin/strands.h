@@ -56,7 +56,7 @@ struct StrandOptions {
   // sub-step the pinned points go to the body's pose at the sub-step's time (slerp and linear
   // between the frames' poses; roots given as points move linearly), the free points are
   // predicted inertially (velocity, gravity, damping, wind) and put back to their lengths by the
-  // projection (overall, tractrix or dftl; shake is for single chains), exactly as SimulateChain
+  // projection (overall, shake, tractrix or dftl), exactly as SimulateChain
   // does for one chain: with one pinned point and no collider, each strand's frames are those of
   // SimulateChain of its chain with the root's path, bit for bit on the scalar engine and to
   // about 1e-14 relative on the SIMD ones. `method` is not used. The sub-steps are `substeps`

@@ -47,8 +47,12 @@ def test_projection_override_and_refusals(tmp_path):
     a = flexkin.run_groom(groom, tmp_path / "a.npz", projection="dftl")
     info = json.loads(bytes(np.load(tmp_path / "a.npz")["groom.json"]).decode())
     assert info["dynamics"]["projection"] == "dftl" and a.failures == 0
+    # SHAKE runs on strands as on chains; an unknown projection is refused by name.
+    b = flexkin.run_groom(groom, tmp_path / "s.npz", projection="shake")
+    info = json.loads(bytes(np.load(tmp_path / "s.npz")["groom.json"]).decode())
+    assert info["dynamics"]["projection"] == "shake" and b.max_length_error < 1e-12
     with pytest.raises(flexkin.InputError, match="projection"):
-        flexkin.run_groom(groom, tmp_path / "b.npz", projection="shake")
+        flexkin.run_groom(groom, tmp_path / "b.npz", projection="shaky")
     with pytest.raises(flexkin.InputError, match="method"):
         flexkin.run_groom(groom, tmp_path / "c.npz", method="ftl")
     bad = small_groom(frame_rate=60)

@@ -9,6 +9,7 @@
 
 #include "chain/substep.h"
 #include "dynamics/least_constraint.h"
+#include "dynamics/shake.h"
 #include "sequential/link_rules.h"
 #include "world/contact.h"
 
@@ -131,55 +132,21 @@ class Projector {
     for (int j = 1; j <= n_; ++j) TractrixLink(p, SweepRule::kTractrix, j, x);
   }
 
-  // SHAKE: x_j = p_j + w_j (lambda_j D_j - lambda_{j+1} D_{j+1}), D the links of `old` and w the
-  // inverse masses (the driven end's 0), with the multipliers that give every link its length:
-  // Newton's method on f_i = |x_i - x_{i-1}|^2 - L_i^2, whose Jacobian is tridiagonal. False if it
-  // did not converge in 30 iterations.
-  bool Shake(const Points& old, const Points& p, const Eigen::VectorXd& inverse_mass, Points* x) {
-    const int n = n_;
-    Eigen::VectorXd lambda = Eigen::VectorXd::Zero(n + 2), f(n + 1), lower(n + 1), diag(n + 1),
-                    upper(n + 1);
-    Points d_old(n + 2, dim_);
-    d_old.setZero();
-    for (int i = 1; i <= n; ++i) d_old.row(i) = old.row(i) - old.row(i - 1);
-    const auto w = [&](int j) { return j >= 1 && j <= n ? inverse_mass[j] : 0.0; };
-    const auto place = [&]() {
-      x->row(0) = p.row(0);
-      for (int j = 1; j <= n; ++j) {
-        x->row(j) = p.row(j) + w(j) * (lambda[j] * d_old.row(j) - lambda[j + 1] * d_old.row(j + 1));
-      }
-    };
-    for (int iteration = 0; iteration < 30; ++iteration) {
-      place();
-      double worst = 0.0;
-      for (int i = 1; i <= n; ++i) {
-        const Eigen::RowVectorXd d = x->row(i) - x->row(i - 1);
-        f[i] = d.squaredNorm() - lengths_[i - 1] * lengths_[i - 1];
-        // |D|^2 - L^2 at the rounding of the positions: 2 |D| (eps |x|) each way.
-        const double level = 8.0 * std::numeric_limits<double>::epsilon() * lengths_[i - 1] *
-                             (x->row(i).cwiseAbs().maxCoeff() +
-                              x->row(i - 1).cwiseAbs().maxCoeff() + lengths_[i - 1]);
-        worst = std::fmax(worst, std::fabs(f[i]) / level);
-        // d D_i / d lambda_{i-1}, lambda_i, lambda_{i+1}.
-        lower[i] = i >= 2 ? 2.0 * d.dot(-w(i - 1) * d_old.row(i - 1)) : 0.0;
-        diag[i] = 2.0 * d.dot((w(i) + w(i - 1)) * d_old.row(i));
-        upper[i] = i < n ? 2.0 * d.dot(-w(i) * d_old.row(i + 1)) : 0.0;
-      }
-      if (worst <= 1.0) return true;  // every length at the rounding of the positions
-      // The tridiagonal solve (Thomas), J delta = -f.
-      for (int i = 2; i <= n; ++i) {
-        const double m = lower[i] / diag[i - 1];
-        diag[i] -= m * upper[i - 1];
-        f[i] -= m * f[i - 1];
-      }
-      for (int i = n; i >= 1; --i) {
-        f[i] = (f[i] - (i < n ? upper[i] * f[i + 1] : 0.0)) / diag[i];
-      }
-      for (int i = 1; i <= n; ++i) lambda[i] -= f[i];
-      if (!lambda.allFinite()) return false;
-    }
-    place();
-    return false;
+  // SHAKE (dynamics/shake.h): the correction along the links of `old`, with the multipliers that
+  // give every link its length. False if it did not converge.
+  bool Shake(const Points& old, const Points& p, Points* x) {
+    internal::ShakeProblem problem;
+    problem.n = n_;
+    problem.head = 0;
+    problem.p = p.data();
+    problem.old = old.data();
+    problem.x = x->data();
+    problem.mass = mass_.data();
+    problem.lengths = lengths_.data();
+    problem.work = work_.data();
+    const double ok = dim_ == 2 ? internal::SolveShake<double, 2>(problem)
+                                : internal::SolveShake<double, 3>(problem);
+    return ok != 0.0;
   }
 
   // The least mass-weighted correction: Newton on the overall problem measured from `p` (point j
@@ -393,8 +360,6 @@ DynamicResult SimulateChain(const Chain& chain, const Points& root_path,
                                          : 1.0;
   }
   mass /= mass.sum();
-  Eigen::VectorXd inverse_mass = Eigen::VectorXd::Zero(n + 1);
-  inverse_mass.tail(n) = mass.tail(n).cwiseInverse();
   const double h = 1.0 / (options.frame_rate * options.substeps);
   const Eigen::RowVectorXd g = options.gravity.transpose();
   Eigen::RowVectorXd air = options.WindAt(0.0, dim).transpose();
@@ -471,7 +436,7 @@ DynamicResult SimulateChain(const Chain& chain, const Points& root_path,
             ++result.failures;
             fell_back = true;
           }
-        } else if (!projector.Shake(x_old, q, inverse_mass, out)) {
+        } else if (!projector.Shake(x_old, q, out)) {
           // SHAKE's forces are those of the sub-step's start: past its stability limit (a step
           // longer than about 2 / the chain's highest frequency) its lengths have no solution.
           // That sub-step is then projected by the overall projection, which always has one.

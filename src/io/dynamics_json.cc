@@ -43,12 +43,6 @@ std::optional<DynamicOptions> JsonReader::ReadDynamics(const json& v, const std:
     if (const auto name = String(*p, ptr + "/projection")) {
       if (const NamedValue<Projection>* entry = FindName<Projection>(*name)) {
         d.projection = entry->value;
-        if (strands && d.projection == Projection::kShake) {
-          Add(ptr + "/projection",
-              "\"shake\" is for single chains (SimulateChain): the strand engine takes "
-              "\"overall\", \"tractrix\" or \"dftl\"",
-              "\"shake\"", "\"overall\", \"tractrix\" or \"dftl\"");
-        }
       } else {
         problems.push_back(UnknownName(ptr + "/projection", Vocabulary<Projection>::kKind, *name,
                                        NamesOf<Projection>()));

@@ -12,6 +12,7 @@
 #include <cstdint>
 
 #include "dynamics/least_constraint.h"
+#include "dynamics/shake.h"
 #include "sequential/link_rules.h"
 #include "strands/strand_engine.h"
 
@@ -132,9 +133,28 @@ inline void OverallLanes(const DynamicLaneStep& q, int lane0) {
   StoreLanes(SolveLeastConstraint<B, Dim>(problem), q.converged + lane0);
 }
 
+// The SHAKE projection of the lanes (dynamics/shake.h) from the prediction q.p and the sub-step's
+// start q.x_old, into q.x: q.converged[lane] 1 where it converged, else 0 (q.x is then not
+// meaningful in that lane).
+template <class B, int Dim>
+inline void ShakeLanes(const DynamicLaneStep& q, int lane0) {
+  ShakeProblem problem;
+  problem.n = q.n;
+  problem.head = q.head;
+  problem.stride = kStrandLanes;
+  problem.p = q.p + lane0;
+  problem.old = q.x_old + lane0;
+  problem.x = q.x + lane0;
+  problem.mass = q.mass + lane0;
+  problem.lengths = q.lengths + lane0;
+  problem.work = q.work + lane0;
+  if (q.ignore != nullptr) problem.ignore = q.ignore + lane0;
+  StoreLanes(SolveShake<B, Dim>(problem), q.converged + lane0);
+}
+
 // The whole block (lanes 0 .. kStrandLanes) for stage 1 (PredictLanes, ProjectLanes), 2
-// (VelocitiesLanes, corrected for the sequential projections where q.correct) or 3
-// (OverallLanes).
+// (VelocitiesLanes, corrected for the sequential projections where q.correct), 3 (OverallLanes)
+// or 4 (ShakeLanes).
 template <class B, int Dim, class Step, class Contact>
 inline void DynamicBlock(const DynamicLaneStep& q, int stage, Step&& tractrix_step,
                          Contact&& contact) {
@@ -144,6 +164,8 @@ inline void DynamicBlock(const DynamicLaneStep& q, int stage, Step&& tractrix_st
       ProjectLanes<B, Dim>(q, lane0, tractrix_step, contact);
     } else if (stage == 3) {
       OverallLanes<B, Dim>(q, lane0);
+    } else if (stage == 4) {
+      ShakeLanes<B, Dim>(q, lane0);
     } else {
       VelocitiesLanes<B, Dim>(q, lane0, q.correct);
     }

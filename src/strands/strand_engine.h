@@ -74,8 +74,9 @@ using StrandSphereSweepFn = void (*)(Method method, int dim, int n, int head, co
 // inertial prediction (the pinned points' new places) and x its sequential projection (tractrix
 // or dftl). Stage 2: v becomes (x - x_old) / h, with Mueller et al.'s correction
 // -s (x_{j+1} - p_{j+1}) / h where `correct`. Stage 3 (between them, for the overall projection):
-// x becomes the overall projection of p (dynamics/least_constraint.h) where it converges. The
-// operations are SimulateChain's.
+// x becomes the overall projection of p (dynamics/least_constraint.h) where it converges. Stage 4
+// (between them, for SHAKE): x becomes the SHAKE projection of p about x_old (dynamics/shake.h),
+// `converged` 1 where it converged. The operations are SimulateChain's.
 struct DynamicLaneStep {
   int n = 0, head = 0;
   bool tractrix = true;  // else dftl
@@ -92,13 +93,14 @@ struct DynamicLaneStep {
   const StrandSphere* sphere = nullptr;
   uint8_t* contact = nullptr;
   int* fallback = nullptr;
-  // Stage 3, the overall projection (from the tractrix projection in x): the points' masses (point
-  // i of lane j at i * kStrandLanes + j), the solver's scratch (LeastConstraintWork(dim, n) *
-  // kStrandLanes, aligned) and, per lane, 1 where it converged, else 0.
+  // Stages 3 and 4, the overall projection (from the tractrix projection in x) and SHAKE: the
+  // points' masses (point i of lane j at i * kStrandLanes + j), the solver's scratch
+  // (LeastConstraintWork(dim, n) * kStrandLanes, aligned) and, per lane, 1 where it converged,
+  // else 0.
   const double* mass = nullptr;
   double* work = nullptr;
   double* multipliers = nullptr;   // the links' (as mass), kept from sub-step to sub-step
-  const double* ignore = nullptr;  // per lane: 1 where the overall projection is not wanted
+  const double* ignore = nullptr;  // per lane: 1 where the stage's projection is not wanted
   // Stage 2 without `correct`: per lane, 1 where the velocities take the correction (the overall
   // projection's lanes that took the tractrix projection with contacts), else 0.
   const double* correct_lanes = nullptr;

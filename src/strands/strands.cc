@@ -154,8 +154,11 @@ class WorkerPool {
 };
 
 struct Block {
-  int n = 0;                                 // links of every strand of the block
-  int pinned = 0;                            // points set from the body: min(k, n + 1)
+  int n = 0;       // links of every strand of the block
+  int pinned = 0;  // points set from the body: min(k, n + 1)
+  // How far a free point (and a link's bound test) can reach from the leading end: the most,
+  // over the lanes, of the free links' total length and two longest links.
+  double reach = 0.0;
   size_t points = 0, lengths = 0, body = 0;  // offsets into the batch's arrays
   int source[L] = {};  // the strand each lane carries (padding lanes repeat the first)
 };
@@ -192,6 +195,8 @@ struct ContactScratch {
   std::vector<int> first_enter;          // per lane: the first link that entered a collider
   std::vector<int> fallback;             // per lane: the first link the lanes' step left
   std::vector<double> clearances;        // per link, bound and lane: the bound's clearance
+  std::vector<ColliderBound> active;     // the bounds some lane of a block can come near
+  std::vector<int> active_index;         // their colliders' indices
   std::vector<uint8_t> contact_flags;    // per link and lane: the lanes' contact step taken
   std::vector<uint64_t> near;            // per lane: the colliders a link came near (bits)
   std::vector<Collider> near_colliders;  // one lane's near colliders
@@ -206,6 +211,7 @@ struct DynamicScratch {
   std::vector<double> pin_from;     // the pinned points at the frame's start (dim x L each)
   AlignedDoubles work;              // the overall projection's (LeastConstraintWork)
   AlignedDoubles sequential;  // the overall projection's start (with the lanes' contact steps)
+  AlignedDoubles shaken;      // SHAKE's projection, while its failed lanes take the overall one
   alignas(64) double converged[kStrandLanes];  // its lanes' outcome
   alignas(64) double ignore[kStrandLanes];     // its lanes not wanted (1)
   alignas(64) double corrected[kStrandLanes];  // its lanes that took the sequential one (1)
@@ -426,32 +432,76 @@ void LinkBoundsOf(int n, int head, const double* points, const ColliderBound* bo
   }
 }
 
-void CheckLanes(StrandBoundsFn measure, int dim, int n, int head, const double* pts,
+void CheckLanes(StrandBoundsFn measure, int dim, int n, int head, double reach, const double* pts,
                 const double* lengths, const double* inv_lengths,
                 const std::vector<Collider>& colliders, const std::vector<ColliderBound>& bounds,
-                double* clearances, double* least, int* first_enter, uint64_t* near) {
-  const int nb = static_cast<int>(bounds.size());
-  measure(dim, n, head, pts, bounds.data(), nb, clearances);
+                ContactScratch* cs) {
+  // A collider whose bound is further than the block's reach from every lane's leading end is
+  // far from every link (each link lies within the reach less its length of the leading end):
+  // it is not measured.
+  cs->active.clear();
+  cs->active_index.clear();
+  const double* h = pts + static_cast<size_t>(head) * dim * L;
+  for (size_t c = 0; c < bounds.size(); ++c) {
+    const ColliderBound& bound = bounds[c];
+    bool near = false;
+    for (int lane = 0; lane < L && !near; ++lane) {
+      double clear = 0.0;
+      if (bound.half_space) {
+        for (int k = 0; k < dim; ++k) clear += bound.up[k] * (h[k * L + lane] - bound.center[k]);
+      } else {
+        double d2 = 0.0;
+        for (int k = 0; k < dim; ++k) {
+          const double d = h[k * L + lane] - bound.center[k];
+          d2 += d * d;
+        }
+        clear = std::sqrt(d2) - bound.radius;
+      }
+      near = !(clear > reach);
+    }
+    if (!near) continue;
+    cs->active.push_back(bound);
+    cs->active_index.push_back(static_cast<int>(c));
+  }
+  const int nb = static_cast<int>(cs->active.size());
+  if (nb == 0) return;
+  double* clearances = cs->clearances.data();
+  measure(dim, n, head, pts, cs->active.data(), nb, clearances);
   for (int i = head + 1; i <= n; ++i) {
     const double* a = pts + (i - 1) * dim * L;
     const double* b = pts + i * dim * L;
     const double* len = lengths + (i - 1) * L;
     const double* inv = inv_lengths + (i - 1) * L;
     const double* clear = clearances + static_cast<size_t>(i - head - 1) * nb * L;
-    for (int c = 0; c < nb; ++c, clear += L) {
-      const ColliderBound& bound = bounds[c];
+    for (int j = 0; j < nb; ++j, clear += L) {
+      const ColliderBound& bound = cs->active[j];
+      const int c = cs->active_index[j];
       const uint64_t bit = c < 64 ? uint64_t{1} << c : ~uint64_t{0};
+      if (bound.exact || bound.half_space) {
+        // The bound's clearance is the collider's: the same as below with no exact measure, in a
+        // loop without branches (the compiler's vector code).
+        for (int lane = 0; lane < L; ++lane) {
+          const double c_lane = clear[lane];
+          const bool near = c_lane < len[lane];
+          cs->near[lane] |= near ? bit : uint64_t{0};
+          const bool enters = near && c_lane < -kContactSlack * len[lane];
+          cs->first_enter[lane] =
+              enters ? std::min(cs->first_enter[lane], i) : cs->first_enter[lane];
+          cs->least[lane] = near ? std::min(cs->least[lane], c_lane * inv[lane]) : cs->least[lane];
+        }
+        continue;
+      }
       for (int lane = 0; lane < L; ++lane) {
         double c_lane = clear[lane];
         if (c_lane >= len[lane]) continue;  // far: not near this collider
-        near[lane] |= bit;
-        if (!bound.exact && !bound.half_space) {
-          const Eigen::Vector3d pa(a[lane], a[L + lane], dim == 3 ? a[2 * L + lane] : 0.0);
-          const Eigen::Vector3d pb(b[lane], b[L + lane], dim == 3 ? b[2 * L + lane] : 0.0);
-          c_lane = SegmentClearance(colliders[c], pa, pb);
+        cs->near[lane] |= bit;
+        const Eigen::Vector3d pa(a[lane], a[L + lane], dim == 3 ? a[2 * L + lane] : 0.0);
+        const Eigen::Vector3d pb(b[lane], b[L + lane], dim == 3 ? b[2 * L + lane] : 0.0);
+        c_lane = SegmentClearance(colliders[c], pa, pb);
+        if (c_lane < -kContactSlack * len[lane]) {
+          cs->first_enter[lane] = std::min(cs->first_enter[lane], i);
         }
-        if (c_lane < -kContactSlack * len[lane]) first_enter[lane] = std::min(first_enter[lane], i);
-        least[lane] = std::min(least[lane], c_lane * inv[lane]);
+        cs->least[lane] = std::min(cs->least[lane], c_lane * inv[lane]);
       }
     }
   }
@@ -532,8 +582,8 @@ void StrandBatchImpl::StepBlockWithColliders(int b, double* scratch_heads, Conta
     std::fill(cs->first_enter.begin(), cs->first_enter.end(), n + 1);
     std::fill(cs->near.begin(), cs->near.end(), 0);
     const std::vector<Collider>& all = placed[s - 1];
-    CheckLanes(measure_bounds, dim, n, head, pts, block_lengths, block_inv, all, bounds[s - 1],
-               cs->clearances.data(), cs->least.data(), cs->first_enter.data(), cs->near.data());
+    CheckLanes(measure_bounds, dim, n, head, block.reach, pts, block_lengths, block_inv, all,
+               bounds[s - 1], cs);
     for (int lane = 0; lane < L; ++lane) {
       int first = cs->first_enter[lane];
       if (in_lanes) {
@@ -706,11 +756,6 @@ Problems StrandOptions::Validate() const {
   check(colliders, "colliders");
   check(body_colliders, "body_colliders");
   if (dynamics) {
-    if (dynamics->projection == Projection::kShake) {
-      problems.push_back(Problem::Invalid("dynamics.projection", "\"shake\"",
-                                          "\"overall\", \"tractrix\" or \"dftl\" (shake is for "
-                                          "single chains, SimulateChain)"));
-    }
     if (dynamics->substeps != 1 && dynamics->substeps != substeps) {
       problems.push_back(Problem::Invalid("dynamics.substeps", std::to_string(dynamics->substeps),
                                           "1 or the strands' substeps (" +
@@ -991,7 +1036,7 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
   q.n = n;
   q.head = head;
   q.tractrix = dyn.projection != Projection::kDftl;
-  q.correct = dyn.projection != Projection::kOverall;
+  q.correct = dyn.projection == Projection::kTractrix || dyn.projection == Projection::kDftl;
   q.h = 1.0 / (dyn.frame_rate * S);
   q.damping = dyn.damping;
   q.dftl_damping = dyn.dftl_damping;
@@ -1026,23 +1071,30 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
     // lane for the sequential projections; for the overall one, the lanes where that projection
     // touched the sphere (the overall projection knows no colliders: it is solved for the others,
     // and a lane it leaves inside a collider is put back to the sequential projection too).
-    const bool overall = dyn.projection == Projection::kOverall;
+    // The solved projections (overall, SHAKE) know no colliders: they are solved for the lanes
+    // the sphere did not touch, and a lane they leave inside a collider is put back to the
+    // sequential projection too.
+    const bool shake = dyn.projection == Projection::kShake;
+    const bool solved = shake || dyn.projection == Projection::kOverall;
     const auto padding = [&](int lane) {
       return lane > 0 && block.source[lane] == block.source[0];
     };
     bool sequential[L];
-    bool failed[L] = {};  // the overall projection did not converge: the tractrix one kept
-    std::fill(sequential, sequential + L, in_lanes && !overall);
-    const auto restore = [&](int lane) {
+    bool failed[L] = {};  // no solved projection converged: the tractrix one kept
+    std::fill(sequential, sequential + L, in_lanes && !solved);
+    const auto put_back = [&](int lane) {
       for (int i = head + 1; i <= n; ++i) {
         for (int k = 0; k < dim; ++k) {
           const size_t at = static_cast<size_t>(i * dim + k) * L + lane;
           pts[at] = ds.sequential.data()[at];
         }
       }
+    };
+    const auto restore = [&](int lane) {
+      put_back(lane);
       sequential[lane] = true;
     };
-    if (overall) {
+    if (solved) {
       bool all_touched = in_lanes;
       if (in_lanes) {
         for (int lane = 0; lane < L; ++lane) {
@@ -1053,15 +1105,46 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
         }
       }
       if (!all_touched) {
-        // The overall projection from the tractrix projection, in the lanes; a lane where it does
-        // not converge keeps the tractrix projection.
-        if (in_lanes) std::copy(pts, pts + size, ds.sequential.data());
+        // The tractrix projection kept: the overall projection's start, SHAKE's fallback.
+        if (in_lanes || shake) std::copy(pts, pts + size, ds.sequential.data());
         for (int lane = 0; lane < L; ++lane) ds.ignore[lane] = sequential[lane] ? 1.0 : 0.0;
         q.ignore = ds.ignore;
-        dynamic_step(dim, q, 3);
-        for (int lane = 0; lane < L; ++lane) {
-          failed[lane] = !sequential[lane] && ds.converged[lane] == 0.0;
-          if (failed[lane] && !padding(lane)) ++ds.failures;
+        bool overall_lanes[L];
+        bool any_overall = !shake;
+        std::fill(overall_lanes, overall_lanes + L, !shake);
+        if (shake) {
+          // SHAKE in the lanes; where it does not converge (past its stability limit), that
+          // lane's sub-step takes the overall projection from the tractrix projection, as
+          // SimulateChain's.
+          dynamic_step(dim, q, 4);
+          for (int lane = 0; lane < L; ++lane) {
+            overall_lanes[lane] = !sequential[lane] && ds.converged[lane] == 0.0;
+            if (!overall_lanes[lane]) continue;
+            if (!padding(lane)) ++ds.failures;
+            put_back(lane);
+            any_overall = true;
+          }
+          for (int lane = 0; lane < L; ++lane) ds.ignore[lane] = overall_lanes[lane] ? 0.0 : 1.0;
+        }
+        if (any_overall) {
+          // The overall projection from the tractrix projection, in the lanes; a lane where it
+          // does not converge keeps the tractrix projection. (It moves the lanes it ignores too:
+          // SHAKE's are kept aside.)
+          if (shake) std::copy(pts, pts + size, ds.shaken.data());
+          dynamic_step(dim, q, 3);
+          for (int lane = 0; lane < L; ++lane) {
+            failed[lane] = overall_lanes[lane] && !sequential[lane] && ds.converged[lane] == 0.0;
+            if (!shake && failed[lane] && !padding(lane)) ++ds.failures;
+          }
+          for (int lane = 0; lane < L && shake; ++lane) {
+            if (overall_lanes[lane] || sequential[lane]) continue;
+            for (int i = head + 1; i <= n; ++i) {
+              for (int k = 0; k < dim; ++k) {
+                const size_t at = static_cast<size_t>(i * dim + k) * L + lane;
+                pts[at] = ds.shaken.data()[at];
+              }
+            }
+          }
         }
         for (int lane = 0; lane < L; ++lane) {
           if (sequential[lane]) restore(lane);
@@ -1073,12 +1156,11 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
         std::fill(cs->least.begin(), cs->least.end(), std::numeric_limits<double>::infinity());
         std::fill(cs->first_enter.begin(), cs->first_enter.end(), n + 1);
         std::fill(cs->near.begin(), cs->near.end(), 0);
-        CheckLanes(measure_bounds, dim, n, head, pts, q.lengths, q.inv_lengths, placed[s - 1],
-                   bounds[s - 1], cs->clearances.data(), cs->least.data(), cs->first_enter.data(),
-                   cs->near.data());
+        CheckLanes(measure_bounds, dim, n, head, block.reach, pts, q.lengths, q.inv_lengths,
+                   placed[s - 1], bounds[s - 1], cs);
       };
       check();
-      if (in_lanes && overall) {
+      if (in_lanes && solved) {
         bool any = false;
         for (int lane = 0; lane < L; ++lane) {
           if (sequential[lane] || cs->first_enter[lane] > n) continue;
@@ -1089,30 +1171,43 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
         for (int lane = 0; lane < L && !padding(lane); ++lane)
           ds.contact_substeps += sequential[lane];
       }
+      // The lanes' own contact steps stand up to the first link projected again: each point
+      // they placed takes no velocity correction (its prediction is made its place). Lane by
+      // lane in the inner loops, without branches (the compiler's vector code).
+      int first_lane[L], stood[L];
       for (int lane = 0; lane < L; ++lane) {
-        int first = cs->first_enter[lane];
-        if (sequential[lane]) {
-          // The lanes' own contact steps stand up to the first link projected again.
-          first = std::min(first, cs->fallback[lane]);
-          for (int i = head + 1; i < first && i <= n; ++i) {
-            if (!cs->contact_flags[i * L + lane]) continue;
-            ++cs->stats.contact_link_steps;
-            for (int k = 0; k < dim; ++k) {
-              const size_t at = static_cast<size_t>(i * dim + k) * L + lane;
-              ds.predicted.data()[at] = pts[at];
-            }
+        first_lane[lane] = sequential[lane] ? std::min(cs->first_enter[lane], cs->fallback[lane])
+                                            : cs->first_enter[lane];
+        stood[lane] = sequential[lane] ? first_lane[lane] : head + 1;
+        stood[lane] = std::min(stood[lane], n + 1);
+      }
+      int64_t contact_steps = 0;
+      for (int i = head + 1; i <= n; ++i) {
+        const uint8_t* flags = cs->contact_flags.data() + i * L;
+        for (int k = 0; k < dim; ++k) {
+          const size_t at = static_cast<size_t>(i * dim + k) * L;
+          double* predicted = ds.predicted.data() + at;
+          const double* placed = pts + at;
+          for (int lane = 0; lane < L; ++lane) {
+            const bool contact = flags[lane] != 0 && i < stood[lane];
+            predicted[lane] = contact ? placed[lane] : predicted[lane];
           }
         }
+        for (int lane = 0; lane < L; ++lane) contact_steps += flags[lane] != 0 && i < stood[lane];
+      }
+      cs->stats.contact_link_steps += contact_steps;
+      for (int lane = 0; lane < L; ++lane) {
+        const int first = first_lane[lane];
         if (first > n) {
           cs->stats.least_clearance = std::min(cs->stats.least_clearance, cs->least[lane]);
           continue;
         }
-        if (overall && !sequential[lane] && !padding(lane)) ++ds.contact_substeps;
-        if (overall) sequential[lane] = true;  // ContactLane's projection is the tractrix one
+        if (solved && !sequential[lane] && !padding(lane)) ++ds.contact_substeps;
+        if (solved) sequential[lane] = true;  // ContactLane's projection is the tractrix one
         ContactLane(block, lane, first, s, ds, pts, cs);
       }
     }
-    if (overall) {
+    if (solved) {
       // A lane that kept or took the tractrix projection (with contacts, or where the overall one
       // did not converge) takes its velocity correction too (without it that projection gains
       // energy: docs/dynamics.md).
@@ -1251,7 +1346,7 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
   m.lengths = internal::AlignedDoubles(num_lengths);
   m.inv_lengths = internal::AlignedDoubles(num_lengths);
   m.body = internal::AlignedDoubles(num_body);
-  for (const auto& block : m.blocks) {
+  for (auto& block : m.blocks) {
     for (int lane = 0; lane < L; ++lane) {
       const Points& p = strands[block.source[lane]];
       // The link lengths as MakeChain and MakeStepper compute them.
@@ -1260,10 +1355,15 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
         for (int k = 0; k < dim; ++k)
           m.points.data()[block.points + (i * dim + k) * L + lane] = p(i, k);
       }
+      double total = 0.0, longest = 0.0;
       for (int i = 0; i < block.n; ++i) {
         m.lengths.data()[block.lengths + i * L + lane] = lengths[i];
         m.inv_lengths.data()[block.lengths + i * L + lane] = 1.0 / lengths[i];
+        if (i < block.pinned - 1) continue;  // a pinned link: not free
+        total += lengths[i];
+        longest = std::max(longest, lengths[i]);
       }
+      block.reach = std::max(block.reach, total + 2.0 * longest);
       for (int j = 0; j < block.pinned; ++j) {
         double q[3];
         internal::ToBody(rest, dim, p.row(j).data(), q);
@@ -1315,7 +1415,9 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
       num_mass += static_cast<size_t>(block.n + 1) * L;
     }
     m.mass = internal::AlignedDoubles(num_mass);
-    if (dyn.projection == Projection::kOverall) {
+    const bool solved =
+        dyn.projection == Projection::kOverall || dyn.projection == Projection::kShake;
+    if (solved) {
       m.multipliers = internal::AlignedDoubles(num_mass);  // 0: the first sub-step's start
     }
     int most_links = 0, most_pinned = 1;
@@ -1349,9 +1451,11 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
       ds.x_old = internal::AlignedDoubles(static_cast<size_t>(most_links + 1) * dim * L);
       ds.predicted = internal::AlignedDoubles(static_cast<size_t>(most_links + 1) * dim * L);
       ds.pin_from.resize(static_cast<size_t>(most_pinned) * dim * L);
-      if (dyn.projection == Projection::kOverall) {
+      if (solved) {
         ds.work = internal::AlignedDoubles(internal::LeastConstraintWork(dim, most_links) * L);
         ds.sequential = internal::AlignedDoubles(static_cast<size_t>(most_links + 1) * dim * L);
+        if (dyn.projection == Projection::kShake)
+          ds.shaken = internal::AlignedDoubles(ds.sequential.size());
       }
     }
     m.block_energy.assign(m.blocks.size(), 0.0);
@@ -1386,6 +1490,8 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
       cs.first_enter.resize(L);
       cs.fallback.resize(L);
       cs.clearances.resize(static_cast<size_t>(most_links) * num * L);
+      cs.active.reserve(num);
+      cs.active_index.reserve(num);
       cs.contact_flags.resize(static_cast<size_t>(most_links + 1) * L);
       cs.near.resize(L);
       cs.near_colliders.reserve(m.placed.back().size());

@@ -120,13 +120,36 @@ __attribute__((always_inline)) inline B SphereClearance(const B* h, const B* ab,
   return xsimd::sqrt(d2) - r;
 }
 
+// Whether the segment [h, h + ab] comes nearer `c` than `inner` (the sphere's radius less the
+// slack: the lanes where its clearance is below -slack), NaN lanes included: the segment's least
+// squared distance times |ab|^2 against inner^2 |ab|^2, with no division and no root.
+template <class B, int Dim>
+__attribute__((always_inline)) inline typename B::batch_bool_type SphereEnters(const B* h,
+                                                                               const B* ab,
+                                                                               const B* c,
+                                                                               const B& inner) {
+  B dot(0.0), ab2(0.0), e2(0.0), f2(0.0);
+  for (int k = 0; k < Dim; ++k) {
+    const B e = c[k] - h[k];  // the centre from the segment's start
+    const B f = e - ab[k];    // and from its end
+    dot += ab[k] * e;
+    ab2 += ab[k] * ab[k];
+    e2 += e * e;
+    f2 += f * f;
+  }
+  // The nearest point at t = dot / ab2, clamped to the segment.
+  const B scaled = xsimd::select(dot <= B(0.0), e2 * ab2,
+                                 xsimd::select(dot >= ab2, f2 * ab2, e2 * ab2 - dot * dot));
+  return (inner > B(0.0)) & !(scaled >= inner * inner * ab2);
+}
+
 // The contact step of lanes `enter` of one link against the sphere (strand_engine.h): the new
 // trailing end into `tail`, the lanes it could not step in `bad`.
 template <class B, int Dim>
-void SphereContact(const B* h, const B* old, const B& length, const B* c, const B& r,
-                   const B& slack, B* tail, typename B::batch_bool_type* bad) {
+void SphereContact(const B* h, const B* old, const B& length, const B& inv_length, const B* c,
+                   const B& r, const B& slack, B* tail, typename B::batch_bool_type* bad) {
   using Bool = typename B::batch_bool_type;
-  const B limit = -slack * length;
+  const B inner = r - slack * length;
   // The direction of the old trailing end.
   B d0[Dim], n0(0.0);
   for (int k = 0; k < Dim; ++k) {
@@ -135,13 +158,14 @@ void SphereContact(const B* h, const B* old, const B& length, const B* c, const 
   }
   n0 = xsimd::sqrt(n0);
   Bool no = !(n0 > B(0.0));
-  for (int k = 0; k < Dim; ++k) d0[k] /= n0;
+  const B inv_n0 = B(1.0) / n0;
+  for (int k = 0; k < Dim; ++k) d0[k] *= inv_n0;
   B along[Dim], step[Dim];
   for (int k = 0; k < Dim; ++k) {
     along[k] = h[k] + length * d0[k];
     step[k] = along[k] - h[k];
   }
-  const Bool blocked = SphereClearance<B, Dim>(h, step, c, r) < limit;
+  const Bool blocked = SphereEnters<B, Dim>(h, step, c, inner);
   // The cone the sphere blocks, about u, the direction of its centre.
   B u[Dim], D2(0.0);
   for (int k = 0; k < Dim; ++k) {
@@ -149,16 +173,25 @@ void SphereContact(const B* h, const B* old, const B& length, const B* c, const 
     D2 += u[k] * u[k];
   }
   const B D = xsimd::sqrt(D2);
-  for (int k = 0; k < Dim; ++k) u[k] /= D;
+  const B inv_D = B(1.0) / D;
+  for (int k = 0; k < Dim; ++k) u[k] *= inv_D;
   const Bool on_surface = D <= r;
   no = no | (on_surface & (r - D > slack * length)) | !(D > B(0.0));
   const B tangent = xsimd::sqrt(xsimd::max((D - r) * (D + r), B(0.0)));
   const Bool reach = length >= tangent;
-  const B cos_far = xsimd::max(
-      B(-1.0), xsimd::min((D2 + length * length - r * r) / (B(2.0) * length * D), B(1.0)));
-  const B sin_far = xsimd::sqrt((B(1.0) - cos_far) * (B(1.0) + cos_far));
-  const B sin_a = xsimd::select(on_surface, B(1.0), xsimd::select(reach, r / D, sin_far));
-  const B cos_a = xsimd::select(on_surface, B(0.0), xsimd::select(reach, tangent / D, cos_far));
+  B sin_a = xsimd::select(on_surface, B(1.0), r * inv_D);
+  B cos_a = xsimd::select(on_surface, B(0.0), tangent * inv_D);
+  const Bool far = !(on_surface | reach);
+  if (xsimd::any(far)) {
+    // The link cannot reach the tangent point: the cone of the directions whose end touches the
+    // sphere.
+    const B cos_far = xsimd::max(
+        B(-1.0),
+        xsimd::min((D2 + length * length - r * r) * (B(0.5) * inv_length * inv_D), B(1.0)));
+    const B sin_far = xsimd::sqrt((B(1.0) - cos_far) * (B(1.0) + cos_far));
+    sin_a = xsimd::select(far, sin_far, sin_a);
+    cos_a = xsimd::select(far, cos_far, cos_a);
+  }
   B du(0.0);
   for (int k = 0; k < Dim; ++k) du += d0[k] * u[k];
   B w[Dim], wn(0.0), wu(0.0);
@@ -173,13 +206,14 @@ void SphereContact(const B* h, const B* old, const B& length, const B* c, const 
   }
   wn = xsimd::sqrt(wn);
   no = no | (blocked & !(wn > B(1e-300)));
+  const B sin_w = sin_a / wn;
   B x[Dim];
   for (int k = 0; k < Dim; ++k) {
-    const B exit = h[k] + length * (cos_a * u[k] + sin_a * (w[k] / wn));
+    const B exit = h[k] + length * (cos_a * u[k] + sin_w * w[k]);
     x[k] = xsimd::select(blocked, exit, along[k]);
     step[k] = x[k] - h[k];
   }
-  no = no | !(SphereClearance<B, Dim>(h, step, c, r) >= limit);
+  no = no | SphereEnters<B, Dim>(h, step, c, inner);
   for (int k = 0; k < Dim; ++k) tail[k] = xsimd::select(no, old[k], x[k]);
   *bad = no;
 }
@@ -217,13 +251,14 @@ void BlockSphereSweep(int n, int head, const double* heads, const double* length
       // The sphere: lanes whose rule step enters it take the contact step.
       B step[Dim];
       for (int k = 0; k < Dim; ++k) step[k] = tail[k] - lead_new[u][k];
-      const auto enter = SphereClearance<B, Dim>(lead_new[u], step, c, r) < -slack * length;
+      const auto enter = SphereEnters<B, Dim>(lead_new[u], step, c, r - slack * length);
       alignas(64) double entered[W], failed[W];
       xsimd::select(enter, B(1.0), B(0.0)).store_aligned(entered);
       if (xsimd::any(enter)) {
         B moved[Dim];
         typename B::batch_bool_type bad;
-        SphereContact<B, Dim>(lead_new[u], old, length, c, r, slack, moved, &bad);
+        SphereContact<B, Dim>(lead_new[u], old, length, B::load_aligned(inv_ptr + u * W), c, r,
+                              slack, moved, &bad);
         for (int k = 0; k < Dim; ++k) tail[k] = xsimd::select(enter, moved[k], tail[k]);
         xsimd::select(enter & bad, B(1.0), B(0.0)).store_aligned(failed);
         for (int j = 0; j < W; ++j) {
@@ -332,14 +367,16 @@ void FLEXKIN_DYNAMIC_ENTRY(int dim, const DynamicLaneStep& q, int stage) {
       const B length = B::load_aligned(q.lengths + static_cast<size_t>(i - 1) * L + lane0);
       B step[Dim];
       for (int k = 0; k < Dim; ++k) step[k] = out[k] - lead[k];
-      const auto enter = SphereClearance<B, Dim>(lead, step, c, r) < -slack * length;
+      const auto enter = SphereEnters<B, Dim>(lead, step, c, r - slack * length);
       alignas(64) double entered[W], failed[W];
       xsimd::select(enter, B(1.0), B(0.0)).store_aligned(entered);
       if (xsimd::any(enter)) {
         B candidate[Dim], moved[Dim];
         for (int k = 0; k < Dim; ++k) candidate[k] = out[k];
         typename B::batch_bool_type bad;
-        SphereContact<B, Dim>(lead, candidate, length, c, r, slack, moved, &bad);
+        const B inv_length =
+            B::load_aligned(q.inv_lengths + static_cast<size_t>(i - 1) * L + lane0);
+        SphereContact<B, Dim>(lead, candidate, length, inv_length, c, r, slack, moved, &bad);
         for (int k = 0; k < Dim; ++k) out[k] = xsimd::select(enter, moved[k], out[k]);
         xsimd::select(enter & bad, B(1.0), B(0.0)).store_aligned(failed);
         for (int j = 0; j < W; ++j) {
