@@ -284,6 +284,55 @@ TEST(SnapshotFigureTest, SvgPngPdfFromTheExtensionAndAutomaticHeight) {
   EXPECT_LE(png.height, 1152);
 }
 
+// Links with a radius (a run's link_radius, a robot's capsules) are drawn as their capsules: for
+// every link of the last configuration, in 2D and 3D, one stroke between its ends' pixels with
+// round caps and the width of its diameter at the scene's scale (orthographic: the capsule's
+// exact outline); without radii, none.
+TEST(SnapshotFigureTest, LinksWithARadiusAreDrawnAsTheirCapsules) {
+  for (int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    TempDir dir;
+    FigureOptions options;
+    ResultFile file = SmallScene(dim);
+    const Eigen::Index n = file.result.lengths.size();
+    const Eigen::VectorXd radii = Eigen::VectorXd::LinSpaced(n, 0.03, 0.08);
+    // The links of `f`'s last configuration drawn as a capsule of `radii`.
+    const auto capsules = [&](const ResultFile& f, const std::string& name) {
+      WriteSnapshotFigure(f, options, dir.Path(name));
+      const std::vector<SvgPath> paths = SvgPaths(ReadFile(dir.Path(name)));
+      const render::ChainScene scene = render::LayoutSnapshot(f, options).scene;
+      const int last = static_cast<int>(f.result.frames.size()) - 1;
+      int found = 0;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        const Eigen::Vector2d a = scene.Pixel(f, last, static_cast<int>(i));
+        const Eigen::Vector2d b = scene.Pixel(f, last, static_cast<int>(i + 1));
+        const double scale = scene.scale();
+        for (const SvgPath& p : paths) {
+          if (p.vertices.size() != 2 || !Near(p.vertices[0], a) || !Near(p.vertices[1], b))
+            continue;
+          if (p.style.find("stroke-linecap:round") == std::string::npos) continue;
+          const std::smatch m = [&] {
+            std::smatch match;
+            static const std::regex kWidth(R"(stroke-width:([0-9.]+))");
+            std::regex_search(p.style, match, kWidth);
+            return match;
+          }();
+          if (m.empty()) continue;
+          const double width = std::stod(m[1].str());
+          if (std::fabs(width - 2.0 * radii[i] * scale) < 1e-3 * width + 0.01) {
+            ++found;
+            break;
+          }
+        }
+      }
+      return found;
+    };
+    EXPECT_EQ(capsules(file, "plain.svg"), 0);
+    file.link_radii = radii;
+    EXPECT_EQ(capsules(file, "capsules.svg"), n);
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Plots.
 

@@ -182,36 +182,38 @@ TEST(ResultColliders, WithoutCollidersTheFileIsAsBefore) {
   }
 }
 
+// The field a result document's reader refuses, or "(no error)".
+std::string FieldOfResultText(const nlohmann::json& doc) {
+  try {
+    ResultFromText(doc.dump());
+  } catch (const InputError& e) {
+    return e.field();
+  }
+  return std::string("(no error)");
+}
+
 TEST(ResultColliders, BadColliderNamedByPointer) {
   std::ostringstream out;
   WriteResultJson(SceneWithColliders(2), out);
   const nlohmann::json good = nlohmann::json::parse(out.str());
-  const auto field_of = [](const nlohmann::json& doc) {
-    try {
-      ResultFromText(doc.dump());
-    } catch (const InputError& e) {
-      return e.field();
-    }
-    return std::string("(no error)");
-  };
   nlohmann::json doc = good;
   doc["colliders"][0]["radius"] = -1;
-  EXPECT_EQ(field_of(doc), "/colliders/0/radius");
+  EXPECT_EQ(FieldOfResultText(doc), "/colliders/0/radius");
   doc = good;
   doc["colliders"][3]["half_extents"] = {0.5, 0.25, 1.0};  // 3 numbers in a 2D result
-  EXPECT_EQ(field_of(doc), "/colliders/3/half_extents");
+  EXPECT_EQ(FieldOfResultText(doc), "/colliders/3/half_extents");
   doc = good;
   doc["colliders"][1]["shape"] = "capsul";
-  EXPECT_EQ(field_of(doc), "/colliders/1/shape");
+  EXPECT_EQ(FieldOfResultText(doc), "/colliders/1/shape");
   doc = good;
   doc["colliders"][5].erase("normal");
-  EXPECT_EQ(field_of(doc), "/colliders/5/normal");
+  EXPECT_EQ(FieldOfResultText(doc), "/colliders/5/normal");
   doc = good;
   doc["colliders"][2]["radius"] = "wide";
-  EXPECT_EQ(field_of(doc), "/colliders/2/radius");
+  EXPECT_EQ(FieldOfResultText(doc), "/colliders/2/radius");
   doc = good;
   doc["colliders"] = 5;
-  EXPECT_EQ(field_of(doc), "/colliders");
+  EXPECT_EQ(FieldOfResultText(doc), "/colliders");
 }
 
 TEST(ResultColliders, WritersRefuseACollider2dCannotSay) {
@@ -229,6 +231,46 @@ TEST(ResultColliders, WritersRefuseACollider2dCannotSay) {
   file.colliders[1].radius = -0.5;
   EXPECT_FALSE(ValidateResult(file).empty());
   EXPECT_THROW(WriteSnapshotFigure(file, FigureOptions(), dir.Path("f.png")), InputError);
+}
+
+// The links' radii: written as "link_radii" when given (a run's link_radius, one per link),
+// read back the same in both formats, absent otherwise; a bad list is refused by pointer when
+// read and by field when written (nothing written).
+TEST(ResultColliders, LinkRadiiRoundTripAndBadOnesNamed) {
+  TempDir dir;
+  ResultFile file = SceneWithColliders(2);
+  const Eigen::Index n = file.result.lengths.size();
+  file.link_radii = Eigen::VectorXd::LinSpaced(n, 0.01, 0.05);
+  for (const char* name : {"r.json", "r.npz"}) {
+    const std::string path = dir.Path(name);
+    WriteResultFile(file, path, ResultFileFormatOfPath(path));
+    EXPECT_EQ(ReadResultFile(path).link_radii, file.link_radii) << name;
+  }
+  std::ostringstream out;
+  WriteResultJson(file, out);
+  const nlohmann::json good = nlohmann::json::parse(out.str());
+  ASSERT_EQ(good["link_radii"].size(), static_cast<size_t>(n));
+  nlohmann::json doc = good;
+  doc["link_radii"][1] = -0.5;
+  EXPECT_EQ(FieldOfResultText(doc), "/link_radii/1");
+  doc["link_radii"] = {0.1};
+  EXPECT_EQ(FieldOfResultText(doc), "/link_radii");
+  doc.erase("link_radii");
+  EXPECT_EQ(FieldOfResultText(doc), "(no error)");
+  file.link_radii[2] = std::nan("");
+  try {
+    WriteResultFile(file, dir.Path("bad.json"), ResultFileFormat::kJson);
+    FAIL() << "a NaN link radius was written";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "link_radii[2]");
+  }
+  EXPECT_FALSE(render_test::Exists(dir.Path("bad.json")));
+  // A run with a link radius writes it for every link.
+  Scenario s = LoadScenarioFile(std::string(FLEXKIN_SOURCE_DIR) + "/examples/rope_round_post.json");
+  s.options.link_radius = 0.02;
+  RunToFiles(s.chain, s.leader_steps, s.options, s.name, {dir.Path("rope.json"), ""});
+  EXPECT_EQ(ReadResultFile(dir.Path("rope.json")).link_radii,
+            Eigen::VectorXd::Constant(s.chain.num_links(), 0.02));
 }
 
 TEST(ResultColliders, RopeRoundPostEndToEnd) {

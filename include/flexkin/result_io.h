@@ -44,8 +44,11 @@ struct ResultHeader {
   // The run's colliders (RunOptions::colliders), written as "colliders" in the scenario's form if
   // any (a file without them is written as before colliders existed).
   std::vector<Collider> colliders;
+  // The links' radii (one per link; RunOptions::link_radius, a robot's capsules), written as
+  // "link_radii" if given: figures draw each link as its capsule. Empty: none.
+  Eigen::VectorXd link_radii;
 };
-// The header of a run of `chain` with `options` (its colliders included).
+// The header of a run of `chain` with `options` (its colliders and link radius included).
 ResultHeader MakeResultHeader(const Chain& chain, const RunOptions& options,
                               const std::string& scenario_name = "");
 
@@ -174,6 +177,8 @@ struct ResultFile {
   // the run's input, known before it starts (RunOptions::colliders), which a run hands on
   // unchanged; what the run made of them is RunResult::contacts.
   std::vector<Collider> colliders;
+  // The links' radii ("link_radii", one per link; empty if the file has none).
+  Eigen::VectorXd link_radii;
 };
 
 // ValidateResult of the file's result, and its colliders: each passes CheckCollider and, in 2D,

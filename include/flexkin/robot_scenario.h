@@ -222,6 +222,8 @@ struct RobotTrajectoryFile {
   // "colliders" (as the scenario gave them; a keyframed one's times in steps: the state of step s
   // where its motion has it at time s), none if the file has none.
   std::vector<Collider> colliders;
+  // "link_radii" (with colliders): each link's capsule radius, base link first; empty if none.
+  Eigen::VectorXd link_radii;
 };
 
 // Whether the file at `path` is a robot trajectory: JSON whose top-level "format" is

@@ -41,6 +41,21 @@ std::optional<Problem> ResultHeaderProblem(const Eigen::VectorXd& lengths, int d
   return std::nullopt;
 }
 
+std::optional<Problem> LinkRadiiProblem(const Eigen::VectorXd& radii, Eigen::Index n) {
+  if (radii.size() == 0) return std::nullopt;
+  if (radii.size() != n) {
+    return Problem("link_radii", "has " + std::to_string(radii.size()) + " entries; expected " +
+                                     std::to_string(n) + ", one per link");
+  }
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (!(radii[i] >= 0.0) || !std::isfinite(radii[i])) {
+      return Problem::Invalid(Index("link_radii", i), FormatNumber(radii[i]),
+                              "a finite number >= 0");
+    }
+  }
+  return std::nullopt;
+}
+
 std::optional<Problem> ResultFrameProblem(size_t f, int64_t step, const PointsRef& p,
                                           const VectorRef& link_angles, int64_t previous_step,
                                           Eigen::Index n, int dim) {
@@ -136,6 +151,11 @@ Problems ValidateResult(const ResultFile& file) {
   if (std::optional<Problem> problem = FirstProblem(file.result, file.dim)) return {*problem};
   Problems problems = CollidersProblems(file.colliders, file.dim);
   if (problems.size() > 1) problems.resize(1);  // the first, as for the rest of the result
+  if (problems.empty()) {
+    if (auto problem = LinkRadiiProblem(file.link_radii, file.result.lengths.size())) {
+      problems.push_back(*problem);
+    }
+  }
   return problems;
 }
 

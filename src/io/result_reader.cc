@@ -9,6 +9,7 @@
 #include "io/colliders_json.h"
 #include "io/json_checked.h"
 #include "io/json_file.h"
+#include "io/result_check.h"
 #include "io/result_json.h"
 
 // Result files in (docs/result-format.md): the first problem is thrown, naming its JSON pointer.
@@ -85,6 +86,16 @@ void ReadResultSummary(const json& j, const ResultArrays* arrays, ResultFile* ou
   r.lengths =
       arrays ? arrays->lengths : ReadVector(Member(j, "", "link_lengths"), "/link_lengths", -1);
   const Eigen::Index n = r.lengths.size();
+  if (const auto it = j.find("link_radii"); it != j.end()) {
+    file.link_radii = ReadVector(*it, "/link_radii", n);
+    if (auto problem = LinkRadiiProblem(file.link_radii, n)) {
+      std::string pointer = "/" + problem->field;  // link_radii[i] -> /link_radii/i
+      for (char& c : pointer) c = c == '[' ? '/' : c;
+      if (!pointer.empty() && pointer.back() == ']') pointer.pop_back();
+      problem->field = pointer;
+      throw InputError(*problem);
+    }
+  }
   r.num_steps = ReadInteger(Member(j, "", "num_steps"), "/num_steps", 0);
 
   const json& accuracy = Member(j, "", "accuracy");

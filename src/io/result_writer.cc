@@ -53,13 +53,15 @@ int CheckResult(const RunResult& r) {
 }
 
 ResultHeader HeaderOfResult(const RunResult& r, int dim, const std::string& scenario_name,
-                            const std::vector<Collider>& colliders = {}) {
+                            const std::vector<Collider>& colliders = {},
+                            const Eigen::VectorXd& link_radii = Eigen::VectorXd()) {
   ResultHeader h;
   h.method = r.method;
   h.dim = dim;
   h.lengths = r.lengths;
   h.scenario_name = scenario_name;
   h.colliders = colliders;
+  h.link_radii = link_radii;
   return h;
 }
 
@@ -217,6 +219,11 @@ void AppendResultHeaderJson(const ResultHeader& h, bool with_lengths, std::strin
     }
     t += "\n],\n";
   }
+  if (h.link_radii.size() > 0) {
+    t += "\"link_radii\": ";
+    AppendVector(h.link_radii, &t);
+    t += ",\n";
+  }
 }
 
 void AppendResultSummaryJson(const RunResult& result, bool with_arrays, std::string* out) {
@@ -316,6 +323,9 @@ ResultHeader MakeResultHeader(const Chain& chain, const RunOptions& options,
   h.lengths = chain.lengths;
   h.scenario_name = scenario_name;
   h.colliders = options.colliders;
+  if (options.link_radius > 0.0) {
+    h.link_radii = Eigen::VectorXd::Constant(chain.num_links(), options.link_radius);
+  }
   return h;
 }
 
@@ -327,6 +337,9 @@ ResultFileWriter::ResultFileWriter(const std::string& path, ResultFileFormat for
   }
   if (Problems problems = CollidersProblems(header.colliders, header.dim); !problems.empty()) {
     ThrowNothingWritten(problems.front());
+  }
+  if (auto problem = LinkRadiiProblem(header.link_radii, header.lengths.size())) {
+    ThrowNothingWritten(*problem);
   }
   if (format == ResultFileFormat::kNpz) {
     impl_ = MakeNpzResultWriter(path, header);
@@ -403,8 +416,8 @@ void WriteResultJson(const RunResult& result, const std::string& path,
 
 void WriteResultJson(const ResultFile& file, std::ostream& out) {
   const int dim = CheckResultFile(file);
-  JsonResultStream stream(out,
-                          HeaderOfResult(file.result, dim, file.scenario_name, file.colliders));
+  JsonResultStream stream(
+      out, HeaderOfResult(file.result, dim, file.scenario_name, file.colliders, file.link_radii));
   for (const Frame& frame : file.result.frames) {
     stream.Add(frame.step, frame.points, frame.link_angles);
   }
@@ -413,8 +426,9 @@ void WriteResultJson(const ResultFile& file, std::ostream& out) {
 
 void WriteResultFile(const ResultFile& file, const std::string& path, ResultFileFormat format) {
   const int dim = CheckResultFile(file);
-  ResultFileWriter writer(path, format,
-                          HeaderOfResult(file.result, dim, file.scenario_name, file.colliders));
+  ResultFileWriter writer(
+      path, format,
+      HeaderOfResult(file.result, dim, file.scenario_name, file.colliders, file.link_radii));
   for (const Frame& frame : file.result.frames) {
     writer.Add(frame.step, frame.points, frame.link_angles);
   }

@@ -82,6 +82,16 @@ RobotTrajectoryFile TrajectoryFromJson(const json& j) {
     t.colliders = ReadCollidersJson(*it, "/colliders", t.dim, &problems);
     ThrowIfAny(problems);
   }
+  if (const auto it = j.find("link_radii"); it != j.end()) {
+    t.link_radii = Vector(*it, "/link_radii", t.link_lengths.size());
+    for (Eigen::Index i = 0; i < t.link_radii.size(); ++i) {
+      if (!(t.link_radii[i] >= 0.0)) {
+        throw InputError("/link_radii/" + std::to_string(i),
+                         "value " + Show((*it)[static_cast<size_t>(i)]) +
+                             " is not valid; expected a finite number >= 0");
+      }
+    }
+  }
 
   t.states.push_back(StatePoints(Member(j, "", "initial"), "/initial", 0, t.dim));
   const Eigen::Index rows = t.states.front().rows();
@@ -203,6 +213,13 @@ ResultFile RobotTrajectoryAsResult(const RobotTrajectoryFile& t) {
   }
   for (Eigen::Index i = 0; i + 1 < g; ++i) {
     if (!(r.lengths[i] > 0.0)) r.lengths[i] = 1.0;
+  }
+  // The links' capsules, end effector first as the points: one per drawn link where the arm has
+  // one link per distinct point, else (joints at one point) the largest radius for every link.
+  if (t.link_radii.size() > 0) {
+    file.link_radii = t.link_radii.size() == g - 1
+                          ? Eigen::VectorXd(t.link_radii.reverse())
+                          : Eigen::VectorXd::Constant(g - 1, t.link_radii.maxCoeff());
   }
   Metrics& m = r.metrics;
   m.path_length = Eigen::VectorXd::Zero(g);

@@ -75,6 +75,10 @@ void DrawMoment(render::Canvas* canvas, const ChainScene& scene, const ResultFil
     chain_rows.push_back(rows);
     styles.push_back({render::FadeColor(0.15 + 0.6 * (kGhosts - g) / kGhosts), 1.2 * ui, false});
   }
+  if (file.link_radii.size() > 0) {
+    scene.DrawCapsules(cr, frames[f].points.data(), rows, file.link_radii,
+                       render::Mix(render::kFinal, render::kWhite, 0.72));
+  }
   chains.push_back(frames[f].points.data());
   chain_rows.push_back(rows);
   styles.push_back({render::kFinal, 2.6 * ui, false});

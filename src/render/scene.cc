@@ -218,6 +218,29 @@ void ChainScene::DrawAxes3D(cairo_t* cr) const {
   }
 }
 
+void ChainScene::DrawCapsules(cairo_t* cr, const double* chain, int rows,
+                              const Eigen::VectorXd& radii, const Rgb& color) const {
+  std::vector<std::pair<double, int>> order;  // (depth, link), far first
+  for (int j = 0; j + 1 < rows && j < radii.size(); ++j) {
+    if (radii[j] > 0.0) {
+      const double* p = chain + dim_ * j;
+      order.emplace_back(-0.5 * (Depth(p) + Depth(p + dim_)), j);
+    }
+  }
+  std::stable_sort(order.begin(), order.end());
+  cairo_save(cr);
+  cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+  SetColor(cr, color);
+  for (const auto& [depth, j] : order) {
+    const Eigen::Vector2d a = Pixel(chain + dim_ * j), b = Pixel(chain + dim_ * (j + 1));
+    cairo_move_to(cr, a.x(), a.y());
+    cairo_line_to(cr, b.x(), b.y());
+    cairo_set_line_width(cr, 2.0 * radii[j] * scale_);
+    cairo_stroke(cr);
+  }
+  cairo_restore(cr);
+}
+
 void ChainScene::DrawChains(cairo_t* cr, const std::vector<const double*>& chains,
                             const std::vector<int>& rows,
                             const std::vector<ChainStyle>& styles) const {

@@ -29,6 +29,8 @@ class ChainScene {
   ChainScene(const ResultFile& file, const Rect& area, double ui, double azimuth, double elevation);
 
   int dim() const { return dim_; }
+  // Pixels per data unit (every axis, and in 3D every direction of the view plane).
+  double scale() const { return scale_; }
   // A point (dim values) in pixels.
   Eigen::Vector2d Pixel(const double* point) const;
   // Point i of frame f in pixels.
@@ -52,6 +54,12 @@ class ChainScene {
   // the farther lighter and thinner; dashes continue along a chain.
   void DrawChains(cairo_t* cr, const std::vector<const double*>& chains,
                   const std::vector<int>& rows, const std::vector<ChainStyle>& styles) const;
+  // Draws one chain's links (a (rows by dim) row-major array) as their capsules: link i, from
+  // point i to i + 1, a stroke of width 2 radii[i] (data units) with round ends, in `color`
+  // (3D: far to near). The view is orthographic, so that a capsule's outline is exactly that
+  // stroke's. Under the chain's lines.
+  void DrawCapsules(cairo_t* cr, const double* chain, int rows, const Eigen::VectorXd& radii,
+                    const Rgb& color) const;
   // Draws the colliders filled in kColliderFill, outlined in kColliderEdge, within the plot
   // (render/scene_colliders.cc): 2D, the exact outline of each (a half-plane: the part of the
   // plot below its line); 3D, each finite shape's silhouette (the hull of its projected surface),

@@ -135,6 +135,10 @@ void DrawSnapshotFigure(const ResultFile& file, const Look& look, const FigureOp
 
   const Points& first = frames.front().points;
   const Points& last = frames.back().points;
+  // Links with a radius: the last configuration's capsules, under its lines.
+  if (file.link_radii.size() > 0) {
+    scene.DrawCapsules(cr, last.data(), rows, file.link_radii, Mix(kFinal, kWhite, 0.72));
+  }
   if (num_frames > 1) scene.DrawChains(cr, {first.data()}, {rows}, {{kInitial, 2.0 * ui, true}});
   scene.DrawChains(cr, {last.data()}, {rows}, {{kFinal, 2.6 * ui, false}});
   // Joints of the last configuration when they are far enough apart to be seen.
