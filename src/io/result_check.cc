@@ -41,16 +41,18 @@ std::optional<Problem> ResultHeaderProblem(const Eigen::VectorXd& lengths, int d
   return std::nullopt;
 }
 
-std::optional<Problem> LinkRadiiProblem(const Eigen::VectorXd& radii, Eigen::Index n) {
+std::optional<Problem> LinkRadiiProblem(const Eigen::VectorXd& radii, Eigen::Index n,
+                                        bool pointer) {
   if (radii.size() == 0) return std::nullopt;
+  const std::string field = pointer ? "/link_radii" : "link_radii";
   if (radii.size() != n) {
-    return Problem("link_radii", "has " + std::to_string(radii.size()) + " entries; expected " +
-                                     std::to_string(n) + ", one per link");
+    return Problem(field, "has " + std::to_string(radii.size()) + " entries; expected " +
+                              std::to_string(n) + ", one per link");
   }
   for (Eigen::Index i = 0; i < n; ++i) {
     if (!(radii[i] >= 0.0) || !std::isfinite(radii[i])) {
-      return Problem::Invalid(Index("link_radii", i), FormatNumber(radii[i]),
-                              "a finite number >= 0");
+      return Problem::Invalid(pointer ? field + "/" + std::to_string(i) : Index(field, i),
+                              FormatNumber(radii[i]), "a finite number >= 0");
     }
   }
   return std::nullopt;

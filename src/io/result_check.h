@@ -14,8 +14,10 @@ namespace flexkin {
 
 // dim 2 or 3, at least one link, positive finite link lengths.
 std::optional<Problem> ResultHeaderProblem(const Eigen::VectorXd& lengths, int dim);
-// The links' radii: none, or one finite number >= 0 per link of `n` ("link_radii").
-std::optional<Problem> LinkRadiiProblem(const Eigen::VectorXd& radii, Eigen::Index n);
+// The links' radii: none, or one finite number >= 0 per link of `n`; named "link_radii" and
+// "link_radii[i]", or as JSON pointers ("/link_radii", "/link_radii/i") for the readers.
+std::optional<Problem> LinkRadiiProblem(const Eigen::VectorXd& radii, Eigen::Index n,
+                                        bool pointer = false);
 // Frame `f` (named "frames[f]..."): (n+1) by dim points, link angles one per link or none, every
 // number finite, step >= 0 and above `previous_step` (-1 for the first frame).
 std::optional<Problem> ResultFrameProblem(size_t f, int64_t step, const PointsRef& points,

@@ -88,13 +88,7 @@ void ReadResultSummary(const json& j, const ResultArrays* arrays, ResultFile* ou
   const Eigen::Index n = r.lengths.size();
   if (const auto it = j.find("link_radii"); it != j.end()) {
     file.link_radii = ReadVector(*it, "/link_radii", n);
-    if (auto problem = LinkRadiiProblem(file.link_radii, n)) {
-      std::string pointer = "/" + problem->field;  // link_radii[i] -> /link_radii/i
-      for (char& c : pointer) c = c == '[' ? '/' : c;
-      if (!pointer.empty() && pointer.back() == ']') pointer.pop_back();
-      problem->field = pointer;
-      throw InputError(*problem);
-    }
+    if (auto problem = LinkRadiiProblem(file.link_radii, n, true)) throw InputError(*problem);
   }
   r.num_steps = ReadInteger(Member(j, "", "num_steps"), "/num_steps", 0);
 

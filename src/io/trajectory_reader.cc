@@ -13,6 +13,7 @@
 #include "io/colliders_json.h"
 #include "io/json_checked.h"
 #include "io/json_file.h"
+#include "io/result_check.h"
 
 namespace flexkin {
 namespace {
@@ -84,12 +85,8 @@ RobotTrajectoryFile TrajectoryFromJson(const json& j) {
   }
   if (const auto it = j.find("link_radii"); it != j.end()) {
     t.link_radii = Vector(*it, "/link_radii", t.link_lengths.size());
-    for (Eigen::Index i = 0; i < t.link_radii.size(); ++i) {
-      if (!(t.link_radii[i] >= 0.0)) {
-        throw InputError("/link_radii/" + std::to_string(i),
-                         "value " + Show((*it)[static_cast<size_t>(i)]) +
-                             " is not valid; expected a finite number >= 0");
-      }
+    if (auto problem = LinkRadiiProblem(t.link_radii, t.link_lengths.size(), true)) {
+      throw InputError(*problem);
     }
   }
 

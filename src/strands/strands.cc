@@ -1068,12 +1068,10 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
     }
     dynamic_step(dim, q, 1);
     // Lanes whose points are the sequential projection's with the lanes' contact steps: every
-    // lane for the sequential projections; for the overall one, the lanes where that projection
-    // touched the sphere (the overall projection knows no colliders: it is solved for the others,
-    // and a lane it leaves inside a collider is put back to the sequential projection too).
-    // The solved projections (overall, SHAKE) know no colliders: they are solved for the lanes
-    // the sphere did not touch, and a lane they leave inside a collider is put back to the
-    // sequential projection too.
+    // lane for the sequential projections; for the solved ones, the lanes where that projection
+    // touched the sphere. The solved projections (overall, SHAKE) know no colliders: they are
+    // solved for the lanes the sphere did not touch, and a lane they leave inside a collider is put
+    // back to the sequential projection too.
     const bool shake = dyn.projection == Projection::kShake;
     const bool solved = shake || dyn.projection == Projection::kOverall;
     const auto padding = [&](int lane) {
@@ -1082,16 +1080,17 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
     bool sequential[L];
     bool failed[L] = {};  // no solved projection converged: the tractrix one kept
     std::fill(sequential, sequential + L, in_lanes && !solved);
-    const auto put_back = [&](int lane) {
+    // A lane's free points from `source` (a block's layout).
+    const auto put_back = [&](int lane, const double* source) {
       for (int i = head + 1; i <= n; ++i) {
         for (int k = 0; k < dim; ++k) {
           const size_t at = static_cast<size_t>(i * dim + k) * L + lane;
-          pts[at] = ds.sequential.data()[at];
+          pts[at] = source[at];
         }
       }
     };
     const auto restore = [&](int lane) {
-      put_back(lane);
+      put_back(lane, ds.sequential.data());
       sequential[lane] = true;
     };
     if (solved) {
@@ -1121,7 +1120,7 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
             overall_lanes[lane] = !sequential[lane] && ds.converged[lane] == 0.0;
             if (!overall_lanes[lane]) continue;
             if (!padding(lane)) ++ds.failures;
-            put_back(lane);
+            put_back(lane, ds.sequential.data());
             any_overall = true;
           }
           for (int lane = 0; lane < L; ++lane) ds.ignore[lane] = overall_lanes[lane] ? 0.0 : 1.0;
@@ -1137,13 +1136,7 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
             if (!shake && failed[lane] && !padding(lane)) ++ds.failures;
           }
           for (int lane = 0; lane < L && shake; ++lane) {
-            if (overall_lanes[lane] || sequential[lane]) continue;
-            for (int i = head + 1; i <= n; ++i) {
-              for (int k = 0; k < dim; ++k) {
-                const size_t at = static_cast<size_t>(i * dim + k) * L + lane;
-                pts[at] = ds.shaken.data()[at];
-              }
-            }
+            if (!overall_lanes[lane] && !sequential[lane]) put_back(lane, ds.shaken.data());
           }
         }
         for (int lane = 0; lane < L; ++lane) {
