@@ -205,67 +205,84 @@ TEST_F(CommitSignalTest, SignalAroundTheCommitLeavesTheOldOrTheWholeNewFile) {
   // in_commit: signalled once the temporary file had its final size (the last byte written),
   // before the rename; commit_stopped: of those, the ones the check before the rename stopped.
   int interrupted = 0, completed = 0, in_commit = 0, commit_stopped = 0, after_exit = 0;
-  for (size_t i = 0; i < triggers.size(); ++i) {
-    Trigger trigger = triggers[i];
-    trigger.signal = i % 2 == 0 ? SIGINT : SIGTERM;
-    const Outcome o = run(trigger);
-    const Watched& w = o.watched;
-    SCOPED_TRACE("trigger " + std::to_string(i) + ": at " + std::to_string(trigger.min_size) +
-                 " bytes + " + std::to_string(1e3 * trigger.delay) + " ms, signal " +
-                 std::to_string(trigger.signal) + " sent at " +
-                 std::to_string(w.temp_size_at_signal) + " bytes; " + o.err);
-    if (!w.signalled) ++after_exit;  // the command was done before the delay: exit 0 below
-    EXPECT_EQ(w.violations, std::vector<std::string>{});
-    ASSERT_TRUE(WIFEXITED(o.status)) << "ended by signal " << WTERMSIG(o.status);
-    const int code = WEXITSTATUS(o.status);
-    const bool signalled_in_commit =
-        w.signalled && w.temp_after_signal && w.temp_size_at_signal == final_size;
-    in_commit += signalled_in_commit;
-    if (code == 0) {
-      ++completed;
-      // The new file, whole: every size seen at the output path since it changed is the final
-      // one, and it reads back as the reference run's frames.
-      const off_t size = Stat(out).size;
-      EXPECT_EQ(w.new_min, size);
-      EXPECT_EQ(w.new_max, size);
-      try {
-        const ResultFile back = ReadResultFile(out);
-        const Frames &a = back.result.frames, &b = expected.result.frames;
-        ASSERT_EQ(a.size(), b.size());
-        ASSERT_EQ(a.points_data().size(), b.points_data().size());
-        ASSERT_EQ(a.link_angles_data().size(), b.link_angles_data().size());
-        EXPECT_EQ(std::memcmp(a.points_data().data(), b.points_data().data(),
-                              sizeof(double) * a.points_data().size()),
-                  0);
-        EXPECT_EQ(std::memcmp(a.link_angles_data().data(), b.link_angles_data().data(),
-                              sizeof(double) * a.link_angles_data().size()),
-                  0);
-        EXPECT_EQ(std::memcmp(a.steps().data(), b.steps().data(), sizeof(int64_t) * a.size()), 0);
-      } catch (const InputError& e) {
-        ADD_FAILURE() << "exit 0 but the output does not read: " << e.what();
+  size_t runs = 0;
+  auto sweep = [&](const std::vector<Trigger>& sweep_triggers) {
+    for (size_t i = 0; i < sweep_triggers.size(); ++i, ++runs) {
+      Trigger trigger = sweep_triggers[i];
+      trigger.signal = i % 2 == 0 ? SIGINT : SIGTERM;
+      const Outcome o = run(trigger);
+      const Watched& w = o.watched;
+      SCOPED_TRACE("trigger " + std::to_string(i) + ": at " + std::to_string(trigger.min_size) +
+                   " bytes + " + std::to_string(1e3 * trigger.delay) + " ms, signal " +
+                   std::to_string(trigger.signal) + " sent at " +
+                   std::to_string(w.temp_size_at_signal) + " bytes; " + o.err);
+      if (!w.signalled) ++after_exit;  // the command was done before the delay: exit 0 below
+      EXPECT_EQ(w.violations, std::vector<std::string>{});
+      ASSERT_TRUE(WIFEXITED(o.status)) << "ended by signal " << WTERMSIG(o.status);
+      const int code = WEXITSTATUS(o.status);
+      // The run's own final size differs from the reference's by the digits of its seconds: a
+      // temporary file within 256 bytes of it has had its last byte, as for the triggers.
+      const bool signalled_in_commit =
+          w.signalled && w.temp_after_signal && w.temp_size_at_signal >= last_byte;
+      in_commit += signalled_in_commit;
+      if (code == 0) {
+        ++completed;
+        // The new file, whole: every size seen at the output path since it changed is the final
+        // one, and it reads back as the reference run's frames.
+        const off_t size = Stat(out).size;
+        EXPECT_EQ(w.new_min, size);
+        EXPECT_EQ(w.new_max, size);
+        try {
+          const ResultFile back = ReadResultFile(out);
+          const Frames &a = back.result.frames, &b = expected.result.frames;
+          ASSERT_EQ(a.size(), b.size());
+          ASSERT_EQ(a.points_data().size(), b.points_data().size());
+          ASSERT_EQ(a.link_angles_data().size(), b.link_angles_data().size());
+          EXPECT_EQ(std::memcmp(a.points_data().data(), b.points_data().data(),
+                                sizeof(double) * a.points_data().size()),
+                    0);
+          EXPECT_EQ(std::memcmp(a.link_angles_data().data(), b.link_angles_data().data(),
+                                sizeof(double) * a.link_angles_data().size()),
+                    0);
+          EXPECT_EQ(std::memcmp(a.steps().data(), b.steps().data(), sizeof(int64_t) * a.size()), 0);
+        } catch (const InputError& e) {
+          ADD_FAILURE() << "exit 0 but the output does not read: " << e.what();
+        }
+      } else {
+        ++interrupted;
+        commit_stopped += signalled_in_commit;
+        EXPECT_EQ(code, 128 + trigger.signal);
+        EXPECT_EQ(ReadFile(out), earlier);
+        EXPECT_EQ(w.new_max, -1) << "the new file was at the output path for a while";
+        const std::string name = trigger.signal == SIGINT ? "SIGINT" : "SIGTERM";
+        EXPECT_NE(o.err.find("interrupted by " + name + "; nothing was written to out.npz"),
+                  std::string::npos);
       }
-    } else {
-      ++interrupted;
-      commit_stopped += signalled_in_commit;
-      EXPECT_EQ(code, 128 + trigger.signal);
-      EXPECT_EQ(ReadFile(out), earlier);
-      EXPECT_EQ(w.new_max, -1) << "the new file was at the output path for a while";
-      const std::string name = trigger.signal == SIGINT ? "SIGINT" : "SIGTERM";
-      EXPECT_NE(o.err.find("interrupted by " + name + "; nothing was written to out.npz"),
-                std::string::npos);
+      EXPECT_EQ(test_util::TemporaryFilesIn(dir_), std::vector<std::string>{});
     }
-    EXPECT_EQ(test_util::TemporaryFilesIn(dir_), std::vector<std::string>{});
+  };
+  sweep(triggers);
+  // The window varies from run to run on a loaded machine (a sanitized build, other tests
+  // beside): where the sweep missed the commit, the commit's part of it again, at most twice,
+  // each time shifted by 1/24 of the window.
+  const bool disk = measured && window >= 2e-3;
+  for (int round = 1; round <= 2 && disk && commit_stopped == 0; ++round) {
+    std::vector<Trigger> again;
+    for (int k = 0; k <= 12; ++k) {
+      again.push_back({last_byte, window * (k + 0.5 * round) / 12.0, 0});
+    }
+    sweep(again);
   }
   std::printf(
       "%zu runs: %d interrupted (earlier file kept), %d completed (new file); %d signalled "
       "between the last byte and the rename, %d of them stopped; %d after the exit\n",
-      triggers.size(), interrupted, completed, in_commit, commit_stopped, after_exit);
+      runs, interrupted, completed, in_commit, commit_stopped, after_exit);
   RecordProperty("in_commit", in_commit);
   // Where syncing takes a while (a disk; not a tmpfs), the sweep hits the commit: the test then
   // tests what it is for, and the check before the rename stops a signal during the sync.
   // (The window varies from run to run on a loaded machine, so a sweep sized by the reference's
   // window may land only once or twice in a later one: one hit is asked for.)
-  if (measured && window >= 2e-3) {
+  if (disk) {
     EXPECT_GE(in_commit, 1) << "the sweep missed the commit";
     EXPECT_GE(commit_stopped, 1) << "no signal during the sync stopped the command";
   }

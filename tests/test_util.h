@@ -20,6 +20,15 @@
 
 namespace flexkin::test_util {
 
+// True in the AddressSanitizer build (make test-sanitize). There, the longest simulations (tens of
+// seconds of simulated time, minutes under the sanitizers) run a shorter span: the same code
+// paths for the sanitizers, while the plain build checks where the runs end (a body at rest).
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+
 // A number for a test message, 3 significant digits.
 inline std::string Str(double x) {
   char buf[32];
