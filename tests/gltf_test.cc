@@ -8,19 +8,24 @@
 #include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <system_error>
+#include <tuple>
 #include <vector>
 
 #include "flexkin/result_io.h"
 #include "flexkin/run.h"
 #include "flexkin/scenario.h"
+#include "gltf/reader.h"
 #include "gltf/rig.h"
 #include "gltf/tube.h"
 #include "io/json_file.h"  // ReadJsonFile, WriteFileAtomically
@@ -364,6 +369,213 @@ TEST(GltfTube, SkinnedTubeFollowsTheChain) {
       }
       EXPECT_LT((centre - frames[f].row(j).transpose()).norm(), 1e-6) << f << " " << j;
     }
+  }
+}
+
+// The rest pose of a written file's tube, seen through the file alone: its vertices, and the
+// joints where the skin's inverse bind matrices put them (the origin of each joint's bind space,
+// in the scene's coordinates).
+struct RestTube {
+  std::vector<Eigen::Vector3d> vertices, normals, joints;
+  double size = 0.0;  // the largest coordinate: float32 rounds relative to it
+};
+RestTube ReadRestTube(const std::string& path) {
+  const gltf::SkinnedMeshRestPose pose = gltf::ReadSkinnedMeshRestPose(path);
+  RestTube tube;
+  tube.vertices = pose.positions;
+  tube.normals = pose.normals;
+  for (const Eigen::Matrix4d& m : pose.inverse_bind_matrices) {
+    tube.joints.push_back(m.inverse().topRightCorner<3, 1>());
+  }
+  for (const Eigen::Vector3d& v : tube.vertices)
+    tube.size = std::max(tube.size, v.cwiseAbs().maxCoeff());
+  return tube;
+}
+
+// Distance from `v` to the segment from a to b.
+double SegmentDistance(const Eigen::Vector3d& v, const Eigen::Vector3d& a,
+                       const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double t = std::clamp((v - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+  return (v - (a + t * ab)).norm();
+}
+
+// Expects the tube of `path` to be the chain of capsules of radii `radii` (times `scale`): every
+// vertex on the surface of its link's capsule, each link's cylinder with a full ring of `sides`
+// vertices of its radius at both its joints, and hemispheres of the end links' radii beyond the
+// end joints, reaching one radius past them, their normals pointing away from the end joint.
+void ExpectCapsules(const std::string& path, const Eigen::VectorXd& radii, double scale,
+                    int sides) {
+  const RestTube tube = ReadRestTube(path);
+  const Eigen::Index n = radii.size();
+  ASSERT_EQ(static_cast<Eigen::Index>(tube.joints.size()), n + 1) << path;
+  ASSERT_EQ(tube.normals.size(), tube.vertices.size()) << path;
+  const double tolerance = 1e-6 * tube.size;
+  const std::vector<Eigen::Vector3d>& p = tube.joints;
+  const auto radius = [&](Eigen::Index k) { return scale * radii[k]; };
+  // On a capsule's surface: at its radius from some link's segment.
+  double worst = 0.0;
+  for (const Eigen::Vector3d& v : tube.vertices) {
+    double best = HUGE_VAL;
+    for (Eigen::Index k = 0; k < n; ++k) {
+      best = std::min(best, std::abs(SegmentDistance(v, p[k], p[k + 1]) - radius(k)));
+    }
+    worst = std::max(worst, best);
+  }
+  EXPECT_LE(worst, tolerance) << path << ": a vertex off every capsule";
+  // Each link's cylinder: a ring of its radius at each of its joints, in the joint's plane.
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const Eigen::Vector3d u = (p[k + 1] - p[k]).normalized();
+    for (const Eigen::Index j : {k, k + 1}) {
+      int ring = 0;
+      for (const Eigen::Vector3d& v : tube.vertices) {
+        ring += std::abs((v - p[j]).dot(u)) <= tolerance &&
+                std::abs((v - p[j]).norm() - radius(k)) <= tolerance;
+      }
+      EXPECT_GE(ring, sides) << path << ": link " << k << " at joint " << j;
+    }
+  }
+  // The caps: beyond each end joint, every vertex at the end link's radius from it with the
+  // sphere's normal there, and the farthest one radius out along the end link.
+  for (const auto& [end, next, k] :
+       {std::tuple<Eigen::Index, Eigen::Index, Eigen::Index>{0, 1, 0}, {n, n - 1, n - 1}}) {
+    const Eigen::Vector3d out = (p[end] - p[next]).normalized();
+    double reach = 0.0;
+    int beyond = 0;
+    for (size_t i = 0; i < tube.vertices.size(); ++i) {
+      const Eigen::Vector3d d = tube.vertices[i] - p[end];
+      reach = std::max(reach, d.dot(out));
+      if (d.dot(out) <= tolerance) continue;
+      beyond += 1;
+      EXPECT_NEAR(d.norm(), radius(k), tolerance) << path << " vertex " << i;
+      EXPECT_LT((tube.normals[i] - d.normalized()).norm(), 1e-5) << path << " vertex " << i;
+    }
+    EXPECT_NEAR(reach, radius(k), tolerance) << path << ": the cap at joint " << end;
+    EXPECT_GT(beyond, 2 * sides) << path << ": the cap at joint " << end;
+  }
+}
+
+// Links of a radius (a result's "link_radii") are exported as their capsules, unless the tube's
+// radius is given; in 2D and 3D, both formats, either up axis and a scale. Radii that change from
+// link to link and some that do not; a link of radius 0 takes the default tube's radius where that
+// is thinner than every capsule (below, the least capsule's).
+TEST(GltfCapsules, LinksOfARadiusAreTheirCapsules) {
+  TempDir dir;
+  std::vector<std::string> files;
+  for (const int dim : {2, 3}) {
+    ResultFile file = MakeResult(dim, 7, 20);
+    file.link_radii.resize(7);
+    file.link_radii << 0.05, 0.05, 0.09, 0.03, 0.03, 0.06, 0.04;
+    GltfOptions options;
+    options.tube_sides = dim == 2 ? 12 : 7;
+    if (dim == 3) options.scale = 0.01;
+    const std::string stem = "capsules" + std::to_string(dim);
+    ExpectRoundTrip(file, options, dir, stem);
+    for (const std::string ext : {".gltf", ".glb"}) {
+      ExpectCapsules(dir / (stem + ext), file.link_radii, options.scale, options.tube_sides);
+      files.push_back(dir / (stem + ext));
+    }
+    // A link of radius 0: the thinner of the default tube and the least capsule.
+    const double total = file.result.lengths.sum();
+    const double thin = std::min(0.25 * total / 7, 0.02 * total);
+    file.link_radii[2] = 0.0;
+    WriteGltf(file, options, dir / "zero.glb");
+    Eigen::VectorXd expected = file.link_radii;
+    expected[2] = std::min(thin, 0.03);
+    ExpectCapsules(dir / "zero.glb", expected, options.scale, options.tube_sides);
+    file.link_radii.setConstant(10.0 * thin);  // one radius: no steps between links
+    WriteGltf(file, options, dir / (stem + "_even.glb"));
+    ExpectCapsules(dir / (stem + "_even.glb"), file.link_radii, options.scale, options.tube_sides);
+    files.push_back(dir / (stem + "_even.glb"));
+  }
+  ExpectValidGltf(files);
+}
+
+// The capsules' mesh itself: closed (every edge, between vertices told apart by position, in two
+// triangles, once each way: vertices with other normals at the same place, as at an annulus, are
+// one point of the surface), every triangle of area > 0 and facing outwards (its normal along its
+// vertices' normals), the weights summing to 1.
+TEST(GltfCapsules, TheCapsuleMeshIsClosedAndFacesOutwards) {
+  Eigen::VectorXd arc(5), radii(4);
+  arc << 0.0, 1.0, 1.5, 2.7, 3.0;
+  radii << 0.2, 0.1, 0.1, 0.3;
+  for (const int sides : {3, 8, 13}) {
+    const gltf::TubeMesh tube =
+        gltf::MakeCapsuleTube(arc, radii, sides, 2, 0.5 * Eigen::Matrix3d::Identity());
+    // Rings: 2 x 2 on the caps, 5 joints' and 3 more at each of the two steps (the annulus's two
+    // and the thicker link's side); 2 poles.
+    ASSERT_EQ(tube.num_vertices(), (4 + 5 + 2 * 3) * sides + 2) << sides;
+    std::map<std::array<float, 3>, uint32_t> places;
+    std::vector<uint32_t> place(tube.num_vertices());
+    for (int v = 0; v < tube.num_vertices(); ++v) {
+      const std::array<float, 3> p = {tube.positions[3 * v], tube.positions[3 * v + 1],
+                                      tube.positions[3 * v + 2]};
+      place[v] = places.emplace(p, static_cast<uint32_t>(places.size())).first->second;
+    }
+    EXPECT_EQ(places.size(), (4 + 5 + 2) * sides + 2u) << sides;
+    std::map<std::pair<uint32_t, uint32_t>, int> edges;
+    for (size_t t = 0; t < tube.indices.size(); t += 3) {
+      const Eigen::Vector3f a(&tube.positions[3 * tube.indices[t]]);
+      const Eigen::Vector3f b(&tube.positions[3 * tube.indices[t + 1]]);
+      const Eigen::Vector3f c(&tube.positions[3 * tube.indices[t + 2]]);
+      Eigen::Vector3f normals = Eigen::Vector3f::Zero();
+      for (int k = 0; k < 3; ++k) {
+        normals += Eigen::Vector3f(&tube.normals[3 * tube.indices[t + k]]);
+        edges[{place[tube.indices[t + k]], place[tube.indices[t + (k + 1) % 3]]}] += 1;
+      }
+      const Eigen::Vector3f face = (b - a).cross(c - a);
+      EXPECT_GT(face.norm(), 1e-6f) << sides << " triangle " << t / 3;
+      EXPECT_GT(face.dot(normals), 0.0f) << sides << " triangle " << t / 3;
+    }
+    for (const auto& [edge, count] : edges) {
+      EXPECT_EQ(count, 1) << edge.first << "-" << edge.second;
+      EXPECT_EQ(edges.count({edge.second, edge.first}), 1u) << edge.first << "-" << edge.second;
+    }
+    for (int v = 0; v < tube.num_vertices(); ++v) {
+      EXPECT_NEAR(tube.weights[4 * v] + tube.weights[4 * v + 1], 1.0, 1e-7);
+    }
+  }
+}
+
+// Without link radii (or with radii all 0), and wherever the tube's radius is given, the export is
+// the one of a result without radii, byte for byte: the straight tube of that radius with flat
+// end caps.
+TEST(GltfCapsules, WithoutRadiiOrWithAGivenTubeRadiusTheTubeIsAsBefore) {
+  TempDir dir;
+  for (const int dim : {2, 3}) {
+    ResultFile file = MakeResult(dim, 6, 12);
+    GltfOptions options;
+    WriteGltf(file, options, dir / "plain.glb");
+    const std::string plain = ReadAll(dir / "plain.glb");
+    // The default tube: every ring at min(0.25 x mean link, 0.02 x total) from the straight axis.
+    const RestTube tube = ReadRestTube(dir / "plain.glb");
+    ASSERT_EQ(tube.vertices.size(), 7u * 12 + 2 * 13);
+    const double total = file.result.lengths.sum();
+    const double radius = std::min(0.25 * total / 6, 0.02 * total);
+    for (size_t i = 0; i < 7 * 12; ++i) {
+      EXPECT_NEAR(SegmentDistance(tube.vertices[i], tube.joints.front(), tube.joints.back()),
+                  radius, 1e-6 * tube.size)
+          << i;
+    }
+    file.link_radii = Eigen::VectorXd::Zero(6);
+    WriteGltf(file, options, dir / "zeros.glb");
+    EXPECT_EQ(ReadAll(dir / "zeros.glb"), plain) << dim << "D, radii all 0";
+    file.link_radii << 0.1, 0.2, 0.1, 0.05, 0.05, 0.1;
+    WriteGltf(file, options, dir / "capsules.glb");
+    EXPECT_NE(ReadAll(dir / "capsules.glb"), plain);
+    options.include_mesh = false;
+    WriteGltf(file, options, dir / "skeleton.gltf");
+    const std::string skeleton = ReadAll(dir / "skeleton.gltf");
+    options.tube_radius = 0.03;
+    options.include_mesh = true;
+    WriteGltf(file, options, dir / "given.gltf");
+    const std::string given = ReadAll(dir / "given.gltf");
+    file.link_radii.resize(0);
+    WriteGltf(file, options, dir / "given_plain.gltf");
+    EXPECT_EQ(given, ReadAll(dir / "given_plain.gltf")) << dim << "D, tube radius given";
+    options.include_mesh = false;
+    WriteGltf(file, options, dir / "skeleton_plain.gltf");
+    EXPECT_EQ(skeleton, ReadAll(dir / "skeleton_plain.gltf")) << dim << "D, no mesh";
   }
 }
 

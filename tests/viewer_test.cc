@@ -2,7 +2,7 @@
 // result's data faithfully, bad input is refused without touching the output file, and the page
 // works in a real browser (headless Chromium driven by tests/viewer/browser_check.mjs) for a small
 // 2D run and the two large runs it must play smoothly: 20 links in 3D over 2650 steps and 80
-// links in 2D over 250 steps.
+// links in 2D over 250 steps; links of a radius are drawn as their capsules.
 #include "flexkin/viewer.h"
 
 #include <gtest/gtest.h>
@@ -133,6 +133,54 @@ TEST_F(ViewerTest, PageIsSelfContainedAndCarriesTheResult) {
   EXPECT_EQ(data["metrics"]["l2_per_step"].size(), 60u);
 }
 
+// Radii for the links of `file` (a few sizes about 2% of the chain's length, every `zero`-th one 0
+// where `zero` > 0): links drawn as their capsules.
+void GiveLinkRadii(ResultFile* file, int zero = 0) {
+  const Eigen::Index n = file->result.lengths.size();
+  const double unit = 0.02 * file->result.lengths.sum();
+  file->link_radii.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    file->link_radii[i] = zero > 0 && i % zero == zero - 1 ? 0.0 : unit * (0.6 + 0.35 * (i % 3));
+  }
+}
+
+// The radii of a result's links go into the page's data, "link_radii", one per link with the
+// coordinates' digits; a result without them has no such key (and the same page as before).
+TEST_F(ViewerTest, PageCarriesTheLinkRadiiWhenTheResultHasThem) {
+  ResultFile file = MakeResult(3, 7, 12, 0.05, "capsules");
+  for (const int digits : {6, 9, 17}) {
+    ViewerOptions options;
+    options.digits = digits;
+    file.link_radii.resize(0);
+    WriteViewerHtml(file, options, Path("plain.html"));
+    EXPECT_FALSE(EmbeddedData(ReadFile(Path("plain.html"))).contains("link_radii")) << digits;
+    GiveLinkRadii(&file, 4);
+    file.link_radii[0] = 1.0 / 3.0;  // more digits than any option keeps
+    WriteViewerHtml(file, options, Path("capsules.html"));
+    const std::string page = ReadFile(Path("capsules.html"));
+    const nlohmann::json data = EmbeddedData(page);
+    ASSERT_TRUE(data.contains("link_radii")) << digits;
+    ASSERT_EQ(data["link_radii"].size(), 7u) << digits;
+    for (int i = 0; i < 7; ++i) {
+      const double want = file.link_radii[i];
+      const double got = data["link_radii"][i].get<double>();
+      if (digits == 17) {
+        EXPECT_EQ(got, want) << i;
+      } else {
+        EXPECT_NEAR(got, want, 0.6 * std::pow(10.0, 1 - digits) * want) << digits << " " << i;
+      }
+    }
+    EXPECT_NE(data["link_radii"][0].get<double>(), 0.0);
+    EXPECT_EQ(data["link_radii"][3].get<double>(), 0.0);
+    // 1/3 written with `digits` significant digits, as the coordinates are.
+    const size_t at = page.find("\"link_radii\":[");
+    ASSERT_NE(at, std::string::npos);
+    const std::string first = page.substr(at + 14, page.find(',', at) - at - 14);
+    EXPECT_EQ(first, digits == 17 ? "0.33333333333333331" : "0." + std::string(digits, '3'))
+        << digits;
+  }
+}
+
 TEST_F(ViewerTest, OptionsAreValidatedNamingTheField) {
   EXPECT_TRUE(ViewerOptions().Validate().empty());
   const ResultFile file = MakeResult(3, 4, 5, 0.1, "");
@@ -214,6 +262,13 @@ TEST_F(ViewerTest, PlaysScrubsAndMovesInHeadlessChromium) {
   WriteViewerHtml(spatial, options, Path("spatial_20x2650.html"));
   WriteViewerHtml(MakeResult(2, 80, 250, 0.07, "80 links 2D, 250 steps"), options,
                   Path("planar_80x250.html"));
+  // Links of a radius: drawn as their capsules (the check measures their strokes).
+  ResultFile capsules_2d = MakeResult(2, 10, 80, 0.05, "capsules 2D");
+  GiveLinkRadii(&capsules_2d, 5);
+  WriteViewerHtml(capsules_2d, options, Path("capsules_2d.html"));
+  ResultFile capsules_3d = MakeResult(3, 8, 120, 0.03, "capsules 3D");
+  GiveLinkRadii(&capsules_3d);
+  WriteViewerHtml(capsules_3d, options, Path("capsules_3d.html"));
   std::printf("page sizes: %ju, %ju, %ju bytes\n",
               static_cast<uintmax_t>(fs::file_size(Path("small_2d.html"))),
               static_cast<uintmax_t>(fs::file_size(Path("spatial_20x2650.html"))),
@@ -223,13 +278,14 @@ TEST_F(ViewerTest, PlaysScrubsAndMovesInHeadlessChromium) {
   const int status =
       RunCommand("node '" + source + "/tests/viewer/browser_check.mjs' '" + tools + "' '" + dir_ +
                      "' '" + Path("small_2d.html") + "' '" + Path("spatial_20x2650.html") + "' '" +
-                     Path("planar_80x250.html") + "'",
+                     Path("planar_80x250.html") + "' '" + Path("capsules_2d.html") + "' '" +
+                     Path("capsules_3d.html") + "'",
                  &output);
   std::printf("%s", output.c_str());
   EXPECT_EQ(status, 0) << output;
   EXPECT_NE(output.find("all viewer checks passed"), std::string::npos);
-  for (const char* shot :
-       {"small_2d-playing.png", "spatial_20x2650-trails.png", "planar_80x250-dragged.png"}) {
+  for (const char* shot : {"small_2d-playing.png", "spatial_20x2650-trails.png",
+                           "planar_80x250-dragged.png", "capsules_3d-opened.png"}) {
     EXPECT_TRUE(fs::exists(Path(shot))) << shot;
   }
 }

@@ -59,7 +59,8 @@ struct GltfOptions {
   // Include a tube mesh skinned to the joints (the visible rope). Without it the file holds the
   // skeleton and its animation only (Blender still makes an armature from the skin).
   bool include_mesh = true;
-  // Radius of the tube, in the chain's length unit (before `scale`). 0 picks
+  // Radius of the tube, in the chain's length unit (before `scale`). 0 picks the links' capsules
+  // where the result carries link radii (docs/gltf-export.md), else
   // min(0.25 * mean link length, 0.02 * total length). >= 0.
   double tube_radius = 0.0;
   // Vertices around the tube. 3 to 64. Typical: 8 to 16.

@@ -1,4 +1,6 @@
 // ReadGltfJointPositions: a glTF file's skin joints, posed by its first animation at each keyframe.
+#include "gltf/reader.h"
+
 #include <tiny_gltf.h>
 
 #include <Eigen/Geometry>
@@ -279,6 +281,49 @@ GltfJointMotion ReadGltfJointPositions(const std::string& path) {
     motion.positions.push_back(std::move(p));
   }
   return motion;
+}
+
+gltf::SkinnedMeshRestPose gltf::ReadSkinnedMeshRestPose(const std::string& path) {
+  const tinygltf::Model model = Load(path);
+  for (size_t i = 0; i < model.nodes.size(); ++i) {
+    const tinygltf::Node& node = model.nodes[i];
+    if (node.mesh < 0 || node.skin < 0) continue;
+    const std::string field = Index("nodes", i);
+    if (node.mesh >= static_cast<int>(model.meshes.size()) ||
+        model.meshes[node.mesh].primitives.empty()) {
+      throw InputError(field + ".mesh",
+                       "mesh " + std::to_string(node.mesh) + " does not exist or has no primitive");
+    }
+    if (node.skin >= static_cast<int>(model.skins.size())) {
+      throw InputError(field + ".skin", "skin " + std::to_string(node.skin) + " does not exist");
+    }
+    const tinygltf::Primitive& primitive = model.meshes[node.mesh].primitives[0];
+    const std::string where = Index("meshes", node.mesh) + ".primitives[0].attributes";
+    SkinnedMeshRestPose pose;
+    const auto vectors = [&](const char* name, std::vector<Eigen::Vector3d>* out) {
+      const auto it = primitive.attributes.find(name);
+      if (it == primitive.attributes.end()) return false;
+      const std::vector<float> values = ReadFloats(model, it->second, 3, where + "." + name);
+      for (size_t k = 0; k + 2 < values.size(); k += 3) {
+        out->emplace_back(values[k], values[k + 1], values[k + 2]);
+      }
+      return true;
+    };
+    if (!vectors("POSITION", &pose.positions)) {
+      throw InputError(where, "has no POSITION; a mesh needs its vertices");
+    }
+    vectors("NORMAL", &pose.normals);
+    const tinygltf::Skin& skin = model.skins[node.skin];
+    const std::vector<float> matrices = ReadFloats(
+        model, skin.inverseBindMatrices, 16, Index("skins", node.skin) + ".inverseBindMatrices");
+    for (size_t k = 0; k + 15 < matrices.size(); k += 16) {
+      // Column-major, as glTF stores them.
+      pose.inverse_bind_matrices.push_back(
+          Eigen::Map<const Eigen::Matrix4f>(&matrices[k]).cast<double>());
+    }
+    return pose;
+  }
+  throw InputError("nodes", "no node has a mesh and a skin; nothing to read");
 }
 
 }  // namespace flexkin

@@ -25,4 +25,16 @@ struct TubeMesh {
 TubeMesh MakeTube(const Eigen::VectorXd& arc, double radius, int sides,
                   const Eigen::Matrix3d& to_scene);
 
+// The chain of capsules of links with radii (a result's "link_radii"): the same straight rest pose
+// and axes as MakeTube, link i (from joint i to joint i + 1) a cylinder of radius radii[i] > 0
+// about its bone, rings of `sides` vertices at its two joints. At an inner joint where the two
+// links' radii differ there are two rings, one of each radius, joined by a flat annulus (with its
+// own vertices, facing along the axis): every vertex of a link's side is at its radius from the
+// link's axis. All of a joint's rings are skinned half to each bone that meets there (MakeTube's
+// inner ring). The ends are hemispheres of the end links' radii: the end ring, `cap_rings` rings
+// of latitude (at 90 / (cap_rings + 1) degree steps) and a pole, skinned fully to the end joint,
+// every vertex at the radius from the end joint with that point's normal.
+TubeMesh MakeCapsuleTube(const Eigen::VectorXd& arc, const Eigen::VectorXd& radii, int sides,
+                         int cap_rings, const Eigen::Matrix3d& to_scene);
+
 }  // namespace flexkin::gltf

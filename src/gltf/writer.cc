@@ -175,6 +175,31 @@ tinygltf::Value Extras(const ResultFile& file, const GltfOptions& options, GltfU
   return tinygltf::Value(std::move(extras));
 }
 
+// Links of a radius (a result's "link_radii", at least one > 0): the tube, unless a radius is
+// given for it, is the links' capsules (gltf::MakeCapsuleTube).
+bool HasCapsules(const ResultFile& file) {
+  return file.link_radii.size() > 0 && file.link_radii.maxCoeff() > 0.0;
+}
+
+// The capsules' radii: each link's own; a link of radius 0 (a line, which the figures draw without
+// a capsule) the smaller of the tube's default radius `thin` and the least radius > 0, so that the
+// tube stays closed and such a link is never thicker than one with a capsule.
+Eigen::VectorXd CapsuleRadii(const Eigen::VectorXd& radii, double thin) {
+  double least = HUGE_VAL;
+  for (const double r : radii) {
+    if (r > 0.0) least = std::min(least, r);
+  }
+  Eigen::VectorXd out = radii;
+  for (double& r : out) {
+    if (!(r > 0.0)) r = std::min(thin, least);
+  }
+  return out;
+}
+
+// Rings of latitude on each end's hemisphere besides its equator: about a quarter of the rings'
+// vertices, at least 2.
+int CapRings(int sides) { return std::max(2, sides / 4); }
+
 void AddMesh(const ResultFile& file, const GltfOptions& options, const Eigen::Matrix3d& to_scene,
              BufferWriter* buffer, tinygltf::Model* model) {
   const Eigen::VectorXd& lengths = file.result.lengths;
@@ -184,7 +209,11 @@ void AddMesh(const ResultFile& file, const GltfOptions& options, const Eigen::Ma
   for (int i = 0; i < n; ++i) arc[i + 1] = arc[i] + lengths[i];
   const double radius =
       options.tube_radius > 0.0 ? options.tube_radius : std::min(0.25 * arc[n] / n, 0.02 * arc[n]);
-  const gltf::TubeMesh tube = gltf::MakeTube(arc, radius, options.tube_sides, to_scene);
+  const gltf::TubeMesh tube =
+      options.tube_radius > 0.0 || !HasCapsules(file)
+          ? gltf::MakeTube(arc, radius, options.tube_sides, to_scene)
+          : gltf::MakeCapsuleTube(arc, CapsuleRadii(file.link_radii, radius), options.tube_sides,
+                                  CapRings(options.tube_sides), to_scene);
   const size_t vertices = tube.num_vertices();
 
   tinygltf::Primitive primitive;

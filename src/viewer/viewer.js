@@ -51,6 +51,16 @@
       hi[k] = Math.max(hi[k], c.bounds[3 + k]);
     }
   }
+  // The links' capsules (viewer_data.cc, "link_radii": one radius per link, link i from point i
+  // to point i+1), or null: the view holds them too.
+  const linkRadii = data.link_radii ? Float64Array.from(data.link_radii) : null;
+  if (linkRadii) {
+    const reach = linkRadii.reduce((a, b) => Math.max(a, b), 0);
+    for (let k = 0; k < dim; ++k) {
+      lo[k] -= reach;
+      hi[k] += reach;
+    }
+  }
   const totalLength = data.link_lengths.reduce((a, b) => a + b, 0);
   const center = [0, 1, 2].map((k) => (lo[k] + hi[k]) / 2);
   const radius = Math.max(0.5 * Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]),
@@ -139,6 +149,13 @@
     leader: '#e08a1e', lead: '#d62f2f', tail: '#1d2330', shadow: 'rgba(60, 70, 90, 0.18)',
     collider: '#d2d2cc', colliderEdge: '#85857f',
   };
+  // Capsules by depth in 3D, far light, near darker (one colour in 2D: capsuleShades[15]).
+  const capsuleShades = [];
+  for (let s = 0; s < 16; ++s) {
+    const t = s / 15;
+    capsuleShades.push('rgb(' + Math.round(226 - 40 * t) + ',' + Math.round(231 - 38 * t) + ',' +
+                       Math.round(240 - 26 * t) + ')');
+  }
   const trailColors = ['#2a9d8f', '#8e44ad', '#e76f51', '#1f77b4', '#c2185b', '#6a8d1f'];
   // Chain colour and width by depth in 3D: far links light and thin, near ones dark and thick.
   const shades = [];
@@ -333,6 +350,35 @@
     g.stroke();
   }
 
+  // Each link of a radius as its capsule, under the links' lines: a stroke from point to point
+  // with round caps, 2 x radius wide, which is the outline of a capsule in 2D and the silhouette
+  // of one in the orthographic 3D view. In perspective the radius is scaled as a point at the
+  // link's midpoint is (the stroke cannot taper). Far capsules first; screenX, screenY and
+  // linkDepth hold the frame's projected points.
+  const capsuleOrder = Array.from({ length: numPoints - 1 }, (_, i) => i);
+  const capsuleDepth = new Float64Array(numPoints - 1);
+  const capsuleByDepth = (a, b) => capsuleDepth[a] - capsuleDepth[b];
+  function drawCapsules(g) {
+    for (let i = 0; i + 1 < numPoints; ++i) {
+      capsuleDepth[i] = 0.5 * (linkDepth[i] + linkDepth[i + 1]);
+    }
+    if (dim === 3) capsuleOrder.sort(capsuleByDepth);
+    for (let j = 0; j < capsuleOrder.length; ++j) {
+      const i = capsuleOrder[j];
+      const r = linkRadii[i];
+      if (!(r > 0)) continue;
+      const d = capsuleDepth[i];
+      const f = dim === 3 && view.perspective ? cameraDistance / (cameraDistance - d) : 1;
+      const t = dim === 3 ? Math.min(1, Math.max(0, (d + radius) / (2 * radius))) : 1;
+      g.strokeStyle = capsuleShades[Math.round(15 * t)];
+      g.lineWidth = 2 * r * view.scale * f;
+      g.beginPath();
+      g.moveTo(screenX[i], screenY[i]);
+      g.lineTo(screenX[i + 1], screenY[i + 1]);
+      g.stroke();
+    }
+  }
+
   function drawChain(g, frame) {
     for (let i = 0; i < numPoints; ++i) {
       projectPoint(frame, i);
@@ -342,6 +388,7 @@
     }
     g.lineCap = 'round';
     g.lineJoin = 'round';
+    if (linkRadii) drawCapsules(g);
     if (dim === 2) {
       g.strokeStyle = '#2b4c8c';
       g.lineWidth = 3;

@@ -229,6 +229,16 @@ std::string ViewerDataJson(const ResultFile& file, const ViewerOptions& options,
     }
   }
   out.push_back(']');
+  // The links' capsules, one radius per link (link i from point i to point i + 1), if any.
+  if (file.link_radii.size() > 0) {
+    AppendKey("link_radii", &out);
+    out.push_back('[');
+    for (Eigen::Index i = 0; i < file.link_radii.size(); ++i) {
+      if (i > 0) out.push_back(',');
+      AppendNumber(file.link_radii[i], options.digits, &out);
+    }
+    out.push_back(']');
+  }
   if (!file.colliders.empty()) AppendColliders(file, options.digits, &out);
 
   const Metrics& m = r.metrics;

@@ -19,6 +19,8 @@ void CheckResult(const ResultFile& result, const ViewerOptions& options);
 // `robot`: the trajectory that `result` was made from (RobotTrajectoryAsResult), whose facts go
 // into a "robot" object (method, targets, unreached, max_ee_error) that the page shows instead of
 // the chain's (and "links", the arm's n); null for a chain result.
+// "link_radii": the links' radii (one per link, link i from point i to point i + 1), with the
+// coordinates' `digits`, where the result has them; the page draws the links as their capsules.
 std::string ViewerDataJson(const ResultFile& result, const ViewerOptions& options,
                            const RobotTrajectoryFile* robot = nullptr);
 

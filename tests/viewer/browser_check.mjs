@@ -53,6 +53,80 @@ async function picture(page) {
   });
 }
 
+// A page whose result has link radii draws each link of the current frame as its capsule: a
+// round-capped stroke from point to point, 2 x radius wide in CSS pixels (view.scale CSS pixels
+// per length unit; in perspective the depth factor of the link's midpoint, between 0.75 and 1.5,
+// scales it). The strokes are recorded while the page draws a frame, and each link's must be
+// there. `perspective`: only the factor's range is checked.
+async function checkCapsules(page, name, perspective) {
+  await page.evaluate(() => {
+    const proto = CanvasRenderingContext2D.prototype;
+    const log = { strokes: [], path: [], saved: {} };
+    window.capsuleLog = log;
+    for (const method of ['beginPath', 'moveTo', 'lineTo', 'stroke']) {
+      log.saved[method] = proto[method];
+    }
+    proto.beginPath = function () { log.path = []; return log.saved.beginPath.call(this); };
+    proto.moveTo = function (x, y) {
+      log.path.push([x, y]);
+      return log.saved.moveTo.call(this, x, y);
+    };
+    proto.lineTo = function (x, y) {
+      log.path.push([x, y]);
+      return log.saved.lineTo.call(this, x, y);
+    };
+    proto.stroke = function (...args) {
+      if (this.canvas.id === 'view') {
+        log.strokes.push({ path: log.path.slice(), width: this.lineWidth, cap: this.lineCap });
+      }
+      return log.saved.stroke.apply(this, args);
+    };
+  });
+  // Draw a frame (one step on and back) with the recorder on, then put the methods back.
+  await page.locator('#view').focus();
+  await page.keyboard.press('ArrowRight');
+  await sleep(100);
+  await page.evaluate(() => { window.capsuleLog.strokes = []; });
+  await page.keyboard.press('ArrowLeft');
+  await sleep(100);
+  const got = await page.evaluate(() => {
+    const log = window.capsuleLog;
+    const proto = CanvasRenderingContext2D.prototype;
+    for (const method of Object.keys(log.saved)) proto[method] = log.saved[method];
+    const v = window.flexkinViewer;
+    const data = JSON.parse(document.getElementById('flexkin-data').textContent);
+    const points = [];
+    for (let i = 0; i < v.numPoints; ++i) points.push(v.pointOnScreen(i));
+    return { strokes: log.strokes, points, scale: v.view.scale, radii: data.link_radii };
+  });
+  let worst = 0, missing = 0, drawn = 0;
+  const near = (p, q) => Math.hypot(p[0] - q.x, p[1] - q.y) < 1e-6;
+  for (let i = 0; i + 1 < got.points.length; ++i) {
+    const r = got.radii[i];
+    if (!(r > 0)) continue;
+    const want = 2 * r * got.scale;
+    const strokes = got.strokes.filter((s) => s.cap === 'round' && s.path.length === 2 &&
+        near(s.path[0], got.points[i]) && near(s.path[1], got.points[i + 1]) &&
+        s.width > 0.7 * want && s.width < 1.6 * want);
+    if (strokes.length !== 1) {
+      missing += 1;
+      continue;
+    }
+    drawn += 1;
+    const ratio = strokes[0].width / want;
+    if (perspective) {
+      if (!(ratio >= 0.75 - 1e-6 && ratio <= 1.5 + 1e-6)) worst = Math.max(worst, Infinity);
+    } else {
+      worst = Math.max(worst, Math.abs(ratio - 1));
+    }
+  }
+  // The canvas keeps lineWidth as a float32.
+  check(missing === 0 && drawn > 0 && worst <= 1e-6,
+        `${name}: ${drawn} links drawn as capsules, stroke 2 x radius x scale ` +
+        `${perspective ? '(perspective: x 0.75 to 1.5) ' : ''}(largest relative difference ` +
+        `${worst.toExponential(1)}, ${missing} missing)`);
+}
+
 const frame = (page) => page.evaluate(() => window.flexkinViewer.frame);
 const playing = (page) => page.evaluate(() => window.flexkinViewer.playing);
 
@@ -79,7 +153,8 @@ async function checkPage(browser, file) {
   const info = await page.evaluate(() => {
     const v = window.flexkinViewer;
     const data = JSON.parse(document.getElementById('flexkin-data').textContent);
-    return { dim: v.dim, numFrames: v.numFrames, numPoints: v.numPoints, steps: data.steps };
+    return { dim: v.dim, numFrames: v.numFrames, numPoints: v.numPoints, steps: data.steps,
+             linkRadii: Boolean(data.link_radii) };
   });
   const n = info.numFrames;
   console.log(`--- ${name}: ${info.dim}D, ${info.numPoints - 1} links, ${n} frames`);
@@ -103,6 +178,16 @@ async function checkPage(browser, file) {
     return Array.from(c.getContext('2d').getImageData(Math.round(at.x * r),
                                                       Math.round(at.y * r), 1, 1).data);
   });
+  if (info.linkRadii) {
+    await checkCapsules(page, name, false);
+    if (info.dim === 3) {
+      await page.click('#perspective');
+      await sleep(50);
+      await checkCapsules(page, `${name} in perspective`, true);
+      await page.click('#perspective');
+      await sleep(50);
+    }
+  }
   check(still1.drawnFraction > 0.002 && still1.colors > 4 && lead[0] > 180 && lead[1] < 90,
         `${name}: canvas not blank (${(100 * still1.drawnFraction).toFixed(1)}% drawn, ` +
         `${still1.colors} colours, leading end rgb(${lead.slice(0, 3)}))`);
