@@ -19,7 +19,8 @@
 namespace flexkin::internal {
 namespace {
 
-// The prediction of the free points (SimulateChain: p = x + h (v + h (g + c (w - v)))).
+// The prediction of the free points (SimulateChain: p = x + h (v + h (g + c (w - v)))), and
+// their start kept in x_old.
 template <class B, int Dim>
 inline void PredictLanes(const DynamicLaneStep& q, int lane0) {
   constexpr int L = kStrandLanes;
@@ -29,7 +30,9 @@ inline void PredictLanes(const DynamicLaneStep& q, int lane0) {
       const size_t at = static_cast<size_t>(i * Dim + k) * L + lane0;
       const B vel = LoadLanes(q.v + at, B());
       const B predicted = vel + h * (B(q.gravity[k]) + c * (B(q.wind[k]) - vel));
-      StoreLanes(LoadLanes(q.x + at, B()) + h * predicted, q.p + at);
+      const B x = LoadLanes(q.x + at, B());
+      StoreLanes(x, q.x_old + at);
+      StoreLanes(x + h * predicted, q.p + at);
     }
   }
   for (int i = 0; i <= q.head; ++i) {

@@ -70,13 +70,13 @@ using StrandSphereSweepFn = void (*)(Method method, int dim, int n, int head, co
 
 // Dynamic strands (flexkin/strands.h `dynamics`): one sub-step of one block, in stages.
 // Stage 1: the pinned points 0 .. head are at the sub-step's end in x (their start in x_old), the
-// free points head + 1 .. n at its start in x and x_old with velocities v; afterwards p holds the
-// inertial prediction (the pinned points' new places) and x its sequential projection (tractrix
-// or dftl). Stage 2: v becomes (x - x_old) / h, with Mueller et al.'s correction
-// -s (x_{j+1} - p_{j+1}) / h where `correct`. Stage 3 (between them, for the overall projection):
-// x becomes the overall projection of p (dynamics/least_constraint.h) where it converges. Stage 4
-// (between them, for SHAKE): x becomes the SHAKE projection of p about x_old (dynamics/shake.h),
-// `converged` 1 where it converged. The operations are SimulateChain's.
+// free points head + 1 .. n at its start in x with velocities v; afterwards x_old holds the free
+// points' start too, p the inertial prediction (the pinned points' new places) and x its
+// sequential projection (tractrix or dftl). Stage 2: v becomes (x - x_old) / h, with Mueller et
+// al.'s correction -s (x_{j+1} - p_{j+1}) / h where `correct`. Stage 3 (between them, for the
+// overall projection): x becomes the overall projection of p (dynamics/least_constraint.h) where it
+// converges. Stage 4 (between them, for SHAKE): x becomes the SHAKE projection of p about x_old
+// (dynamics/shake.h), `converged` 1 where it converged. The operations are SimulateChain's.
 struct DynamicLaneStep {
   int n = 0, head = 0;
   bool tractrix = true;  // else dftl

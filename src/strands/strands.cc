@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <mutex>
 #include <new>
 #include <string>
@@ -1054,7 +1055,8 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
   const SubnormalsAsZero subnormals;
   ContactScratch* cs = has_colliders ? &contact[thread] : nullptr;
   for (int s = 1; s <= S; ++s) {
-    std::copy(pts, pts + size, ds.x_old.data());
+    // The pinned points' start; the free points' is kept by stage 1.
+    std::copy(pts, pts + pinned_size, ds.x_old.data());
     PinnedAt(block, s, ds.pin_from.data(), pts);
     for (int k = 0; k < dim; ++k) q.wind[k] = winds[s - 1][k];
     // The SIMD engines take the contact step against a lone sphere (a scalp) in the lanes.
@@ -1177,16 +1179,29 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
       int64_t contact_steps = 0;
       for (int i = head + 1; i <= n; ++i) {
         const uint8_t* flags = cs->contact_flags.data() + i * L;
+        // All ones where the lane's contact step placed point i and stands, else 0: the
+        // selection below is a bitwise one, which compiles to vector code, not branches.
+        uint64_t take[L];
+        int taken = 0;
+        for (int lane = 0; lane < L; ++lane) {
+          const int contact = (flags[lane] != 0) & (i < stood[lane]);
+          take[lane] = uint64_t{0} - static_cast<uint64_t>(contact);
+          taken += contact;
+        }
+        if (taken == 0) continue;
+        contact_steps += taken;
         for (int k = 0; k < dim; ++k) {
           const size_t at = static_cast<size_t>(i * dim + k) * L;
           double* predicted = ds.predicted.data() + at;
           const double* placed = pts + at;
           for (int lane = 0; lane < L; ++lane) {
-            const bool contact = flags[lane] != 0 && i < stood[lane];
-            predicted[lane] = contact ? placed[lane] : predicted[lane];
+            uint64_t a, b;
+            std::memcpy(&a, placed + lane, sizeof a);
+            std::memcpy(&b, predicted + lane, sizeof b);
+            b = (a & take[lane]) | (b & ~take[lane]);
+            std::memcpy(predicted + lane, &b, sizeof b);
           }
         }
-        for (int lane = 0; lane < L; ++lane) contact_steps += flags[lane] != 0 && i < stood[lane];
       }
       cs->stats.contact_link_steps += contact_steps;
       for (int lane = 0; lane < L; ++lane) {
