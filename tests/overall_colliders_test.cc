@@ -20,6 +20,7 @@
 #include "flexkin/leader.h"
 #include "flexkin/run.h"
 #include "overall_contact_peer.h"
+#include "test_util.h"
 
 namespace flexkin {
 namespace {
@@ -178,6 +179,12 @@ TEST(OverallCollidersTest, EveryConvexShapeKeepsEveryLinkOutsideWhereTheFreeRunC
     };
     const RunResult free = flexkin::Run(r.chain, r.path, OverallOptionsWith({}));
     for (const auto& [name, c] : shapes) {
+      // Under the sanitizers (test_util::kSanitized) the ellipsoid and the cylinder in 2D only:
+      // their distances are the same 3D code in both (2D points have z = 0), and the 3D contact
+      // search runs on the other shapes; in 3D they take minutes there (the ellipsoid's distance
+      // is itself a bisection).
+      if (test_util::kSanitized && dim == 3 && (name == "ellipsoid" || name == "cylinder"))
+        continue;
       SCOPED_TRACE(name + " " + std::to_string(dim) + "D");
       EXPECT_LT(LeastSampled(free, c, 50), -0.1) << "the free run does not cut through";
       const RunResult result = flexkin::Run(r.chain, r.path, OverallOptionsWith({c}));
