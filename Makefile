@@ -39,7 +39,7 @@ test-release: build
 	@ctest --test-dir $(BUILD) --output-on-failure -j$(JOBS)
 
 test-sanitize: deps
-	@cmake -S . -B $(BUILD_SAN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLEXKIN_SANITIZE=ON \
+	@cmake -S . -B $(BUILD_SAN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLEXKIN_SANITIZE=ON -DFLEXKIN_UNITY=ON \
 	  -DFLEXKIN_BUILD_BENCHMARKS=OFF -DFLEXKIN_BUILD_EXAMPLES=OFF > /dev/null
 	@cmake --build $(BUILD_SAN) -j$(JOBS)
 	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
@@ -49,7 +49,7 @@ test-sanitize: deps
 # from several threads at once), under ThreadSanitizer: only their programs are built.
 TSAN_TESTS = strands_test groom_run_test thread_safety_test
 test-thread: deps
-	@cmake -S . -B $(BUILD_TSAN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLEXKIN_SANITIZE_THREAD=ON \
+	@cmake -S . -B $(BUILD_TSAN) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLEXKIN_SANITIZE_THREAD=ON -DFLEXKIN_UNITY=ON \
 	  -DFLEXKIN_BUILD_APPS=OFF -DFLEXKIN_BUILD_BENCHMARKS=OFF -DFLEXKIN_BUILD_EXAMPLES=OFF \
 	  -DFLEXKIN_PYTHON=OFF > /dev/null
 	@cmake --build $(BUILD_TSAN) -j$(JOBS) --target $(TSAN_TESTS)
@@ -62,7 +62,7 @@ test-thread: deps
 # $(BUILD_FUZZ)/fuzz-run/); `make test-fuzz` for FUZZ_SHORT_SECONDS from the seeds alone, and
 # fails if any target finds something.
 fuzz-build: deps
-	@CC=clang-14 CXX=clang++-14 cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLEXKIN_FUZZ=ON \
+	@CC=clang-14 CXX=clang++-14 cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFLEXKIN_FUZZ=ON -DFLEXKIN_UNITY=ON \
 	  -DFLEXKIN_BUILD_APPS=OFF -DFLEXKIN_BUILD_TESTS=OFF -DFLEXKIN_BUILD_BENCHMARKS=OFF \
 	  -DFLEXKIN_BUILD_EXAMPLES=OFF -DFLEXKIN_PYTHON=OFF > /dev/null
 	@cmake --build $(BUILD_FUZZ) -j$(JOBS)

@@ -22,7 +22,7 @@ namespace flexkin {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr int kMaxLinks = 1 << 20;
+constexpr int kMaxGrownLinks = 1 << 20;
 // Root placement gives up when, after this many candidates, fewer than 1 in kMinAcceptance of
 // them fell in the region.
 constexpr int64_t kGiveUpCandidates = 1000000;
@@ -104,10 +104,10 @@ Problems ValidateGrowSpec(const GrowSpec& spec) {
     problems.push_back(Problem::Invalid("roots", std::to_string(spec.roots),
                                         "an integer from 1 to " + std::to_string(kMaxGroomRoots)));
   }
-  const bool links_ok = spec.links >= 1 && spec.links <= kMaxLinks;
+  const bool links_ok = spec.links >= 1 && spec.links <= kMaxGrownLinks;
   if (!links_ok) {
     problems.push_back(Problem::Invalid("links", std::to_string(spec.links),
-                                        "an integer from 1 to " + std::to_string(kMaxLinks)));
+                                        "an integer from 1 to " + std::to_string(kMaxGrownLinks)));
   }
   if (roots_ok && links_ok) {
     const int64_t points = int64_t{spec.roots} * (spec.links + 1);

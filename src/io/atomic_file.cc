@@ -21,6 +21,11 @@
 #include "flexkin/result_io.h"
 
 namespace flexkin {
+
+void ThrowNothingWritten(Problem problem) {
+  problem.message += "; nothing was written";
+  throw InputError(problem);
+}
 namespace {
 
 std::system_error SystemError(int err, const std::string& what) {

@@ -11,7 +11,13 @@
 #include <string>
 #include <system_error>
 
+#include "flexkin/error.h"
+
 namespace flexkin {
+
+// Throws `problem` as an InputError, its message ending "; nothing was written": a writer's
+// refusal of its input before any byte of the file.
+[[noreturn]] void ThrowNothingWritten(Problem problem);
 
 // The whole content of the file at `path`. Throws std::system_error ("cannot read 'PATH'" and the
 // system's reason) if it cannot be read.

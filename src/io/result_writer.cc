@@ -37,11 +37,6 @@ std::string JsonString(const std::string& s) {
   return json(s).dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
-[[noreturn]] void ThrowNothingWritten(Problem problem) {
-  problem.message += "; nothing was written";
-  throw InputError(problem);
-}
-
 // The result's dimension, after the one check of results (ValidateResult): consistent shapes and
 // finite numbers everywhere, which JSON needs.
 int CheckResult(const RunResult& r) {

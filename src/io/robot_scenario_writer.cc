@@ -136,11 +136,6 @@ json SummaryJson(const ArmTrajectory& t, int64_t steps) {
   return summary;
 }
 
-[[noreturn]] void ThrowNothingWritten(Problem problem) {
-  problem.message += "; nothing was written";
-  throw InputError(problem);
-}
-
 std::optional<Problem> NotFinite(const std::string& field, double x) {
   if (std::isfinite(x)) return std::nullopt;
   return Problem(field, "value " + FormatNumber(x) + " is not a finite number", FormatNumber(x),
