@@ -9,7 +9,11 @@
 //    least signed distance along the link, reached at x_{i-1} + s (x_i - x_{i-1}) (gradient, by
 //    the envelope theorem: (1 - s) normal in x_{i-1}, s normal in x_i).
 // A link is outside a convex collider exactly when both its ends are and, where its interior
-// comes nearest, that point is: the two kinds together say "no point and no link inside".
+// comes nearest, that point is: the two kinds together say "no point and no link inside". A
+// mesh, not convex, is measured at the local minimum of the distance along the link that
+// NearestOnSegment finds (where the mesh's features are coarser than its samples, the least);
+// its faces' normals jump at edges, as a box's do. A sub-problem's solution is kept only where
+// the exact clearances (SegmentClearance: a mesh's crossings) find every link outside.
 //
 // KKT conditions, with the Lagrangian f + lambda'c - mu'g: grad f + J_c' lambda - J_g' mu = 0,
 // c = 0, and g >= 0, mu >= 0, mu g = 0. The complementarity is met by a primal-dual active set:
@@ -140,11 +144,13 @@ class ContactSolver {
 Contact ContactSolver::Measure(const Contact& contact, const Points& x) const {
   Contact out = contact;
   const Collider& c = colliders_[contact.collider];
-  // A box's edges and a cylinder's rims: on or inside the surface there the normal is a face's,
-  // not the gradient of the distance to the edge, which turns by up to a right angle across it.
-  // Measured again a hair outside (1e-6 of a link along the normal), where it is the direction
-  // from the edge: on a face the same normal, at an edge the one across it.
-  const bool edged = c.shape == ColliderShape::kBox || c.shape == ColliderShape::kCylinder;
+  // A box's edges, a cylinder's rims and a mesh's edges and vertices: on or inside the surface
+  // there the normal is a face's, not the gradient of the distance to the edge, which turns by up
+  // to a right angle across it. Measured again a hair outside (1e-6 of a link along the normal),
+  // where it is the direction from the edge: on a face the same normal, at an edge the one across
+  // it.
+  const bool edged = c.shape == ColliderShape::kBox || c.shape == ColliderShape::kCylinder ||
+                     c.shape == ColliderShape::kMesh;
   const double hair = 1e-6 * lengths_[contact.index - 1];
   if (!contact.link) {
     const Vector3d p = At(x, contact.index);
@@ -634,6 +640,9 @@ void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& h
   OverallReport result;
   result.status = OverallStatus::kConverged;
   int iterations = 0, fallbacks = 0;
+  const bool has_mesh = std::any_of(colliders.begin(), colliders.end(), [](const Collider& c) {
+    return c.shape == ColliderShape::kMesh;
+  });
   Eigen::VectorXd target(dim);
   ContactStats sweep_stats;
   for (int s = 1; s <= sub_steps; ++s) {
@@ -645,6 +654,11 @@ void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& h
     ContactSolver solver(lengths, old, options, colliders, state);
     OverallReport sub = solver.Solve(points);
     iterations += sub.iterations;
+    // The solver measures a link against a mesh at its nearest local minimum (NearestOnSegment):
+    // a converged solution is kept only where every link is clear by the exact clearances.
+    if (sub.converged() && has_mesh && !Clear(*points, lengths, colliders, &least, &touching)) {
+      sub.status = OverallStatus::kFailed;
+    }
     if (!sub.converged()) {
       ++fallbacks;
       *points = state->start;

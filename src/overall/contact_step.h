@@ -26,8 +26,8 @@ struct OverallContactState {
 };
 
 // One overall step of the chain (`lengths`, `*points`) with the head moving to `head`, for
-// options and colliders the caller has checked (RunOptions::Validate: a smooth metric, convex
-// colliders; the chain starts outside them). `*report` tells how it was solved; `*stats` gains the
+// options and colliders the caller has checked (RunOptions::Validate: a smooth metric; the chain
+// starts outside the colliders). `*report` tells how it was solved; `*stats` gains the
 // links in contact and the least clearance. Where a sub-problem's Newton iteration does not
 // converge, that sub-step keeps its sequential contact step (outside every collider) and the
 // report says so. Throws InputError where the colliders leave a link no room.

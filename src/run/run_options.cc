@@ -50,8 +50,7 @@ Problems RunOptions::Validate() const {
     problems.insert(problems.end(), collider.begin(), collider.end());
   }
   if (!colliders.empty() && method == Method::kOverall) {
-    // The overall step with colliders (overall/contact_step.h) needs a smooth metric and convex
-    // colliders.
+    // The overall step with colliders (overall/contact_step.h) needs a smooth metric.
     for (const char* term : {"l2", "l2_weighted"}) {
       const double weight =
           std::string(term) == "l2" ? overall.weights.l2 : overall.weights.l2_weighted;
@@ -63,14 +62,6 @@ Problems RunOptions::Validate() const {
                               "to 0, or use \"tractrix\"",
                               FormatNumber(weight), "0 with colliders");
       }
-    }
-    for (size_t i = 0; i < colliders.size(); ++i) {
-      if (colliders[i].shape != ColliderShape::kMesh) continue;
-      problems.emplace_back("colliders[" + std::to_string(i) + "].shape",
-                            "the overall method with colliders takes convex colliders (sphere, "
-                            "ellipsoid, capsule, cylinder, box, half_space); a mesh is not yet "
-                            "supported with it: use \"tractrix\" or \"ftl\"",
-                            "\"mesh\"", "a convex shape with \"overall\"");
     }
   }
   if (!(std::isfinite(link_radius) && link_radius >= 0.0)) {
