@@ -16,13 +16,16 @@
 #include <vector>
 
 #include "collider_test_util.h"
+#include "dynamics/least_constraint.h"
 #include "flexkin/chain.h"
 #include "flexkin/colliders.h"
 #include "flexkin/error.h"
 #include "flexkin/leader.h"
 #include "flexkin/run.h"
 #include "mesh_test_util.h"
+#include "overall/contact_step.h"
 #include "overall_contact_peer.h"
+#include "sequential/sweep.h"
 #include "test_util.h"
 
 namespace flexkin {
@@ -292,6 +295,112 @@ TEST(OverallCollidersTest, ABoxMeshIsSolvedAsTheBox) {
   EXPECT_GE(LeastBrute(b, mesh), -1e-12);
   std::printf("box mesh vs box 2D: %lld link steps in contact, largest difference %.3g\n",
               (long long)b.contacts.contact_link_steps, worst);
+}
+
+// The dynamic chains' overall projection with contacts (LeastConstraintContact, used by
+// SimulateChain): the positions nearest the prediction (equal masses: the squared metric from the
+// prediction) that keep the lengths and stay outside, against IPOPT on the same minimization. A
+// chain lying just above a sphere (and, in 3D, a second one), its prediction pressed into them
+// as by gravity and a push, its driven end moved a little; the start is the tractrix contact
+// sweep of the prediction.
+TEST(OverallCollidersTest, TheDynamicContactProjectionIsIpoptsSolution) {
+  int compared = 0, most_iterations = 0;
+  double worst = 0.0;
+  for (int dim : {2, 3}) {
+    for (int trial = 0; trial < 4; ++trial) {
+      const int n = 16;
+      std::vector<Collider> spheres = {Sphere(Vector3d(0.0, 0.0, 0.0), 0.5)};
+      if (dim == 3) spheres.push_back(Sphere(Vector3d(0.45, 0.45, 0.3), 0.15));
+      Points x = Points::Zero(n + 1, dim);
+      for (int j = 0; j <= n; ++j) {
+        const double a = 2.6 - 0.11 * j;  // round the sphere at 0.503, from the upper left
+        x(j, 0) = 0.503 * std::cos(a);
+        x(j, 1) = 0.503 * std::sin(a);
+        if (dim == 3) x(j, 2) = 0.01 * j;
+      }
+      const Chain chain = MakeChain(x);
+      Points predicted = x;
+      for (int j = 0; j <= n; ++j) {
+        predicted(j, 0) += 0.002 * std::sin(1.3 * j + trial);
+        predicted(j, 1) -= 0.004 + 0.002 * trial;  // gravity's pull, into the sphere
+        if (dim == 3) predicted(j, 2) += 0.002 * std::cos(0.7 * j + trial);
+      }
+      predicted.row(0) = x.row(0) + 0.5 * (predicted.row(0) - x.row(0));
+      // The start: the projection without colliders (dynamics/least_constraint.h, from the
+      // chain's points with its driven end moved), inside the sphere.
+      Eigen::VectorXd mass = Eigen::VectorXd::Constant(n + 1, 1.0 / n);
+      mass[0] = 0.0;
+      Points start = x;
+      start.row(0) = predicted.row(0);
+      {
+        const Eigen::VectorXd inv = chain.lengths.cwiseInverse();
+        std::vector<double> work(internal::LeastConstraintWork(dim, n));
+        internal::LeastConstraintProblem free;
+        free.n = n;
+        free.p = predicted.data();
+        free.x = start.data();
+        free.mass = mass.data();
+        free.lengths = chain.lengths.data();
+        free.inv_lengths = inv.data();
+        free.work = work.data();
+        const double converged = dim == 2 ? internal::SolveLeastConstraint<double, 2>(free)
+                                          : internal::SolveLeastConstraint<double, 3>(free);
+        ASSERT_EQ(converged, 1.0);
+      }
+      double entered = 0.0;
+      for (Eigen::Index i = 1; i <= n; ++i) {
+        entered =
+            std::fmin(entered, SampledDistance(spheres[0], At(start, i - 1), At(start, i), 50));
+      }
+      ASSERT_LT(entered, -1e-4) << "the projection without the sphere does not enter it";
+      internal::OverallContactState state;
+      Points ours = start;
+      int iterations = 0;
+      ASSERT_TRUE(internal::LeastConstraintContact(chain.lengths, mass, predicted, spheres, &state,
+                                                   &ours, &iterations))
+          << dim << "D trial " << trial;
+      peers::OverallContactProblem problem;
+      problem.lengths = chain.lengths;
+      problem.squared = 1.0;
+      problem.old_points = predicted;
+      problem.head = predicted.row(0).transpose();
+      for (const Collider& c : spheres) problem.spheres.push_back({c.pose.translation(), c.radius});
+      double best = std::numeric_limits<double>::infinity();
+      Eigen::MatrixXd best_x;
+      // IPOPT from the chain's points (its driven end moved) and from ours moved by 1e-3 of a
+      // link at every point; its best answer.
+      Eigen::MatrixXd moved = x, nudged = ours;
+      moved.row(0) = predicted.row(0);
+      for (Eigen::Index j = 1; j <= n; ++j) {
+        nudged(j, 0) += 1e-4 * std::cos(7.0 * j);
+        nudged(j, 1) += 1e-4 * std::sin(5.0 * j);
+      }
+      for (const Eigen::MatrixXd& from : {moved, nudged}) {
+        Eigen::MatrixXd solution;
+        if (!peers::IpoptOverallContact(problem, from, &solution)) continue;
+        const double value = peers::OverallContactObjective(problem, solution);
+        if (value < best) best = value, best_x = solution;
+      }
+      ASSERT_TRUE(std::isfinite(best)) << "IPOPT found no solution";
+      EXPECT_LE(peers::OverallContactObjective(problem, ours), best + 1e-12 * std::fmax(1.0, best));
+      const double distance = (Eigen::MatrixXd(ours) - best_x).cwiseAbs().maxCoeff();
+      EXPECT_LE(distance, 1e-8) << dim << "D trial " << trial;
+      // It touches: the prediction is inside, the projection on the surface.
+      double nearest = std::numeric_limits<double>::infinity();
+      for (Eigen::Index i = 1; i <= n; ++i) {
+        nearest = std::fmin(nearest, SampledDistance(spheres[0], At(ours, i - 1), At(ours, i)));
+      }
+      EXPECT_LT(nearest, 1e-6);
+      EXPECT_GE(nearest, -1e-12);
+      worst = std::fmax(worst, distance);
+      most_iterations = std::max(most_iterations, iterations);
+      ++compared;
+    }
+  }
+  std::printf(
+      "dynamic contact projections compared with IPOPT: %d, largest distance %.3g, at most %d "
+      "Newton iterations\n",
+      compared, worst, most_iterations);
 }
 
 TEST(OverallCollidersTest, TheL2MetricIsRefusedByName) {

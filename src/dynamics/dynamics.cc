@@ -10,6 +10,7 @@
 #include "chain/substep.h"
 #include "dynamics/least_constraint.h"
 #include "dynamics/shake.h"
+#include "overall/contact_step.h"
 #include "sequential/link_rules.h"
 #include "world/contact.h"
 
@@ -364,6 +365,7 @@ DynamicResult SimulateChain(const Chain& chain, const Points& root_path,
   const Eigen::RowVectorXd g = options.gravity.transpose();
   Eigen::RowVectorXd air = options.WindAt(0.0, dim).transpose();
   Projector projector(lengths, dim, mass);
+  internal::OverallContactState contact_state;
 
   Points x = chain.points, x_old, p(n + 1, dim), projected(n + 1, dim), corrected(n + 1, dim),
          pushed;
@@ -449,13 +451,29 @@ DynamicResult SimulateChain(const Chain& chain, const Points& root_path,
         case Projection::kShake:
           project(p, &projected);
           if (!now.empty() && !projector.Clear(projected, now)) {
-            // The projection knows no colliders. Where it leaves a point or a link inside one,
-            // the prediction is moved out by that penetration (the contact's inelastic impulse)
-            // and projected again, up to 8 times; if that does not clear it, the projection is
-            // kept up to the first link not clear, and from there on each trailing end is
-            // carried by the tractrix step of its leading end's change and, where its link is not
-            // clear, takes the clear direction nearest that (the sequential contact sweep).
             contact = true;
+            // The overall projection with the contacts as constraints of its own solve
+            // (overall/contact_step.h): the least mass-weighted motion from the prediction that
+            // keeps the lengths and every point and link outside every collider, from the
+            // tractrix contact projection.
+            if (options.projection == Projection::kOverall) {
+              projector.Sequential(p, SweepRule::kTractrix, now, &corrected);
+              int iterations = 0;
+              if (internal::LeastConstraintContact(lengths, mass, p, now, &contact_state,
+                                                   &corrected, &iterations)) {
+                projected = corrected;
+                ++result.contact_solves;
+                break;
+              }
+              ++result.contact_solve_failures;
+            }
+            // SHAKE's projection, and an overall one with contacts that did not converge: where
+            // the projection leaves a point or a link inside a collider, the prediction is moved
+            // out by that penetration (the contact's inelastic impulse) and projected again, up
+            // to 8 times; if that does not clear it, the projection is kept up to the first link
+            // not clear, and from there on each trailing end is carried by the tractrix step of
+            // its leading end's change and, where its link is not clear, takes the clear
+            // direction nearest that (the sequential contact sweep).
             pushed = p;
             bool clear = false;
             for (int round = 0; round < 8 && !clear; ++round) {

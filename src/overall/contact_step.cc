@@ -56,9 +56,11 @@ struct Contact {
 
 class ContactSolver {
  public:
+  // `point_weights` (n + 1 entries, [0] unused; their largest about 1), if set: the metric is
+  // sum_j w_j |x_j - old_j|^2 (options' squared weight 1, the others 0).
   ContactSolver(const Eigen::VectorXd& lengths, const Points& old_points,
                 const OverallOptions& options, const std::vector<Collider>& colliders,
-                OverallContactState* state)
+                OverallContactState* state, const Eigen::VectorXd* point_weights = nullptr)
       : lengths_(lengths),
         old_(old_points),
         options_(options),
@@ -73,6 +75,7 @@ class ContactSolver {
     sink_.dim = dim_;
     sink_.offset.assign(n_ + 1, -1);
     for (int j = 1; j <= n_; ++j) sink_.offset[j] = (j - 1) * dim_;
+    if (point_weights != nullptr) sink_.point_weights = point_weights->data();
   }
 
   // Solves the sub-problem with the head at row 0 of `*x`, from `*x` (outside every collider,
@@ -683,6 +686,35 @@ void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& h
                     " sub-steps kept the sequential contact step (not converged)";
   }
   *report = std::move(result);
+}
+
+bool LeastConstraintContact(const Eigen::VectorXd& lengths, const Eigen::VectorXd& mass,
+                            const Points& predicted, const std::vector<Collider>& colliders,
+                            OverallContactState* state, Points* x, int* iterations) {
+  const int n = static_cast<int>(lengths.size());
+  const size_t pairs = static_cast<size_t>(n + 1) * colliders.size();
+  if (state->point_multipliers.size() != pairs) {
+    state->point_multipliers.assign(pairs, 0.0);
+    state->link_multipliers.assign(pairs, 0.0);
+  }
+  // The masses scaled to a largest of 1: the squared metric's scale, which the solver's
+  // tolerances and merit are measured against (the minimizer is the same).
+  Eigen::VectorXd weights = mass / mass.tail(n).maxCoeff();
+  weights[0] = 0.0;
+  OverallOptions options;
+  options.weights = ObjectiveWeights();
+  options.weights.squared = 1.0;
+  state->start = *x;
+  ContactSolver solver(lengths, predicted, options, colliders, state, &weights);
+  const OverallReport report = solver.Solve(x);
+  if (iterations != nullptr) *iterations = report.iterations;
+  double least = 0.0;
+  int touching = 0;
+  if (report.converged() && Clear(*x, lengths, colliders, &least, &touching)) return true;
+  *x = state->start;
+  std::fill(state->point_multipliers.begin(), state->point_multipliers.end(), 0.0);
+  std::fill(state->link_multipliers.begin(), state->link_multipliers.end(), 0.0);
+  return false;
 }
 
 }  // namespace flexkin::internal
