@@ -367,6 +367,20 @@ TEST_F(DynamicRunTest, CollidersAreTaken) {
   }
   EXPECT_GT(lowest, -0.6 - 1e-9);
   EXPECT_LT(lowest, -0.59);  // it reached the floor
+  // The contact counts, in the report and the file: the overall projection (the default) solved
+  // its contact sub-steps with the contacts.
+  ASSERT_EQ(options.projection, Projection::kOverall);
+  EXPECT_GT(direct.contact_solves, 0);
+  for (const DynamicRunReport* d : {&r.dynamics, &file.result.dynamics}) {
+    EXPECT_EQ(d->contact_substeps, direct.contact_substeps);
+    EXPECT_EQ(d->contact_solves, direct.contact_solves);
+    EXPECT_EQ(d->contact_solve_failures, direct.contact_solve_failures);
+  }
+  EXPECT_NE(
+      r.BriefReport().find(std::to_string(direct.contact_substeps) + " contact sub-steps (" +
+                           std::to_string(direct.contact_solves) + " solved with the contacts"),
+      std::string::npos)
+      << r.BriefReport();
 
   std::ofstream(Path("tet.obj")) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
                                  << "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";

@@ -174,6 +174,10 @@ struct DynamicRunReport {
   // kinetic plus potential, the free points' masses summing to 1).
   Eigen::VectorXd energy;
   int64_t failures = 0;  // sub-steps whose projection's Newton solve did not converge
+  // With colliders (DynamicResult): sub-steps in which a collider moved a point; of those, with
+  // the overall projection, the ones solved with the contacts as constraints and the ones whose
+  // contact solve did not converge (they took the pushed re-projection).
+  int64_t contact_substeps = 0, contact_solves = 0, contact_solve_failures = 0;
 };
 
 struct RunResult {

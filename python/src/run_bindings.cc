@@ -443,12 +443,16 @@ The result of a run (flexkin.run, flexkin.run_scenario), as in a result file
             out["frame_rate"] = d.frame_rate;
             out["substeps"] = d.substeps;
             out["failures"] = d.failures;
+            out["contact_substeps"] = d.contact_substeps;
+            out["contact_solves"] = d.contact_solves;
+            out["contact_solve_failures"] = d.contact_solve_failures;
             out["energy"] = ToArray(d.energy);
             return std::move(out);
           },
           "A dynamic chain's (a scenario's \"dynamics\", docs/dynamics.md): a dict with "
-          "projection, frame_rate, substeps, failures and energy ((num_steps + 1,) float64, the "
-          "energy at every frame); None for a kinematic run.")
+          "projection, frame_rate, substeps, failures, contact_substeps, contact_solves, "
+          "contact_solve_failures and energy ((num_steps + 1,) float64, the energy at every "
+          "frame); None for a kinematic run.")
       .def_property_readonly(
           "dim", [](const Result& r) { return r.file.dim; }, "2 or 3.")
       .def_property_readonly(

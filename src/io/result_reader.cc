@@ -142,6 +142,14 @@ void ReadResultSummary(const json& j, const ResultArrays* arrays, ResultFile* ou
     report.substeps =
         static_cast<int>(ReadInteger(Member(d, "/dynamics", "substeps"), "/dynamics/substeps", 1));
     report.failures = ReadInteger(Member(d, "/dynamics", "failures"), "/dynamics/failures", 0);
+    // The contact counts (absent from files written before they were): 0 if absent.
+    for (auto [key, to] : {std::pair{"contact_substeps", &report.contact_substeps},
+                           std::pair{"contact_solves", &report.contact_solves},
+                           std::pair{"contact_solve_failures", &report.contact_solve_failures}}) {
+      if (const auto at = d.find(key); at != d.end()) {
+        *to = ReadInteger(*at, std::string("/dynamics/") + key, 0);
+      }
+    }
     report.energy =
         ReadVector(Member(d, "/dynamics", "energy"), "/dynamics/energy", r.num_steps + 1);
   }

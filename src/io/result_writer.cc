@@ -262,7 +262,11 @@ void AppendResultSummaryJson(const RunResult& result, bool with_arrays, std::str
     t += "\"dynamics\": {\"projection\": " + JsonString(d.projection) + ", \"frame_rate\": ";
     AppendJsonDouble(d.frame_rate, &t);
     t += ", \"substeps\": " + std::to_string(d.substeps) +
-         ", \"failures\": " + std::to_string(d.failures) + ",\n\"energy\": ";
+         ", \"failures\": " + std::to_string(d.failures) +
+         ", \"contact_substeps\": " + std::to_string(d.contact_substeps) +
+         ", \"contact_solves\": " + std::to_string(d.contact_solves) +
+         ", \"contact_solve_failures\": " + std::to_string(d.contact_solve_failures) +
+         ",\n\"energy\": ";
     AppendVector(d.energy, &t);
     t += "},\n";
   }

@@ -30,6 +30,13 @@ std::string RunResult::BriefReport() const {
           << Format("%.6g", dynamics.energy[dynamics.energy.size() - 1]) << " at the end";
     }
     if (dynamics.failures > 0) out << ", " << dynamics.failures << " sub-steps' solves failed";
+    if (dynamics.contact_substeps > 0) {
+      out << ", " << dynamics.contact_substeps << " contact sub-steps";
+      if (dynamics.contact_solves + dynamics.contact_solve_failures > 0) {
+        out << " (" << dynamics.contact_solves << " solved with the contacts, "
+            << dynamics.contact_solve_failures << " pushed out)";
+      }
+    }
     out << ", " << Format("%.3g", seconds) << " s";
     return out.str();
   }

@@ -191,6 +191,9 @@ RunResult RunDynamicChain(const Scenario& s, const RunOptions& options, const Ru
   report.substeps = dynamics.substeps;
   report.energy = run.energy;
   report.failures = run.failures;
+  report.contact_substeps = run.contact_substeps;
+  report.contact_solves = run.contact_solves;
+  report.contact_solve_failures = run.contact_solve_failures;
 
   const Eigen::VectorXd no_angles;
   for (Eigen::Index f = 0; f <= frames; ++f) {
