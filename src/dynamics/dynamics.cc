@@ -455,13 +455,21 @@ DynamicResult SimulateChain(const Chain& chain, const Points& root_path,
             // The overall projection with the contacts as constraints of its own solve
             // (overall/contact_step.h): the least mass-weighted motion from the prediction that
             // keeps the lengths and every point and link outside every collider, from the
-            // tractrix contact projection.
+            // projection without them (where that did not converge, the tractrix projection it
+            // kept), and where that does not converge, from the tractrix contact projection.
+            // Solved, it is the projection: no velocity correction.
             if (options.projection == Projection::kOverall) {
-              projector.Sequential(p, SweepRule::kTractrix, now, &corrected);
-              int iterations = 0;
-              if (internal::LeastConstraintContact(lengths, mass, p, now, &contact_state,
-                                                   &corrected, &iterations)) {
+              corrected = projected;
+              bool solved = internal::LeastConstraintContact(lengths, mass, p, now, &contact_state,
+                                                             &corrected);
+              if (!solved) {
+                projector.Sequential(p, SweepRule::kTractrix, now, &corrected);
+                solved = internal::LeastConstraintContact(lengths, mass, p, now, &contact_state,
+                                                          &corrected);
+              }
+              if (solved) {
                 projected = corrected;
+                fell_back = false;
                 ++result.contact_solves;
                 break;
               }

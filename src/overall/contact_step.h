@@ -39,9 +39,9 @@ void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& h
 // The least-constraint projection with colliders (dynamics, docs/dynamics.md): of the positions
 // that keep every link's length and every point and link outside every collider, the one nearest
 // `predicted` in the mass-weighted distance sum_j m_j |x_j - p_j|^2 (`mass`: n + 1 entries, [0]
-// unused; point 0 held at predicted's row 0), solved as OverallContactStep's sub-problem from `*x`:
-// the projection without colliders (the lengths kept, the metric stationary; points or links
-// inside a collider), from which the contacts join the solve. Returns true where it converged
+// unused; point 0 held at predicted's row 0), solved as OverallContactStep's sub-problem from `*x`
+// (the lengths kept; the projection without colliders, whose points or links inside a collider
+// join the solve as contacts, or a start outside every collider). Returns true where it converged
 // with every link clear (exact clearances); else `*x` is left as it was. `*iterations` (if set):
 // the Newton iterations taken.
 bool LeastConstraintContact(const Eigen::VectorXd& lengths, const Eigen::VectorXd& mass,
