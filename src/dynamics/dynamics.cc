@@ -455,15 +455,16 @@ DynamicResult SimulateChain(const Chain& chain, const Points& root_path,
             // The overall projection with the contacts as constraints of its own solve
             // (overall/contact_step.h): the least mass-weighted motion from the prediction that
             // keeps the lengths and every point and link outside every collider, from the
-            // projection without them (where that did not converge, the tractrix projection it
-            // kept), and where that does not converge, from the tractrix contact projection.
-            // Solved, it is the projection: no velocity correction.
+            // tractrix contact projection (outside every collider), and where that does not
+            // converge, from the projection without colliders (where that did not converge, the
+            // tractrix projection it kept). Solved, it is the projection: no velocity
+            // correction.
             if (options.projection == Projection::kOverall) {
-              corrected = projected;
+              projector.Sequential(p, SweepRule::kTractrix, now, &corrected);
               bool solved = internal::LeastConstraintContact(lengths, mass, p, now, &contact_state,
                                                              &corrected);
               if (!solved) {
-                projector.Sequential(p, SweepRule::kTractrix, now, &corrected);
+                corrected = projected;
                 solved = internal::LeastConstraintContact(lengths, mass, p, now, &contact_state,
                                                           &corrected);
               }
