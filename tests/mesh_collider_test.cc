@@ -159,13 +159,8 @@ TEST(MeshColliderTest, ABoxMeshMovesAChainAsTheBoxDoes) {
   box.extents = Vector3d(0.08, 0.08, 0.5);
   box.pose.translation() = Vector3d(0.25, -0.25, 0.05);
   box.pose.linear() = Eigen::AngleAxisd(0.3, Vector3d::UnitZ()).toRotationMatrix();
-  // The same box as 12 triangles: one unit cell, centred, scaled per axis into its vertices.
-  TestMesh cube = Voxels({{0, 0, 0}}, 1.0, Vector3d::Constant(-0.5));
-  ASSERT_EQ(cube.triangles.rows(), 12);
-  for (Eigen::Index i = 0; i < cube.vertices.rows(); ++i) {
-    cube.vertices.row(i) = (2.0 * cube.vertices.row(i).transpose()).cwiseProduct(box.extents);
-  }
-  const Collider mesh = MeshCollider(cube, box.pose);
+  // The same box as 12 triangles.
+  const Collider mesh = BoxMesh(box.extents, box.pose);
   RunOptions options;
   options.method = Method::kTractrix;
   options.substeps = 2;

@@ -131,6 +131,18 @@ inline Collider MeshCollider(const TestMesh& m,
   return c;
 }
 
+// A box of half-extents `half` placed by `pose`, as a mesh of 12 triangles (one cell, centred and
+// scaled per axis).
+inline Collider BoxMesh(const Vector3d& half,
+                        const Eigen::Isometry3d& pose = Eigen::Isometry3d::Identity()) {
+  TestMesh cube = Voxels({{0, 0, 0}}, 1.0, Vector3d::Constant(-0.5));
+  EXPECT_EQ(cube.triangles.rows(), 12);
+  for (Eigen::Index i = 0; i < cube.vertices.rows(); ++i) {
+    cube.vertices.row(i) = (2.0 * cube.vertices.row(i).transpose()).cwiseProduct(half);
+  }
+  return MeshCollider(cube, pose);
+}
+
 // ---- The test's own brute force, over every triangle of the placed mesh. ----
 
 struct World {

@@ -93,15 +93,11 @@ double LengthError(const RunResult& result) {
   return worst;
 }
 
-// A box of half-extents `half` about `center` as a mesh of 12 triangles (one cell, scaled).
+// A box of half-extents `half` about `center` as a mesh of 12 triangles.
 Collider BoxMesh(const Vector3d& center, const Vector3d& half) {
-  mesh_test::TestMesh cube = mesh_test::Voxels({{0, 0, 0}}, 1.0, Vector3d::Constant(-0.5));
-  for (Eigen::Index i = 0; i < cube.vertices.rows(); ++i) {
-    cube.vertices.row(i) = (2.0 * cube.vertices.row(i).transpose()).cwiseProduct(half);
-  }
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.translation() = center;
-  return mesh_test::MeshCollider(cube, pose);
+  return mesh_test::BoxMesh(half, pose);
 }
 
 // The least signed distance of any link of any frame to a mesh, relative to its link, by the

@@ -606,6 +606,20 @@ bool Clear(const Points& x, const Eigen::VectorXd& lengths, const std::vector<Co
   return *least >= -kContactSlack;
 }
 
+// The state's contact multipliers sized for n links and `colliders` (kept where they are).
+void SizeMultipliers(int n, size_t colliders, OverallContactState* state) {
+  const size_t pairs = static_cast<size_t>(n + 1) * colliders;
+  if (state->point_multipliers.size() != pairs) {
+    state->point_multipliers.assign(pairs, 0.0);
+    state->link_multipliers.assign(pairs, 0.0);
+  }
+}
+
+void ClearMultipliers(OverallContactState* state) {
+  std::fill(state->point_multipliers.begin(), state->point_multipliers.end(), 0.0);
+  std::fill(state->link_multipliers.begin(), state->link_multipliers.end(), 0.0);
+}
+
 }  // namespace
 
 void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& head,
@@ -614,11 +628,7 @@ void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& h
                         OverallReport* report, ContactStats* stats) {
   const int n = static_cast<int>(lengths.size());
   const int dim = static_cast<int>(points->cols());
-  const size_t pairs = static_cast<size_t>(n + 1) * colliders.size();
-  if (state->point_multipliers.size() != pairs) {
-    state->point_multipliers.assign(pairs, 0.0);
-    state->link_multipliers.assign(pairs, 0.0);
-  }
+  SizeMultipliers(n, colliders.size(), state);
   // The step without colliders, kept where it ends clear.
   state->free = *points;
   OverallStepUnchecked(lengths, head, options, &state->free, workspace, report);
@@ -628,8 +638,7 @@ void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& h
     stats->contact_link_steps += touching;
     *points = state->free;
     stats->least_clearance = std::fmin(stats->least_clearance, least);
-    std::fill(state->point_multipliers.begin(), state->point_multipliers.end(), 0.0);
-    std::fill(state->link_multipliers.begin(), state->link_multipliers.end(), 0.0);
+    ClearMultipliers(state);
     return;
   }
   // Continuation in head sub-steps of at most half the shortest link, each from the sequential
@@ -665,8 +674,7 @@ void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& h
     if (!sub.converged()) {
       ++fallbacks;
       *points = state->start;
-      std::fill(state->point_multipliers.begin(), state->point_multipliers.end(), 0.0);
-      std::fill(state->link_multipliers.begin(), state->link_multipliers.end(), 0.0);
+      ClearMultipliers(state);
       result.status = sub.status;
     }
     result.objective = sub.objective;
@@ -692,11 +700,7 @@ bool LeastConstraintContact(const Eigen::VectorXd& lengths, const Eigen::VectorX
                             const Points& predicted, const std::vector<Collider>& colliders,
                             OverallContactState* state, Points* x, int* iterations) {
   const int n = static_cast<int>(lengths.size());
-  const size_t pairs = static_cast<size_t>(n + 1) * colliders.size();
-  if (state->point_multipliers.size() != pairs) {
-    state->point_multipliers.assign(pairs, 0.0);
-    state->link_multipliers.assign(pairs, 0.0);
-  }
+  SizeMultipliers(n, colliders.size(), state);
   // The masses scaled to a largest of 1: the squared metric's scale, which the solver's
   // tolerances and merit are measured against (the minimizer is the same).
   Eigen::VectorXd weights = mass / mass.tail(n).maxCoeff();
@@ -712,8 +716,7 @@ bool LeastConstraintContact(const Eigen::VectorXd& lengths, const Eigen::VectorX
   int touching = 0;
   if (report.converged() && Clear(*x, lengths, colliders, &least, &touching)) return true;
   *x = state->start;
-  std::fill(state->point_multipliers.begin(), state->point_multipliers.end(), 0.0);
-  std::fill(state->link_multipliers.begin(), state->link_multipliers.end(), 0.0);
+  ClearMultipliers(state);
   return false;
 }
 
