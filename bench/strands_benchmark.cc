@@ -9,7 +9,8 @@
 // capsules (a neck, two shoulders, a torso), against the same hair without colliders and against
 // the baseline hair simulators use: follow-the-leader, then each point pushed out of the
 // colliders (BM_Draped*; the counters give the deepest link inside a collider after the frame and
-// the worst relative link-length error, over the run).
+// the worst relative link-length error, over the run); and the hair of 1 and 2 on the upper half
+// of the scalp with and without the same colliders (BM_Grown*: a groom as the head demo's).
 // ns_per_link_step is the time per link per strand per frame (printed in seconds: "3.3n").
 // Run: build/bench/strands_benchmark --benchmark_repetitions=5
 //        --benchmark_report_aggregates_only=true ; FLEXKIN_SIMD=avx2 caps the engine at AVX2.
@@ -29,7 +30,9 @@ namespace flexkin {
 namespace {
 
 // Strands on the unit sphere, growing outward with small random bends, links of 0.01 to 0.02.
-std::vector<Points> Hair(int count, int links) {
+// `upper`: rooted on the upper half only (a root below the equator mirrored in it), each link kept
+// at least 0.3 of its length away from the sphere's centre (no strand curls back into it).
+std::vector<Points> Hair(int count, int links, bool upper = false) {
   std::mt19937 rng(42);
   std::normal_distribution<double> normal;
   std::uniform_real_distribution<double> uniform(0.01, 0.02);
@@ -39,9 +42,12 @@ std::vector<Points> Hair(int count, int links) {
     Points p(links + 1, 3);
     Eigen::Vector3d dir(normal(rng), normal(rng), normal(rng));
     dir.normalize();
+    if (upper) dir.z() = std::fabs(dir.z());
     p.row(0) = dir.transpose();
     for (int i = 1; i <= links; ++i) {
       dir = (dir + 0.2 * Eigen::Vector3d(normal(rng), normal(rng), normal(rng))).normalized();
+      const Eigen::Vector3d out = p.row(i - 1).transpose().normalized();
+      if (upper && dir.dot(out) < 0.3) dir = (dir + (0.3 - dir.dot(out)) * out).normalized();
       p.row(i) = p.row(i - 1) + uniform(rng) * dir.transpose();
     }
     strands.push_back(p);
@@ -216,14 +222,16 @@ BodyPose ShakePose(int64_t frame) {
   return pose;
 }
 
-void DrapedEngine(benchmark::State& state, bool colliders) {
+// The strands on a head moved by `pose`, with or without the scalp and 4 capsules, by threads.
+void BodyEngine(benchmark::State& state, const std::vector<Points>& strands,
+                BodyPose (*pose)(int64_t), bool colliders) {
   StrandOptions options;
   options.threads = static_cast<int>(state.range(0));
   if (colliders) options.body_colliders = Body();
-  StrandBatch batch(Draped(10000, 32), options);
+  StrandBatch batch(strands, options);
   int64_t frame = 0;
   for (auto _ : state) {
-    StepStrands(&batch, ShakePose(++frame));
+    StepStrands(&batch, pose(++frame));
     benchmark::ClobberMemory();
   }
   state.SetLabel(batch.engine());
@@ -234,6 +242,9 @@ void DrapedEngine(benchmark::State& state, bool colliders) {
     state.counters["least_clearance"] = batch.contacts().least_clearance;
   }
 }
+void DrapedEngine(benchmark::State& state, bool colliders) {
+  BodyEngine(state, Draped(10000, 32), ShakePose, colliders);
+}
 void BM_DrapedFree(benchmark::State& state) { DrapedEngine(state, false); }
 void BM_DrapedColliders(benchmark::State& state) { DrapedEngine(state, true); }
 BENCHMARK(BM_DrapedFree)
@@ -243,6 +254,28 @@ BENCHMARK(BM_DrapedFree)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_DrapedColliders)
+    ->Arg(1)
+    ->Arg(2)
+    ->Iterations(120)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// Hair grown outward as in 1 and 2 (the head nodding and turning as there), rooted on the upper
+// half of the scalp (the neck capsule would hold roots at the bottom), with and without the scalp
+// and 4 capsules: a groom as the head demo's, where the strands the turning head lays against the
+// scalp touch it.
+void GrownEngine(benchmark::State& state, bool colliders) {
+  BodyEngine(state, Hair(10000, 32, true), HeadPose, colliders);
+}
+void BM_GrownFree(benchmark::State& state) { GrownEngine(state, false); }
+void BM_GrownColliders(benchmark::State& state) { GrownEngine(state, true); }
+BENCHMARK(BM_GrownFree)
+    ->Arg(1)
+    ->Arg(2)
+    ->Iterations(120)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_GrownColliders)
     ->Arg(1)
     ->Arg(2)
     ->Iterations(120)
