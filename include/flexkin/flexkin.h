@@ -34,4 +34,5 @@
 #include "flexkin/scenario_kind.h"   // the kinds of scenario file
 #include "flexkin/strand_file.h"     // strand files (.npz): every strand at every frame
 #include "flexkin/strands.h"         // many strands (hair, fur) stepped together
+#include "flexkin/tree.h"            // bodies that branch: trees driven at one point
 #include "flexkin/vocabulary.h"      // the names of every enumerated choice

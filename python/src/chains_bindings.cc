@@ -4,7 +4,9 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include <limits>
 #include <string>
+#include <vector>
 
 #include "convert.h"
 #include "fields.h"
@@ -13,6 +15,7 @@
 #include "flexkin/link_step.h"
 #include "flexkin/overall.h"
 #include "flexkin/propagate.h"
+#include "flexkin/tree.h"
 #include "flexkin/vocabulary.h"
 
 namespace flexkin::python {
@@ -121,6 +124,61 @@ OverallReport StepChainOverall(Chain* chain, py::handle head, py::handle options
   const OverallOptions o = OverallArg(options);
   py::gil_scoped_release release;
   return OverallStep(h, o, chain);
+}
+
+// A sequence of integers (Python ints or numpy integers, not bools or floats), each named
+// "name[i]" in errors.
+std::vector<int> IndexList(py::handle object, const std::string& name) {
+  if (!py::isinstance<py::sequence>(object) && !py::isinstance<py::array>(object)) {
+    ThrowInput(name, "is not a sequence of point indices", std::string(py::repr(object)),
+               "a list of ints, -1 for the root");
+  }
+  std::vector<int> out;
+  Py_ssize_t i = 0;
+  for (py::handle item : object) {
+    const std::string field = name + "[" + std::to_string(i++) + "]";
+    if (py::isinstance<py::bool_>(item) || !PyIndex_Check(item.ptr())) {
+      ThrowInput(field, "is not an integer", std::string(py::repr(item)),
+                 "a point index, -1 for the root");
+    }
+    const Py_ssize_t value = PyNumber_AsSsize_t(item.ptr(), nullptr);
+    if (value == -1 && PyErr_Occurred()) throw py::error_already_set();
+    if (value < -1 || value > std::numeric_limits<int>::max()) {
+      ThrowInput(field, "is not a point index", std::to_string(value),
+                 "-1 (the root) or a point index");
+    }
+    out.push_back(static_cast<int>(value));
+  }
+  return out;
+}
+
+// The tree's frames: the start, then the configuration after each target of `path`.
+py::array_t<double> MoveTree(ArrayLike points, IndexSequence parents, ArrayLike path, int driven,
+                             const std::string& method, int substeps) {
+  Tree tree;
+  tree.points = ReadPoints(points, "points", 2);
+  tree.parents = IndexList(parents, "parents");
+  ValidateTree(tree, "");
+  const TreeStepper stepper = MakeTreeStepper(MethodArg(method), tree, driven);
+  const int dim = stepper.dim;
+  const auto targets = ReadArray(path, "path", 2, 1, dim);
+  if (substeps < 1) {
+    ThrowInput("substeps", "must be at least 1", std::to_string(substeps), "1 or more");
+  }
+  const py::ssize_t count = targets.shape(0), rows = tree.points.rows();
+  py::array_t<double> frames({count + 1, rows, static_cast<py::ssize_t>(dim)});
+  double* out = frames.mutable_data();
+  const double* target = targets.data();
+  Points pts = tree.points;
+  const size_t frame = static_cast<size_t>(rows) * dim;
+  py::gil_scoped_release release;
+  std::copy(pts.data(), pts.data() + frame, out);
+  for (py::ssize_t i = 0; i < count; ++i) {
+    MoveTreePoint(stepper, Eigen::Map<const Eigen::VectorXd>(target + i * dim, dim), substeps,
+                  &pts);
+    std::copy(pts.data(), pts.data() + frame, out + (i + 1) * frame);
+  }
+  return frames;
 }
 
 }  // namespace
@@ -331,6 +389,15 @@ Chain(points, *, link_length=None, lengths=None)
       "moves in a straight line to target in `substeps` equal sub-steps, each link following by "
       "`method` (\"tractrix\", \"ftl\", \"min_rotation\", \"min_joint_angle\"). Returns the new "
       "(n+1, dim) points; the input is not changed (Chain.move_leader moves a chain in place).");
+  m.def("move_tree", &MoveTree, py::arg("points"), py::arg("parents"), py::arg("path"),
+        py::kw_only(), py::arg("driven") = 0, py::arg("method") = "tractrix",
+        py::arg("substeps") = 1,
+        "A tree driven at one point (docs/trees.md): points is (n+1, dim), parents the point "
+        "each point hangs from (n+1 ints, -1 for the one root; a path is [-1, 0, 1, ...]). The "
+        "point `driven` moves through the targets of path ((m, dim)), each in `substeps` straight "
+        "sub-steps, and every link, outward from it along every branch, follows by `method` "
+        "(\"tractrix\" or \"ftl\"). Returns the frames, (m+1, n+1, dim): the start, then the "
+        "tree after each target.");
   m.def(
       "overall_step",
       [](PointsOrChain points, ArrayLike head, OverallLike options) {

@@ -73,6 +73,7 @@ FLEXKIN_PYTHON_ARG(AnimationLike, "Union[AnimationOptions, dict, None]")
 FLEXKIN_PYTHON_ARG(ViewerLike, "Union[ViewerOptions, dict, None]")
 FLEXKIN_PYTHON_ARG(GltfLike, "Union[GltfOptions, dict, None]")
 FLEXKIN_PYTHON_ARG(StrandList, "Sequence[ArrayLike]")
+FLEXKIN_PYTHON_ARG(IndexSequence, "Sequence[int]")
 FLEXKIN_PYTHON_ARG(PoseLike, "Union[BodyPose, ArrayLike, Tuple[ArrayLike, ArrayLike], dict, None]")
 FLEXKIN_PYTHON_ARG(StrandOptionsLike, "Union[StrandOptions, dict, None]")
 #undef FLEXKIN_PYTHON_ARG

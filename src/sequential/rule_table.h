@@ -44,6 +44,9 @@ enum RuleEngine : unsigned {
   kStrandEngine = 1u << 2,
   // One chain moved as a whole per sub-step (metric_rules.cc). Calls Rule::WholeChainSweeps.
   kWholeChainEngine = 1u << 3,
+  // A tree driven at one point, link after link outward from it (tree.cc). Calls Rule::Step<Dim>
+  // on doubles.
+  kTreeEngine = 1u << 4,
 };
 
 // The engine's name in messages ("the strand engine").
@@ -57,6 +60,8 @@ inline const char* RuleEngineName(RuleEngine engine) {
       return "the strand engine";
     case kWholeChainEngine:
       return "the whole-chain sweep";
+    case kTreeEngine:
+      return "trees";
   }
   return "?";
 }
@@ -65,7 +70,8 @@ inline const char* RuleEngineName(RuleEngine engine) {
 struct TractrixLinkRule {
   static constexpr Method kMethod = Method::kTractrix;
   static constexpr int kOrder = 2;
-  static constexpr unsigned kEngines = kSweepsEngine | kWavefrontEngine | kStrandEngine;
+  static constexpr unsigned kEngines =
+      kSweepsEngine | kWavefrontEngine | kStrandEngine | kTreeEngine;
   template <int Dim, class Exp = StdExp>
   using Step = TractrixRule<Dim, Exp>;
 };
@@ -75,7 +81,8 @@ struct TractrixLinkRule {
 struct FollowTheLeaderLinkRule {
   static constexpr Method kMethod = Method::kFollowTheLeader;
   static constexpr int kOrder = 1;
-  static constexpr unsigned kEngines = kSweepsEngine | kWavefrontEngine | kStrandEngine;
+  static constexpr unsigned kEngines =
+      kSweepsEngine | kWavefrontEngine | kStrandEngine | kTreeEngine;
   template <int Dim, class Exp = StdExp>
   using Step = FollowTheLeaderRule<Dim>;
 };
