@@ -12,6 +12,8 @@
 // (source[j] = j - 1); here every iteration's results go to `rows` and are read back by link and
 // lane (a gather).
 
+#include <immintrin.h>
+
 #include <algorithm>
 #include <cstdint>
 #include <vector>
@@ -27,8 +29,28 @@ namespace {
 
 // Sweeps done by the engine (a multiple of the lanes W); the caller finishes the rest with the
 // one-pass sweep.
+// Lane i: base[index[i]], by the hardware gather (xsimd 8's own gather of doubles by 64-bit
+// indices for AVX-512 is a loop over the lanes, not inlined).
+#if defined(__AVX512F__)
+inline __m512d GatherAt(const double* base, __m512i index) {
+  return _mm512_i64gather_pd(index, base, 8);
+}
+#endif
+#if defined(__AVX2__)
+inline __m256d GatherAt(const double* base, __m256i index) {
+  return _mm256_i64gather_pd(base, index, 8);
+}
+#endif
+
 // U registers of W lanes: G = U W sweeps in flight (the registers' rule evaluations are
 // independent, so their latencies overlap). Starts at sweep `g`, returns the sweep it stopped at.
+//
+// Lane l of iteration t works on link j = t - l: its values are at index P + m - 1 - t + l of the
+// link arrays below, reversed and padded by P = G - 1 either side (so that a register's lanes are
+// one contiguous load), and its leading end's positions are gathered (from the rows, or from
+// `heads` for the links from the driven point). A lane whose j is not a link (the group's first
+// and last G - 1 iterations) steps a unit link whose leading end stays still: finite, on the exp's
+// fast path, and read by no other lane.
 template <class Arch, class Rule, int Dim, int U>
 int64_t TreeWavefrontGroups(const double* heads, int64_t g, int64_t num_sweeps,
                             const TreeLinks& tree, double* points) {
@@ -36,125 +58,104 @@ int64_t TreeWavefrontGroups(const double* heads, int64_t g, int64_t num_sweeps,
   using I = xsimd::batch<int64_t, Arch>;
   constexpr int W = B::size;
   constexpr int G = U * W;
+  constexpr int P = G - 1;
   constexpr int64_t kRow = Dim * G;  // doubles in one iteration's row
   const int m = tree.num_links;
   if (num_sweeps - g < G || m == 0) return g;
-  // rows[t], iteration t: lane l's trailing end of link t - l after sweep g + l, as [k][l].
+  // rows[t], iteration t: lane l's trailing end of link t - l after sweep g + l, as [k][l]; one
+  // row more in front, which lane 0's read of the row before, one lane before, touches at t = 1.
   const int iterations = m + G - 1;
   thread_local std::vector<double, xsimd::aligned_allocator<double>> rows;
-  rows.resize(static_cast<size_t>(iterations) * kRow);
-  const auto row = [&](int t) { return rows.data() + static_cast<size_t>(t) * kRow; };
-  // The iterations whose G lanes all work on links (G - 1 <= t < m) whose leading end is not the
-  // driven point read their data with vector loads and gathers: lane l of iteration t works on
-  // link t - l, whose values are at index m - 1 - t + l of the reversed arrays below. The others
-  // (a group's first and last G - 1 iterations, the links from the driven point) gather lane by
-  // lane.
-  thread_local std::vector<int64_t> source_row;  // where the row of link j's leading end starts
-  thread_local std::vector<double> rev_len, rev_inv;
-  thread_local std::vector<char> fast;
-  source_row.resize(m);
-  rev_len.resize(m);
-  rev_inv.resize(m);
-  fast.assign(iterations, 0);
+  rows.resize(static_cast<size_t>(iterations + 1) * kRow);
+  double* const base = rows.data() + kRow;
+  const auto row = [&](int t) { return base + static_cast<size_t>(t) * kRow; };
+  // Per link, reversed and padded: where its leading end's row starts (0 for the driven point),
+  // whether that is the driven point, its length and inverse, whether it is a link at all.
+  thread_local std::vector<int64_t> source_row;
+  thread_local std::vector<double> rev_len, rev_inv, rev_driven, rev_on;
+  source_row.assign(m + 2 * P, 0);
+  rev_len.assign(m + 2 * P, 1.0);
+  rev_inv.assign(m + 2 * P, 1.0);
+  rev_driven.assign(m + 2 * P, 0.0);
+  rev_on.assign(m + 2 * P, 0.0);
+  for (int j = 0; j < m; ++j) {
+    const int r = P + m - 1 - j;
+    source_row[r] = tree.source[j] < 0 ? 0 : tree.source[j] * kRow;
+    rev_len[r] = tree.lengths[j];
+    rev_inv[r] = tree.inv_lengths[j];
+    rev_driven[r] = tree.source[j] < 0 ? 1.0 : 0.0;
+    rev_on[r] = 1.0;
+  }
+  // The iterations whose lanes all work on links (G - 1 <= t < m), none from the driven point,
+  // need no masks.
+  thread_local std::vector<char> plain;
+  plain.assign(iterations, 0);
   int driven_leads = 0;  // among links t - G + 1 .. t
   for (int t = 0; t < iterations; ++t) {
-    if (t < m) {
-      source_row[m - 1 - t] = tree.source[t] < 0 ? 0 : tree.source[t] * kRow;
-      rev_len[m - 1 - t] = tree.lengths[t];
-      rev_inv[m - 1 - t] = tree.inv_lengths[t];
-      driven_leads += tree.source[t] < 0;
-    }
+    if (t < m) driven_leads += tree.source[t] < 0;
     if (t >= G && t - G < m) driven_leads -= tree.source[t - G] < 0;
-    fast[t] = t >= G - 1 && t < m && driven_leads == 0;
+    plain[t] = t >= G - 1 && t < m && driven_leads == 0;
   }
-  alignas(64) int64_t step_of_lane[G];
+  alignas(64) int64_t row_step[G], head_step[G];
   alignas(64) double lane_index[W];
-  for (int l = 0; l < G; ++l) step_of_lane[l] = l * (kRow + 1);
+  for (int l = 0; l < G; ++l) row_step[l] = l * (kRow + 1), head_step[l] = l * Dim;
   for (int l = 0; l < W; ++l) lane_index[l] = l;
   const auto lane0 = B::load_aligned(lane_index) == B(0.0);
   const int d = tree.driven;
   for (; g + G <= num_sweeps; g += G) {
     for (int t = 0; t < iterations; ++t) {
-      B lead_old[U][Dim], lead_new[U][Dim], tail[U][Dim], length[U], inv[U];
-      xsimd::batch_bool<double, Arch> active[U];
-      if (fast[t]) {
-        // Lane l: its leading end after sweep g + l at row(source + l), lane l, and after sweep
-        // g + l - 1 one row and one lane before; its own old position in the last row, one lane
-        // before. Lane 0 (sweep g) reads the positions before the group.
-        const int a = tree.lead[t], b = tree.tail[t];
-        for (int u = 0; u < U; ++u) {
-          const int rev = m - 1 - t + u * W;
-          const I at =
-              I::load_unaligned(source_row.data() + rev) + I::load_aligned(step_of_lane + u * W);
-          const I before = xsimd::max(at - I(kRow + 1), I(0));
-          for (int k = 0; k < Dim; ++k) {
-            const double* lanes = rows.data() + k * G;
-            lead_new[u][k] = B::gather(lanes, at);
-            lead_old[u][k] = B::gather(lanes, before);
-            tail[u][k] = B::load_unaligned(row(t - 1) + k * G + u * W - 1);
-            if (u == 0) {
-              lead_old[u][k] = xsimd::select(lane0, B(points[a * Dim + k]), lead_old[u][k]);
-              tail[u][k] = xsimd::select(lane0, B(points[b * Dim + k]), tail[u][k]);
-            }
-          }
-          length[u] = B::load_unaligned(rev_len.data() + rev);
-          inv[u] = B::load_unaligned(rev_inv.data() + rev);
-          active[u] = B(1.0) == B(1.0);
-        }
-      } else {
-        alignas(64) double lo[Dim][G], ln[Dim][G], tl[Dim][G], len[G], iv[G], on[G];
-        for (int l = 0; l < G; ++l) {
-          const int j = t - l;
-          on[l] = (j >= 0 && j < m) ? 1.0 : 0.0;
-          if (on[l] == 0.0) {
-            // An idle lane steps a unit link whose leading end does not move: finite, and on the
-            // exp's fast path.
-            for (int k = 0; k < Dim; ++k) lo[k][l] = ln[k][l] = (k == 0), tl[k][l] = 0.0;
-            len[l] = iv[l] = 1.0;
-            continue;
-          }
-          const int a = tree.lead[j], b = tree.tail[j], s = tree.source[j];
-          const int64_t sweep = g + l;
-          for (int k = 0; k < Dim; ++k) {
-            ln[k][l] = s < 0 ? heads[sweep * Dim + k] : row(s + l)[k * G + l];
-            if (l == 0) {
-              lo[k][l] = points[a * Dim + k];
-              tl[k][l] = points[b * Dim + k];
-            } else {
-              lo[k][l] = s < 0 ? heads[(sweep - 1) * Dim + k] : row(s + l - 1)[k * G + l - 1];
-              tl[k][l] = row(t - 1)[k * G + l - 1];
-            }
-          }
-          len[l] = tree.lengths[j];
-          iv[l] = tree.inv_lengths[j];
-        }
-        for (int u = 0; u < U; ++u) {
-          for (int k = 0; k < Dim; ++k) {
-            lead_old[u][k] = B::load_aligned(lo[k] + u * W);
-            lead_new[u][k] = B::load_aligned(ln[k] + u * W);
-            tail[u][k] = B::load_aligned(tl[k] + u * W);
-          }
-          length[u] = B::load_aligned(len + u * W);
-          inv[u] = B::load_aligned(iv + u * W);
-          active[u] = B::load_aligned(on + u * W) != B(0.0);
-        }
-      }
       double* out = row(t);
+      // Lane 0 (sweep g) reads the positions before the group.
+      const bool lane0_on = t < m;
+      const int a0 = lane0_on ? tree.lead[t] : 0, b0 = lane0_on ? tree.tail[t] : 0;
+      const bool masked = !plain[t];
       for (int u = 0; u < U; ++u) {
+        const int rev = P + m - 1 - t + u * W;
+        const auto on = B::load_unaligned(rev_on.data() + rev) != B(0.0);
+        const auto driven = B::load_unaligned(rev_driven.data() + rev) != B(0.0);
+        // Lane l: its leading end after sweep g + l at row(source + l), lane l, and after sweep
+        // g + l - 1 one row and one lane before (the driven point: heads g + l and g + l - 1);
+        // its own old position in the last row, one lane before.
+        const I at = I::load_unaligned(source_row.data() + rev) + I::load_aligned(row_step + u * W);
+        const I before = xsimd::max(at - I(kRow + 1), I(0));
+        const I head_at = I(g * Dim) + I::load_aligned(head_step + u * W);
+        const I head_before = xsimd::max(head_at - I(Dim), I(0));
+        const bool any_driven = masked && xsimd::any(driven);
+        B lead_old[Dim], lead_new[Dim], tail[Dim];
+        for (int k = 0; k < Dim; ++k) {
+          const double* lanes = base + k * G;
+          lead_new[k] = B(GatherAt(lanes, at));
+          lead_old[k] = B(GatherAt(lanes, before));
+          if (any_driven) {
+            lead_new[k] = xsimd::select(driven, B(GatherAt(heads + k, head_at)), lead_new[k]);
+            lead_old[k] = xsimd::select(driven, B(GatherAt(heads + k, head_before)), lead_old[k]);
+          }
+          tail[k] = t > 0 ? B::load_unaligned(row(t - 1) + k * G + u * W - 1) : B(0.0);
+          if (u == 0 && lane0_on) {
+            lead_old[k] = xsimd::select(lane0, B(points[a0 * Dim + k]), lead_old[k]);
+            tail[k] = xsimd::select(lane0, B(points[b0 * Dim + k]), tail[k]);
+          }
+          if (masked) {
+            lead_old[k] = xsimd::select(on, lead_old[k], B(k == 0 ? 1.0 : 0.0));
+            lead_new[k] = xsimd::select(on, lead_new[k], B(k == 0 ? 1.0 : 0.0));
+            tail[k] = xsimd::select(on, tail[k], B(0.0));
+          }
+        }
+        const B length = B::load_unaligned(rev_len.data() + rev);
+        const B inv = B::load_unaligned(rev_inv.data() + rev);
         B old[Dim];
-        for (int k = 0; k < Dim; ++k) old[k] = tail[u][k];
-        const auto fix =
-            Rule::Apply(lead_old[u], lead_new[u], tail[u], length[u], -inv[u]) & active[u];
-        for (int k = 0; k < Dim; ++k) tail[u][k].store_aligned(out + k * G + u * W);
+        for (int k = 0; k < Dim; ++k) old[k] = tail[k];
+        const auto fix = Rule::Apply(lead_old, lead_new, tail, length, -inv) & on;
+        for (int k = 0; k < Dim; ++k) tail[k].store_aligned(out + k * G + u * W);
         if (xsimd::any(fix)) {
           // Rare lanes (degenerate or extreme moves): the scalar reference, as the chain's.
           alignas(64) double lo[Dim][W], ln[Dim][W], tl[Dim][W], len[W], mask[W];
           for (int k = 0; k < Dim; ++k) {
-            lead_old[u][k].store_aligned(lo[k]);
-            lead_new[u][k].store_aligned(ln[k]);
+            lead_old[k].store_aligned(lo[k]);
+            lead_new[k].store_aligned(ln[k]);
             old[k].store_aligned(tl[k]);
           }
-          length[u].store_aligned(len);
+          length.store_aligned(len);
           xsimd::select(fix, B(1.0), B(0.0)).store_aligned(mask);
           for (int l = 0; l < W; ++l) {
             if (mask[l] == 0.0) continue;
@@ -168,8 +169,8 @@ int64_t TreeWavefrontGroups(const double* heads, int64_t g, int64_t num_sweeps,
     }
     // The group's last sweep (lane G - 1) is the tree's state for the next group.
     for (int j = 0; j < m; ++j) {
-      const double* last = row(j + G - 1);
-      for (int k = 0; k < Dim; ++k) points[tree.tail[j] * Dim + k] = last[k * G + G - 1];
+      const double* final_row = row(j + G - 1);
+      for (int k = 0; k < Dim; ++k) points[tree.tail[j] * Dim + k] = final_row[k * G + G - 1];
     }
     for (int k = 0; k < Dim; ++k) points[d * Dim + k] = heads[(g + G - 1) * Dim + k];
   }
