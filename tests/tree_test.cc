@@ -13,6 +13,7 @@
 
 #include "chain/substep.h"
 #include "flexkin/error.h"
+#include "flexkin/link_step.h"
 #include "sequential/sweep.h"
 #include "sequential/tree_sweep.h"
 
@@ -201,6 +202,72 @@ TEST(TreeTest, TheWavefrontMovesAsTheOnePassSweep) {
   }
 }
 
+// The whole-tree rules: a path driven at point 0 moves as MoveLeader moves the chain, bit for bit;
+// on a tree, min_rotation translates it with the driven point, and min_joint_angle steps each link
+// from the driven point by the tractrix and carries the subtree behind it rigidly.
+TEST(TreeTest, TheWholeTreeRulesMoveAPathAsTheChainAndATreeRigidlyBehindItsFirstLinks) {
+  for (const Method method : {Method::kMinRotation, Method::kMinJointAngle}) {
+    for (const int dim : {2, 3}) {
+      Points pts = Points::Zero(12, dim);
+      for (int i = 1; i < 12; ++i) {
+        pts.row(i) = pts.row(i - 1);
+        pts(i, 0) += 0.3;
+        pts(i, 1) += 0.1 * std::sin(i);
+      }
+      const Chain chain = MakeChain(pts);
+      const TreeStepper stepper = MakeTreeStepper(method, TreeOfChain(chain), 0);
+      Chain moved = chain;
+      Points tree_points = chain.points;
+      const Stepper chain_stepper = MakeStepper(method, chain);
+      for (int step = 0; step < 20; ++step) {
+        Eigen::VectorXd target = tree_points.row(0).transpose();
+        target[0] += 0.05 * std::cos(step);
+        target[1] += 0.07;
+        MoveTreePoint(stepper, target, 3, &tree_points);
+        MoveLeader(chain_stepper, target, 3, &moved.points);
+        ASSERT_TRUE(tree_points == moved.points) << MethodName(method) << " " << dim << "D";
+      }
+    }
+  }
+  const Tree tree = RandomTree(40, 3, 21);
+  const int driven = 6;
+  Eigen::VectorXd target = tree.points.row(driven).transpose();
+  target += Eigen::Vector3d(0.4, -0.3, 0.2);
+  {
+    const TreeStepper stepper = MakeTreeStepper(Method::kMinRotation, tree, driven);
+    Points moved = tree.points;
+    MoveTreePoint(stepper, target, 5, &moved);
+    const Eigen::RowVectorXd shift = moved.row(0) - tree.points.row(0);
+    EXPECT_LT(((moved - tree.points).rowwise() - shift).cwiseAbs().maxCoeff(), 1e-15);
+    EXPECT_LT((shift.transpose() - Eigen::Vector3d(0.4, -0.3, 0.2)).norm(), 1e-15);
+  }
+  const TreeStepper stepper = MakeTreeStepper(Method::kMinJointAngle, tree, driven);
+  Points moved = tree.points;
+  MoveTreePoint(stepper, target, 1, &moved);
+  // The first links' trailing ends by the tractrix step; every point behind one of them at the
+  // same distances from the others behind it and from that trailing end (a rigid motion).
+  std::vector<int> first_of(stepper.lead.size());
+  for (size_t j = 0; j < stepper.lead.size(); ++j) {
+    first_of[j] = stepper.source[j] < 0 ? static_cast<int>(j) : first_of[stepper.source[j]];
+  }
+  int checked = 0;
+  for (size_t j = 0; j < stepper.lead.size(); ++j) {
+    const int b = stepper.tail[j], f = stepper.tail[first_of[j]];
+    if (stepper.source[j] < 0) {
+      const Eigen::Vector3d expected = TractrixStep(
+          Eigen::Vector3d(tree.points.row(driven).transpose()), Eigen::Vector3d(target),
+          Eigen::Vector3d(tree.points.row(b).transpose()), stepper.lengths[j]);
+      EXPECT_LT((moved.row(b).transpose() - expected).norm(), 1e-14);
+      continue;
+    }
+    const double before = (tree.points.row(b) - tree.points.row(f)).norm();
+    EXPECT_NEAR((moved.row(b) - moved.row(f)).norm(), before, 1e-14);
+    ++checked;
+  }
+  EXPECT_GT(checked, 20);
+  EXPECT_LT(MaxTreeLengthError(stepper, moved), 1e-14);
+}
+
 TEST(TreeTest, AStillDrivenPointLeavesTheTreeExactlyInPlace) {
   const Tree tree = RandomTree(30, 3, 9);
   for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {
@@ -294,7 +361,7 @@ TEST(TreeTest, BadStepperAndMoveArgumentsAreRefused) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.field(), "driven");
   }
-  for (const Method method : {Method::kMinRotation, Method::kMinJointAngle, Method::kOverall}) {
+  for (const Method method : {Method::kOverall, Method::kFollowPath}) {
     try {
       MakeTreeStepper(method, tree, 0);
       ADD_FAILURE() << MethodName(method) << " accepted";

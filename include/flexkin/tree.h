@@ -46,7 +46,7 @@ struct TreeStepper {
 };
 
 // Throws InputError if `tree` is not valid (ValidateTree), `driven` is not one of its points, or
-// `method` is not a link rule that runs on trees (tractrix, ftl).
+// `method` is not a rule that runs on trees (tractrix, ftl, min_rotation, min_joint_angle).
 TreeStepper MakeTreeStepper(Method method, const Tree& tree, int driven);
 
 // The driven point moves in a straight line from where it is to `target` in `substeps` equal

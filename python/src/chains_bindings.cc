@@ -396,7 +396,8 @@ Chain(points, *, link_length=None, lengths=None)
         "each point hangs from (n+1 ints, -1 for the one root; a path is [-1, 0, 1, ...]). The "
         "point `driven` moves through the targets of path ((m, dim)), each in `substeps` straight "
         "sub-steps, and every link, outward from it along every branch, follows by `method` "
-        "(\"tractrix\" or \"ftl\"). Returns the frames, (m+1, n+1, dim): the start, then the "
+        "(\"tractrix\", \"ftl\", \"min_rotation\", \"min_joint_angle\"). Returns the frames, (m+1, "
+        "n+1, dim): the start, then the "
         "tree after each target.");
   m.def(
       "overall_step",

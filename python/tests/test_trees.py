@@ -67,7 +67,7 @@ def test_bad_arguments_are_named():
         flexkin.move_tree(points, [-1, 0, 1, 2], [[0.1, 0.1]])
     assert e.value.field == "points[2]" and "from its parent point 1" in str(e.value)
     points[2] = [2, 0]
-    for kwargs, field in [({"driven": 4}, "driven"), ({"method": "min_rotation"}, "method"),
+    for kwargs, field in [({"driven": 4}, "driven"), ({"method": "overall"}, "method"),
                           ({"substeps": 0}, "substeps")]:
         with pytest.raises(flexkin.InputError) as e:
             flexkin.move_tree(points, [-1, 0, 1, 2], [[0.1, 0.1]], **kwargs)

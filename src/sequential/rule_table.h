@@ -25,6 +25,7 @@
 #include "flexkin/propagate.h"
 #include "sequential/link_rules.h"
 #include "sequential/sweep.h"
+#include "sequential/tree_sweep.h"
 
 namespace flexkin::internal {
 // Internal linkage, as link_rules.h: translation units built for different instruction sets each
@@ -47,6 +48,9 @@ enum RuleEngine : unsigned {
   // A tree driven at one point, link after link outward from it (tree.cc). Calls Rule::Step<Dim>
   // on doubles.
   kTreeEngine = 1u << 4,
+  // A tree driven at one point, moved as a whole per sub-step (tree.cc). Calls
+  // Rule::WholeTreeSweeps.
+  kWholeTreeEngine = 1u << 5,
 };
 
 // The engine's name in messages ("the strand engine").
@@ -62,6 +66,8 @@ inline const char* RuleEngineName(RuleEngine engine) {
       return "the whole-chain sweep";
     case kTreeEngine:
       return "trees";
+    case kWholeTreeEngine:
+      return "trees moved whole";
   }
   return "?";
 }
@@ -92,12 +98,17 @@ struct FollowTheLeaderLinkRule {
 struct MinRotationLinkRule {
   static constexpr Method kMethod = Method::kMinRotation;
   static constexpr int kOrder = 0;
-  static constexpr unsigned kEngines = kWholeChainEngine;
+  static constexpr unsigned kEngines = kWholeChainEngine | kWholeTreeEngine;
   // (sweep.h, metric_rules.cc)
   static void WholeChainSweeps(int dim, const double* heads, int64_t num_sweeps,
                                const double* /*lengths*/, const double* /*inv_lengths*/, int n,
                                double* points) {
     SweepsMinRotation(dim, heads, num_sweeps, n, points);
+  }
+  // (tree_sweep.h, tree.cc)
+  static void WholeTreeSweeps(int dim, const double* heads, int64_t num_sweeps,
+                              const TreeLinks& tree, double* points) {
+    TreeSweepsMinRotation(dim, heads, num_sweeps, tree, points);
   }
 };
 
@@ -106,11 +117,15 @@ struct MinRotationLinkRule {
 struct MinJointAngleLinkRule {
   static constexpr Method kMethod = Method::kMinJointAngle;
   static constexpr int kOrder = 0;
-  static constexpr unsigned kEngines = kWholeChainEngine;
+  static constexpr unsigned kEngines = kWholeChainEngine | kWholeTreeEngine;
   static void WholeChainSweeps(int dim, const double* heads, int64_t num_sweeps,
                                const double* lengths, const double* inv_lengths, int n,
                                double* points) {
     SweepsMinJointAngle(dim, heads, num_sweeps, lengths, inv_lengths, n, points);
+  }
+  static void WholeTreeSweeps(int dim, const double* heads, int64_t num_sweeps,
+                              const TreeLinks& tree, double* points) {
+    TreeSweepsMinJointAngle(dim, heads, num_sweeps, tree, points);
   }
 };
 

@@ -11,6 +11,7 @@
 #include "chain/simd.h"
 #include "chain/substep.h"
 #include "flexkin/error.h"
+#include "sequential/joint_rotation.h"
 #include "sequential/link_rules.h"
 #include "sequential/rule_table.h"
 #include "sequential/tree_sweep.h"
@@ -169,8 +170,11 @@ TreeStepper MakeTreeStepper(Method method, const Tree& tree, int driven) {
     throw InputError("driven", "is point " + std::to_string(driven) + "; the tree has points 0.." +
                                    std::to_string(count - 1));
   }
-  if (!internal::RuleRunsOn(method, internal::kTreeEngine)) {
-    throw InputError(internal::RuleRefused("method", method, internal::kTreeEngine));
+  constexpr unsigned kTreeEngines = internal::kTreeEngine | internal::kWholeTreeEngine;
+  if (!internal::RuleRunsOn(method, kTreeEngines)) {
+    throw InputError(Problem::Invalid(
+        "method", std::string("\"") + MethodName(method) + "\"",
+        QuotedList(internal::RuleNamesOn(kTreeEngines)) + " (the methods of trees)"));
   }
   TreeStepper t;
   t.method = method;
@@ -239,6 +243,13 @@ void MoveTreePoint(const TreeStepper& stepper, const Eigen::Ref<const Eigen::Vec
     }
   }
   const internal::SubnormalsAsZero subnormals;
+  if (internal::RuleRunsOn(stepper.method, internal::kWholeTreeEngine)) {
+    internal::DispatchRule<internal::kWholeTreeEngine>(stepper.method, [&](auto rule) {
+      decltype(rule)::WholeTreeSweeps(dim, heads.data(), substeps, internal::LinksOf(stepper),
+                                      points->data());
+    });
+    return;
+  }
   // The SIMD wavefront takes groups of as many sub-steps as it has lanes (tree_wavefront.h), the
   // one-pass sweep the rest.
   int64_t done = 0;
@@ -283,6 +294,7 @@ TreeWavefrontFn ChosenTreeWavefront() {
 TreeLinks LinksOf(const TreeStepper& stepper) {
   TreeLinks links;
   links.driven = stepper.driven;
+  links.num_points = static_cast<int>(stepper.parents.size());
   links.num_links = static_cast<int>(stepper.lead.size());
   links.lead = stepper.lead.data();
   links.tail = stepper.tail.data();
@@ -290,6 +302,65 @@ TreeLinks LinksOf(const TreeStepper& stepper) {
   links.lengths = stepper.lengths.data();
   links.inv_lengths = stepper.inv_lengths.data();
   return links;
+}
+
+void TreeSweepsMinRotation(int dim, const double* heads, int64_t num_sweeps, const TreeLinks& tree,
+                           double* points) {
+  const int d = tree.driven;
+  for (int64_t s = 0; s < num_sweeps; ++s) {
+    for (int k = 0; k < dim; ++k) {
+      const double shift = heads[s * dim + k] - points[d * dim + k];
+      for (int i = 0; i < tree.num_points; ++i) points[i * dim + k] += shift;
+    }
+  }
+}
+
+namespace {
+
+template <int Dim>
+void TreeMinJointAngle(const double* heads, int64_t num_sweeps, const TreeLinks& tree,
+                       double* points) {
+  using Vec = Eigen::Matrix<double, Dim, 1>;
+  using Mat = Eigen::Matrix<double, Dim, Dim>;
+  Eigen::Map<Eigen::Matrix<double, Dim, Eigen::Dynamic>> p(points, Dim, tree.num_points);
+  // The link from the driven point that each link hangs behind (itself for those links).
+  std::vector<int> first_of(tree.num_links);
+  for (int j = 0; j < tree.num_links; ++j) {
+    first_of[j] = tree.source[j] < 0 ? j : first_of[tree.source[j]];
+  }
+  std::vector<Vec> first_old(tree.num_links), first_new(tree.num_links);
+  std::vector<Mat> rotation(tree.num_links);
+  const int d = tree.driven;
+  for (int64_t s = 0; s < num_sweeps; ++s) {
+    const Vec head_old = p.col(d);
+    const Vec head_new = Eigen::Map<const Vec>(heads + s * Dim);
+    for (int j = 0; j < tree.num_links; ++j) {
+      if (tree.source[j] >= 0) continue;
+      first_old[j] = p.col(tree.tail[j]);
+      first_new[j] = first_old[j];
+      TractrixStep<Dim>(head_old.data(), head_new.data(), first_new[j].data(), tree.lengths[j],
+                        tree.inv_lengths[j]);
+      rotation[j] =
+          RotationBetween<Dim>(Vec(first_old[j] - head_old), Vec(first_new[j] - head_new));
+    }
+    for (int j = 0; j < tree.num_links; ++j) {
+      if (tree.source[j] < 0) continue;
+      const int f = first_of[j];
+      p.col(tree.tail[j]) = first_new[f] + rotation[f] * (p.col(tree.tail[j]) - first_old[f]);
+    }
+    p.col(d) = head_new;
+    for (int j = 0; j < tree.num_links; ++j) {
+      if (tree.source[j] < 0) p.col(tree.tail[j]) = first_new[j];
+    }
+  }
+}
+
+}  // namespace
+
+void TreeSweepsMinJointAngle(int dim, const double* heads, int64_t num_sweeps,
+                             const TreeLinks& tree, double* points) {
+  dim == 2 ? TreeMinJointAngle<2>(heads, num_sweeps, tree, points)
+           : TreeMinJointAngle<3>(heads, num_sweeps, tree, points);
 }
 
 }  // namespace internal

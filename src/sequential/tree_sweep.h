@@ -12,6 +12,7 @@ namespace flexkin::internal {
 
 struct TreeLinks {
   int driven = 0;
+  int num_points = 0;
   int num_links = 0;
   const int* lead = nullptr;    // link j joins point lead[j] (leading) ...
   const int* tail = nullptr;    // ... to point tail[j]
@@ -19,6 +20,15 @@ struct TreeLinks {
   const double* lengths = nullptr;
   const double* inv_lengths = nullptr;
 };
+
+// The whole-tree rules, driven at tree.driven through `heads` (num_sweeps by dim): min_rotation
+// (every point moves by the driven point's shift, as SweepsMinRotation), min_joint_angle (each
+// link from the driven point by the tractrix step, the subtree behind it turned and moved rigidly
+// with it, as SweepsMinJointAngle).
+void TreeSweepsMinRotation(int dim, const double* heads, int64_t num_sweeps, const TreeLinks& tree,
+                           double* points);
+void TreeSweepsMinJointAngle(int dim, const double* heads, int64_t num_sweeps,
+                             const TreeLinks& tree, double* points);
 
 // The first sweeps of `num_sweeps` (a multiple of the SIMD width) of a tree rule on the
 // instruction set's wavefront; returns how many were done. The driven point visits `heads`
