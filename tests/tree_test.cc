@@ -268,6 +268,31 @@ TEST(TreeTest, TheWholeTreeRulesMoveAPathAsTheChainAndATreeRigidlyBehindItsFirst
   EXPECT_LT(MaxTreeLengthError(stepper, moved), 1e-14);
 }
 
+// Moves near the largest doubles: every engine's result finite.
+TEST(TreeTest, MovesNearTheLargestDoublesStayFinite) {
+  const Tree tree = RandomTree(30, 2, 4);
+  for (const internal::TreeWavefrontEngine& engine : internal::AvailableTreeWavefronts()) {
+    for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {
+      for (const double far : {1e300, 1e155, -1e308}) {
+        const TreeStepper stepper = MakeTreeStepper(method, tree, 3);
+        std::vector<double> heads;
+        for (int s = 1; s <= 32; ++s)
+          heads.push_back(far * (s / 32.0)), heads.push_back(-far * (s / 32.0));
+        Points pts = tree.points;
+        engine.fn(method, 2, heads.data(), 32, internal::LinksOf(stepper), pts.data());
+        EXPECT_TRUE(pts.allFinite()) << engine.name << " " << MethodName(method) << " " << far;
+      }
+    }
+  }
+  for (const Method method : {Method::kTractrix, Method::kFollowTheLeader, Method::kMinRotation,
+                              Method::kMinJointAngle}) {
+    const TreeStepper stepper = MakeTreeStepper(method, tree, 3);
+    Points pts = tree.points;
+    MoveTreePoint(stepper, Eigen::Vector2d(1e300, -1e300), 19, &pts);
+    EXPECT_TRUE(pts.allFinite()) << MethodName(method);
+  }
+}
+
 TEST(TreeTest, AStillDrivenPointLeavesTheTreeExactlyInPlace) {
   const Tree tree = RandomTree(30, 3, 9);
   for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {

@@ -271,6 +271,30 @@ TEST(WavefrontTest, RunFramesAreTheConfigurationsOfSuccessiveMoves) {
 
 // Where the motion has died out completely (the head of a link did not move) both paths leave
 // the rest of the chain exactly where it was.
+// Moves near the largest doubles: the vector step overflows where the one-pass loop's does not;
+// those lanes take the scalar reference, and nothing non-finite comes out of any engine.
+TEST(WavefrontTest, MovesNearTheLargestDoublesStayFinite) {
+  const std::vector<internal::WavefrontEngine> engines = internal::AvailableWavefronts();
+  if (engines.empty()) GTEST_SKIP() << "no SIMD wavefront on this CPU (it has no AVX2 and FMA)";
+  for (const internal::WavefrontEngine& engine : engines) {
+    for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {
+      for (const double far : {1e300, 1e155, -1e308}) {
+        const int n = 12, sweeps = 32;
+        std::vector<double> points, lengths(n, 0.5), inv(n, 2.0), heads;
+        for (int i = 0; i <= n; ++i) points.push_back(0.5 * i), points.push_back(0.0);
+        for (int s = 1; s <= sweeps; ++s) {
+          heads.push_back(far * (static_cast<double>(s) / sweeps));
+          heads.push_back(-far * (static_cast<double>(s) / sweeps));
+        }
+        engine.fn(method, 2, heads.data(), sweeps, lengths.data(), inv.data(), n, points.data());
+        for (double x : points) {
+          ASSERT_TRUE(std::isfinite(x)) << engine.name << " " << MethodName(method) << " " << far;
+        }
+      }
+    }
+  }
+}
+
 TEST(WavefrontTest, StillHeadLeavesTheChainExactlyInPlace) {
   std::mt19937 rng(11);
   for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <vector>
 #include <xsimd/xsimd.hpp>
 
@@ -51,6 +52,8 @@ inline __m256d GatherAt(const double* base, __m256i index) {
 // `heads` for the links from the driven point). A lane whose j is not a link (the group's first
 // and last G - 1 iterations) steps a unit link whose leading end stays still: finite, on the exp's
 // fast path, and read by no other lane.
+constexpr double kLargest = std::numeric_limits<double>::max();
+
 template <class Arch, class Rule, int Dim, int U>
 int64_t TreeWavefrontGroups(const double* heads, int64_t g, int64_t num_sweeps,
                             const TreeLinks& tree, double* points) {
@@ -145,7 +148,11 @@ int64_t TreeWavefrontGroups(const double* heads, int64_t g, int64_t num_sweeps,
         const B inv = B::load_unaligned(rev_inv.data() + rev);
         B old[Dim];
         for (int k = 0; k < Dim; ++k) old[k] = tail[k];
-        const auto fix = Rule::Apply(lead_old, lead_new, tail, length, -inv) & on;
+        auto fix = Rule::Apply(lead_old, lead_new, tail, length, -inv);
+        // Lanes whose vector step overflowed (moves near the largest doubles) take the reference
+        // too: nothing non-finite leaves the engine where the one-pass sweep gives a number.
+        for (int k = 0; k < Dim; ++k) fix = fix | !(xsimd::abs(tail[k]) <= B(kLargest));
+        fix = fix & on;
         for (int k = 0; k < Dim; ++k) tail[k].store_aligned(out + k * G + u * W);
         if (xsimd::any(fix)) {
           // Rare lanes (degenerate or extreme moves): the scalar reference, as the chain's.

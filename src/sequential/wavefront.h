@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 #include <xsimd/xsimd.hpp>
 
@@ -170,8 +171,13 @@ int64_t WavefrontGroups(const double* heads, int64_t g, int64_t num_sweeps, cons
         for (int k = 0; k < Dim; ++k) tail[u][k] = window[u][k];
         const B length = B::load_unaligned(&len[pad + first]);
         const B neg_inv_length = B::load_unaligned(&neg_inv_len[pad + first]);
-        const auto fix = Rule::Apply(lead_old[u], lead_new[u], tail[u], length, neg_inv_length) &
-                         (index >= B(1.0)) & (index <= last);
+        auto fix = Rule::Apply(lead_old[u], lead_new[u], tail[u], length, neg_inv_length);
+        // Lanes whose vector step overflowed (moves near the largest doubles) take the reference
+        // too: nothing non-finite leaves the engine where the one-pass loop gives a number.
+        for (int k = 0; k < Dim; ++k) {
+          fix = fix | !(xsimd::abs(tail[u][k]) <= B(std::numeric_limits<double>::max()));
+        }
+        fix = fix & (index >= B(1.0)) & (index <= last);
         if (xsimd::any(fix)) {
           // Rare lanes (degenerate or extreme moves): redo them with the scalar reference.
           alignas(64) double lo[Dim][W], ln[Dim][W], old[Dim][W], out[Dim][W], mask[W], len_j[W];
