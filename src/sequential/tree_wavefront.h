@@ -151,7 +151,11 @@ int64_t TreeWavefrontGroups(const double* heads, int64_t g, int64_t num_sweeps,
         auto fix = Rule::Apply(lead_old, lead_new, tail, length, -inv);
         // Lanes whose vector step overflowed (moves near the largest doubles) take the reference
         // too: nothing non-finite leaves the engine where the one-pass sweep gives a number.
-        for (int k = 0; k < Dim; ++k) fix = fix | !(xsimd::abs(tail[k]) <= B(kLargest));
+        // (The sum of the coordinates is not finite where one is not; where it overflows alone,
+        // the lane takes the reference for nothing.)
+        B sum = tail[0];
+        for (int k = 1; k < Dim; ++k) sum += tail[k];
+        fix = fix | !(xsimd::abs(sum) <= B(kLargest));
         fix = fix & on;
         for (int k = 0; k < Dim; ++k) tail[k].store_aligned(out + k * G + u * W);
         if (xsimd::any(fix)) {

@@ -174,9 +174,11 @@ int64_t WavefrontGroups(const double* heads, int64_t g, int64_t num_sweeps, cons
         auto fix = Rule::Apply(lead_old[u], lead_new[u], tail[u], length, neg_inv_length);
         // Lanes whose vector step overflowed (moves near the largest doubles) take the reference
         // too: nothing non-finite leaves the engine where the one-pass loop gives a number.
-        for (int k = 0; k < Dim; ++k) {
-          fix = fix | !(xsimd::abs(tail[u][k]) <= B(std::numeric_limits<double>::max()));
-        }
+        // (The sum of the coordinates is not finite where one is not; where it overflows alone,
+        // the lane takes the reference for nothing.)
+        B sum = tail[u][0];
+        for (int k = 1; k < Dim; ++k) sum += tail[u][k];
+        fix = fix | !(xsimd::abs(sum) <= B(std::numeric_limits<double>::max()));
         fix = fix & (index >= B(1.0)) & (index <= last);
         if (xsimd::any(fix)) {
           // Rare lanes (degenerate or extreme moves): redo them with the scalar reference.
