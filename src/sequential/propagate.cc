@@ -11,6 +11,7 @@
 #include "chain/substep.h"
 #include "flexkin/error.h"
 #include "sequential/link_rules.h"
+#include "sequential/move_checks.h"
 #include "sequential/rule_table.h"
 #include "sequential/sweep.h"
 #include "sequential/whole_chain.h"
@@ -261,14 +262,15 @@ Stepper internal::MakeStepperUnchecked(Method method, const Chain& chain) {
   return s;
 }
 
-void MoveLeader(const Stepper& stepper, const Eigen::Ref<const Eigen::VectorXd>& target,
-                int substeps, Points* points) {
-  if (target.size() != stepper.dim) {
-    throw InputError("target", "has " + std::to_string(target.size()) +
-                                   " coordinates; the chain is " + std::to_string(stepper.dim) +
-                                   "D");
+namespace internal {
+
+void CheckMove(const Eigen::Ref<const Eigen::VectorXd>& target, int dim, int substeps,
+               const char* body) {
+  if (target.size() != dim) {
+    throw InputError("target", "has " + std::to_string(target.size()) + " coordinates; the " +
+                                   body + " is " + std::to_string(dim) + "D");
   }
-  for (int k = 0; k < stepper.dim; ++k) {
+  for (int k = 0; k < dim; ++k) {
     if (!std::isfinite(target[k])) {
       throw InputError("target[" + std::to_string(k) + "]", "is not a finite number");
     }
@@ -276,6 +278,13 @@ void MoveLeader(const Stepper& stepper, const Eigen::Ref<const Eigen::VectorXd>&
   if (substeps < 1) {
     throw InputError("substeps", "is " + std::to_string(substeps) + "; must be at least 1");
   }
+}
+
+}  // namespace internal
+
+void MoveLeader(const Stepper& stepper, const Eigen::Ref<const Eigen::VectorXd>& target,
+                int substeps, Points* points) {
+  internal::CheckMove(target, stepper.dim, substeps, "chain");
   if (points->rows() != stepper.lengths.size() + 1 || points->cols() != stepper.dim) {
     throw InputError("points", "shape " + std::to_string(points->rows()) + "x" +
                                    std::to_string(points->cols()) +

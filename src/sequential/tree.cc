@@ -13,6 +13,7 @@
 #include "flexkin/error.h"
 #include "sequential/joint_rotation.h"
 #include "sequential/link_rules.h"
+#include "sequential/move_checks.h"
 #include "sequential/rule_table.h"
 #include "sequential/tree_sweep.h"
 
@@ -216,18 +217,7 @@ TreeStepper MakeTreeStepper(Method method, const Tree& tree, int driven) {
 void MoveTreePoint(const TreeStepper& stepper, const Eigen::Ref<const Eigen::VectorXd>& target,
                    int substeps, Points* points) {
   const int dim = stepper.dim;
-  if (target.size() != dim) {
-    throw InputError("target", "has " + std::to_string(target.size()) +
-                                   " coordinates; the tree is " + std::to_string(dim) + "D");
-  }
-  for (int k = 0; k < dim; ++k) {
-    if (!std::isfinite(target[k])) {
-      throw InputError("target[" + std::to_string(k) + "]", "is not a finite number");
-    }
-  }
-  if (substeps < 1) {
-    throw InputError("substeps", "is " + std::to_string(substeps) + "; must be at least 1");
-  }
+  internal::CheckMove(target, dim, substeps, "tree");
   const size_t count = stepper.parents.size();
   if (points->rows() != static_cast<Eigen::Index>(count) || points->cols() != dim) {
     throw InputError("points", "shape " + std::to_string(points->rows()) + "x" +
