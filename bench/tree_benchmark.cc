@@ -15,44 +15,14 @@
 
 #include "flexkin/propagate.h"
 #include "flexkin/tree.h"
+#include "scenes/scenes.h"
 
 namespace flexkin {
 namespace {
 
 enum Shape { kChain10 = 0, kTwoArms = 1, kBinary10 = 2 };
 
-// A point hanging from `parent` one unit away in the direction `d`.
-void Hang(Tree* tree, int parent, const Eigen::RowVector3d& d) {
-  const int i = static_cast<int>(tree->parents.size());
-  tree->parents.push_back(parent);
-  tree->points.conservativeResize(i + 1, 3);
-  tree->points.row(i) = tree->points.row(parent) + d.normalized();
-}
-
-Tree MakeShape(int shape) {
-  Tree tree;
-  tree.points = Points::Zero(1, 3);
-  tree.parents = {-1};
-  if (shape == kChain10) {
-    for (int i = 0; i < 10; ++i) Hang(&tree, i, {1.0, 0.2 * std::sin(i), 0.1 * i});
-  } else if (shape == kTwoArms) {
-    Hang(&tree, 0, {0, 0, 1});
-    Hang(&tree, 1, {0, 0.1, 1});
-    for (const double side : {-1.0, 1.0}) {
-      int at = 2;
-      for (int i = 0; i < 5; ++i) {
-        Hang(&tree, at, {side, 0.1 * i, -0.2 * i});
-        at = static_cast<int>(tree.parents.size()) - 1;
-      }
-    }
-  } else {
-    for (int i = 1; i < 2047; ++i) {
-      const int depth = static_cast<int>(std::log2(i + 1));
-      Hang(&tree, (i - 1) / 2, {(i % 2 ? 1.0 : -1.0) * std::pow(0.8, depth), 0.5, 0.1 * depth});
-    }
-  }
-  return tree;
-}
+Tree MakeShape(int shape) { return scenes::TreeShape(static_cast<scenes::TreeKind>(shape)); }
 
 Eigen::Vector3d Target(const Eigen::Vector3d& origin, int64_t step) {
   const double t = 0.01 * static_cast<double>(step);

@@ -8,9 +8,11 @@
 
 #include <Eigen/Core>
 #include <random>
+#include <vector>
 
 #include "flexkin/arm.h"
 #include "flexkin/chain.h"
+#include "flexkin/tree.h"
 
 namespace flexkin::scenes {
 
@@ -109,5 +111,20 @@ Points CircleOfTargets(const ArmModel& model, double radius, int count,
 // 0.05 rad of phase a step. Reachable by construction: end effectors of angles within the
 // limits. Draws 4 numbers per joint from `rng`. count by model.dim.
 Points SaturatingPath(const ArmModel& model, double limit, int count, std::mt19937* rng);
+
+// ----- Trees (scenes/trees.cc) -----------------------------------------------------------------
+
+// TheComet/ik's shapes, of unit links, rooted at the origin (point 0): a chain of 10 links; two
+// arms of 5 links on a shoulder (point 2) at the end of a spine of 2 links from the root; a binary
+// tree of depth 10 (2,047 points). In 2D, the same construction in the x-z plane.
+enum class TreeKind { kChain10, kTwoArms, kBinary10 };
+Tree TreeShape(TreeKind kind, int dim = 3);
+// The points the several-targets tests and benchmarks drive: the chain's tip, the two hands, four
+// leaves of the binary tree.
+std::vector<int> TreeTips(TreeKind kind);
+
+// A random tree of `count` points: point i > 0 hangs from a random earlier point (so the root is
+// 0), at a random direction and a length in [0.5, 1.5).
+Tree RandomTree(int count, int dim, unsigned seed);
 
 }  // namespace flexkin::scenes

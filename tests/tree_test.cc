@@ -14,30 +14,14 @@
 #include "chain/substep.h"
 #include "flexkin/error.h"
 #include "flexkin/link_step.h"
+#include "scenes/scenes.h"
 #include "sequential/sweep.h"
 #include "sequential/tree_sweep.h"
 
 namespace flexkin {
 namespace {
 
-// A random tree of `count` points in `dim` dimensions: point i > 0 hangs from a random earlier
-// point (so the root is 0), at a random direction and a length in [0.5, 1.5).
-Tree RandomTree(int count, int dim, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> normal;
-  std::uniform_real_distribution<double> length(0.5, 1.5);
-  Tree tree;
-  tree.points = Points::Zero(count, dim);
-  tree.parents.assign(count, -1);
-  for (int i = 1; i < count; ++i) {
-    const int p = std::uniform_int_distribution<int>(0, i - 1)(rng);
-    tree.parents[i] = p;
-    Eigen::VectorXd d(dim);
-    for (int k = 0; k < dim; ++k) d[k] = normal(rng);
-    tree.points.row(i) = tree.points.row(p) + length(rng) * d.normalized().transpose();
-  }
-  return tree;
-}
+using scenes::RandomTree;
 
 // The points from `from` to `to` along the tree (the unique path between them).
 std::vector<int> PathBetween(const std::vector<int>& parents, int from, int to) {

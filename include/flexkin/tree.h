@@ -15,6 +15,7 @@
 
 #include "flexkin/chain.h"
 #include "flexkin/propagate.h"
+#include "flexkin/vocabulary.h"
 
 namespace flexkin {
 
@@ -60,5 +61,100 @@ void MoveTreePoint(const TreeStepper& stepper, const Eigen::Ref<const Eigen::Vec
 // Largest |(|p_tail - p_lead| - L)| / L over the stepper's links (a Chain's is
 // MaxRelativeLengthError).
 double MaxTreeLengthError(const TreeStepper& stepper, const Points& points);
+
+}  // namespace flexkin
+
+namespace flexkin {
+
+// ---- Several targets and fixed points (docs/trees.md, "Several targets") ----
+//
+// Several points of a tree driven to their own targets at once, any points held where they are
+// (bases, sub-bases). The iterative natural method: passes of the link rule (tractrix or ftl)
+// between the targets and the fixed points, as FABRIK's passes are with follow-the-leader. The
+// tree is taken as hanging from one anchor, the root of the passes (the first fixed point, else
+// the first target's point). A gathering pass moves every other anchor to its target, each in a
+// straight line, with the links between it and the root following it by the rule; a branch point
+// that several such branches pull is placed by the branch rule. A spreading pass then moves the
+// root to its anchor and every link, outward from it, follows its leading end by the rule; the
+// points that nothing pulls (branches without a target) move only here, as a body driven at the
+// root would. Passes repeat until every target and fixed point lies within `tolerance` of where it
+// should be; they stop short of it after `max_passes`, or once a pass moves no point by more than
+// a hundredth of the tolerance (a target out of reach: the report gives the residual).
+// Every link keeps its length to rounding after every pass.
+
+enum class BranchRule {
+  // FABRIK's rule: the weighted centroid of what the branches propose.
+  kCentroid,
+  // The rule derived from the least-motion problem (docs/trees.md): its linearized constraints
+  // keep every branch's first link, so the point matches each branch's proposal along that link
+  // (weighted least squares), blended with the proposals' centroid, which alone places it in the
+  // directions no branch constrains. About half the passes of the centroid; the body moves more.
+  kKeepLinks,
+};
+template <>
+struct Vocabulary<BranchRule> {
+  static constexpr const char* kKind = "branch rule";
+  static constexpr NamedValue<BranchRule> kEntries[] = {
+      {BranchRule::kCentroid, "centroid", "the weighted centroid of the proposals (FABRIK's)"},
+      {BranchRule::kKeepLinks, "keep_links",
+       "each branch's first link kept to first order, blended with the centroid (derived from "
+       "the least-motion problem's linearized constraints)"},
+  };
+};
+
+struct ReachOptions {
+  Method method = Method::kTractrix;  // the rule of the passes: tractrix or ftl
+  BranchRule branch_rule = BranchRule::kCentroid;
+  double tolerance = 1e-10;  // the largest distance allowed from a target, as a fraction of the
+                             // tree's longest link
+  int max_passes = 1000;
+};
+
+// A tree prepared for several targets: its anchors (the targets' points, then the fixed points),
+// the root of the passes and the orders the passes take.
+struct TreeReacher {
+  ReachOptions options;
+  int dim = 0;
+  std::vector<int> parents;         // the tree's
+  std::vector<int> target_points;   // as given
+  std::vector<double> weights;      // per target, then 1 per fixed point
+  std::vector<int> fixed_points;    // as given
+  Points fixed_positions;           // where the fixed points are held (one row each)
+  int root = 0;                     // the anchor the passes hang the tree from
+  std::vector<int> anchor_of;       // per point: its index among the anchors, or -1
+  std::vector<int> up;              // per point: its neighbour toward the root (-1: the root)
+  std::vector<double> up_length;    // the length of the link to it
+  std::vector<int> order;           // the points, the root first, each after its `up`
+  std::vector<int> down_begin;      // the points whose `up` is v: down[down_begin[v]] up to
+  std::vector<int> down;            // (not including) down[down_begin[v + 1]]
+  std::vector<char> pulled;         // per point: an anchor lies beyond it (or it is one)
+  std::vector<double> pull_weight;  // the weights of the anchors beyond it (itself included)
+  std::vector<int> pulled_order;    // the pulled points in `order`'s order (the passes' points)
+  std::vector<int> free_order;      // the others (the branches that follow once, at the end)
+  double longest_link = 0.0;
+};
+
+struct ReachReport {
+  int passes = 0;         // pairs of passes done
+  double residual = 0.0;  // the largest distance of a target or fixed point from where it
+                          // should be, after the last pass, as a fraction of the longest link
+  bool reached = false;   // residual <= options.tolerance
+};
+
+// Throws InputError naming the field ("targets[2]", "fixed[0]", "weights[1]", "method",
+// "tolerance", "max_passes") on a tree that ValidateTree refuses, a point that the tree does not
+// have, a point driven twice or both driven and fixed, no target, a weight that is not positive
+// and finite, a method other than tractrix and ftl, or a tolerance or max_passes out of range.
+// `weights` is empty (every target 1) or one per target. The fixed points are held where `tree`
+// has them.
+TreeReacher MakeTreeReacher(const Tree& tree, const std::vector<int>& targets,
+                            const std::vector<int>& fixed, const std::vector<double>& weights = {},
+                            const ReachOptions& options = ReachOptions());
+
+// Moves `points` (the tree's shape: (n+1) by dim, each link at its length) so that target k's
+// point reaches row k of `positions` (one row per target, dim columns, finite). Throws
+// InputError on positions or points of the wrong shape or with non-finite values; a refused call
+// changes nothing.
+ReachReport ReachTargets(const TreeReacher& reacher, const Points& positions, Points* points);
 
 }  // namespace flexkin

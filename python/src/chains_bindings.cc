@@ -4,6 +4,7 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <limits>
 #include <string>
 #include <vector>
@@ -179,6 +180,77 @@ py::array_t<double> MoveTree(ArrayLike points, IndexSequence parents, ArrayLike 
     std::copy(pts.data(), pts.data() + frame, out + (i + 1) * frame);
   }
   return frames;
+}
+
+// The frames of a tree whose points `targets` reach the rows of each frame of `paths` ((m, k,
+// dim)), with a report per frame.
+py::tuple ReachTree(ArrayLike points, IndexSequence parents, IndexSequence targets, ArrayLike paths,
+                    IndexSequence fixed, py::handle weights, const std::string& method,
+                    py::handle branch_rule, double tolerance, int max_passes) {
+  Tree tree;
+  tree.points = ReadPoints(points, "points", 2);
+  tree.parents = IndexList(parents, "parents");
+  ValidateTree(tree, "");
+  ReachOptions options;
+  options.method = MethodArg(method);
+  options.branch_rule = NameArg<BranchRule>(branch_rule, "branch_rule");
+  options.tolerance = tolerance;
+  options.max_passes = max_passes;
+  std::vector<double> w;
+  if (!weights.is_none()) {
+    const auto array = ReadArray(weights, "weights", 1, 1, 0, -1);
+    w.assign(array.data(), array.data() + array.size());
+  }
+  const TreeReacher reacher =
+      MakeTreeReacher(tree, IndexList(targets, "targets"), IndexList(fixed, "fixed"), w, options);
+  const py::ssize_t dim = reacher.dim, k = static_cast<py::ssize_t>(reacher.target_points.size());
+  const auto frames_in =
+      py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(paths);
+  if (!frames_in || frames_in.ndim() != 3 || frames_in.shape(1) != k || frames_in.shape(2) != dim) {
+    std::string given = "not an array";
+    if (frames_in) {
+      given = "shape (";
+      for (py::ssize_t d = 0; d < frames_in.ndim(); ++d) {
+        given += (d > 0 ? ", " : "") + std::to_string(frames_in.shape(d));
+      }
+      given += ")";
+    }
+    ThrowInput("paths", "is " + given + "; expected (m, " + std::to_string(k) + ", " +
+                            std::to_string(dim) + "): each frame's position of every target");
+  }
+  const py::ssize_t count = frames_in.shape(0), rows = tree.points.rows();
+  for (py::ssize_t i = 0; i < frames_in.size(); ++i) {
+    if (!std::isfinite(frames_in.data()[i])) {
+      const py::ssize_t f = i / (k * dim), t = i / dim % k;
+      ThrowInput("paths[" + std::to_string(f) + "][" + std::to_string(t) + "]",
+                 "has a non-finite coordinate", FormatNumber(frames_in.data()[i]), "finite values");
+    }
+  }
+  py::array_t<double> frames({count + 1, rows, dim});
+  py::array_t<int> passes(count);
+  py::array_t<double> residual(count);
+  py::array_t<bool> reached(count);
+  double* out = frames.mutable_data();
+  Points pts = tree.points, goal(k, dim);
+  const size_t frame = static_cast<size_t>(rows) * dim;
+  {
+    py::gil_scoped_release release;
+    std::copy(pts.data(), pts.data() + frame, out);
+    for (py::ssize_t i = 0; i < count; ++i) {
+      std::copy(frames_in.data() + i * k * dim, frames_in.data() + (i + 1) * k * dim, goal.data());
+      const ReachReport report = ReachTargets(reacher, goal, &pts);
+      std::copy(pts.data(), pts.data() + frame, out + (i + 1) * frame);
+      passes.mutable_data()[i] = report.passes;
+      residual.mutable_data()[i] = report.residual;
+      reached.mutable_data()[i] = report.reached;
+    }
+  }
+  py::dict report;
+  report["passes"] = passes;
+  report["residual"] = residual;
+  report["reached"] = reached;
+  report["root"] = reacher.root;
+  return py::make_tuple(frames, report);
 }
 
 }  // namespace
@@ -399,6 +471,19 @@ Chain(points, *, link_length=None, lengths=None)
         "(\"tractrix\", \"ftl\", \"min_rotation\", \"min_joint_angle\"). Returns the frames, (m+1, "
         "n+1, dim): the start, then the "
         "tree after each target.");
+  m.def("reach_tree", &ReachTree, py::arg("points"), py::arg("parents"), py::arg("targets"),
+        py::arg("paths"), py::kw_only(), py::arg("fixed") = std::vector<int>(),
+        py::arg("weights") = py::none(), py::arg("method") = "tractrix",
+        py::arg("branch_rule") = "centroid", py::arg("tolerance") = 1e-10,
+        py::arg("max_passes") = 1000,
+        "Several targets on a tree (docs/trees.md): the points `targets` (k point indices) reach, "
+        "frame by frame, the positions of paths ((m, k, dim)) while the points `fixed` stay where "
+        "they are, by passes of `method` (\"tractrix\" or \"ftl\") between them, with "
+        "`branch_rule` (\"centroid\", FABRIK's, or \"keep_links\") where pulled branches meet; "
+        "each frame starts where the last ended. weights: one per target (default 1). tolerance: "
+        "of the longest link. Returns (frames, report): frames (m+1, n+1, dim), the start then "
+        "each frame; report a dict of per-frame arrays passes, residual (of the longest link) and "
+        "reached, and root (the point the passes hang the tree from).");
   m.def(
       "overall_step",
       [](PointsOrChain points, ArrayLike head, OverallLike options) {

@@ -1,0 +1,90 @@
+"""flexkin.reach_tree: several targets and fixed points on a tree (docs/trees.md, "Several
+targets"). The targets are reachable by construction (points of another configuration of the same
+tree), so every frame must reach them; one target with nothing fixed moves as move_tree moves the
+tree driven at that point, bit for bit; a target out of reach reports its residual."""
+import numpy as np
+import pytest
+
+import flexkin
+
+# Two arms of three links on a shoulder (point 2), on a spine of two links from the base (point 0).
+ARMS = np.array([[0, 0], [0, 1], [0, 2], [0.8, 2.3], [1.6, 2.0], [2.4, 2.2], [-0.8, 2.3],
+                 [-1.6, 2.0], [-2.4, 2.2]])
+ARM_PARENTS = [-1, 0, 1, 2, 3, 4, 2, 6, 7]
+
+
+def lengths(points, parents):
+    return np.array([np.linalg.norm(points[i] - points[p]) for i, p in enumerate(parents) if p >= 0])
+
+
+def bent(points, parents, angle, seed):
+    """The tree with every link turned by a random angle up to `angle`, its length kept."""
+    rng = np.random.default_rng(seed)
+    out = points.copy()
+    for i, p in enumerate(parents):
+        if p < 0:
+            continue
+        link = points[i] - points[p]
+        a = rng.uniform(-angle, angle)
+        rot = np.array([[np.cos(a), -np.sin(a)], [np.sin(a), np.cos(a)]])
+        out[i] = out[p] + rot @ link
+    return out
+
+
+@pytest.mark.parametrize("method", ["tractrix", "ftl"])
+@pytest.mark.parametrize("rule", ["centroid", "keep_links"])
+def test_the_hands_reach_reachable_targets_in_every_frame(method, rule):
+    goals = [bent(ARMS, ARM_PARENTS, 0.3, seed) for seed in range(5)]
+    paths = np.array([[g[5], g[8]] for g in goals])
+    frames, report = flexkin.reach_tree(ARMS, ARM_PARENTS, [5, 8], paths, fixed=[0], method=method,
+                                        branch_rule=rule)
+    assert frames.shape == (6, 9, 2)
+    assert report["reached"].all() and report["root"] == 0
+    assert (report["residual"] <= 1e-10).all()
+    start = lengths(ARMS, ARM_PARENTS)
+    for f, goal in enumerate(goals):
+        np.testing.assert_allclose(frames[f + 1][[5, 8]], goal[[5, 8]], rtol=0, atol=1e-10 * start.max())
+        np.testing.assert_array_equal(frames[f + 1][0], ARMS[0])
+        np.testing.assert_allclose(lengths(frames[f + 1], ARM_PARENTS), start, rtol=1e-14)
+
+
+@pytest.mark.parametrize("driven", [0, 4, 8])
+def test_one_target_and_nothing_fixed_moves_as_move_tree(driven):
+    path = ARMS[driven] + np.array([[0.3, 0.1], [0.5, -0.2], [0.2, -0.6]])
+    frames, report = flexkin.reach_tree(ARMS, ARM_PARENTS, [driven], path[:, None, :])
+    expected = flexkin.move_tree(ARMS, ARM_PARENTS, path, driven=driven)
+    np.testing.assert_array_equal(frames, expected)
+    assert (report["passes"] == 1).all() and (report["residual"] == 0).all()
+
+
+def test_a_target_out_of_reach_reports_its_residual():
+    points = np.array([[float(i), 0.0] for i in range(6)])  # 5 unit links along x
+    parents = [-1, 0, 1, 2, 3, 4]
+    frames, report = flexkin.reach_tree(points, parents, [5], [[[0.0, 8.0]]], fixed=[0])
+    assert not report["reached"][0]
+    assert report["residual"][0] == pytest.approx(3.0, abs=1e-3)  # 8 away, 5 long
+    assert np.linalg.norm(frames[1][5] - [0.0, 8.0]) == pytest.approx(report["residual"][0], abs=1e-15)
+
+
+@pytest.mark.parametrize("kwargs, field, part", [
+    (dict(targets=[5, 9]), "targets[1]", "0..8"),
+    (dict(targets=[5, 5]), "targets[1]", "targets[0] drives"),
+    (dict(fixed=[0, 5]), "fixed[1]", "targets[0] drives"),
+    (dict(targets=[]), "targets", "at least one"),
+    (dict(weights=[1.0]), "weights", "one per target"),
+    (dict(weights=[1.0, -2.0]), "weights[1]", "> 0"),
+    (dict(method="overall"), "method", "\"tractrix\" or \"ftl\""),
+    (dict(branch_rule="mean"), "branch_rule", "\"centroid\" or \"keep_links\""),
+    (dict(tolerance=0.0), "tolerance", "> 0"),
+    (dict(max_passes=0), "max_passes", ">= 1"),
+    (dict(paths=np.zeros((3, 1, 2))), "paths", "expected (m, 2, 2)"),
+    (dict(paths=np.full((1, 2, 2), np.nan)), "paths[0][0]", "non-finite"),
+])
+def test_bad_arguments_are_named(kwargs, field, part):
+    args = dict(targets=[5, 8], paths=np.zeros((1, 2, 2)) + [[2.0, 2.5], [-2.0, 2.5]], fixed=[0])
+    args.update(kwargs)
+    targets, paths = args.pop("targets"), args.pop("paths")
+    with pytest.raises(flexkin.InputError) as error:
+        flexkin.reach_tree(ARMS, ARM_PARENTS, targets, paths, **args)
+    assert error.value.field == field
+    assert part in str(error.value)

@@ -1,0 +1,380 @@
+// Several targets and fixed points on a tree (flexkin/tree.h, ReachTargets). The targets are
+// reachable by construction (the points of another configuration of the same tree, with the same
+// root and lengths), so the passes must reach them to the tolerance; a path with one target and
+// nothing fixed must move as MoveTreePoint moves it, bit for bit; a target out of reach is
+// reported with its residual, which for a straight pull on a chain is known in closed form.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "flexkin/error.h"
+#include "flexkin/tree.h"
+#include "scenes/scenes.h"
+
+namespace flexkin {
+namespace {
+
+using scenes::RandomTree;
+using scenes::TreeKind;
+
+// The first `most` leaves of `tree` (points no other point hangs from).
+std::vector<int> Leaves(const Tree& tree, size_t most) {
+  std::vector<char> has_child(tree.parents.size(), 0);
+  for (int p : tree.parents) {
+    if (p >= 0) has_child[p] = 1;
+  }
+  std::vector<int> leaves;
+  for (size_t i = 0; i < has_child.size() && leaves.size() < most; ++i) {
+    if (!has_child[i]) leaves.push_back(static_cast<int>(i));
+  }
+  return leaves;
+}
+
+// Another configuration of `tree`: the root where it is, every link turned by a random small
+// rotation of its direction (at most `angle` off), its length kept.
+Points Bent(const Tree& tree, double angle, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal;
+  const int dim = static_cast<int>(tree.points.cols());
+  Points out = tree.points;
+  for (int i = 0; i < tree.points.rows(); ++i) {  // parents come first (RandomReachTree, Ys)
+    const int p = tree.parents[i];
+    if (p < 0) continue;
+    const Eigen::VectorXd link = (tree.points.row(i) - tree.points.row(p)).transpose();
+    Eigen::VectorXd nudge(dim);
+    for (int k = 0; k < dim; ++k) nudge[k] = normal(rng);
+    nudge -= nudge.dot(link) / link.squaredNorm() * link;
+    const Eigen::VectorXd dir =
+        (link.normalized() + std::tan(angle) * 0.5 * nudge.normalized()).normalized();
+    out.row(i) = out.row(p) + link.norm() * dir.transpose();
+  }
+  return out;
+}
+
+Points Rows(const Points& points, const std::vector<int>& which) {
+  Points out(which.size(), points.cols());
+  for (size_t k = 0; k < which.size(); ++k) out.row(k) = points.row(which[k]);
+  return out;
+}
+
+double Residual(const Points& points, const std::vector<int>& which, const Points& targets) {
+  return (Rows(points, which) - targets).rowwise().norm().maxCoeff();
+}
+
+struct Variant {
+  Method method;
+  BranchRule rule;
+};
+const Variant kVariants[] = {{Method::kTractrix, BranchRule::kCentroid},
+                             {Method::kTractrix, BranchRule::kKeepLinks},
+                             {Method::kFollowTheLeader, BranchRule::kCentroid},
+                             {Method::kFollowTheLeader, BranchRule::kKeepLinks}};
+
+ReachOptions OptionsOf(const Variant& v) {
+  ReachOptions options;
+  options.method = v.method;
+  options.branch_rule = v.rule;
+  return options;
+}
+
+std::string Name(const Variant& v) { return std::string(NameOf(v.method)) + "/" + NameOf(v.rule); }
+
+// The shapes (scenes::TreeShape): a chain of 10 links, two arms on a shoulder, a binary
+// tree of depth 10 (2047 points), their tips driven (scenes::TreeTips); a fixed base. The targets
+// are the points of a bent configuration (every link turned by up to 0.25 rad): reachable.
+Tree TwoArms(int dim = 2);
+
+TEST(TreeReachTest, ReachesReachableTargetsOnTheBenchmarkShapesToTheTolerance) {
+  struct Shape {
+    const char* name;
+    Tree tree;
+    std::vector<int> targets;
+  };
+  int cases = 0;
+  for (int dim : {2, 3}) {
+    std::vector<Shape> shapes;
+    for (TreeKind kind : {TreeKind::kChain10, TreeKind::kTwoArms, TreeKind::kBinary10}) {
+      const char* names[] = {"chain", "two arms", "binary"};
+      shapes.push_back(
+          {names[static_cast<int>(kind)], scenes::TreeShape(kind, dim), scenes::TreeTips(kind)});
+    }
+    shapes.push_back({"arms on a spine", TwoArms(dim), {5, 8}});
+    for (const Shape& shape : shapes) {
+      for (unsigned seed = 1; seed <= 3; ++seed) {
+        const Points targets = Rows(Bent(shape.tree, 0.25, seed), shape.targets);
+        for (const Variant& v : kVariants) {
+          const TreeReacher reacher =
+              MakeTreeReacher(shape.tree, shape.targets, {0}, {}, OptionsOf(v));
+          Points points = shape.tree.points;
+          const ReachReport report = ReachTargets(reacher, targets, &points);
+          SCOPED_TRACE(Name(v) + " " + shape.name + " dim " + std::to_string(dim) + " seed " +
+                       std::to_string(seed));
+          EXPECT_TRUE(report.reached) << "residual " << report.residual << " in " << report.passes;
+          EXPECT_LE(report.residual, 1e-10);
+          // The report's residual is the points' own, scaled by the longest link.
+          EXPECT_LE(Residual(points, shape.targets, targets), 1e-10 * reacher.longest_link);
+          EXPECT_EQ((points.row(0) - shape.tree.points.row(0)).norm(), 0.0);  // the base, exactly
+          EXPECT_LE(MaxTreeLengthError(MakeTreeStepper(Method::kTractrix, shape.tree, 0), points),
+                    1e-13);
+          ++cases;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(cases, 96);
+}
+
+// Random trees of 40 points with five leaves driven: the passes are not proven to converge on a
+// tree (nor are FABRIK's), and on some of these they stall (docs/trees.md gives the count). What
+// must hold in every case: the report says which, its residual is the points' own, the lengths
+// are kept and the base is exactly fixed.
+TEST(TreeReachTest, ReportsTruthfullyOnRandomTrees) {
+  int reached = 0, cases = 0;
+  for (int dim : {2, 3}) {
+    for (unsigned seed = 1; seed <= 6; ++seed) {
+      const Tree tree = RandomTree(40, dim, seed);
+      const std::vector<int> leaves = Leaves(tree, 5);
+      const Points targets = Rows(Bent(tree, 0.25, 100 + seed), leaves);
+      for (const Variant& v : kVariants) {
+        const TreeReacher reacher = MakeTreeReacher(tree, leaves, {0}, {}, OptionsOf(v));
+        Points points = tree.points;
+        const ReachReport report = ReachTargets(reacher, targets, &points);
+        SCOPED_TRACE(Name(v) + " dim " + std::to_string(dim) + " seed " + std::to_string(seed));
+        const double own = Residual(points, leaves, targets) / reacher.longest_link;
+        EXPECT_NEAR(report.residual, own, 1e-15 * (1 + own));
+        EXPECT_EQ(report.reached, own <= 1e-10);
+        EXPECT_EQ((points.row(0) - tree.points.row(0)).norm(), 0.0);
+        EXPECT_LE(MaxTreeLengthError(MakeTreeStepper(Method::kTractrix, tree, 0), points), 1e-13);
+        if (!report.reached) {
+          std::printf("stalled: %s dim %d seed %u, residual %.3g after %d passes\n",
+                      Name(v).c_str(), dim, seed, report.residual, report.passes);
+        }
+        reached += report.reached;
+        ++cases;
+      }
+    }
+  }
+  EXPECT_EQ(cases, 48);
+  std::printf("random trees: %d of %d reached to 1e-10\n", reached, cases);
+  EXPECT_GE(reached, 32);  // 36 of 48 when this was written (docs/trees.md)
+}
+
+TEST(TreeReachTest, OneTargetAndNothingFixedMovesAsTheTreeDrivenAtThatPoint) {
+  for (int dim : {2, 3}) {
+    const Tree tree = RandomTree(30, dim, 7);
+    for (Method method : {Method::kTractrix, Method::kFollowTheLeader}) {
+      for (int driven : {0, 11, 29}) {
+        Eigen::VectorXd target = tree.points.row(driven).transpose();
+        target[0] += 0.7;
+        target[1] -= 0.4;
+        ReachOptions options;
+        options.method = method;
+        Points reached = tree.points;
+        const ReachReport report = ReachTargets(MakeTreeReacher(tree, {driven}, {}, {}, options),
+                                                target.transpose(), &reached);
+        Points moved = tree.points;
+        MoveTreePoint(MakeTreeStepper(method, tree, driven), target, 1, &moved);
+        EXPECT_EQ(report.passes, 1);
+        EXPECT_TRUE(report.reached);
+        EXPECT_EQ(report.residual, 0.0);
+        EXPECT_TRUE(reached == moved) << "driven " << driven << ": largest difference "
+                                      << (reached - moved).cwiseAbs().maxCoeff();
+      }
+    }
+  }
+}
+
+// A straight chain of 10 unit links fixed at point 0, its tip pulled toward a point 13 away: out
+// of reach by 3. The passes settle on the chain stretched toward the target; the residual is 3
+// (of the longest link, 1) to the accuracy at which they stop.
+TEST(TreeReachTest, ReportsTheResidualOfATargetOutOfReach) {
+  Tree chain;
+  chain.points = Points::Zero(11, 2);
+  chain.parents.assign(11, -1);
+  for (int i = 1; i <= 10; ++i) {
+    chain.parents[i] = i - 1;
+    chain.points.row(i) << std::cos(0.2 * i) + chain.points(i - 1, 0),
+        std::sin(0.2 * i) + chain.points(i - 1, 1);
+  }
+  const Eigen::Vector2d target(5.0, 12.0);  // 13 from the base
+  for (const Variant& v : kVariants) {
+    ReachOptions options = OptionsOf(v);
+    Points points = chain.points;
+    const ReachReport report =
+        ReachTargets(MakeTreeReacher(chain, {10}, {0}, {}, options), target.transpose(), &points);
+    SCOPED_TRACE(Name(v));
+    EXPECT_FALSE(report.reached);
+    EXPECT_LT(report.passes, options.max_passes);  // settled, not run out
+    EXPECT_NEAR(report.residual, 3.0, 1e-3);
+    EXPECT_NEAR(report.residual, (points.row(10).transpose() - target).norm(), 1e-15);
+    // Stretched: the tip 10 from the base, toward the target.
+    EXPECT_NEAR(points.row(10).norm(), 10.0, 1e-3);
+    EXPECT_LE(MaxTreeLengthError(MakeTreeStepper(Method::kTractrix, chain, 0), points), 1e-14);
+  }
+}
+
+// Two arms of three links on a shoulder, on a trunk of two from a fixed base (the benchmark's
+// shape): a Y. The targets move along circles in steps of 0.01; every frame starts from the last.
+Tree TwoArms(int dim) {
+  Tree t;
+  t.points = Points::Zero(9, dim);
+  t.points.leftCols(2) << 0, 0, 0, 1, 0, 2, 0.8, 2.3, 1.6, 2.0, 2.4, 2.2, -0.8, 2.3, -1.6, 2.0,
+      -2.4, 2.2;
+  if (dim == 3) t.points.col(2) << 0, 0, 0, 0.2, 0.3, 0.1, -0.1, 0.2, 0.3;
+  t.parents = {-1, 0, 1, 2, 3, 4, 2, 6, 7};
+  return t;
+}
+
+TEST(TreeReachTest, TheMotionIsContinuousFromFrameToFrame) {
+  const Tree tree = TwoArms();
+  const std::vector<int> hands = {5, 8};
+  for (const Variant& v : kVariants) {
+    const TreeReacher reacher = MakeTreeReacher(tree, hands, {0}, {}, OptionsOf(v));
+    Points points = tree.points;
+    double largest_jump = 0.0, largest_step = 0.0;
+    int reached = 0;
+    const int frames = 200;
+    Points previous_targets = Rows(tree.points, hands);
+    for (int f = 1; f <= frames; ++f) {
+      Points targets = Rows(tree.points, hands);
+      for (int k = 0; k < 2; ++k) {  // circles of radius 0.3, the hands reach all of them
+        const double a = 2 * M_PI * f / frames;
+        targets(k, 0) += 0.3 * (std::cos(a + k) - std::cos(double(k)));
+        targets(k, 1) += 0.3 * (std::sin(a + k) - std::sin(double(k)));
+      }
+      const Points before = points;
+      reached += ReachTargets(reacher, targets, &points).reached;
+      largest_jump = std::max(largest_jump, (points - before).rowwise().norm().maxCoeff());
+      largest_step =
+          std::max(largest_step, (targets - previous_targets).rowwise().norm().maxCoeff());
+      previous_targets = targets;
+    }
+    SCOPED_TRACE(Name(v));
+    EXPECT_EQ(reached, frames);
+    // No point jumps: a flip would move a hand's arm by a link's length (about 0.8) in a frame.
+    EXPECT_LE(largest_jump, 5 * largest_step) << "targets move " << largest_step;
+  }
+}
+
+// A Y from a fixed base whose two hands are pulled apart beyond reach: the heavier target is
+// reached more nearly.
+TEST(TreeReachTest, WeightsDecideBetweenTargetsThatConflict) {
+  const Tree tree = TwoArms();
+  Points targets(2, 2);
+  targets << 4.0, 2.0, -4.0, 2.0;  // each 4 from the shoulder; the arms are about 2.5 long
+  for (const Variant& v : kVariants) {
+    ReachOptions options = OptionsOf(v);
+    Points even = tree.points, heavy = tree.points;
+    ReachTargets(MakeTreeReacher(tree, {5, 8}, {0}, {}, options), targets, &even);
+    ReachTargets(MakeTreeReacher(tree, {5, 8}, {0}, {4.0, 1.0}, options), targets, &heavy);
+    const double even_gap = (even.row(5) - targets.row(0)).norm();
+    const double heavy_gap = (heavy.row(5) - targets.row(0)).norm();
+    const double light_gap = (heavy.row(8) - targets.row(1)).norm();
+    SCOPED_TRACE(Name(v));
+    EXPECT_LT(heavy_gap, even_gap - 0.05);
+    EXPECT_LT(heavy_gap, light_gap - 0.05);
+  }
+}
+
+// A fixed sub-base: the shoulder held as well as the base; the hands reach targets of a bent
+// configuration with the trunk unchanged.
+TEST(TreeReachTest, HoldsFixedPointsBetweenTheTargets) {
+  const Tree tree = TwoArms();
+  Points goal = Bent(tree, 0.3, 5);
+  goal.topRows(3) = tree.points.topRows(3);  // the trunk as it was
+  for (int i = 3; i < 9; ++i) {              // the arms rebuilt from it, their links as bent
+    const int p = tree.parents[i];
+    const Eigen::RowVector2d dir = (Bent(tree, 0.3, 5).row(i) - Bent(tree, 0.3, 5).row(p));
+    goal.row(i) = goal.row(p) + dir;
+  }
+  for (const Variant& v : kVariants) {
+    ReachOptions options = OptionsOf(v);
+    options.max_passes = 20000;
+    const TreeReacher reacher = MakeTreeReacher(tree, {5, 8}, {0, 2}, {}, options);
+    Points points = tree.points;
+    const ReachReport report = ReachTargets(reacher, Rows(goal, {5, 8}), &points);
+    SCOPED_TRACE(Name(v));
+    EXPECT_TRUE(report.reached) << report.residual;
+    EXPECT_LE((points.row(2) - tree.points.row(2)).norm(), 1e-10);
+    EXPECT_LE(Residual(points, {5, 8}, Rows(goal, {5, 8})), 1e-10);
+  }
+}
+
+std::string RefusalOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(accepted)";
+}
+
+TEST(TreeReachTest, RefusesBadInputNamingTheField) {
+  const Tree tree = TwoArms();
+  auto make = [&](std::vector<int> targets, std::vector<int> fixed, std::vector<double> weights,
+                  ReachOptions options) {
+    return [=] { MakeTreeReacher(tree, targets, fixed, weights, options); };
+  };
+  const ReachOptions plain;
+  EXPECT_EQ(RefusalOf(make({}, {0}, {}, plain)),
+            "targets: none given; at least one point must be driven");
+  EXPECT_EQ(RefusalOf(make({5, 9}, {0}, {}, plain)),
+            "targets[1]: value 9 is not valid; expected a point of the tree, 0..8");
+  EXPECT_EQ(RefusalOf(make({5, 5}, {0}, {}, plain)),
+            "targets[1]: is point 5, which targets[0] drives already; a point takes one target "
+            "or is fixed");
+  EXPECT_EQ(RefusalOf(make({5}, {0, 5}, {}, plain)),
+            "fixed[1]: is point 5, which targets[0] drives already; a point takes one target or "
+            "is fixed");
+  EXPECT_EQ(RefusalOf(make({5, 8}, {0, -1}, {}, plain)),
+            "fixed[1]: value -1 is not valid; expected a point of the tree, 0..8");
+  EXPECT_NE(RefusalOf(make({5, 8}, {0}, {1.0}, plain)).find("weights: has 1 entries for 2"),
+            std::string::npos);
+  EXPECT_EQ(RefusalOf(make({5, 8}, {0}, {1.0, 0.0}, plain)),
+            "weights[1]: value 0 is not valid; expected a finite number > 0");
+  EXPECT_EQ(RefusalOf(make({5, 8}, {0}, {1.0, NAN}, plain)),
+            "weights[1]: value nan is not valid; expected a finite number > 0");
+  ReachOptions bad = plain;
+  bad.method = Method::kOverall;
+  EXPECT_EQ(RefusalOf(make({5}, {0}, {}, bad)),
+            "method: value \"overall\" is not valid; expected \"tractrix\" or \"ftl\" (the rules "
+            "of the passes)");
+  bad = plain;
+  bad.tolerance = 0.0;
+  EXPECT_EQ(RefusalOf(make({5}, {0}, {}, bad)),
+            "tolerance: value 0 is not valid; expected a finite number > 0 (of the longest link)");
+  bad = plain;
+  bad.max_passes = 0;
+  EXPECT_EQ(RefusalOf(make({5}, {0}, {}, bad)),
+            "max_passes: value 0 is not valid; expected an integer >= 1");
+  Tree cycle = tree;
+  cycle.parents[1] = 4;
+  EXPECT_NE(RefusalOf([&] { MakeTreeReacher(cycle, {5}, {0}); }).find("tree.parents"),
+            std::string::npos);
+
+  // The targets at solve time; a refused call leaves the points as they were.
+  const TreeReacher reacher = MakeTreeReacher(tree, {5, 8}, {0});
+  Points points = tree.points;
+  Points wrong(1, 2);
+  wrong << 1.0, 2.0;
+  EXPECT_EQ(RefusalOf([&] { ReachTargets(reacher, wrong, &points); }),
+            "positions: shape 1x2; expected 2x2 (one row per target)");
+  Points nan_target(2, 2);
+  nan_target << 1.0, 2.0, NAN, 0.0;
+  EXPECT_EQ(RefusalOf([&] { ReachTargets(reacher, nan_target, &points); }),
+            "positions[1]: has a non-finite coordinate; a target must be finite");
+  Points short_points = tree.points.topRows(4);
+  EXPECT_NE(RefusalOf([&] {
+              ReachTargets(reacher, Rows(tree.points, {5, 8}), &short_points);
+            }).find("points: shape 4x2"),
+            std::string::npos);
+  EXPECT_TRUE(points == tree.points);
+}
+
+}  // namespace
+}  // namespace flexkin
