@@ -17,6 +17,7 @@
 #include "flexkin/overall.h"
 #include "flexkin/propagate.h"
 #include "flexkin/tree.h"
+#include "flexkin/tree_overall.h"
 #include "flexkin/vocabulary.h"
 
 namespace flexkin::python {
@@ -185,8 +186,9 @@ py::array_t<double> MoveTree(ArrayLike points, IndexSequence parents, ArrayLike 
 // The frames of a tree whose points `targets` reach the rows of each frame of `paths` ((m, k,
 // dim)), with a report per frame.
 py::tuple ReachTree(ArrayLike points, IndexSequence parents, IndexSequence targets, ArrayLike paths,
-                    IndexSequence fixed, py::handle weights, const std::string& method,
-                    py::handle branch_rule, double tolerance, int max_passes) {
+                    IndexSequence fixed, OptionalArray weights, const std::string& method,
+                    NameText branch_rule, double tolerance, int max_passes,
+                    OptionalWeights overall) {
   Tree tree;
   tree.points = ReadPoints(points, "points", 2);
   tree.parents = IndexList(parents, "parents");
@@ -203,6 +205,9 @@ py::tuple ReachTree(ArrayLike points, IndexSequence parents, IndexSequence targe
   }
   const TreeReacher reacher =
       MakeTreeReacher(tree, IndexList(targets, "targets"), IndexList(fixed, "fixed"), w, options);
+  const bool exact = !overall.is_none();
+  TreeOverallOptions overall_options;
+  if (exact) overall_options.weights = WeightsArg(overall);
   const py::ssize_t dim = reacher.dim, k = static_cast<py::ssize_t>(reacher.target_points.size());
   const auto frames_in =
       py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(paths);
@@ -229,7 +234,7 @@ py::tuple ReachTree(ArrayLike points, IndexSequence parents, IndexSequence targe
   py::array_t<double> frames({count + 1, rows, dim});
   py::array_t<int> passes(count);
   py::array_t<double> residual(count);
-  py::array_t<bool> reached(count);
+  py::array_t<bool> reached(count), converged(count);
   double* out = frames.mutable_data();
   Points pts = tree.points, goal(k, dim);
   const size_t frame = static_cast<size_t>(rows) * dim;
@@ -238,7 +243,14 @@ py::tuple ReachTree(ArrayLike points, IndexSequence parents, IndexSequence targe
     std::copy(pts.data(), pts.data() + frame, out);
     for (py::ssize_t i = 0; i < count; ++i) {
       std::copy(frames_in.data() + i * k * dim, frames_in.data() + (i + 1) * k * dim, goal.data());
-      const ReachReport report = ReachTargets(reacher, goal, &pts);
+      ReachReport report;
+      if (exact) {
+        const TreeOverallReport step = StepTreeOverall(reacher, goal, overall_options, &pts);
+        report = step.start;
+        converged.mutable_data()[i] = step.converged;
+      } else {
+        report = ReachTargets(reacher, goal, &pts);
+      }
       std::copy(pts.data(), pts.data() + frame, out + (i + 1) * frame);
       passes.mutable_data()[i] = report.passes;
       residual.mutable_data()[i] = report.residual;
@@ -250,6 +262,7 @@ py::tuple ReachTree(ArrayLike points, IndexSequence parents, IndexSequence targe
   report["residual"] = residual;
   report["reached"] = reached;
   report["root"] = reacher.root;
+  if (exact) report["converged"] = converged;
   return py::make_tuple(frames, report);
 }
 
@@ -475,7 +488,7 @@ Chain(points, *, link_length=None, lengths=None)
         py::arg("paths"), py::kw_only(), py::arg("fixed") = std::vector<int>(),
         py::arg("weights") = py::none(), py::arg("method") = "tractrix",
         py::arg("branch_rule") = "centroid", py::arg("tolerance") = 1e-10,
-        py::arg("max_passes") = 1000,
+        py::arg("max_passes") = 1000, py::arg("overall") = py::none(),
         "Several targets on a tree (docs/trees.md): the points `targets` (k point indices) reach, "
         "frame by frame, the positions of paths ((m, k, dim)) while the points `fixed` stay where "
         "they are, by passes of `method` (\"tractrix\" or \"ftl\") between them, with "
@@ -483,7 +496,10 @@ Chain(points, *, link_length=None, lengths=None)
         "each frame starts where the last ended. weights: one per target (default 1). tolerance: "
         "of the longest link. Returns (frames, report): frames (m+1, n+1, dim), the start then "
         "each frame; report a dict of per-frame arrays passes, residual (of the longest link) and "
-        "reached, and root (the point the passes hang the tree from).");
+        "reached, and root (the point the passes hang the tree from). overall: objective weights "
+        "(ObjectiveWeights or a dict: squared, squared_weighted, rotation): each frame is then the "
+        "exact least-motion step, from the passes by Newton's method (docs/trees.md), and the "
+        "report adds converged; the passes' points where it does not converge.");
   m.def(
       "overall_step",
       [](PointsOrChain points, ArrayLike head, OverallLike options) {

@@ -165,6 +165,9 @@ namespace flexkin::python {
 py::tuple StateTuple(const py::tuple& state, size_t size, const char* type);
 // Method from its name, as in scenario files ("tractrix", "ftl", ...); InputError naming `field`.
 Method MethodArg(const std::string& name, const std::string& field = "method");
+// ObjectiveWeights or a dict of term weights (options_bindings.cc), every weight finite; throws
+// InputError naming "weights" or "weights.<term>".
+ObjectiveWeights WeightsArg(py::handle object);
 // The overall options from an `overall` argument: None (the defaults), OverallOptions,
 // ObjectiveWeights or a dict of term weights (only the terms given count).
 OverallOptions OverallArg(py::handle object);

@@ -96,8 +96,6 @@ OverallOptions OverallArg(py::handle object) {
   return options;
 }
 
-namespace {
-
 ObjectiveWeights WeightsArg(py::handle object) {
   ObjectiveWeights w;
   if (py::isinstance<ObjectiveWeights>(object)) {
@@ -113,6 +111,8 @@ ObjectiveWeights WeightsArg(py::handle object) {
   }
   return w;
 }
+
+namespace {
 
 // OverallObjective of checked arguments: the value, and with `gradient` or `hessian` a tuple of
 // it and the gradient (n dim,) (and the Hessian (n dim, n dim)).

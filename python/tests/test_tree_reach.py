@@ -88,3 +88,24 @@ def test_bad_arguments_are_named(kwargs, field, part):
         flexkin.reach_tree(ARMS, ARM_PARENTS, targets, paths, **args)
     assert error.value.field == field
     assert part in str(error.value)
+
+
+def test_overall_gives_the_least_motion_that_reaches_the_targets():
+    paths = np.array([[ARMS[5] + [0.05, 0.03], ARMS[8] + [-0.04, 0.05]]])
+    passes, _ = flexkin.reach_tree(ARMS, ARM_PARENTS, [5, 8], paths, fixed=[0])
+    frames, report = flexkin.reach_tree(ARMS, ARM_PARENTS, [5, 8], paths, fixed=[0],
+                                        overall={"squared": 1.0})
+    assert report["converged"].all()
+    np.testing.assert_array_equal(frames[1][[5, 8]], paths[0])
+    np.testing.assert_array_equal(frames[1][0], ARMS[0])
+    np.testing.assert_allclose(lengths(frames[1], ARM_PARENTS), lengths(ARMS, ARM_PARENTS), rtol=1e-14)
+    free = [1, 2, 3, 4, 6, 7]
+    moved = lambda f: float(np.sum((f[1][free] - ARMS[free]) ** 2))
+    assert moved(frames) < moved(passes)
+
+
+def test_overall_refuses_terms_trees_do_not_take():
+    with pytest.raises(flexkin.InputError) as error:
+        flexkin.reach_tree(ARMS, ARM_PARENTS, [5, 8], np.array([[ARMS[5], ARMS[8]]]), fixed=[0],
+                           overall={"l2": 1.0})
+    assert error.value.field == "weights.l2"
