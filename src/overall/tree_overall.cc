@@ -147,47 +147,67 @@ class TreeKkt {
       const double length = r_.up_length[v];
       const double kappa = unit ? 0.0 : kappa_[v];
       const Vec own = d_[v] / length;
-      b.kkt.setZero();
-      b.kkt.template topLeftCorner<Dim, Dim>() = a_[v];
-      b.kkt.template block<Dim, 1>(0, Dim) = own;
-      b.kkt.template block<1, Dim>(Dim, 0) = own.transpose();
-      b.rb.setZero();
-      b.rb.template block<Dim, 1>(0, 0) = rx_[v];
-      b.rb(Dim, 0) = -c_[v];
-      for (size_t j = 0; j < kids.size(); ++j) {
-        const int c = kids[j];
-        const Vec g = -d_[c] / r_.up_length[c];
-        b.kkt.template block<Dim, 1>(0, Dim + 1 + j) = g;
-        b.kkt.template block<1, Dim>(Dim + 1 + j, 0) = g.transpose();
-        b.rb(Dim + 1 + j, 0) = -c_[c];
-      }
-      // The coupling B to the parent's dx: kappa I in the dx rows, own^T in the link's row.
-      b.rb.template block<Dim, Dim>(0, 1) = kappa * Mat::Identity();
-      b.rb.template block<1, Dim>(Dim, 1) = own.transpose();
-      b.lu.compute(b.kkt);
-      if (!(std::abs(b.lu.determinant()) > 0.0)) return false;
-      b.x = b.lu.solve(b.rb);  // column 0: K^-1 r; columns 1..Dim: K^-1 B
-      if (inertia_ok != nullptr) {
-        // With A (the block's dx rows, after its children's Schur complements) positive
-        // definite and the link gradients independent (the LU above), the block has exactly Dim
-        // positive eigenvalues (A's, the Schur complement -G^T A^-1 G being negative definite);
-        // only otherwise are they counted.
-        if (Eigen::LLT<Mat>(a_[v]).info() == Eigen::Success) {
+      // The fast form: no anchored child and A (the block's dx rows, after its children's Schur
+      // complements) positive definite, so K = [A own; own^T 0] is solved through A's Cholesky
+      // factor and the scalar S = own^T A^-1 own > 0; and K has exactly Dim positive eigenvalues
+      // (A's; the Schur complement -S is negative).
+      const Eigen::LLT<Mat> llt(a_[v]);
+      b.fast = kids.empty() && llt.info() == Eigen::Success;
+      if (b.fast) {
+        const Mat ainv = llt.solve(Mat::Identity());
+        const Vec g = ainv * own;
+        const double schur = own.dot(g);
+        if (!(schur > 0.0)) return false;
+        const Vec af = ainv * rx_[v];
+        b.y0 = (own.dot(af) + c_[v]) / schur;
+        b.x0 = af - g * b.y0;
+        b.y = (kappa * own.transpose() * ainv - own.transpose()) / schur;
+        b.xb = kappa * ainv - g * b.y;
+        if (inertia_ok != nullptr) {
           positive += Dim;
-        } else {
-          eigen_.compute(b.kkt, Eigen::EigenvaluesOnly);
-          positive += static_cast<int>((eigen_.eigenvalues().array() > 0.0).count());
+          unknowns += Dim;
         }
-        unknowns += Dim;
+      } else {
+        b.kkt.setZero();
+        b.kkt.template topLeftCorner<Dim, Dim>() = a_[v];
+        b.kkt.template block<Dim, 1>(0, Dim) = own;
+        b.kkt.template block<1, Dim>(Dim, 0) = own.transpose();
+        b.rb.setZero();
+        b.rb.template block<Dim, 1>(0, 0) = rx_[v];
+        b.rb(Dim, 0) = -c_[v];
+        for (size_t j = 0; j < kids.size(); ++j) {
+          const int c = kids[j];
+          const Vec g = -d_[c] / r_.up_length[c];
+          b.kkt.template block<Dim, 1>(0, Dim + 1 + j) = g;
+          b.kkt.template block<1, Dim>(Dim + 1 + j, 0) = g.transpose();
+          b.rb(Dim + 1 + j, 0) = -c_[c];
+        }
+        // The coupling B to the parent's dx: kappa I in the dx rows, own^T in the link's row.
+        b.rb.template block<Dim, Dim>(0, 1) = kappa * Mat::Identity();
+        b.rb.template block<1, Dim>(Dim, 1) = own.transpose();
+        b.lu.compute(b.kkt);
+        if (!(std::abs(b.lu.determinant()) > 0.0)) return false;
+        b.x = b.lu.solve(b.rb);  // column 0: K^-1 r; columns 1..Dim: K^-1 B
+        b.x0 = b.x.template block<Dim, 1>(0, 0);
+        b.y0 = b.x(Dim, 0);
+        b.xb = b.x.template block<Dim, Dim>(0, 1);
+        b.y = b.x.template block<1, Dim>(Dim, 1);
+        if (inertia_ok != nullptr) {
+          if (llt.info() == Eigen::Success) {  // as above: A's Dim positive eigenvalues
+            positive += Dim;
+          } else {
+            eigen_.compute(b.kkt, Eigen::EigenvaluesOnly);
+            positive += static_cast<int>((eigen_.eigenvalues().array() > 0.0).count());
+          }
+          unknowns += Dim;
+        }
       }
       const int u = r_.up[v];
       if (Free(u)) {
         // B^T rows: kappa I over the dx rows, own over the link's row (the anchored children's
         // rows of B are zero).
-        const auto kinv_b = b.x.template block<Dim + 1, Dim>(0, 1);
-        const auto kinv_r = b.x.template block<Dim + 1, 1>(0, 0);
-        a_[u] -= kappa * kinv_b.template topRows<Dim>() + own * kinv_b.row(Dim);
-        rx_[u] += kappa * kinv_r.template topRows<Dim>() + own * kinv_r(Dim);
+        a_[u] -= kappa * b.xb + own * b.y;
+        rx_[u] += kappa * b.x0 + own * b.y0;
       }
     }
     dx.resize(count_);
@@ -197,12 +217,16 @@ class TreeKkt {
       if (!Free(v)) continue;
       const Block& b = blocks_[v];
       const int u = r_.up[v];
-      z_ = b.x.col(0);
-      if (Free(u)) z_.noalias() += b.x.rightCols(Dim) * dx[u];
-      const Eigen::VectorXd& z = z_;
-      dx[v] = z.template head<Dim>();
-      dlambda[v] = z[Dim];
-      for (size_t j = 0; j < anchored_[v].size(); ++j) dlambda[anchored_[v][j]] = z[Dim + 1 + j];
+      const Vec du = Free(u) ? dx[u] : Vec::Zero();
+      dx[v] = b.x0 + b.xb * du;
+      dlambda[v] = b.y0 + b.y.dot(du);
+      if (!b.fast) {
+        z_ = b.x.col(0);
+        if (Free(u)) z_.noalias() += b.x.rightCols(Dim) * du;
+        for (size_t j = 0; j < anchored_[v].size(); ++j) {
+          dlambda[anchored_[v][j]] = z_[Dim + 1 + j];
+        }
+      }
       if (!dx[v].allFinite()) return false;
     }
     if (inertia_ok != nullptr) *inertia_ok = positive == unknowns;
@@ -240,9 +264,14 @@ class TreeKkt {
   // each correction the least one that makes them hold to first order. False if it does not
   // reach `tolerance`.
   bool Retract(double tolerance, Points* p) {
+    double previous = HUGE_VAL;
     for (int it = 0; it < 20; ++it) {
       Evaluate(*p, true);
       if (length_error_ <= tolerance) return true;
+      // Gauss-Newton converges quadratically; once it stops halving the error it is at the
+      // rounding of the points (which grows with the tree's size).
+      if (length_error_ > 0.5 * previous) return length_error_ <= 64.0 * tolerance;
+      previous = length_error_;
       if (!StepInto(0.0, true, nullptr, &retract_dx_, &retract_dlambda_)) return false;
       for (int v = 0; v < count_; ++v) {
         if (Free(v)) Row(p, v) += retract_dx_[v];
@@ -279,9 +308,17 @@ class TreeKkt {
         Evaluate(at, false);
         bool inertia_ok = false;
         if (!Step(extra, false, &inertia_ok) || !inertia_ok) continue;
+        if (extra == 0.0 && StepSize() <= step_tolerance) {  // converged: the last small step
+          Advance(at, 1.0, &trial_);
+          if (Retract(length_tolerance, &trial_)) {
+            SetLambda(lambda, 1.0);
+            *p = trial_;
+            return it;
+          }
+        }
         const double slope = Slope();
         const double allowance = 64.0 * 2.2e-16 * (std::abs(objective) + 1.0);
-        for (double alpha = 1.0; alpha > 1e-10; alpha *= 0.5) {
+        for (double alpha = 1.0; alpha > 1e-6; alpha *= 0.5) {
           Advance(at, alpha, &trial_);
           if (!Retract(length_tolerance, &trial_)) continue;
           SetLambda(lambda, alpha);
@@ -311,6 +348,13 @@ class TreeKkt {
 
  private:
   struct Block {
+    bool fast = false;
+    // z = K^-1 (r + B du): dx = x0 + xb du, the own link's dlambda = y0 + y du.
+    Vec x0;
+    double y0 = 0.0;
+    Mat xb;
+    Eigen::Matrix<double, 1, Dim> y;
+    // The general form (anchored children, or A not positive definite).
     Eigen::MatrixXd kkt, rb, x;
     Eigen::PartialPivLU<Eigen::MatrixXd> lu;
   };
