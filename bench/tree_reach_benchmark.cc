@@ -24,21 +24,6 @@
 namespace flexkin {
 namespace {
 
-// The frames' targets, computed before the timing: each tip round a circle of radius 0.3 in the
-// x-y plane, phases one radian apart, `frames` frames a turn.
-std::vector<Points> CircleFrames(const Tree& tree, const std::vector<int>& tips, int frames) {
-  std::vector<Points> targets(frames, Points(tips.size(), 3));
-  for (int f = 0; f < frames; ++f) {
-    for (size_t k = 0; k < tips.size(); ++k) {
-      const double a = 2 * M_PI * (f + 1) / frames, phase = static_cast<double>(k);
-      targets[f].row(k) = tree.points.row(tips[k]) +
-                          0.3 * Eigen::RowVector3d(std::cos(a + phase) - std::cos(phase),
-                                                   std::sin(a + phase) - std::sin(phase), 0.0);
-    }
-  }
-  return targets;
-}
-
 // Args: shape (scenes::TreeKind), variant (0 FABRIK: ftl + centroid; 1 tractrix + centroid;
 // 2 tractrix + keep_links; 3 ftl + keep_links), -log10 of the tolerance.
 void BM_Reach(benchmark::State& state) {
@@ -52,7 +37,7 @@ void BM_Reach(benchmark::State& state) {
   options.tolerance = std::pow(10.0, -static_cast<double>(state.range(2)));
   const TreeReacher reacher = MakeTreeReacher(tree, tips, {0}, {}, options);
   const int frames = 120;
-  const std::vector<Points> targets = CircleFrames(tree, tips, frames);
+  const std::vector<Points> targets = scenes::TipCircles(tree, tips, frames);
   Points points = tree.points, before;
   int64_t solves = 0, passes = 0, reached = 0;
   double motion = 0.0;
@@ -92,7 +77,7 @@ void BM_Overall(benchmark::State& state) {
   const std::vector<int> tips = scenes::TreeTips(kind);
   const TreeReacher reacher = MakeTreeReacher(tree, tips, {0});
   const int frames = 120;
-  const std::vector<Points> targets = CircleFrames(tree, tips, frames);
+  const std::vector<Points> targets = scenes::TipCircles(tree, tips, frames);
   const TreeOverallOptions options;
   Points points = tree.points, before;
   int64_t solves = 0, iterations = 0, converged = 0;

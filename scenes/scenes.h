@@ -123,6 +123,11 @@ Tree TreeShape(TreeKind kind, int dim = 3);
 // leaves of the binary tree.
 std::vector<int> TreeTips(TreeKind kind);
 
+// The tips' targets of an animation: frame f (0..frames-1) puts tip k at its point plus 0.3 (cos(a
+// + k) - cos k, sin(a + k) - sin k) in the first two coordinates, a = 2 pi (f + 1) / frames: each
+// tip round a circle of radius 0.3, a turn in `frames` frames, the phases a radian apart.
+std::vector<Points> TipCircles(const Tree& tree, const std::vector<int>& tips, int frames);
+
 // A random tree of `count` points: point i > 0 hangs from a random earlier point (so the root is
 // 0), at a random direction and a length in [0.5, 1.5).
 Tree RandomTree(int count, int dim, unsigned seed);

@@ -57,6 +57,20 @@ std::vector<int> TreeTips(TreeKind kind) {
   return {};
 }
 
+std::vector<Points> TipCircles(const Tree& tree, const std::vector<int>& tips, int frames) {
+  const int dim = static_cast<int>(tree.points.cols());
+  std::vector<Points> targets(frames, Points(tips.size(), dim));
+  for (int f = 0; f < frames; ++f) {
+    for (size_t k = 0; k < tips.size(); ++k) {
+      const double a = 2 * M_PI * (f + 1) / frames, phase = static_cast<double>(k);
+      targets[f].row(k) = tree.points.row(tips[k]);
+      targets[f](k, 0) += 0.3 * (std::cos(a + phase) - std::cos(phase));
+      targets[f](k, 1) += 0.3 * (std::sin(a + phase) - std::sin(phase));
+    }
+  }
+  return targets;
+}
+
 Tree RandomTree(int count, int dim, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> normal;
