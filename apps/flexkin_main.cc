@@ -288,6 +288,29 @@ int RunGroom(const RunArgs& args, flexkin::AnyScenario scenario) {
   }
 }
 
+// The options of `flexkin run` that only chain scenarios take (a robot's and a tree's run refuse
+// them), with their names.
+std::vector<std::pair<CLI::Option*, const char*>> ChainRunOptions(const RunArgs& args) {
+  return {{args.substeps_opt, "--substeps"},
+          {args.projection_opt, "--projection"},
+          {args.tolerance_opt, "--tolerance"},
+          {args.max_substeps_opt, "--max-substeps"},
+          {args.record_every_opt, "--record-every"},
+          {args.threads_opt, "--threads"},
+          {args.precision_opt, "--precision"},
+          {args.no_link_angles_opt, "--no-link-angles"},
+          {args.report_opt, "--report"}};
+}
+
+// The name of the last of `options` given on the command line, or null.
+const char* LastGiven(const std::vector<std::pair<CLI::Option*, const char*>>& options) {
+  const char* given = nullptr;
+  for (const auto& [option, name] : options) {
+    if (*option) given = name;
+  }
+  return given;
+}
+
 // A robot scenario (docs/robot-format.md) is tracked into its trajectory JSON (and joint CSV), as
 // `flexkin robot` does; --method names a FixedBaseMethod, the options of chain runs are refused.
 int RunRobot(const RunArgs& args, flexkin::AnyScenario scenario) {
@@ -298,20 +321,35 @@ int RunRobot(const RunArgs& args, flexkin::AnyScenario scenario) {
   r.max_output_size = args.max_output_size;
   r.quiet = args.quiet;
   if (*args.method_opt) r.method = args.method;
-  const std::pair<CLI::Option*, const char*> unsupported[] = {
-      {args.substeps_opt, "--substeps"},
-      {args.projection_opt, "--projection"},
-      {args.tolerance_opt, "--tolerance"},
-      {args.max_substeps_opt, "--max-substeps"},
-      {args.record_every_opt, "--record-every"},
-      {args.threads_opt, "--threads"},
-      {args.precision_opt, "--precision"},
-      {args.no_link_angles_opt, "--no-link-angles"},
-      {args.report_opt, "--report"}};
-  for (const auto& [option, name] : unsupported) {
-    if (*option) r.unsupported = name;
-  }
+  if (const char* name = LastGiven(ChainRunOptions(args))) r.unsupported = name;
   return flexkin::cli::RunRobotCommand(r, std::move(scenario));
+}
+
+// `flexkin run` on a tree scenario (docs/trees.md): the result (.npz or .json) and one line.
+int RunTreeCommand(const RunArgs& args, const flexkin::AnyScenario& any) {
+  std::vector<std::pair<CLI::Option*, const char*>> options = ChainRunOptions(args);
+  options.push_back({args.csv_opt, "--csv"});
+  options.push_back({args.method_opt, "--method"});
+  if (const char* name = LastGiven(options)) {
+    throw flexkin::InputError(flexkin::Problem(
+        name, "is not available for a tree scenario (" + args.scenario +
+                  "); the scenario file sets a tree's method and options (docs/trees.md)"));
+  }
+  flexkin::cli::CheckOutputDirectory(args.output);
+  flexkin::cli::Writing(args.output);
+  const flexkin::TreeRunResult result =
+      flexkin::RunScenarioToFiles(any, {args.output, ""}, [](int64_t, int64_t) {
+        flexkin::cli::ThrowIfInterrupted();
+      }).tree;
+  if (!args.quiet) std::cout << result.BriefReport() << "\n";
+  if (result.failures() > 0) {
+    std::fprintf(stderr,
+                 "flexkin: warning: %d of %zu frames did not reach their targets or converge "
+                 "(their residuals are in the result); the result was written to %s\n",
+                 result.failures(), result.reached.size(), args.output.c_str());
+    return kExitNotConverged;
+  }
+  return kExitOk;
 }
 
 int RunCommand(const RunArgs& args) {
@@ -324,6 +362,7 @@ int RunCommand(const RunArgs& args) {
   }
   if (any.kind == flexkin::ScenarioKind::kRobot) return RunRobot(args, std::move(any));
   if (any.kind == flexkin::ScenarioKind::kGroom) return RunGroom(args, std::move(any));
+  if (any.kind == flexkin::ScenarioKind::kTree) return RunTreeCommand(args, any);
   if (*args.threads_opt || *args.precision_opt) {
     throw flexkin::InputError(
         flexkin::Problem(*args.threads_opt ? "--threads" : "--precision",
@@ -427,6 +466,11 @@ int ValidateCommand(const std::string& path) {
       break;
     case flexkin::ScenarioKind::kRobot:
       PrintRobotOutput(*s.robot);
+      break;
+    case flexkin::ScenarioKind::kTree:
+      std::cout << "output: " << s.tree->frames() + 1
+                << " frames (the start and one per path point) of " << s.tree->tree.points.rows()
+                << " points, as .npz or .json\n";
       break;
   }
   return kExitOk;

@@ -11,6 +11,7 @@
 #include "flexkin/render.h"
 #include "flexkin/scenario_kind.h"
 #include "flexkin/strand_file.h"
+#include "flexkin/tree.h"
 #include "flexkin/vocabulary.h"
 
 namespace flexkin::cli {
@@ -39,6 +40,9 @@ void PrintVocabulary(std::ostream& out) {
   Table<ScenarioKind>(out, "Scenario kinds",
                       "What `flexkin run`, `flexkin validate` and Python's `validate_scenario` "
                       "tell apart by a file's keys (`ScenarioKind`, flexkin/scenario_kind.h).");
+  Table<BranchRule>(out, "Branch rules",
+                    "`\"branch_rule\"` of a tree scenario, `reach_tree(branch_rule=)`: where a "
+                    "tree's pulled branches meet (`BranchRule`, flexkin/tree.h; docs/trees.md).");
   Table<StrandPrecision>(out, "Strand file precisions",
                          "`\"record\"/\"precision\"` of a groom scenario, `flexkin run "
                          "--precision`, `run_groom(precision=)` (`StrandPrecision`, "

@@ -215,12 +215,7 @@ TEST(DynamicScenarioTest, SchemaListsTheKeysAndProjections) {
   std::set<std::string> accepted;
   for (const Problem& p : ValidateScenario(doc)) {
     ASSERT_EQ(p.field, "/dynamics/zzz_unknown");
-    const std::string list = p.message.substr(p.message.find("valid keys here are"));
-    for (size_t open = list.find('"'); open != std::string::npos;
-         open = list.find('"', list.find('"', open + 1) + 1)) {
-      const size_t close = list.find('"', open + 1);
-      accepted.insert(list.substr(open + 1, close - open - 1));
-    }
+    accepted = test_util::KeysOfUnknownKeyMessage(p.message);
   }
   EXPECT_EQ(accepted, keys);
   EXPECT_EQ(d["properties"]["projection"]["enum"].get<std::vector<std::string>>(),

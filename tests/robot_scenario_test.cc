@@ -25,6 +25,8 @@
 #include "flexkin/scenario.h"
 #include "flexkin/urdf.h"
 #include "io/json_file.h"  // ReadJsonFile, ReadTextFile
+#include "schema_test_util.h"
+#include "test_util.h"
 
 namespace flexkin {
 namespace {
@@ -368,29 +370,12 @@ INSTANTIATE_TEST_SUITE_P(RobotScenario, BadRobotScenarioTest, testing::ValuesIn(
                            return name;
                          });
 
-// The keys the reader accepts at `pointer` of `doc`, read from its unknown-key message.
-std::set<std::string> AcceptedKeys(json doc, const std::string& pointer) {
-  doc[json::json_pointer(pointer)]["zzz_unknown"] = 1;
-  for (const Problem& p : ValidateRobotScenarioText(doc.dump())) {
-    if (p.field != pointer + "/zzz_unknown") continue;
-    std::set<std::string> keys;
-    const std::string list = p.message.substr(p.message.find("valid keys here are"));
-    for (size_t open = list.find('"'); open != std::string::npos;
-         open = list.find('"', list.find('"', open + 1) + 1)) {
-      const size_t close = list.find('"', open + 1);
-      keys.insert(list.substr(open + 1, close - open - 1));
-    }
-    return keys;
-  }
-  ADD_FAILURE() << "no unknown-key problem at " << pointer;
-  return {};
+// The keys the reader accepts at `pointer` of `doc`.
+std::set<std::string> AcceptedKeys(const json& doc, const std::string& pointer) {
+  return test_util::AcceptedKeys(
+      doc, pointer, [](const std::string& text) { return ValidateRobotScenarioText(text); });
 }
-
-std::set<std::string> SchemaKeys(const json& object_schema) {
-  std::set<std::string> keys;
-  for (const auto& item : object_schema["properties"].items()) keys.insert(item.key());
-  return keys;
-}
+using test_util::SchemaKeys;
 
 // docs/schema/robot.schema.json lists exactly the keys the reader accepts, everywhere.
 TEST(RobotScenarioSchemaTest, SchemaAndReaderAcceptTheSameKeys) {

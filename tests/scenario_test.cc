@@ -19,6 +19,8 @@
 #include "flexkin/run.h"
 #include "io/json_file.h"      // ParseJsonText, ReadJsonFile
 #include "io/scenario_json.h"  // ParseScenario, ValidateScenario of a parsed document
+#include "schema_test_util.h"
+#include "test_util.h"
 
 namespace flexkin {
 namespace {
@@ -416,29 +418,12 @@ TEST(ScenarioTextTest, TextAndFileFunctionsAgreeWithTheDocument) {
   EXPECT_THROW(ValidateScenarioFile("/nonexistent-dir/scenario.json"), std::system_error);
 }
 
-// The keys the parser accepts at `pointer` of `doc`, read from its unknown-key message.
-std::set<std::string> AcceptedKeys(json doc, const std::string& pointer) {
-  doc[json::json_pointer(pointer)]["zzz_unknown"] = 1;
-  for (const Problem& p : ValidateScenario(doc)) {
-    if (p.field != pointer + "/zzz_unknown") continue;
-    std::set<std::string> keys;
-    const std::string list = p.message.substr(p.message.find("valid keys here are"));
-    for (size_t open = list.find('"'); open != std::string::npos;
-         open = list.find('"', list.find('"', open + 1) + 1)) {
-      const size_t close = list.find('"', open + 1);
-      keys.insert(list.substr(open + 1, close - open - 1));
-    }
-    return keys;
-  }
-  ADD_FAILURE() << "no unknown-key problem at " << pointer;
-  return {};
+// The keys the reader accepts at `pointer` of `doc`.
+std::set<std::string> AcceptedKeys(const json& doc, const std::string& pointer) {
+  return test_util::AcceptedKeys(
+      doc, pointer, [](const std::string& text) { return ValidateScenario(json::parse(text)); });
 }
-
-std::set<std::string> SchemaKeys(const json& object_schema) {
-  std::set<std::string> keys;
-  for (const auto& item : object_schema["properties"].items()) keys.insert(item.key());
-  return keys;
-}
+using test_util::SchemaKeys;
 
 // docs/schema/scenario.schema.json lists exactly the keys the parser accepts, everywhere.
 TEST(ScenarioSchemaTest, SchemaAndParserAcceptTheSameKeys) {

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -62,6 +63,19 @@ inline Eigen::VectorXd LengthsOf(const Points& p) {
 }
 
 // The whole content of a file ("" if it cannot be read).
+// The keys a JSON reader's unknown-key message lists ("unknown key "x"; valid keys here are "a",
+// "b" or "c""): what the reader accepts there, for the tests that compare it with a schema.
+inline std::set<std::string> KeysOfUnknownKeyMessage(const std::string& message) {
+  std::set<std::string> keys;
+  const std::string list = message.substr(message.find("valid keys here are"));
+  for (size_t open = list.find('"'); open != std::string::npos;
+       open = list.find('"', list.find('"', open + 1) + 1)) {
+    const size_t close = list.find('"', open + 1);
+    keys.insert(list.substr(open + 1, close - open - 1));
+  }
+  return keys;
+}
+
 inline std::string ReadFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::stringstream text;

@@ -19,6 +19,7 @@
 #include "flexkin/robot_scenario.h"
 #include "flexkin/scenario.h"
 #include "flexkin/scenario_kind.h"
+#include "flexkin/tree_scenario.h"
 
 namespace flexkin {
 
@@ -40,6 +41,7 @@ struct AnyScenario {
   std::optional<Scenario> chain;
   std::optional<GroomScenario> groom;
   std::optional<RobotScenario> robot;
+  std::optional<TreeScenario> tree;
 
   bool valid() const { return problems.empty(); }
   // One line, as `flexkin validate` prints it (ScenarioSummary, GroomSummary or
@@ -71,6 +73,7 @@ struct ScenarioRunReport {
   RunResult chain;          // frames not kept: they went to the files
   StrandRunReport strands;  // a groom's
   ArmTrajectory robot;      // the summary; the steps went to the files
+  TreeRunResult tree;       // a tree's, its frames included
   // One line: the kind's own brief report.
   std::string BriefReport() const;
 };

@@ -34,5 +34,7 @@
 #include "flexkin/scenario_kind.h"   // the kinds of scenario file
 #include "flexkin/strand_file.h"     // strand files (.npz): every strand at every frame
 #include "flexkin/strands.h"         // many strands (hair, fur) stepped together
-#include "flexkin/tree.h"            // bodies that branch: trees driven at one point
+#include "flexkin/tree.h"            // bodies that branch: driven at one point, several targets
+#include "flexkin/tree_overall.h"    // the exact least-motion step of a tree with several targets
+#include "flexkin/tree_scenario.h"   // tree scenario files and results
 #include "flexkin/vocabulary.h"      // the names of every enumerated choice

@@ -179,10 +179,12 @@ Scenario ScenarioArg(ScenarioSource scenario) {
     // The front door (flexkin/any_scenario.h): one read, the kind told apart in the library.
     AnyScenario any = ReadScenarioFile(path, options);
     if (any.kind != ScenarioKind::kChain) {
-      const bool groom = any.kind == ScenarioKind::kGroom;
+      const char* runner = any.kind == ScenarioKind::kGroom   ? "run_groom"
+                           : any.kind == ScenarioKind::kRobot ? "run_robot"
+                                                              : "run_scenario";
       throw InputError(Problem("", std::string("is a ") + NameOf(any.kind) +
                                        " scenario, not a chain one; run it with flexkin." +
-                                       (groom ? "run_groom" : "run_robot")));
+                                       runner));
     }
     any.ThrowIfInvalid();
     return std::move(*any.chain);
@@ -326,6 +328,53 @@ AnyScenario AnyScenarioArg(py::handle scenario) {
   });
 }
 
+// A tree scenario (docs/trees.md): run (into `files.result` where given, .npz or .json) and
+// returned as a dict of arrays: frames (F, n+1, dim), parents (n+1,), and per frame after the
+// start passes, residual, reached, converged.
+py::dict RunTreeToDict(const AnyScenario& any, ProgressCallback progress, const RunFiles& files) {
+  if (!files.csv.empty()) {
+    ThrowInput("csv", "is not written for a tree scenario", Quoted(files.csv), "None");
+  }
+  ProgressHook hook(std::move(progress));
+  TreeRunResult r;
+  try {
+    const auto tick = [&hook](int64_t done, int64_t total) { hook.Tick(done, total); };
+    if (files.result.empty()) {
+      r = RunTree(*any.tree, tick);
+    } else {
+      r = OnFile(files.result, [&] {
+        return RunScenarioToFiles(any, {files.result, ""}, tick).tree;
+      });
+    }
+  } catch (const StopRun&) {
+    hook.Rethrow();
+  }
+  const py::ssize_t count = static_cast<py::ssize_t>(r.frames.size()),
+                    rows = any.tree->tree.points.rows(), dim = any.tree->tree.points.cols();
+  py::array_t<double> frames({count, rows, dim});
+  for (py::ssize_t f = 0; f < count; ++f) {
+    std::copy(r.frames[f].data(), r.frames[f].data() + rows * dim,
+              frames.mutable_data() + f * rows * dim);
+  }
+  py::dict out;
+  out["frames"] = frames;
+  out["parents"] = py::array_t<int>(static_cast<py::ssize_t>(any.tree->tree.parents.size()),
+                                    any.tree->tree.parents.data());
+  out["passes"] = py::array_t<int>(static_cast<py::ssize_t>(r.passes.size()), r.passes.data());
+  out["residual"] =
+      py::array_t<double>(static_cast<py::ssize_t>(r.residual.size()), r.residual.data());
+  py::array_t<bool> reached(static_cast<py::ssize_t>(r.reached.size())),
+      converged(static_cast<py::ssize_t>(r.converged.size()));
+  for (size_t i = 0; i < r.reached.size(); ++i) {
+    reached.mutable_data()[i] = r.reached[i] != 0;
+    converged.mutable_data()[i] = r.converged[i] != 0;
+  }
+  out["reached"] = reached;
+  out["converged"] = converged;
+  out["max_length_error"] = r.max_length_error;
+  return out;
+}
+
 // flexkin.run_scenario: a chain to a Result, a robot to a RobotResult, any other kind into its
 // files through the library's one call, its report returned.
 py::object RunAnyScenario(ScenarioSource scenario, ProgressCallback progress, OptionalPath output,
@@ -342,6 +391,7 @@ py::object RunAnyScenario(ScenarioSource scenario, ProgressCallback progress, Op
     if (any.kind == ScenarioKind::kRobot) {
       return TrackToResult(*any.robot, std::move(progress), output, csv);
     }
+    if (any.kind == ScenarioKind::kTree) return RunTreeToDict(any, std::move(progress), files);
   }
   if (chain != nullptr) {
     if (!files.result.empty()) ResultFileFormatOfPath(files.result, "output");
@@ -583,9 +633,12 @@ changed before flexkin.run_scenario runs it.
         "validate` does; or a Scenario) as `flexkin run` (or `flexkin robot`) does, with the "
         "same result bit for bit. A chain returns a Result (progress as in run); a robot a "
         "RobotResult, as run_robot; a groom runs into its strand file `output` (required, .npz) "
-        "and returns a StrandRunReport, as run_groom. output, csv: None or the paths of the "
+        "and returns a StrandRunReport, as run_groom; a tree (docs/trees.md) returns a dict of "
+        "arrays: frames (F, n+1, dim), parents, and per frame passes, residual, reached, "
+        "converged. output, csv: None or the paths of the "
         "files `flexkin run -o --csv` writes (a chain's result file, .json or .npz, and frames "
-        "CSV; a robot's trajectory JSON and joint CSV; a groom's strand file), written through "
+        "CSV; a robot's trajectory JSON and joint CSV; a groom's strand file; a tree's result, "
+        ".npz or .json), written through "
         "the library's one call (RunScenarioToFiles): streamed while the run goes, renamed into "
         "place only when complete.");
 }

@@ -109,3 +109,26 @@ def test_overall_refuses_terms_trees_do_not_take():
         flexkin.reach_tree(ARMS, ARM_PARENTS, [5, 8], np.array([[ARMS[5], ARMS[8]]]), fixed=[0],
                            overall={"l2": 1.0})
     assert error.value.field == "weights.l2"
+
+
+def test_a_tree_scenario_runs_through_the_front_door(tmp_path):
+    scenario = {
+        "format": "flexkin-tree",
+        "tree": {"points": ARMS.tolist(), "parents": ARM_PARENTS},
+        "targets": [{"point": 5, "path": [(ARMS[5] + [0.05, 0.03]).tolist()]},
+                    {"point": 8, "path": [(ARMS[8] + [-0.04, 0.05]).tolist()]}],
+        "fixed": [0],
+    }
+    result = flexkin.run_scenario(scenario, output=tmp_path / "tree.npz")
+    expected, report = flexkin.reach_tree(ARMS, ARM_PARENTS, [5, 8],
+                                          [[ARMS[5] + [0.05, 0.03], ARMS[8] + [-0.04, 0.05]]],
+                                          fixed=[0])
+    np.testing.assert_array_equal(result["frames"], expected)
+    np.testing.assert_array_equal(result["passes"], report["passes"])
+    with np.load(tmp_path / "tree.npz") as archive:
+        np.testing.assert_array_equal(archive["frames"], expected)
+        np.testing.assert_array_equal(archive["parents"], ARM_PARENTS)
+    scenario["fixed"] = [0, 5]
+    with pytest.raises(flexkin.InputError) as error:
+        flexkin.run_scenario(scenario)
+    assert error.value.field == "/fixed/1"

@@ -14,10 +14,12 @@ ScenarioKind KindOf(const json& root) {
   if (!root.is_object()) return ScenarioKind::kChain;
   if (const auto format = root.find("format"); format != root.end()) {
     if (*format == "flexkin-robot") return ScenarioKind::kRobot;
+    if (*format == "flexkin-tree") return ScenarioKind::kTree;
   } else if ((root.contains("arm") || root.contains("urdf")) && !root.contains("curve") &&
              !root.contains("leader")) {
     return ScenarioKind::kRobot;
   }
+  if (root.contains("tree")) return ScenarioKind::kTree;
   if (root.contains("groom") || root.contains("strands")) return ScenarioKind::kGroom;
   return ScenarioKind::kChain;
 }

@@ -11,12 +11,13 @@
 #include "flexkin/robot_scenario.h"
 #include "flexkin/scenario.h"
 #include "flexkin/scenario_kind.h"
+#include "flexkin/tree_scenario.h"
 
 namespace flexkin::internal {
 
 // The one place kinds are told apart (docs/scenario-format.md): a robot has "format":
-// "flexkin-robot", or "arm" or "urdf" and neither "curve" nor "leader"; a groom has "groom" or
-// "strands"; anything else is a chain scenario.
+// "flexkin-robot", or "arm" or "urdf" and neither "curve" nor "leader"; a tree has "format":
+// "flexkin-tree", or "tree"; a groom has "groom" or "strands"; anything else is a chain scenario.
 ScenarioKind KindOf(const nlohmann::json& root);  // scenario_kind.cc
 
 // A mesh collider's relative "file" is taken from `directory` ("" : the working directory).
@@ -25,6 +26,7 @@ Scenario ReadChainScenario(const nlohmann::json& root, Problems* problems,
 // Relative "urdf" paths are taken from `directory` ("" : the working directory).
 RobotScenario ReadRobotScenario(const nlohmann::json& root, const RobotScenarioOptions& options,
                                 const std::string& directory,
-                                Problems* problems);  // robot_scenario.cc
+                                Problems* problems);                            // robot_scenario.cc
+TreeScenario ReadTreeScenario(const nlohmann::json& root, Problems* problems);  // tree_scenario.cc
 
 }  // namespace flexkin::internal

@@ -47,6 +47,11 @@ AnyScenario Read(const std::string& text, const ScenarioReadOptions& options,
       if (out.problems.empty()) out.robot = std::move(s);
       break;
     }
+    case ScenarioKind::kTree: {
+      TreeScenario s = internal::ReadTreeScenario(root, &out.problems);
+      if (out.problems.empty()) out.tree = std::move(s);
+      break;
+    }
   }
   return out;
 }
@@ -57,6 +62,7 @@ std::string AnyScenario::Summary() const {
   if (chain) return ScenarioSummary(*chain);
   if (groom) return GroomSummary(*groom);
   if (robot) return RobotScenarioSummary(*robot);
+  if (tree) return TreeSummary(*tree);
   return "";
 }
 
@@ -226,6 +232,8 @@ std::string ScenarioRunReport::BriefReport() const {
       return chain.BriefReport();
     case ScenarioKind::kRobot:
       return robot.BriefReport();
+    case ScenarioKind::kTree:
+      return tree.BriefReport();
     case ScenarioKind::kGroom:
       break;
   }
@@ -271,6 +279,20 @@ ScenarioRunReport RunScenarioToFiles(const AnyScenario& scenario, const Scenario
       std::optional<ArmProgress> tick;
       if (progress) tick.emplace(progress, s.path.rows());
       report.robot = TrackToFiles(s, outputs.output, outputs.csv, tick ? &*tick : nullptr);
+      break;
+    }
+    case ScenarioKind::kTree: {
+      if (!outputs.csv.empty()) {
+        throw InputError(Problem::Invalid("csv", "\"" + outputs.csv + "\"",
+                                          "none: a tree run writes a tree result only"));
+      }
+      if (!EndsWith(outputs.output, ".npz") && !EndsWith(outputs.output, ".json")) {
+        throw InputError(Problem::Invalid("output", "\"" + outputs.output + "\"",
+                                          "a path ending in .npz or .json (a tree result, "
+                                          "docs/trees.md)"));
+      }
+      report.tree = RunTree(*scenario.tree, progress);
+      WriteTreeResult(outputs.output, *scenario.tree, report.tree);
       break;
     }
   }

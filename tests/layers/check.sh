@@ -11,7 +11,7 @@ cd "$root"
 declare -A header_layer=(
   [error]=chain [chain]=chain [vocabulary]=chain [curves]=chain [leader]=chain
   [colliders]=world
-  [link_step]=sequential [propagate]=sequential [tree]=sequential [tree_overall]=overall
+  [link_step]=sequential [propagate]=sequential [tree]=sequential [tree_overall]=overall [tree_scenario]=io
   [overall]=overall
   [run]=run [frames]=run [dynamics]=dynamics
   [arm]=arm [strands]=strands [groom]=groom [strand_file]=io

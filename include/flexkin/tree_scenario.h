@@ -1,0 +1,68 @@
+#pragma once
+// Tree scenario files (docs/trees.md, "Scenario files"; docs/schema/tree.schema.json): a tree,
+// the points driven along their paths, the fixed points, and the method; read through the front
+// door (flexkin/any_scenario.h) as the scenario kind "tree", run, and written as a tree result
+// (.npz or .json: the frames and the parents).
+//
+//   {"format": "flexkin-tree",
+//    "tree": {"points": [[0, 0, 0], [0, 0, 1], ...], "parents": [-1, 0, 1, ...]},
+//    "targets": [{"point": 7, "path": [[...], ...]}, {"point": 12, "path": [[...], ...]}],
+//    "fixed": [0], "method": "tractrix"}
+
+#include <string>
+#include <vector>
+
+#include "flexkin/overall.h"
+#include "flexkin/tree.h"
+#include "flexkin/tree_overall.h"
+
+namespace flexkin {
+
+struct TreeScenario {
+  std::string name;                   // "name", "" if none
+  Tree tree;                          // "tree"
+  std::vector<int> targets;           // "targets"[k]."point"
+  std::vector<Points> paths;          // "targets"[k]."path": one row per frame, all as long
+  std::vector<double> weights;        // "targets"[k]."weight" (1 if none)
+  std::vector<int> fixed;             // "fixed"
+  Method method = Method::kTractrix;  // "method"
+  int substeps = 1;                   // "substeps": one target and nothing fixed only
+  ReachOptions reach;                 // "branch_rule", "tolerance", "max_passes"
+  TreeOverallOptions overall;         // "overall": the metric's weights (method "overall")
+
+  // One driven point and nothing fixed: moved by MoveTreePoint (any rule of trees); otherwise
+  // by the passes (tractrix, ftl) or, with method "overall", by StepTreeOverall.
+  bool driven_at_one_point() const { return targets.size() == 1 && fixed.empty(); }
+  int frames() const { return paths.empty() ? 0 : static_cast<int>(paths[0].rows()); }
+};
+
+// Every frame of a tree run: the start and one per row of the paths, with each frame's report.
+struct TreeRunResult {
+  std::vector<Points> frames;
+  std::vector<int> passes;        // per frame after the start (0 for a tree driven at one point)
+  std::vector<double> residual;   // of the longest link (0 for a tree driven at one point)
+  std::vector<char> reached;      // (1 for a tree driven at one point)
+  std::vector<char> converged;    // the overall step's (method "overall"; else 1)
+  double max_length_error = 0.0;  // largest relative link-length error over the frames
+
+  int failures() const;  // frames not reached or not converged
+  std::string BriefReport() const;
+};
+
+// "tree: 13 points (12 links, 3D), 2 targets, 1 fixed, tractrix passes (centroid), 120 frames".
+std::string TreeSummary(const TreeScenario& scenario);
+
+// Runs every frame, each from the last. Throws InputError where the library refuses the scenario
+// (a scenario read without problems is not refused). `progress(done, total)`, if set, is called
+// after every frame and may throw to stop the run.
+TreeRunResult RunTree(const TreeScenario& scenario,
+                      const std::function<void(int64_t, int64_t)>& progress = {});
+
+// Writes the result to `path`, whole or not at all (an earlier file stays if writing fails): .npz
+// (arrays frames (F, n+1, dim), parents (n+1), passes, residual, reached, converged (F-1), and
+// tree.json: the format, name and method) or .json (docs/trees.md, "Results"). Throws InputError
+// for another extension (field "output") and std::system_error if it cannot be written.
+void WriteTreeResult(const std::string& path, const TreeScenario& scenario,
+                     const TreeRunResult& result);
+
+}  // namespace flexkin

@@ -1,0 +1,424 @@
+// Tree scenario files (flexkin/tree_scenario.h, docs/trees.md "Scenario files"): the reader (every
+// problem by JSON pointer), the run, and the result writers.
+#include "flexkin/tree_scenario.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "flexkin/error.h"
+#include "io/atomic_file.h"
+#include "io/json_values.h"
+#include "io/npz.h"
+#include "io/scenario_kinds.h"
+
+namespace flexkin {
+namespace {
+
+using json = nlohmann::json;
+
+// A library field ("tree.parents[4]", "targets[1]", "weights[0]") as the file's JSON pointer.
+std::string TreePointer(const std::string& field) {
+  std::string out = "/";
+  for (char c : field) {
+    if (c == '.' || c == '[') {
+      out += '/';
+    } else if (c != ']') {
+      out += c;
+    }
+  }
+  if (out.rfind("/targets/", 0) == 0 && std::count(out.begin(), out.end(), '/') == 2) {
+    out += "/point";  // targets[k] names the target's point
+  }
+  if (out.rfind("/weights/", 0) == 0) out = "/targets/" + out.substr(9) + "/weight";
+  return out;
+}
+
+class TreeScenarioReader : public json_internal::JsonReader {
+ public:
+  TreeScenario Read(const json& root) {
+    TreeScenario s;
+    if (!ExpectObject(root, "", "an object (a tree scenario, docs/trees.md)")) return s;
+    CheckKeys(root, "",
+              {"format", "name", "tree", "targets", "fixed", "method", "substeps", "branch_rule",
+               "tolerance", "max_passes", "overall"});
+    if (const json* format = Find(root, "format")) {
+      if (!(format->is_string() && *format == "flexkin-tree")) {
+        ValueProblem(*format, "/format", "\"flexkin-tree\"");
+      }
+    }
+    Optional(
+        root, "", "name", [&](const json& v, const std::string& p) { return String(v, p); },
+        &s.name);
+    const bool tree_ok = ReadTree(root, &s.tree);
+    const int count = tree_ok ? static_cast<int>(s.tree.points.rows()) : 0;
+    const int dim = tree_ok ? static_cast<int>(s.tree.points.cols()) : 0;
+    ReadTargets(root, count, dim, &s);
+    if (const json* fixed = Find(root, "fixed")) {
+      if (!fixed->is_array()) {
+        TypeProblem(*fixed, "/fixed", "an array of point indices");
+      } else {
+        for (size_t k = 0; k < fixed->size(); ++k) {
+          if (auto i = Integer((*fixed)[k], "/fixed/" + std::to_string(k), 0, 1 << 30)) {
+            s.fixed.push_back(static_cast<int>(*i));
+          }
+        }
+      }
+    }
+    std::string method = "tractrix";
+    Optional(
+        root, "", "method",
+        [&](const json& v, const std::string& p) {
+          return Choice(v, p, {"tractrix", "ftl", "min_rotation", "min_joint_angle", "overall"});
+        },
+        &method);
+    s.method = ParseName<Method>(method, "/method");
+    int64_t substeps = 1;
+    Optional(
+        root, "", "substeps",
+        [&](const json& v, const std::string& p) { return Integer(v, p, 1, 1 << 20); }, &substeps);
+    s.substeps = static_cast<int>(substeps);
+    std::string rule = NameOf(s.reach.branch_rule);
+    Optional(
+        root, "", "branch_rule",
+        [&](const json& v, const std::string& p) { return Choice(v, p, NamesOf<BranchRule>()); },
+        &rule);
+    s.reach.branch_rule = ParseName<BranchRule>(rule, "/branch_rule");
+    Optional(
+        root, "", "tolerance",
+        [&](const json& v, const std::string& p) {
+          return Number(v, p, json_internal::Range::kPositive);
+        },
+        &s.reach.tolerance);
+    int64_t max_passes = s.reach.max_passes;
+    Optional(
+        root, "", "max_passes",
+        [&](const json& v, const std::string& p) { return Integer(v, p, 1, 1 << 24); },
+        &max_passes);
+    s.reach.max_passes = static_cast<int>(max_passes);
+    if (const json* overall = Find(root, "overall")) ReadOverall(*overall, &s);
+    if (problems.empty()) CheckTogether(root, &s);
+    return s;
+  }
+
+ private:
+  bool ReadTree(const json& root, Tree* tree) {
+    const json* t = Required(root, "", "tree", "an object with \"points\" and \"parents\"");
+    if (t == nullptr || !ExpectObject(*t, "/tree", "an object with \"points\" and \"parents\"")) {
+      return false;
+    }
+    CheckKeys(*t, "/tree", {"points", "parents"});
+    const size_t before = problems.size();
+    dimension_of_ = "the tree";
+    Require(
+        *t, "/tree", "points", "an array of points (2 or 3 numbers each), at least 2",
+        [&](const json& v, const std::string& p) { return PointList(v, p, 0, 2, 1 << 24); },
+        &tree->points);
+    if (const json* parents =
+            Required(*t, "/tree", "parents", "an array of parent indices, -1 for the root")) {
+      if (!parents->is_array()) {
+        TypeProblem(*parents, "/tree/parents", "an array of parent indices, -1 for the root");
+      } else {
+        for (size_t k = 0; k < parents->size(); ++k) {
+          const auto i = Integer((*parents)[k], "/tree/parents/" + std::to_string(k), -1, 1 << 30);
+          tree->parents.push_back(i ? static_cast<int>(*i) : 0);
+        }
+      }
+    }
+    if (problems.size() != before) return false;
+    try {
+      ValidateTree(*tree, "tree");
+    } catch (const InputError& e) {
+      Problem p = e.problem();
+      p.field = TreePointer(p.field);
+      problems.push_back(p);
+      return false;
+    }
+    return true;
+  }
+
+  void ReadTargets(const json& root, int count, int dim, TreeScenario* s) {
+    const json* targets =
+        Required(root, "", "targets", "an array of {\"point\": i, \"path\": [...]}, at least one");
+    if (targets == nullptr) return;
+    if (!targets->is_array() || targets->empty()) {
+      TypeProblem(*targets, "/targets",
+                  "an array of {\"point\": i, \"path\": [...]}, at least one");
+      return;
+    }
+    for (size_t k = 0; k < targets->size(); ++k) {
+      const std::string ptr = "/targets/" + std::to_string(k);
+      const json& t = (*targets)[k];
+      if (!ExpectObject(t, ptr, "an object with \"point\" and \"path\"")) continue;
+      CheckKeys(t, ptr, {"point", "path", "weight"});
+      int64_t point = -1;
+      Require(
+          t, ptr, "point", "a point index",
+          [&](const json& v, const std::string& p) {
+            return Integer(v, p, 0, count > 0 ? count - 1 : (1 << 30));
+          },
+          &point);
+      Points path;
+      Require(
+          t, ptr, "path", "an array of points, one per frame",
+          [&](const json& v, const std::string& p) { return PointList(v, p, dim, 1, 1 << 24); },
+          &path);
+      double weight = 1.0;
+      Optional(
+          t, ptr, "weight",
+          [&](const json& v, const std::string& p) {
+            return Number(v, p, json_internal::Range::kPositive);
+          },
+          &weight);
+      s->targets.push_back(static_cast<int>(point));
+      s->paths.push_back(std::move(path));
+      s->weights.push_back(weight);
+    }
+  }
+
+  void ReadOverall(const json& v, TreeScenario* s) {
+    if (!ExpectObject(v, "/overall",
+                      "an object of term weights (squared, squared_weighted, "
+                      "rotation)")) {
+      return;
+    }
+    ObjectiveWeights w;
+    w.squared = 0.0;
+    CheckKeys(v, "/overall", {"squared", "squared_weighted", "rotation"});
+    for (const char* term : {"squared", "squared_weighted", "rotation"}) {
+      Optional(
+          v, "/overall", term,
+          [&](const json& x, const std::string& p) {
+            return Number(x, p, json_internal::Range::kNonNegative);
+          },
+          &w[ParseName<ObjectiveTerm>(term, "/overall")]);
+    }
+    if (!(w.squared > 0.0 || w.squared_weighted > 0.0 || w.rotation > 0.0)) {
+      Add("/overall", "has no positive weight", "",
+          "at least one of squared, squared_weighted "
+          "and rotation > 0");
+    }
+    s->overall.weights = w;
+  }
+
+  // What only the whole scenario can tell: the paths' lengths, the method against the targets,
+  // and the library's own checks (a point driven twice, fixed and driven, ...).
+  void CheckTogether(const json& root, TreeScenario* s) {
+    for (size_t k = 1; k < s->paths.size(); ++k) {
+      if (s->paths[k].rows() != s->paths[0].rows()) {
+        Add("/targets/" + std::to_string(k) + "/path", "has " + std::to_string(s->paths[k].rows()) +
+                                                           " points; every target's path has one "
+                                                           "point per frame, " +
+                                                           std::to_string(s->paths[0].rows()) +
+                                                           " as /targets/0/path");
+      }
+    }
+    const bool one = s->driven_at_one_point();
+    if (!one && s->method != Method::kTractrix && s->method != Method::kFollowTheLeader &&
+        s->method != Method::kOverall) {
+      problems.push_back(Problem::Invalid(
+          "/method", std::string("\"") + NameOf(s->method) + "\"",
+          "\"tractrix\", \"ftl\" or \"overall\" (with several targets or fixed points)"));
+    }
+    if (!one && root.contains("substeps")) {
+      Add("/substeps",
+          "is an option of a tree driven at one point (one target, nothing fixed); "
+          "several targets or fixed points take \"max_passes\" and \"tolerance\"");
+    }
+    if (!problems.empty()) return;
+    try {
+      ReachOptions reach = s->reach;
+      if (s->method == Method::kFollowTheLeader) reach.method = s->method;
+      MakeTreeReacher(s->tree, s->targets, s->fixed, s->weights, reach);
+    } catch (const InputError& e) {
+      Problem p = e.problem();
+      p.field = TreePointer(p.field);
+      problems.push_back(p);
+    }
+  }
+};
+
+// The JSON of a result (and of an .npz's tree.json, without the arrays).
+json TreeResultHeader(const TreeScenario& s, const TreeRunResult& r) {
+  json j;
+  j["format"] = "flexkin-tree-result";
+  j["name"] = s.name;
+  j["method"] = NameOf(s.method);
+  j["dim"] = s.tree.points.cols();
+  j["parents"] = s.tree.parents;
+  j["targets"] = s.targets;
+  j["fixed"] = s.fixed;
+  j["max_length_error"] = r.max_length_error;
+  j["failures"] = r.failures();
+  return j;
+}
+
+bool TreePathEndsWith(const std::string& s, const std::string& end) {
+  return s.size() >= end.size() && s.compare(s.size() - end.size(), end.size(), end) == 0;
+}
+
+}  // namespace
+
+namespace internal {
+TreeScenario ReadTreeScenario(const json& root, Problems* problems) {
+  TreeScenarioReader reader;
+  TreeScenario s = reader.Read(root);
+  for (Problem& p : reader.problems) problems->push_back(std::move(p));
+  return s;
+}
+}  // namespace internal
+
+int TreeRunResult::failures() const {
+  int n = 0;
+  for (size_t i = 0; i < reached.size(); ++i) n += !reached[i] || !converged[i];
+  return n;
+}
+
+std::string TreeRunResult::BriefReport() const {
+  std::ostringstream out;
+  const int worst_passes = passes.empty() ? 0 : *std::max_element(passes.begin(), passes.end());
+  const double worst = residual.empty() ? 0.0 : *std::max_element(residual.begin(), residual.end());
+  out << frames.size() << " frames; " << failures() << " not reached or not converged; passes at "
+      << "most " << worst_passes << "; residual at most " << worst << " of the longest link; "
+      << "link lengths within " << max_length_error;
+  return out.str();
+}
+
+std::string TreeSummary(const TreeScenario& s) {
+  std::ostringstream out;
+  const Eigen::Index n = s.tree.points.rows();
+  out << "tree" << (s.name.empty() ? "" : " \"" + s.name + "\"") << ": " << n << " points ("
+      << n - 1 << " links, " << s.tree.points.cols() << "D), " << s.targets.size()
+      << (s.targets.size() == 1 ? " target" : " targets") << ", " << s.fixed.size() << " fixed, ";
+  if (s.driven_at_one_point() && s.method != Method::kOverall) {
+    out << NameOf(s.method) << " driven at point " << s.targets[0] << " (" << s.substeps
+        << (s.substeps == 1 ? " sub-step" : " sub-steps") << " a frame)";
+  } else if (s.method == Method::kOverall) {
+    out << "overall (exact least motion)";
+  } else {
+    out << NameOf(s.method) << " passes (" << NameOf(s.reach.branch_rule) << ")";
+  }
+  out << ", " << s.frames() << " frames";
+  return out.str();
+}
+
+TreeRunResult RunTree(const TreeScenario& s,
+                      const std::function<void(int64_t, int64_t)>& progress) {
+  TreeRunResult r;
+  const int frames = s.frames();
+  const int dim = static_cast<int>(s.tree.points.cols());
+  Points points = s.tree.points;
+  r.frames.reserve(frames + 1);
+  r.frames.push_back(points);
+  const bool one = s.driven_at_one_point() && s.method != Method::kOverall;
+  TreeStepper stepper;
+  TreeReacher reacher;
+  ReachOptions reach = s.reach;
+  reach.method = s.method == Method::kFollowTheLeader ? s.method : Method::kTractrix;
+  if (one) {
+    stepper = MakeTreeStepper(s.method, s.tree, s.targets[0]);
+  } else {
+    reacher = MakeTreeReacher(s.tree, s.targets, s.fixed, s.weights, reach);
+  }
+  Points goal(s.targets.size(), dim);
+  for (int f = 0; f < frames; ++f) {
+    for (size_t k = 0; k < s.targets.size(); ++k) goal.row(k) = s.paths[k].row(f);
+    int passes = 0;
+    double residual = 0.0;
+    char reached = 1, converged = 1;
+    if (one) {
+      MoveTreePoint(stepper, goal.row(0).transpose(), s.substeps, &points);
+    } else if (s.method == Method::kOverall) {
+      const TreeOverallReport report = StepTreeOverall(reacher, goal, s.overall, &points);
+      passes = report.start.passes;
+      residual = report.converged ? 0.0 : report.start.residual;
+      reached = report.start.reached;
+      converged = report.converged;
+    } else {
+      const ReachReport report = ReachTargets(reacher, goal, &points);
+      passes = report.passes;
+      residual = report.residual;
+      reached = report.reached;
+    }
+    r.passes.push_back(passes);
+    r.residual.push_back(residual);
+    r.reached.push_back(reached);
+    r.converged.push_back(converged);
+    r.frames.push_back(points);
+    for (size_t i = 0; i < s.tree.parents.size(); ++i) {
+      const int u = s.tree.parents[i];
+      if (u < 0) continue;
+      const double length = (s.tree.points.row(i) - s.tree.points.row(u)).norm();
+      r.max_length_error = std::max(
+          r.max_length_error, std::abs((points.row(i) - points.row(u)).norm() - length) / length);
+    }
+    if (progress) progress(f + 1, frames);
+  }
+  return r;
+}
+
+void WriteTreeResult(const std::string& path, const TreeScenario& s, const TreeRunResult& r) {
+  const bool npz = TreePathEndsWith(path, ".npz");
+  if (!npz && !TreePathEndsWith(path, ".json")) {
+    throw InputError(Problem::Invalid("output", "\"" + path + "\"",
+                                      "a path ending in .npz or .json (a tree result)"));
+  }
+  json header = TreeResultHeader(s, r);
+  AtomicFile file(path);
+  if (npz) {
+    ZipWriter zip(&file);
+    const uint64_t frames = r.frames.size(), rows = s.tree.points.rows(),
+                   dim = s.tree.points.cols();
+    std::string data = NpyHeader("<f8", {frames, rows, dim});
+    for (const Points& p : r.frames) {
+      data.append(reinterpret_cast<const char*>(p.data()), sizeof(double) * rows * dim);
+    }
+    zip.AddMember("frames.npy", data);
+    auto ints = [&](const char* name, const std::vector<int>& v) {
+      std::string d = NpyHeader("<i8", {v.size()});
+      for (const int x : v) {
+        const int64_t y = x;
+        d.append(reinterpret_cast<const char*>(&y), sizeof(y));
+      }
+      zip.AddMember(name, d);
+    };
+    ints("parents.npy", s.tree.parents);
+    ints("passes.npy", r.passes);
+    std::string res = NpyHeader("<f8", {r.residual.size()});
+    res.append(reinterpret_cast<const char*>(r.residual.data()),
+               sizeof(double) * r.residual.size());
+    zip.AddMember("residual.npy", res);
+    for (const auto& [name, v] :
+         {std::pair<const char*, const std::vector<char>*>{"reached.npy", &r.reached},
+          {"converged.npy", &r.converged}}) {
+      std::string d = NpyHeader("|b1", {v->size()});
+      for (const char c : *v) d.push_back(c ? 1 : 0);
+      zip.AddMember(name, d);
+    }
+    zip.AddMember("tree.json", header.dump(2) + "\n");
+    zip.Finish();
+  } else {
+    json frames = json::array();
+    for (const Points& p : r.frames) {
+      json rows = json::array();
+      for (Eigen::Index i = 0; i < p.rows(); ++i) {
+        rows.push_back(std::vector<double>(p.row(i).data(), p.row(i).data() + p.cols()));
+      }
+      frames.push_back(std::move(rows));
+    }
+    header["frames"] = std::move(frames);
+    header["passes"] = r.passes;
+    header["residual"] = r.residual;
+    header["reached"] = std::vector<bool>(r.reached.begin(), r.reached.end());
+    header["converged"] = std::vector<bool>(r.converged.begin(), r.converged.end());
+    file.stream() << header.dump() << "\n";
+  }
+  file.Check();
+  file.Commit();
+}
+
+}  // namespace flexkin

@@ -1,0 +1,307 @@
+// Tree scenario files (flexkin/tree_scenario.h) through the front door (flexkin/any_scenario.h)
+// and the command line: every problem named by its JSON pointer, the run the library's own
+// calls (bit for bit), the result files whole.
+#include "flexkin/tree_scenario.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "cli_process.h"
+#include "flexkin/any_scenario.h"
+#include "schema_test_util.h"
+#include "test_util.h"
+
+namespace flexkin {
+namespace {
+
+using json = nlohmann::json;
+
+// Two arms of two links on a shoulder (point 1) above a fixed base (point 0); 2D; the hands'
+// paths of 3 frames.
+json TwoHands() {
+  return json::parse(R"({
+    "format": "flexkin-tree",
+    "name": "two hands",
+    "tree": {"points": [[0, 0], [0, 1], [1, 1.2], [2, 1.1], [-1, 1.2], [-2, 1.1]],
+             "parents": [-1, 0, 1, 2, 1, 4]},
+    "targets": [{"point": 3, "path": [[2, 1.2], [1.9, 1.3], [1.8, 1.4]]},
+                {"point": 5, "path": [[-2, 1.2], [-1.9, 1.3], [-1.8, 1.4]], "weight": 2}],
+    "fixed": [0]
+  })");
+}
+
+AnyScenario Read(const json& j) { return ReadScenarioText(j.dump()); }
+
+// The first problem's "field: message".
+std::string FirstProblem(const json& j) {
+  const AnyScenario s = Read(j);
+  EXPECT_EQ(s.kind, ScenarioKind::kTree);
+  return s.problems.empty() ? "(valid)" : s.problems.front().Text();
+}
+
+TEST(TreeScenarioTest, ReadsAValidScenarioAsATree) {
+  const AnyScenario s = Read(TwoHands());
+  ASSERT_TRUE(s.valid()) << s.problems.front().Text();
+  EXPECT_EQ(s.kind, ScenarioKind::kTree);
+  ASSERT_TRUE(s.tree.has_value());
+  EXPECT_EQ(s.tree->targets, (std::vector<int>{3, 5}));
+  EXPECT_EQ(s.tree->weights, (std::vector<double>{1.0, 2.0}));
+  EXPECT_EQ(s.tree->frames(), 3);
+  EXPECT_EQ(s.Summary(),
+            "tree \"two hands\": 6 points (5 links, 2D), 2 targets, 1 fixed, tractrix passes "
+            "(centroid), 3 frames");
+  // A file with "tree" and no "format" is a tree too.
+  json j = TwoHands();
+  j.erase("format");
+  EXPECT_EQ(Read(j).kind, ScenarioKind::kTree);
+}
+
+TEST(TreeScenarioTest, NamesEveryProblemByItsJsonPointer) {
+  auto with = [](const std::function<void(json&)>& change) {
+    json j = TwoHands();
+    change(j);
+    return FirstProblem(j);
+  };
+  // The tree: a cycle, a second root, a parent out of range, a link of length 0.
+  EXPECT_EQ(with([](json& j) { j["tree"]["parents"] = {-1, 0, 3, 2, 1, 4}; }),
+            "/tree/parents/2: is 3: point 2 does not lead to the root 0; its parents form the "
+            "cycle 2 -> 3 -> 2");
+  EXPECT_NE(with([](json& j) { j["tree"]["parents"][4] = -1; }).find("/tree/parents/4: is -1"),
+            std::string::npos);
+  EXPECT_NE(with([](json& j) { j["tree"]["parents"][5] = 9; }).find("/tree/parents/5: is 9"),
+            std::string::npos);
+  EXPECT_NE(with([](json& j) {
+              j["tree"]["points"][2] = {0, 1};
+            }).find("/tree/points/2: lies at distance 0 from its parent point 1"),
+            std::string::npos);
+  EXPECT_NE(with([](json& j) { j["tree"]["parents"].push_back(4); }).find("/tree/parents: has 7"),
+            std::string::npos);
+  // The targets: a point that does not exist, a point driven twice, paths of other lengths.
+  EXPECT_EQ(with([](json& j) { j["targets"][1]["point"] = 6; }),
+            "/targets/1/point: value 6 is not valid; expected an integer from 0 to 5");
+  EXPECT_EQ(with([](json& j) { j["targets"][1]["point"] = 3; }),
+            "/targets/1/point: is point 3, which targets[0] drives already; a point takes one "
+            "target or is fixed");
+  EXPECT_EQ(with([](json& j) { j["targets"][1]["path"].erase(2); }),
+            "/targets/1/path: has 2 points; every target's path has one point per frame, 3 as "
+            "/targets/0/path");
+  EXPECT_NE(with([](json& j) {
+              j["targets"][0]["path"][1] = {1, 2, 3};
+            }).find("/targets/0/path/1"),
+            std::string::npos);
+  EXPECT_NE(with([](json& j) { j["targets"][1]["weight"] = 0; }).find("/targets/1/weight"),
+            std::string::npos);
+  EXPECT_NE(with([](json& j) { j["targets"] = json::array(); }).find("/targets"),
+            std::string::npos);
+  // Fixed points that conflict with a target; options that do not apply.
+  EXPECT_EQ(with([](json& j) {
+              j["fixed"] = {0, 5};
+            }),
+            "/fixed/1: is point 5, which targets[1] drives already; a point takes one target or "
+            "is fixed");
+  EXPECT_EQ(with([](json& j) { j["method"] = "min_rotation"; }),
+            "/method: value \"min_rotation\" is not valid; expected \"tractrix\", \"ftl\" or "
+            "\"overall\" (with several targets or fixed points)");
+  EXPECT_NE(with([](json& j) { j["substeps"] = 4; }).find("/substeps: is an option of a tree "),
+            std::string::npos);
+  EXPECT_NE(with([](json& j) { j["method"] = "fabrik"; }).find("/method"), std::string::npos);
+  EXPECT_NE(with([](json& j) { j["branch_rule"] = "mean"; }).find("/branch_rule"),
+            std::string::npos);
+  EXPECT_NE(with([](json& j) { j["tolerance"] = -1; }).find("/tolerance"), std::string::npos);
+  EXPECT_NE(with([](json& j) { j["overall"] = {{"l2", 1}}; }).find("/overall"), std::string::npos);
+  EXPECT_NE(with([](json& j) {
+              j["overall"] = {{"squared", 0}};
+            }).find("/overall: has no positive weight"),
+            std::string::npos);
+  EXPECT_NE(with([](json& j) { j["trees"] = 1; }).find("unknown key"), std::string::npos);
+  EXPECT_NE(with([](json& j) { j["format"] = "flexkin-trees"; }).find("/format"),
+            std::string::npos);
+  // Every problem is listed, not only the first.
+  json many = TwoHands();
+  many["tolerance"] = 0;
+  many["max_passes"] = 0;
+  EXPECT_EQ(Read(many).problems.size(), 2u);
+}
+
+TEST(TreeScenarioTest, RunsAsTheLibrarysOwnCalls) {
+  const AnyScenario s = Read(TwoHands());
+  ASSERT_TRUE(s.valid());
+  const TreeRunResult r = RunTree(*s.tree);
+  ASSERT_EQ(r.frames.size(), 4u);
+  const TreeReacher reacher = MakeTreeReacher(s.tree->tree, {3, 5}, {0}, {1.0, 2.0});
+  Points points = s.tree->tree.points;
+  for (int f = 0; f < 3; ++f) {
+    Points goal(2, 2);
+    goal.row(0) = s.tree->paths[0].row(f);
+    goal.row(1) = s.tree->paths[1].row(f);
+    const ReachReport report = ReachTargets(reacher, goal, &points);
+    EXPECT_TRUE(r.frames[f + 1] == points);
+    EXPECT_EQ(r.passes[f], report.passes);
+    EXPECT_TRUE(r.reached[f]);
+  }
+  EXPECT_EQ(r.failures(), 0);
+  EXPECT_LE(r.max_length_error, 1e-14);
+
+  // Driven at one point with nothing fixed: MoveTreePoint with the file's method and sub-steps.
+  json one = TwoHands();
+  one.erase("fixed");
+  one["targets"].erase(1);
+  one["method"] = "min_joint_angle";
+  one["substeps"] = 3;
+  const AnyScenario single = Read(one);
+  ASSERT_TRUE(single.valid()) << single.problems.front().Text();
+  const TreeRunResult rs = RunTree(*single.tree);
+  const TreeStepper stepper = MakeTreeStepper(Method::kMinJointAngle, single.tree->tree, 3);
+  Points moved = single.tree->tree.points;
+  for (int f = 0; f < 3; ++f) {
+    MoveTreePoint(stepper, single.tree->paths[0].row(f).transpose(), 3, &moved);
+    EXPECT_TRUE(rs.frames[f + 1] == moved);
+  }
+
+  // Method "overall": StepTreeOverall with the file's weights.
+  json exact = TwoHands();
+  exact["method"] = "overall";
+  exact["overall"] = {{"squared", 1}, {"rotation", 0.5}};
+  const AnyScenario o = Read(exact);
+  ASSERT_TRUE(o.valid()) << o.problems.front().Text();
+  const TreeRunResult ro = RunTree(*o.tree);
+  TreeOverallOptions options;
+  options.weights.rotation = 0.5;
+  Points p = o.tree->tree.points;
+  for (int f = 0; f < 3; ++f) {
+    Points goal(2, 2);
+    goal.row(0) = o.tree->paths[0].row(f);
+    goal.row(1) = o.tree->paths[1].row(f);
+    EXPECT_TRUE(StepTreeOverall(reacher, goal, options, &p).converged);
+    EXPECT_TRUE(ro.frames[f + 1] == p);
+    EXPECT_TRUE(ro.converged[f]);
+  }
+}
+
+// The keys the reader accepts at `pointer` of `doc`.
+std::set<std::string> AcceptedKeys(const json& doc, const std::string& pointer) {
+  return test_util::AcceptedKeys(
+      doc, pointer, [](const std::string& text) { return ReadScenarioText(text).problems; });
+}
+using test_util::SchemaKeys;
+
+// docs/schema/tree.schema.json lists exactly the keys and names the reader accepts.
+TEST(TreeScenarioTest, TheSchemaAndTheReaderAgree) {
+  const json schema =
+      json::parse(std::ifstream(std::string(FLEXKIN_SOURCE_DIR) + "/docs/schema/tree.schema.json"));
+  json doc = TwoHands();
+  doc["overall"] = {{"squared", 1}};
+  EXPECT_EQ(AcceptedKeys(doc, ""), SchemaKeys(schema));
+  EXPECT_EQ(AcceptedKeys(doc, "/tree"), SchemaKeys(schema["properties"]["tree"]));
+  EXPECT_EQ(AcceptedKeys(doc, "/targets/0"), SchemaKeys(schema["properties"]["targets"]["items"]));
+  EXPECT_EQ(AcceptedKeys(doc, "/overall"), SchemaKeys(schema["properties"]["overall"]));
+  EXPECT_EQ(schema["properties"]["branch_rule"]["enum"].get<std::vector<std::string>>(),
+            NamesOf<BranchRule>());
+  for (const std::string method : schema["properties"]["method"]["enum"]) {
+    json one = TwoHands();
+    one.erase("fixed");
+    one["targets"].erase(1);
+    one["method"] = method;
+    EXPECT_TRUE(Read(one).valid()) << method;
+  }
+}
+
+class TreeResultFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("flexkin_tree_scenario_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+    scenario_ = (dir_ / "two_hands.json").string();
+    std::ofstream(scenario_) << TwoHands().dump();
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::filesystem::path dir_;
+  std::string scenario_;
+};
+
+TEST_F(TreeResultFileTest, WritesJsonAndNpzWholeAndRefusesOtherPaths) {
+  const AnyScenario s = ReadScenarioFile(scenario_);
+  ASSERT_TRUE(s.valid());
+  const std::string json_path = (dir_ / "r.json").string();
+  const ScenarioRunReport report = RunScenarioToFiles(s, {json_path, ""});
+  const json written = json::parse(std::ifstream(json_path));
+  EXPECT_EQ(written["format"], "flexkin-tree-result");
+  EXPECT_EQ(written["parents"], TwoHands()["tree"]["parents"]);
+  ASSERT_EQ(written["frames"].size(), 4u);
+  for (size_t f = 0; f < 4; ++f) {
+    for (int i = 0; i < 6; ++i) {
+      for (int k = 0; k < 2; ++k) {
+        EXPECT_EQ(written["frames"][f][i][k].get<double>(), report.tree.frames[f](i, k));
+      }
+    }
+  }
+  // .npz: the frames' array holds the same doubles (the header then the data, C order).
+  const std::string npz_path = (dir_ / "r.npz").string();
+  RunScenarioToFiles(s, {npz_path, ""});
+  std::ifstream in(npz_path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const double* first = report.tree.frames[3].data();
+  const std::string last_frame(reinterpret_cast<const char*>(first), sizeof(double) * 12);
+  EXPECT_NE(bytes.find(last_frame), std::string::npos);
+  EXPECT_NE(bytes.find("parents.npy"), std::string::npos);
+  // Another extension, or a CSV: refused, nothing written.
+  const std::string bad = (dir_ / "r.csv").string();
+  EXPECT_THROW(RunScenarioToFiles(s, {bad, ""}), InputError);
+  EXPECT_THROW(RunScenarioToFiles(s, {(dir_ / "r2.npz").string(), bad}), InputError);
+  EXPECT_FALSE(std::filesystem::exists(bad));
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "r2.npz"));
+}
+
+TEST_F(TreeResultFileTest, TheCommandLineRunsAndValidatesTrees) {
+  using test_util::CliProcess;
+  {
+    CliProcess p(test_util::kCli, dir_.string(), {"validate", scenario_});
+    ASSERT_TRUE(p.Wait(60));
+    EXPECT_EQ(p.exit_code(), 0) << p.err();
+    EXPECT_NE(p.out().find("ok: tree \"two hands\": 6 points"), std::string::npos) << p.out();
+  }
+  {
+    CliProcess p(test_util::kCli, dir_.string(), {"run", scenario_, "-o", "out.npz"});
+    ASSERT_TRUE(p.Wait(60));
+    EXPECT_EQ(p.exit_code(), 0) << p.err();
+    EXPECT_TRUE(std::filesystem::exists(dir_ / "out.npz"));
+    EXPECT_NE(p.out().find("4 frames; 0 not reached"), std::string::npos) << p.out();
+  }
+  {
+    CliProcess p(test_util::kCli, dir_.string(),
+                 {"run", scenario_, "-o", "out2.npz", "--substeps", "4"});
+    ASSERT_TRUE(p.Wait(60));
+    EXPECT_NE(p.exit_code(), 0);
+    EXPECT_NE(p.err().find("--substeps: is not available for a tree scenario"), std::string::npos)
+        << p.err();
+    EXPECT_FALSE(std::filesystem::exists(dir_ / "out2.npz"));
+  }
+  {  // A bad file: its problem by JSON pointer, exit 1, nothing written.
+    json bad = TwoHands();
+    bad["fixed"] = {0, 3};
+    std::ofstream((dir_ / "bad.json").string()) << bad.dump();
+    CliProcess p(test_util::kCli, dir_.string(), {"run", "bad.json", "-o", "bad.npz"});
+    ASSERT_TRUE(p.Wait(60));
+    EXPECT_EQ(p.exit_code(), 1);
+    EXPECT_NE(p.err().find("bad.json: /fixed/1: is point 3"), std::string::npos) << p.err();
+    EXPECT_FALSE(std::filesystem::exists(dir_ / "bad.npz"));
+  }
+  {  // The examples run.
+    for (const char* example : {"tree_two_arms.json", "tree_plant.json"}) {
+      CliProcess p(test_util::kCli, dir_.string(),
+                   {"run", test_util::kExamples + example, "-o", "example.npz"});
+      ASSERT_TRUE(p.Wait(120));
+      EXPECT_EQ(p.exit_code(), 0) << example << ": " << p.err();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace flexkin
