@@ -69,6 +69,13 @@ for name in rope_round_post rope_post_floor rope_swept snake_pegs snake_pegs_tra
   "$flexkin" run "examples/$name.json" -o "out/$name.json"
   "$flexkin" render "out/$name.json" -o out --formats png,mp4,html --quiet
 done
+echo "== trees (docs/trees.md): two arms on a spine whose hands go round circles, the base fixed"
+echo "   (the passes between the targets), and a plant whose trunk sways (its canopy following)"
+for name in tree_two_arms tree_plant; do
+  "$flexkin" run "examples/$name.json" -o "out/$name.npz"
+done
+/usr/bin/python3 examples/python/tree_figure.py out/tree_two_arms.npz
+/usr/bin/python3 examples/python/tree_figure.py out/tree_plant.npz --view y
 echo "== a dynamic chain (docs/dynamics.md): a rope of 40 links released from horizontal, its"
 echo "   first point held, falling under gravity (overall projection, 3 s at 60 fps)"
 "$flexkin" run examples/rope_fall.json -o out/rope_fall.json
@@ -100,3 +107,4 @@ echo "hair: out/groom_head.npz (docs/strands.md: numpy.load reads it), out/groom
 echo "pictures: out/*.{svg,png,pdf}, out/*_{path_length,link_angles,length_error}.{svg,png},"
 echo "  out/*.{mp4,gif}, out/*.html (open in a browser), out/*.glb (docs/rendering.md)"
 echo "Python examples' figures: out/python/*.png (docs/python-examples.md)"
+echo "trees: out/tree_*.npz (docs/trees.md, \"Results\") and their figures out/tree_*.png"

@@ -189,3 +189,14 @@ def test_page_example_runs(index, monkeypatch):
     monkeypatch.chdir(SOURCE_DIR)
     exec(compile(PAGE_EXAMPLES[index], f"docs/python-examples.md example {index + 1}", "exec"),
          {"__name__": "__main__"})
+
+
+def test_tree_figure_draws_a_tree_result(tmp_path, flexkin_cli):
+    """examples/python/tree_figure.py (run by make demo) draws a tree result read with numpy."""
+    result = tmp_path / "tree_two_arms.npz"
+    subprocess.run([flexkin_cli, "run", str(EXAMPLES / "tree_two_arms.json"), "-o", str(result)],
+                   check=True, capture_output=True, timeout=120)
+    out = run_example("tree_figure.py", result, "--out", tmp_path / "tree.png")
+    assert out.returncode == 0, out.stderr
+    assert_png(tmp_path / "tree.png")
+    assert "61 frames" in out.stdout
