@@ -112,7 +112,7 @@ void ReadGroomScenario(const std::string& bytes) {
   ValidateThenParse([&] { return ValidateGroomText(bytes); }, [&] { ParseGroomText(bytes); });
   // The front door (flexkin/any_scenario.h) reads the same text, of any kind, once.
   const AnyScenario any = ReadScenarioText(bytes);
-  if (any.valid() != (any.chain || any.groom || any.robot)) {
+  if (any.valid() != (any.chain || any.groom || any.robot || any.tree)) {
     throw std::logic_error("the front door's problems and its scenario disagree");
   }
 }
