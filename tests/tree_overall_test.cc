@@ -174,6 +174,59 @@ TEST(TreeOverallTest, SeveralTargetsMatchIpopt) {
   EXPECT_EQ(cases, 8);
 }
 
+// Random trees of 40 points, 5 leaves driven to a bent configuration (reachable): where the passes
+// stall short of the targets (tests/tree_reach_test.cc: 3 of 12 trees), Newton, started from
+// them, reaches the targets exactly in 2 of the 3 (the third: its retraction from the stalled
+// points does not converge; reported, the passes' points returned).
+TEST(TreeOverallTest, ReachesTargetsWhereThePassesStall) {
+  int stalled = 0, reached = 0;
+  for (int dim : {2, 3}) {
+    for (unsigned seed = 1; seed <= 6; ++seed) {
+      const Tree tree = scenes::RandomTree(40, dim, seed);
+      std::vector<char> has_child(tree.parents.size(), 0);
+      for (int p : tree.parents) {
+        if (p >= 0) has_child[p] = 1;
+      }
+      std::vector<int> leaves;
+      for (size_t i = 0; i < has_child.size() && leaves.size() < 5; ++i) {
+        if (!has_child[i]) leaves.push_back(static_cast<int>(i));
+      }
+      // The targets: the leaves of the tree bent by up to 0.25 rad a link (as the passes' test).
+      std::mt19937 rng(100 + seed);
+      std::normal_distribution<double> normal;
+      Points goal = tree.points;
+      for (int i = 1; i < tree.points.rows(); ++i) {
+        const int p = tree.parents[i];
+        const Eigen::VectorXd link = (tree.points.row(i) - tree.points.row(p)).transpose();
+        Eigen::VectorXd nudge(dim);
+        for (int k = 0; k < dim; ++k) nudge[k] = normal(rng);
+        nudge -= nudge.dot(link) / link.squaredNorm() * link;
+        const Eigen::VectorXd dir =
+            (link.normalized() + std::tan(0.25) * 0.5 * nudge.normalized()).normalized();
+        goal.row(i) = goal.row(p) + link.norm() * dir.transpose();
+      }
+      Points targets(leaves.size(), dim);
+      for (size_t k = 0; k < leaves.size(); ++k) targets.row(k) = goal.row(leaves[k]);
+      const TreeReacher reacher = MakeTreeReacher(tree, leaves, {0});
+      Points points = tree.points;
+      const TreeOverallReport report =
+          StepTreeOverall(reacher, targets, TreeOverallOptions(), &points);
+      if (!report.start.reached) {
+        ++stalled;
+        reached += report.converged;
+        if (report.converged) {
+          for (size_t k = 0; k < leaves.size(); ++k) {
+            EXPECT_TRUE(points.row(leaves[k]) == targets.row(k));
+          }
+        }
+        EXPECT_LE(LengthError(tree, points), 1e-14);
+      }
+    }
+  }
+  EXPECT_GE(stalled, 1);            // the case this test is about occurs (3 when written)
+  EXPECT_GE(reached + 1, stalled);  // 2 of 3 when written
+}
+
 TEST(TreeOverallTest, ATargetOutOfReachLeavesThePassesPointsAndSaysSo) {
   const Tree tree = scenes::TreeShape(TreeKind::kChain10, 2);
   const TreeReacher reacher = MakeTreeReacher(tree, {10}, {0});
