@@ -227,6 +227,26 @@ TEST(TreeOverallTest, ReachesTargetsWhereThePassesStall) {
   EXPECT_GE(reached + 1, stalled);  // 2 of 3 when written
 }
 
+// An animation: the two hands round circles (scenes::TipCircles, 120 frames a turn), every frame
+// from the last. Every frame converges, and no point jumps: each moves at most a few times the
+// targets' step in a frame (a flip would move an arm by a link's length, 1).
+TEST(TreeOverallTest, TheMotionIsContinuousFromFrameToFrame) {
+  const Tree tree = scenes::TreeShape(TreeKind::kTwoArms, 3);
+  const std::vector<int> tips = scenes::TreeTips(TreeKind::kTwoArms);
+  const TreeReacher reacher = MakeTreeReacher(tree, tips, {0});
+  const std::vector<Points> frames = scenes::TipCircles(tree, tips, 120);
+  Points points = tree.points;
+  double largest_jump = 0.0;
+  for (const Points& goal : frames) {
+    const Points before = points;
+    EXPECT_TRUE(StepTreeOverall(reacher, goal, TreeOverallOptions(), &points).converged);
+    largest_jump = std::max(largest_jump, (points - before).rowwise().norm().maxCoeff());
+  }
+  const double step = 2 * 0.3 * std::sin(M_PI / 120);  // a target's chord in one frame
+  EXPECT_LE(largest_jump, 5 * step);
+  EXPECT_LE(LengthError(tree, points), 1e-14);
+}
+
 TEST(TreeOverallTest, ATargetOutOfReachLeavesThePassesPointsAndSaysSo) {
   const Tree tree = scenes::TreeShape(TreeKind::kChain10, 2);
   const TreeReacher reacher = MakeTreeReacher(tree, {10}, {0});
