@@ -65,4 +65,8 @@ TreeRunResult RunTree(const TreeScenario& scenario,
 void WriteTreeResult(const std::string& path, const TreeScenario& scenario,
                      const TreeRunResult& result);
 
+// Whether the file at `path` is a tree result (.npz with tree.json and frames.npy, or JSON whose
+// "format" is "flexkin-tree-result"); false for anything else, unreadable files included.
+bool IsTreeResultFile(const std::string& path);
+
 }  // namespace flexkin

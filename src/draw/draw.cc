@@ -9,6 +9,7 @@
 
 #include "flexkin/error.h"
 #include "flexkin/strand_file.h"
+#include "flexkin/tree_scenario.h"
 
 namespace flexkin {
 namespace {
@@ -335,6 +336,12 @@ DrawnKind KindOfDrawnFile(const std::string& path) {
 }
 
 std::vector<std::string> DrawFile(const std::string& path, const DrawOptions& options) {
+  if (IsTreeResultFile(path)) {
+    throw InputError(Problem(path,
+                             "is a tree result (docs/trees.md, \"Results\"); flexkin render "
+                             "does not draw trees yet: examples/python/tree_figure.py "
+                             "draws one"));
+  }
   const DrawnKind kind = KindOfDrawnFile(path);
   ThrowIfAny(ValidateDrawOptions(kind, options));  // the options' problems first, once
   Output o(options);

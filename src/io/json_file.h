@@ -19,4 +19,8 @@ nlohmann::json ParseJsonText(const std::string& text);
 // InputError as ParseJsonText.
 nlohmann::json ReadJsonFile(const std::string& path);
 
+// The top-level "format" string of the JSON file at `path`, read only as far as that key's value;
+// "" where there is none, the file is not JSON or cannot be read (trajectory_reader.cc).
+std::string JsonFileFormat(const std::string& path);
+
 }  // namespace flexkin

@@ -161,16 +161,20 @@ class FormatProbe : public nlohmann::json_sax<json> {
 
 }  // namespace
 
-bool IsRobotTrajectoryFile(const std::string& path) {
+std::string JsonFileFormat(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
+  if (!in) return "";
   FormatProbe probe;
   try {
     json::sax_parse(in, &probe);
   } catch (...) {
-    return false;
+    return "";
   }
-  return probe.format == kRobotTrajectoryFormat;
+  return probe.format;
+}
+
+bool IsRobotTrajectoryFile(const std::string& path) {
+  return JsonFileFormat(path) == kRobotTrajectoryFormat;
 }
 
 RobotTrajectoryFile ReadRobotTrajectoryFile(const std::string& path) {

@@ -12,6 +12,7 @@
 
 #include "flexkin/error.h"
 #include "io/atomic_file.h"
+#include "io/json_file.h"
 #include "io/json_values.h"
 #include "io/npz.h"
 #include "io/scenario_kinds.h"
@@ -243,8 +244,8 @@ class TreeScenarioReader : public json_internal::JsonReader {
 };
 
 // The JSON of a result (and of an .npz's tree.json, without the arrays).
-json TreeResultHeader(const TreeScenario& s, const TreeRunResult& r) {
-  json j;
+nlohmann::ordered_json TreeResultHeader(const TreeScenario& s, const TreeRunResult& r) {
+  nlohmann::ordered_json j;
   j["format"] = "flexkin-tree-result";
   j["name"] = s.name;
   j["method"] = NameOf(s.method);
@@ -361,13 +362,23 @@ TreeRunResult RunTree(const TreeScenario& s,
   return r;
 }
 
+bool IsTreeResultFile(const std::string& path) {
+  if (JsonFileFormat(path) == "flexkin-tree-result") return true;
+  try {
+    ZipReader zip(path);
+    return zip.Has("tree.json") && zip.Has("frames.npy");
+  } catch (...) {
+    return false;
+  }
+}
+
 void WriteTreeResult(const std::string& path, const TreeScenario& s, const TreeRunResult& r) {
   const bool npz = TreePathEndsWith(path, ".npz");
   if (!npz && !TreePathEndsWith(path, ".json")) {
     throw InputError(Problem::Invalid("output", "\"" + path + "\"",
                                       "a path ending in .npz or .json (a tree result)"));
   }
-  json header = TreeResultHeader(s, r);
+  nlohmann::ordered_json header = TreeResultHeader(s, r);
   AtomicFile file(path);
   if (npz) {
     ZipWriter zip(&file);
@@ -402,9 +413,9 @@ void WriteTreeResult(const std::string& path, const TreeScenario& s, const TreeR
     zip.AddMember("tree.json", header.dump(2) + "\n");
     zip.Finish();
   } else {
-    json frames = json::array();
+    nlohmann::ordered_json frames = nlohmann::ordered_json::array();
     for (const Points& p : r.frames) {
-      json rows = json::array();
+      nlohmann::ordered_json rows = nlohmann::ordered_json::array();
       for (Eigen::Index i = 0; i < p.rows(); ++i) {
         rows.push_back(std::vector<double>(p.row(i).data(), p.row(i).data() + p.cols()));
       }
