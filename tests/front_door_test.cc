@@ -51,7 +51,7 @@ std::vector<std::string> ExampleScenarios() {
 TEST(AnyScenarioTest, EveryExampleIsReadAsItsKind) {
   const std::vector<std::string> paths = ExampleScenarios();
   ASSERT_GE(paths.size(), 15u);
-  int kinds[3] = {0, 0, 0};
+  int kinds[std::size(Vocabulary<ScenarioKind>::kEntries)] = {};
   for (const std::string& path : paths) {
     SCOPED_TRACE(path);
     const AnyScenario s = ReadScenarioFile(path, WithUrdf());
@@ -83,11 +83,17 @@ TEST(AnyScenarioTest, EveryExampleIsReadAsItsKind) {
         EXPECT_EQ(s.Summary(), RobotScenarioSummary(direct));
         break;
       }
+      case ScenarioKind::kTree: {
+        ASSERT_TRUE(s.tree.has_value());
+        EXPECT_FALSE(s.chain || s.groom || s.robot);
+        EXPECT_EQ(s.Summary(), TreeSummary(*s.tree));
+        EXPECT_GT(s.tree->frames(), 0);
+        break;
+      }
     }
   }
-  EXPECT_GT(kinds[0], 0);
-  EXPECT_GT(kinds[1], 0);
-  EXPECT_GT(kinds[2], 0);
+  // Every kind has an example.
+  for (const int count : kinds) EXPECT_GT(count, 0);
 }
 
 // Every problem is listed, the same as each kind's own validator lists, for each kind.
@@ -104,7 +110,7 @@ TEST(AnyScenarioTest, ListsEveryProblemOfEachKind) {
     SCOPED_TRACE(text);
     const AnyScenario s = ReadScenarioText(text);
     EXPECT_EQ(s.kind, kind);
-    EXPECT_FALSE(s.chain || s.groom || s.robot);
+    EXPECT_FALSE(s.chain || s.groom || s.robot || s.tree);
     EXPECT_EQ(s.Summary(), "");
     ASSERT_GE(s.problems.size(), 2u);
     ASSERT_EQ(s.problems.size(), expected.size());
