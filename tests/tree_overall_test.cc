@@ -15,6 +15,7 @@
 #include "flexkin/error.h"
 #include "scenes/scenes.h"
 #include "tree_overall_peer.h"
+#include "tree_test_util.h"
 
 namespace flexkin {
 namespace {
@@ -183,28 +184,9 @@ TEST(TreeOverallTest, ReachesTargetsWhereThePassesStall) {
   for (int dim : {2, 3}) {
     for (unsigned seed = 1; seed <= 6; ++seed) {
       const Tree tree = scenes::RandomTree(40, dim, seed);
-      std::vector<char> has_child(tree.parents.size(), 0);
-      for (int p : tree.parents) {
-        if (p >= 0) has_child[p] = 1;
-      }
-      std::vector<int> leaves;
-      for (size_t i = 0; i < has_child.size() && leaves.size() < 5; ++i) {
-        if (!has_child[i]) leaves.push_back(static_cast<int>(i));
-      }
+      const std::vector<int> leaves = test_util::Leaves(tree, 5);
       // The targets: the leaves of the tree bent by up to 0.25 rad a link (as the passes' test).
-      std::mt19937 rng(100 + seed);
-      std::normal_distribution<double> normal;
-      Points goal = tree.points;
-      for (int i = 1; i < tree.points.rows(); ++i) {
-        const int p = tree.parents[i];
-        const Eigen::VectorXd link = (tree.points.row(i) - tree.points.row(p)).transpose();
-        Eigen::VectorXd nudge(dim);
-        for (int k = 0; k < dim; ++k) nudge[k] = normal(rng);
-        nudge -= nudge.dot(link) / link.squaredNorm() * link;
-        const Eigen::VectorXd dir =
-            (link.normalized() + std::tan(0.25) * 0.5 * nudge.normalized()).normalized();
-        goal.row(i) = goal.row(p) + link.norm() * dir.transpose();
-      }
+      const Points goal = test_util::Bent(tree, 0.25, 100 + seed);
       Points targets(leaves.size(), dim);
       for (size_t k = 0; k < leaves.size(); ++k) targets.row(k) = goal.row(leaves[k]);
       const TreeReacher reacher = MakeTreeReacher(tree, leaves, {0});

@@ -65,6 +65,11 @@ TreeRunResult RunTree(const TreeScenario& scenario,
 void WriteTreeResult(const std::string& path, const TreeScenario& scenario,
                      const TreeRunResult& result);
 
+// Whether a tree result at `path` is .npz (true) or .json (false); throws InputError (field
+// "output") for another extension. WriteTreeResult and RunScenarioToFiles check with it before
+// anything runs or is written.
+bool CheckTreeResultPath(const std::string& path);
+
 // Whether the file at `path` is a tree result (.npz with tree.json and frames.npy, or JSON whose
 // "format" is "flexkin-tree-result"); false for anything else, unreadable files included.
 bool IsTreeResultFile(const std::string& path);

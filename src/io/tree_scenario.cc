@@ -258,10 +258,6 @@ nlohmann::ordered_json TreeResultHeader(const TreeScenario& s, const TreeRunResu
   return j;
 }
 
-bool TreePathEndsWith(const std::string& s, const std::string& end) {
-  return s.size() >= end.size() && s.compare(s.size() - end.size(), end.size(), end) == 0;
-}
-
 }  // namespace
 
 namespace internal {
@@ -325,6 +321,11 @@ TreeRunResult RunTree(const TreeScenario& s,
   } else {
     reacher = MakeTreeReacher(s.tree, s.targets, s.fixed, s.weights, reach);
   }
+  std::vector<double> lengths(s.tree.parents.size(), 0.0);  // each point's link to its parent
+  for (size_t i = 0; i < lengths.size(); ++i) {
+    const int u = s.tree.parents[i];
+    if (u >= 0) lengths[i] = (s.tree.points.row(i) - s.tree.points.row(u)).norm();
+  }
   Points goal(s.targets.size(), dim);
   for (int f = 0; f < frames; ++f) {
     for (size_t k = 0; k < s.targets.size(); ++k) goal.row(k) = s.paths[k].row(f);
@@ -350,16 +351,28 @@ TreeRunResult RunTree(const TreeScenario& s,
     r.reached.push_back(reached);
     r.converged.push_back(converged);
     r.frames.push_back(points);
-    for (size_t i = 0; i < s.tree.parents.size(); ++i) {
+    for (size_t i = 0; i < lengths.size(); ++i) {
       const int u = s.tree.parents[i];
       if (u < 0) continue;
-      const double length = (s.tree.points.row(i) - s.tree.points.row(u)).norm();
-      r.max_length_error = std::max(
-          r.max_length_error, std::abs((points.row(i) - points.row(u)).norm() - length) / length);
+      r.max_length_error =
+          std::max(r.max_length_error,
+                   std::abs((points.row(i) - points.row(u)).norm() - lengths[i]) / lengths[i]);
     }
     if (progress) progress(f + 1, frames);
   }
   return r;
+}
+
+bool CheckTreeResultPath(const std::string& path) {
+  auto ends_with = [&path](const std::string& end) {
+    return path.size() >= end.size() &&
+           path.compare(path.size() - end.size(), end.size(), end) == 0;
+  };
+  if (ends_with(".npz")) return true;
+  if (ends_with(".json")) return false;
+  throw InputError(
+      Problem::Invalid("output", "\"" + path + "\"",
+                       "a path ending in .npz or .json (a tree result, docs/trees.md)"));
 }
 
 bool IsTreeResultFile(const std::string& path) {
@@ -373,11 +386,7 @@ bool IsTreeResultFile(const std::string& path) {
 }
 
 void WriteTreeResult(const std::string& path, const TreeScenario& s, const TreeRunResult& r) {
-  const bool npz = TreePathEndsWith(path, ".npz");
-  if (!npz && !TreePathEndsWith(path, ".json")) {
-    throw InputError(Problem::Invalid("output", "\"" + path + "\"",
-                                      "a path ending in .npz or .json (a tree result)"));
-  }
+  const bool npz = CheckTreeResultPath(path);
   nlohmann::ordered_json header = TreeResultHeader(s, r);
   AtomicFile file(path);
   if (npz) {

@@ -24,6 +24,24 @@
 namespace flexkin {
 namespace {
 
+// Each point's weight in the squared terms: squared + squared_weighted * (half the lengths of
+// the links at the point); 0 for an anchor, whose motion is given and not part of the metric.
+std::vector<double> TreePointWeights(const TreeReacher& r, const ObjectiveWeights& weights) {
+  const int count = static_cast<int>(r.parents.size());
+  std::vector<double> w(count, weights.squared);
+  for (int v = 0; v < count; ++v) {
+    const int u = r.up[v];
+    if (u < 0) continue;
+    const double half = 0.5 * weights.squared_weighted * r.up_length[v];
+    w[v] += half;
+    w[u] += half;
+  }
+  for (int v = 0; v < count; ++v) {
+    if (r.anchor_of[v] >= 0) w[v] = 0.0;
+  }
+  return w;
+}
+
 // The solver of one call of StepTreeOverall for a tree of `Dim` dimensions: the problem's
 // constants and every buffer of its iterations, allocated once.
 template <int Dim>
@@ -35,18 +53,11 @@ class TreeKkt {
 
   TreeKkt(const TreeReacher& r, const ObjectiveWeights& weights, const Points& old)
       : r_(r), count_(static_cast<int>(r.parents.size())), rotation_(weights.rotation), old_(old) {
-    w_.assign(count_, weights.squared);
+    w_ = TreePointWeights(r, weights);
     anchored_.resize(count_);
     for (int v = 0; v < count_; ++v) {
       const int u = r.up[v];
-      if (u < 0) continue;
-      const double half = 0.5 * weights.squared_weighted * r.up_length[v];
-      w_[v] += half;
-      w_[u] += half;
-      if (!Free(v) && Free(u)) anchored_[u].push_back(v);
-    }
-    for (int v = 0; v < count_; ++v) {
-      if (!Free(v)) w_[v] = 0.0;  // an anchor's motion is given: not part of the metric
+      if (u >= 0 && !Free(v) && Free(u)) anchored_[u].push_back(v);
     }
     lambda_.setZero(count_);
     d_.resize(count_);
@@ -380,16 +391,11 @@ class TreeKkt {
 // The metric of the step from `old` to `p`, over the points that are not anchors.
 double TreeObjective(const TreeReacher& r, const TreeOverallOptions& options, const Points& old,
                      const Points& p) {
+  const std::vector<double> w = TreePointWeights(r, options.weights);
   double sum = 0.0;
-  const int count = static_cast<int>(r.parents.size());
-  for (int v = 0; v < count; ++v) {
+  for (size_t v = 0; v < w.size(); ++v) {
+    sum += w[v] * (p.row(v) - old.row(v)).squaredNorm();
     const int u = r.up[v];
-    double w = options.weights.squared;
-    for (int e = r.down_begin[v]; e < r.down_begin[v + 1]; ++e) {
-      w += 0.5 * options.weights.squared_weighted * r.up_length[r.down[e]];
-    }
-    if (u >= 0) w += 0.5 * options.weights.squared_weighted * r.up_length[v];
-    if (r.anchor_of[v] < 0) sum += w * (p.row(v) - old.row(v)).squaredNorm();
     if (u >= 0) {
       sum += options.weights.rotation *
              ((p.row(v) - p.row(u)) - (old.row(v) - old.row(u))).squaredNorm() / r.up_length[v];
@@ -399,7 +405,7 @@ double TreeObjective(const TreeReacher& r, const TreeOverallOptions& options, co
 }
 
 // The largest |(|D|^2 - L^2)| / (2 L^2) over the links.
-double MaxTreeLengthError(const TreeReacher& r, const Points& p) {
+double TreeConstraintError(const TreeReacher& r, const Points& p) {
   double worst = 0.0;
   for (size_t v = 0; v < r.parents.size(); ++v) {
     const int u = r.up[v];
@@ -465,7 +471,7 @@ TreeOverallReport TreeContinuation(const TreeReacher& reacher, const Points& pos
     report.start = ReachTargets(reacher, positions, &p);
   }
   report.objective = TreeObjective(reacher, options, *points, p);
-  report.length_error = MaxTreeLengthError(reacher, p);
+  report.length_error = TreeConstraintError(reacher, p);
   *points = p;
   return report;
 }
@@ -505,7 +511,7 @@ TreeOverallReport StepTreeOverall(const TreeReacher& reacher, const Points& posi
       // Out of reach: the passes' points, reported.
       *points = probe;
       report.objective = TreeObjective(reacher, options, *points, probe);
-      report.length_error = MaxTreeLengthError(reacher, probe);
+      report.length_error = TreeConstraintError(reacher, probe);
       return report;
     }
   }

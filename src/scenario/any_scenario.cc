@@ -286,11 +286,7 @@ ScenarioRunReport RunScenarioToFiles(const AnyScenario& scenario, const Scenario
         throw InputError(Problem::Invalid("csv", "\"" + outputs.csv + "\"",
                                           "none: a tree run writes a tree result only"));
       }
-      if (!EndsWith(outputs.output, ".npz") && !EndsWith(outputs.output, ".json")) {
-        throw InputError(Problem::Invalid("output", "\"" + outputs.output + "\"",
-                                          "a path ending in .npz or .json (a tree result, "
-                                          "docs/trees.md)"));
-      }
+      CheckTreeResultPath(outputs.output);
       report.tree = RunTree(*scenario.tree, progress);
       WriteTreeResult(outputs.output, *scenario.tree, report.tree);
       break;
