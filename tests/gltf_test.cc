@@ -25,6 +25,7 @@
 #include "flexkin/result_io.h"
 #include "flexkin/run.h"
 #include "flexkin/scenario.h"
+#include "flexkin/tree.h"
 #include "gltf/reader.h"
 #include "gltf/rig.h"
 #include "gltf/tube.h"
@@ -649,6 +650,159 @@ TEST(GltfBadInput, ReaderErrors) {
   }
   { std::ofstream(dir / "no_skin.gltf") << R"({"asset": {"version": "2.0"}})"; }
   ExpectInputError([&] { ReadGltfJointPositions(dir / "no_skin.gltf"); }, "skins", "no skin");
+}
+
+}  // namespace
+}  // namespace flexkin
+
+namespace flexkin {
+namespace {
+
+// A tree result: a random tree (root 0) driven at a leaf round a circle, `frames` frames.
+TreeResultFile MakeTreeResult(int dim, int count, int frames, unsigned seed) {
+  const Tree tree = scenes::RandomTree(count, dim, seed);
+  std::vector<char> has_child(count, 0);
+  for (int p : tree.parents) {
+    if (p >= 0) has_child[p] = 1;
+  }
+  int leaf = count - 1;
+  while (has_child[leaf]) --leaf;
+  const TreeStepper stepper = MakeTreeStepper(Method::kTractrix, tree, leaf);
+  TreeResultFile file;
+  file.name = "random tree";
+  file.dim = dim;
+  file.parents = tree.parents;
+  file.targets = {leaf};
+  Points p = tree.points;
+  file.frames.push_back(p);
+  for (int f = 1; f < frames; ++f) {
+    Eigen::VectorXd target = tree.points.row(leaf).transpose();
+    const double a = 2.0 * M_PI * f / frames;
+    target[0] += 2.0 * (std::cos(a) - 1.0);
+    target[1] += 2.0 * std::sin(a);
+    MoveTreePoint(stepper, target, 8, &p);
+    file.frames.push_back(p);
+    file.reached.push_back(1);
+  }
+  return file;
+}
+
+// Every joint read back where the tree's point it sits on is, in every frame, to 1e-6 of the
+// scene's size; the joints are the root, a bone per link, a tip per leaf.
+void ExpectTreeRoundTrip(const TreeResultFile& tree, const GltfOptions& options,
+                         const std::string& path) {
+  WriteTreeGltf(tree, options, path);
+  const GltfJointMotion motion = ReadGltfJointPositions(path);
+  EXPECT_EQ(motion.dim, tree.dim);
+  int leaves = 0;
+  std::vector<char> has_child(tree.parents.size(), 0);
+  for (int p : tree.parents) {
+    if (p >= 0) has_child[p] = 1;
+  }
+  for (char c : has_child) leaves += !c;
+  ASSERT_EQ(motion.joint_points.size(), tree.parents.size() + leaves);
+  ASSERT_EQ(motion.positions.size(), tree.frames.size());
+  double worst = 0.0, size = 0.0;
+  for (size_t f = 0; f < tree.frames.size(); ++f) {
+    EXPECT_EQ(motion.times[f], static_cast<float>(f / options.steps_per_second));
+    for (size_t j = 0; j < motion.joint_points.size(); ++j) {
+      worst = std::max(
+          worst, (motion.positions[f].row(j) - tree.frames[f].row(motion.joint_points[j])).norm());
+    }
+    size = std::max(size, tree.frames[f].cwiseAbs().maxCoeff());
+  }
+  EXPECT_LE(worst, 1e-6 * size) << path;
+  std::printf("  %s: %zu frames x %zu joints, max error %.3g (scene size %.3g)\n", path.c_str(),
+              tree.frames.size(), motion.joint_points.size(), worst, size);
+}
+
+TEST(GltfTree, JointsFollowThePointsInBothFormsAndAxes) {
+  TempDir dir;
+  std::vector<std::string> files;
+  for (const int dim : {2, 3}) {
+    const TreeResultFile tree = MakeTreeResult(dim, 40, 30, 7 + dim);
+    for (const char* ext : {".gltf", ".glb"}) {
+      files.push_back(dir / ("tree" + std::to_string(dim) + ext));
+      ExpectTreeRoundTrip(tree, GltfOptions{}, files.back());
+    }
+    GltfOptions options;
+    options.scale = 0.01;
+    options.up_axis = dim == 2 ? GltfUpAxis::kZ : GltfUpAxis::kY;
+    options.steps_per_second = 24.0;
+    files.push_back(dir / ("tree_scaled" + std::to_string(dim) + ".glb"));
+    ExpectTreeRoundTrip(tree, options, files.back());
+  }
+  // The plant: a binary tree of depth 10 (2,047 points, 3,071 joints).
+  const Tree binary = scenes::TreeShape(scenes::TreeKind::kBinary10);
+  TreeResultFile plant;
+  plant.dim = 3;
+  plant.parents = binary.parents;
+  const TreeStepper trunk = MakeTreeStepper(Method::kTractrix, binary, 0);
+  Points p = binary.points;
+  plant.frames = {p};
+  for (int f = 1; f <= 3; ++f) {
+    MoveTreePoint(trunk, Eigen::Vector3d(0.8 * f, 0.3 * f * f, 0.0), 4, &p);
+    plant.frames.push_back(p);
+    plant.reached.push_back(1);
+  }
+  GltfOptions plant_options;
+  plant_options.tube_sides = 6;
+  files.push_back(dir / "binary.glb");
+  ExpectTreeRoundTrip(plant, plant_options, files.back());
+  ExpectValidGltf(files);
+}
+
+// The mesh: a capsule per link in the first frame's pose (every vertex at the capsule's radius
+// from its link, in the scene's coordinates), and the inverse bind matrices put each joint on its
+// point of the first frame.
+TEST(GltfTree, CapsulesLieOnTheLinksAndTheBindPoseIsTheFirstFrame) {
+  TempDir dir;
+  const TreeResultFile tree = MakeTreeResult(3, 25, 5, 3);
+  GltfOptions options;
+  options.up_axis = GltfUpAxis::kY;  // the scene's coordinates are flexkin's
+  options.tube_radius = 0.05;
+  const std::string path = dir / "tree.glb";
+  WriteTreeGltf(tree, options, path);
+  const gltf::SkinnedMeshRestPose rest = gltf::ReadSkinnedMeshRestPose(path);
+  const Points& first = tree.frames.front();
+  for (size_t v = 0; v < rest.positions.size(); ++v) {
+    double nearest = HUGE_VAL;
+    for (size_t c = 0; c < tree.parents.size(); ++c) {
+      if (tree.parents[c] < 0) continue;
+      const Eigen::Vector3d a = first.row(tree.parents[c]).transpose();
+      const Eigen::Vector3d b = first.row(c).transpose();
+      const double t =
+          std::clamp((rest.positions[v] - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+      nearest = std::min(nearest, (rest.positions[v] - (a + t * (b - a))).norm());
+    }
+    // On some capsule's surface (or inside another where links meet), never off the tree.
+    EXPECT_LE(nearest, 0.05 * (1 + 1e-5)) << v;
+  }
+  const GltfJointMotion motion = ReadGltfJointPositions(path);
+  ASSERT_EQ(rest.inverse_bind_matrices.size(), motion.joint_points.size());
+  for (size_t j = 0; j < motion.joint_points.size(); ++j) {
+    const Eigen::Vector3d origin = rest.inverse_bind_matrices[j].inverse().topRightCorner<3, 1>();
+    EXPECT_LT((origin - first.row(motion.joint_points[j]).transpose()).norm(), 1e-5) << j;
+  }
+}
+
+TEST(GltfTree, RefusedWithoutWriting) {
+  TempDir dir;
+  TreeResultFile tree = MakeTreeResult(2, 6, 3, 1);
+  const std::string path = dir / "tree.glb";
+  EXPECT_THROW(WriteTreeGltf(tree, GltfOptions{}, dir / "tree.obj"), InputError);
+  tree.frames[2].row(4) = tree.frames[2].row(tree.parents[4]);
+  try {
+    WriteTreeGltf(tree, GltfOptions{}, path);
+    ADD_FAILURE() << "a link of length 0 was written";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "frames[2].points[4]");
+    EXPECT_NE(std::string(e.what()).find("coincides with its parent"), std::string::npos);
+  }
+  GltfOptions bad;
+  bad.tube_sides = 2;
+  EXPECT_THROW(WriteTreeGltf(MakeTreeResult(2, 6, 3, 1), bad, path), InputError);
+  EXPECT_FALSE(std::filesystem::exists(path));
 }
 
 }  // namespace

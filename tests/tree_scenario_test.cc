@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
@@ -257,6 +258,59 @@ TEST_F(TreeResultFileTest, WritesJsonAndNpzWholeAndRefusesOtherPaths) {
   EXPECT_THROW(RunScenarioToFiles(s, {(dir_ / "r2.npz").string(), bad}), InputError);
   EXPECT_FALSE(std::filesystem::exists(bad));
   EXPECT_FALSE(std::filesystem::exists(dir_ / "r2.npz"));
+}
+
+// ReadTreeResultFile gives back what WriteTreeResult wrote, in both forms, and names a damaged
+// file's member or JSON pointer.
+TEST_F(TreeResultFileTest, ReadsBothFormsBackExactly) {
+  const AnyScenario s = ReadScenarioFile(scenario_);
+  ASSERT_TRUE(s.valid());
+  for (const char* name : {"r.json", "r.npz"}) {
+    const std::string path = (dir_ / name).string();
+    const ScenarioRunReport report = RunScenarioToFiles(s, {path, ""});
+    const TreeResultFile back = ReadTreeResultFile(path);
+    EXPECT_EQ(back.name, "two hands");
+    EXPECT_EQ(back.dim, 2);
+    EXPECT_EQ(back.parents, s.tree->tree.parents);
+    EXPECT_EQ(back.targets, s.tree->targets);
+    EXPECT_EQ(back.fixed, s.tree->fixed);
+    EXPECT_EQ(back.method, s.tree->method);
+    ASSERT_EQ(back.frames.size(), report.tree.frames.size()) << name;
+    for (size_t f = 0; f < back.frames.size(); ++f) {
+      EXPECT_EQ(back.frames[f], report.tree.frames[f]) << name << " frame " << f;  // bit for bit
+    }
+    ASSERT_EQ(back.reached.size(), back.frames.size() - 1);
+    for (size_t f = 0; f < back.reached.size(); ++f) {
+      EXPECT_EQ(bool(back.reached[f]), report.tree.reached[f] && report.tree.converged[f]);
+    }
+  }
+  // Damaged JSON results: each problem by its pointer, with the value.
+  json good = json::parse(std::ifstream((dir_ / "r.json").string()));
+  auto problem = [&](const std::function<void(json*)>& damage) {
+    json bad = good;
+    damage(&bad);
+    const std::string path = (dir_ / "bad.json").string();
+    std::ofstream(path) << bad.dump();
+    try {
+      ReadTreeResultFile(path);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(read without a problem)");
+  };
+  EXPECT_EQ(problem([](json* j) { (*j)["parents"][3] = 3; }).rfind("/parents/3: ", 0), 0u);
+  EXPECT_EQ(problem([](json* j) { (*j)["frames"][2][4] = {1.0}; }).rfind("/frames/2/4: ", 0), 0u);
+  EXPECT_EQ(problem([](json* j) { (*j)["frames"][1].erase(5); }).rfind("/frames/1: ", 0), 0u);
+  EXPECT_EQ(problem([](json* j) { (*j)["targets"][0] = 6; }).rfind("/targets/0: ", 0), 0u);
+  EXPECT_EQ(problem([](json* j) { (*j)["format"] = "flexkin-result"; }).rfind("/format: ", 0), 0u);
+  EXPECT_EQ(problem([](json* j) { (*j)["reached"].erase(0); }).rfind("/reached: ", 0), 0u);
+  EXPECT_EQ(problem([](json* j) {
+              (*j)["frames"][0][2] = (*j)["frames"][0][1];
+            }).rfind("/frames/0/2: ", 0),
+            0u);
+  // A chain result is not a tree result.
+  EXPECT_NE(problem([](json* j) { j->erase("parents"); }).find("/parents: missing"),
+            std::string::npos);
 }
 
 TEST_F(TreeResultFileTest, TheCommandLineRunsAndValidatesTrees) {

@@ -6,6 +6,7 @@
 #include "flexkin/chain.h"
 #include "flexkin/result_io.h"
 #include "flexkin/robot_scenario.h"
+#include "flexkin/tree_scenario.h"
 #include "flexkin/vocabulary.h"
 
 namespace flexkin {
@@ -84,6 +85,18 @@ struct GltfOptions {
 // is written; std::system_error if the file cannot be written.
 void WriteGltf(const ResultFile& result, const GltfOptions& options, const std::string& path);
 
+// Writes a tree result (flexkin/tree_scenario.h) to `path` as WriteGltf writes a chain's, with a
+// skeleton of a bone per link (docs/gltf-export.md, "Trees"): joint "point_<r>" on the root point,
+// "link_<c>" on the parent of each other point c with its +Y toward c, "tip_<c>" on each leaf c.
+// Frame f's keyframe is at f / steps_per_second seconds. The mesh (include_mesh) is a capsule per
+// link, each moving rigidly with its link's bone, of radius tube_radius, or by default
+// min(0.25 * mean link length, 0.02 * total length, 0.25 * its own length). The file's extras
+// name the tree's parents and the point of each joint (ReadGltfJointPositions's joint_points).
+// Written atomically. Throws InputError as WriteGltf: invalid options; a path without .gltf or
+// .glb ("path"); a result glTF cannot hold ("frames[f].points[i]" beyond float32 or on its parent
+// point, too many joints).
+void WriteTreeGltf(const TreeResultFile& tree, const GltfOptions& options, const std::string& path);
+
 namespace internal {
 // The same for a drawing and options Draw (flexkin/draw.h) has checked: only glTF's own limits
 // (joints, float32, link directions) are checked here.
@@ -101,6 +114,9 @@ struct GltfJointMotion {
   // coordinates, metres (joints by 3).
   std::vector<Points> positions;
   int dim = 3;  // columns of each entry of `positions`
+  // For a tree written by WriteTreeGltf: the point of the tree each joint sits on (its head).
+  // Empty for other files.
+  std::vector<int> joint_points;
 };
 
 // Reads a .gltf or .glb file (told apart by content) and evaluates its first animation at each

@@ -70,6 +70,26 @@ void WriteTreeResult(const std::string& path, const TreeScenario& scenario,
 // anything runs or is written.
 bool CheckTreeResultPath(const std::string& path);
 
+// A tree result read back (ReadTreeResultFile): what WriteTreeResult wrote, as far as the
+// pictures, animations and glTF need it.
+struct TreeResultFile {
+  std::string name;                   // the scenario's name, "" if none
+  Method method = Method::kTractrix;  // the method of the run
+  int dim = 0;                        // 2 or 3
+  std::vector<int> parents;           // n+1 entries: a valid tree (ValidateTree)
+  std::vector<int> targets;           // the driven points, in the scenario's order
+  std::vector<int> fixed;             // the fixed points
+  std::vector<Points> frames;         // F >= 1 frames, each (n+1) by dim, finite
+  std::vector<char> reached;          // F - 1: each frame after the start reached and converged
+};
+
+// Reads a tree result (.npz or .json, told apart by content) and checks it: the format, the
+// shapes (every frame (n+1) by dim, n+1 = the number of parents), finite coordinates, the parents
+// a tree whose first frame has no link of length 0, targets and fixed points among its points.
+// Throws std::system_error if the file cannot be read, InputError naming the member or JSON
+// pointer ("tree.json/parents/4", "frames.npy", "/frames/3/7/1") otherwise.
+TreeResultFile ReadTreeResultFile(const std::string& path);
+
 // Whether the file at `path` is a tree result (.npz with tree.json and frames.npy, or JSON whose
 // "format" is "flexkin-tree-result"); false for anything else, unreadable files included.
 bool IsTreeResultFile(const std::string& path);

@@ -257,6 +257,23 @@ GltfJointMotion ReadGltfJointPositions(const std::string& path) {
     const GltfUpAxis axis = ParseGltfUpAxis(up.Get<std::string>(), "asset.extras.flexkin.up_axis");
     if (axis == GltfUpAxis::kZ) to_flexkin << 1, 0, 0, 0, 0, -1, 0, 1, 0;  // (x, z, -y) back
     to_flexkin /= scale.GetNumberAsDouble();
+    const tinygltf::Value& heads = info.Get("joint_points");
+    if (heads.IsArray()) {
+      for (size_t j = 0; j < heads.ArrayLen(); ++j) {
+        const tinygltf::Value& h = heads.Get(static_cast<int>(j));
+        if (!h.IsNumber() || h.GetNumberAsInt() < 0) {
+          throw InputError("asset.extras.flexkin.joint_points[" + std::to_string(j) + "]",
+                           "is not a point index; expected an integer >= 0");
+        }
+        motion.joint_points.push_back(h.GetNumberAsInt());
+      }
+      if (motion.joint_points.size() != joints.size()) {
+        throw InputError("asset.extras.flexkin.joint_points",
+                         "has " + std::to_string(motion.joint_points.size()) +
+                             " entries; expected one per joint of the skin (" +
+                             std::to_string(joints.size()) + ")");
+      }
+    }
   }
 
   std::vector<Matrix4d> global(num_nodes);

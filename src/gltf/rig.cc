@@ -29,6 +29,42 @@ Quaterniond SmallestRotation(const Vector3d& a, const Vector3d& b) {
   return Quaterniond(a.dot(half), axis.x(), axis.y(), axis.z()).normalized();
 }
 
+// A joint's world rotation and position as a reader composes them from the stored float32
+// values.
+struct Composed {
+  Matrix3d rotation = Matrix3d::Identity();
+  Vector3d position = Vector3d::Zero();
+};
+
+// Stores frame f of every joint: joint j, at `head.row(j)` with world orientation world[j], under
+// joint parent[j] (-1: the skeleton's root; every parent before its children). Composes what was
+// stored as a reader will, so that each translation is computed from the float32 rotations and
+// translations of the joint's ancestors: the composed position is the wanted one to float32
+// rounding of that translation alone. Quaternion signs stay continuous over time (`previous`).
+void StorePose(int f, const Points& head, const std::vector<Quaterniond>& world,
+               const std::vector<int>& parent, std::vector<Composed>* composed,
+               std::vector<Quaterniond>* previous, RigAnimation* rig) {
+  static const Composed kOrigin;
+  for (size_t j = 0; j < world.size(); ++j) {
+    const Composed& up = parent[j] < 0 ? kOrigin : (*composed)[parent[j]];
+    Quaterniond local(up.rotation.transpose() * world[j].toRotationMatrix());
+    local.normalize();
+    if (f > 0 && local.dot((*previous)[j]) < 0.0) local.coeffs() *= -1.0;
+    float* q = &rig->rotation[j][4 * static_cast<size_t>(f)];
+    q[0] = static_cast<float>(local.x());
+    q[1] = static_cast<float>(local.y());
+    q[2] = static_cast<float>(local.z());
+    q[3] = static_cast<float>(local.w());
+    (*previous)[j] = Quaterniond(q[3], q[0], q[1], q[2]);
+
+    const Vector3d offset = up.rotation.transpose() * (head.row(j).transpose() - up.position);
+    float* t = &rig->translation[j][3 * static_cast<size_t>(f)];
+    for (int k = 0; k < 3; ++k) t[k] = static_cast<float>(offset[k]);
+    (*composed)[j].position = up.position + up.rotation * Vector3d(t[0], t[1], t[2]);
+    (*composed)[j].rotation = up.rotation * QuaternionMatrix(q[0], q[1], q[2], q[3]);
+  }
+}
+
 }  // namespace
 
 Matrix3d QuaternionMatrix(double x, double y, double z, double w) {
@@ -48,8 +84,11 @@ RigAnimation PoseChain(const std::vector<Points>& frames) {
   std::vector<Vector3d> dir(joints);          // dir[i]: unit vector of link i (1-based)
   std::vector<Quaterniond> world(joints);     // wanted world orientation of each joint
   std::vector<Quaterniond> previous(joints);  // last frame's stored local rotations
-  Quaterniond root;                           // joint 0's orientation, carried over time
-  Vector3d root_bone = Vector3d::UnitY();     // joint 0's bone direction in the last frame
+  std::vector<Composed> composed(joints);
+  std::vector<int> chain_parent(joints);
+  for (int j = 0; j < joints; ++j) chain_parent[j] = j - 1;
+  Quaterniond root;                        // joint 0's orientation, carried over time
+  Vector3d root_bone = Vector3d::UnitY();  // joint 0's bone direction in the last frame
   for (int f = 0; f < num_frames; ++f) {
     const Points& p = frames[f];
     assert(p.rows() == joints && p.cols() == 3);
@@ -68,28 +107,92 @@ RigAnimation PoseChain(const std::vector<Points>& frames) {
     }
     world[joints - 1] = world[joints - 2];
 
-    // Store, composing what was stored as a reader will: W and P are the parent's world
-    // rotation and position built from the float32 values.
-    Matrix3d parent_rotation = Matrix3d::Identity();
-    Vector3d parent_position = Vector3d::Zero();
-    for (int j = 0; j < joints; ++j) {
-      Quaterniond local(parent_rotation.transpose() * world[j].toRotationMatrix());
-      local.normalize();
-      if (f > 0 && local.dot(previous[j]) < 0.0) local.coeffs() *= -1.0;
-      float* q = &rig.rotation[j][4 * static_cast<size_t>(f)];
-      q[0] = static_cast<float>(local.x());
-      q[1] = static_cast<float>(local.y());
-      q[2] = static_cast<float>(local.z());
-      q[3] = static_cast<float>(local.w());
-      previous[j] = Quaterniond(q[3], q[0], q[1], q[2]);
+    StorePose(f, p, world, chain_parent, &composed, &previous, &rig);
+  }
+  return rig;
+}
 
-      const Vector3d offset =
-          parent_rotation.transpose() * (p.row(j).transpose() - parent_position);
-      float* t = &rig.translation[j][3 * static_cast<size_t>(f)];
-      for (int k = 0; k < 3; ++k) t[k] = static_cast<float>(offset[k]);
-      parent_position += parent_rotation * Vector3d(t[0], t[1], t[2]);
-      parent_rotation = parent_rotation * QuaternionMatrix(q[0], q[1], q[2], q[3]);
+}  // namespace flexkin::gltf
+
+namespace flexkin::gltf {
+
+TreeSkeleton MakeTreeSkeleton(const std::vector<int>& parents) {
+  const int points = static_cast<int>(parents.size());
+  std::vector<std::vector<int>> children(points);
+  int root = 0;
+  for (int i = 0; i < points; ++i) {
+    if (parents[i] < 0) {
+      root = i;
+    } else {
+      children[parents[i]].push_back(i);
     }
+  }
+  // The points in breadth-first order from the root, each point's children in index order.
+  std::vector<int> order = {root};
+  for (size_t k = 0; k < order.size(); ++k) {
+    for (const int c : children[order[k]]) order.push_back(c);
+  }
+  TreeSkeleton s;
+  std::vector<int> link_joint(points, 0);  // the joint of the link that ends at each point
+  s.parent.push_back(-1);
+  s.head.push_back(root);
+  s.toward.push_back(children[root].empty() ? -1 : children[root].front());
+  s.names.push_back("point_" + std::to_string(root));
+  for (size_t k = 1; k < order.size(); ++k) {
+    const int c = order[k], p = parents[c];
+    link_joint[c] = static_cast<int>(s.head.size());
+    s.parent.push_back(p == root ? 0 : link_joint[p]);
+    s.head.push_back(p);
+    s.toward.push_back(c);
+    s.names.push_back("link_" + std::to_string(c));
+  }
+  for (size_t k = 1; k < order.size(); ++k) {
+    const int c = order[k];
+    if (!children[c].empty()) continue;
+    s.parent.push_back(link_joint[c]);
+    s.head.push_back(c);
+    s.toward.push_back(-1);
+    s.names.push_back("tip_" + std::to_string(c));
+  }
+  return s;
+}
+
+RigAnimation PoseTree(const TreeSkeleton& skeleton, const std::vector<Points>& frames) {
+  const int joints = static_cast<int>(skeleton.head.size());
+  const int num_frames = static_cast<int>(frames.size());
+  RigAnimation rig;
+  rig.num_joints = joints;
+  rig.num_frames = num_frames;
+  rig.translation.assign(joints, std::vector<float>(3 * static_cast<size_t>(num_frames)));
+  rig.rotation.assign(joints, std::vector<float>(4 * static_cast<size_t>(num_frames)));
+
+  std::vector<Vector3d> bone(joints);         // each joint's bone direction (unit)
+  std::vector<Quaterniond> world(joints);     // wanted world orientation of each joint
+  std::vector<Quaterniond> previous(joints);  // last frame's stored local rotations
+  std::vector<Composed> composed(joints);
+  Points head(joints, 3);
+  Quaterniond root;
+  Vector3d root_bone = Vector3d::UnitY();
+  for (int f = 0; f < num_frames; ++f) {
+    const Points& p = frames[f];
+    for (int j = 0; j < joints; ++j) {
+      head.row(j) = p.row(skeleton.head[j]);
+      const int to = skeleton.toward[j];
+      // A tip continues its link; the root of a lone point (no children) keeps +Y.
+      bone[j] = to >= 0 ? Vector3d((p.row(to) - p.row(skeleton.head[j])).transpose().normalized())
+                : j > 0 ? bone[skeleton.parent[j]]
+                        : Vector3d::UnitY();
+    }
+    root = (f == 0 ? SmallestRotation(Vector3d::UnitY(), bone[0])
+                   : SmallestRotation(root_bone, bone[0]) * root)
+               .normalized();
+    root_bone = bone[0];
+    world[0] = root;
+    for (int j = 1; j < joints; ++j) {
+      const int up = skeleton.parent[j];
+      world[j] = (SmallestRotation(bone[up], bone[j]) * world[up]).normalized();
+    }
+    StorePose(f, head, world, skeleton.parent, &composed, &previous, &rig);
   }
   return rig;
 }

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <string>
 #include <vector>
 
 #include "flexkin/chain.h"
@@ -33,5 +34,27 @@ struct RigAnimation {
 // signs are kept continuous over time (a LINEAR sampler then takes the short way). Consecutive
 // points must not coincide (checked by the caller).
 RigAnimation PoseChain(const std::vector<Points>& frames);
+
+// The skeleton of a tree (docs/gltf-export.md, "Trees"): a bone per link, as a rig has. Joint 0,
+// "point_<r>", sits on the root point r; each other point c has the joint "link_<c>" on its
+// parent's point, whose +Y points to c (the link's bone, a child of the joint of the link that
+// ends at the parent, or of joint 0); each leaf c has a joint "tip_<c>" on c, a child of link_<c>
+// with its orientation. Joints are ordered root, links (breadth first from the root, children in
+// index order), tips: every parent before its children.
+struct TreeSkeleton {
+  std::vector<int> parent;  // each joint's parent joint; -1 for joint 0
+  std::vector<int> head;    // the point each joint sits on
+  std::vector<int> toward;  // the point its +Y points to; -1 for a tip (and a lone root)
+  std::vector<std::string> names;
+};
+// `parents`: a valid tree (ValidateTree).
+TreeSkeleton MakeTreeSkeleton(const std::vector<int>& parents);
+
+// Poses the tree's skeleton for each of `frames` ((n+1) by 3, the tree's points; no link of
+// length 0), as PoseChain poses a chain: joint 0 turned from frame to frame by the smallest
+// rotation that turns its bone (toward the root's first child), each other joint from its parent
+// by the smallest rotation between their bones, translations from the float32 values of the
+// ancestors.
+RigAnimation PoseTree(const TreeSkeleton& skeleton, const std::vector<Points>& frames);
 
 }  // namespace flexkin::gltf

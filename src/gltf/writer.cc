@@ -14,6 +14,7 @@
 #include "flexkin/error.h"
 #include "flexkin/gltf.h"
 #include "flexkin/propagate.h"
+#include "gltf/model.h"
 #include "gltf/rig.h"
 #include "gltf/tube.h"
 #include "io/atomic_file.h"
@@ -22,11 +23,13 @@
 namespace flexkin {
 namespace {
 
-// glTF enums (the specification's numbers).
-constexpr int kArrayBuffer = 34962;
-constexpr int kElementArrayBuffer = 34963;
-// The most joints that the unsigned 16-bit indices of JOINTS_0 can address.
-constexpr int kMaxJoints = 65536;
+using gltf::AddChannel;
+using gltf::BufferWriter;
+using gltf::kArrayBuffer;
+using gltf::kElementArrayBuffer;
+using gltf::kMaxJoints;
+using gltf::MinMax;
+using gltf::UpRotation;
 
 std::string Index(const std::string& name, size_t i) {
   return name + "[" + std::to_string(i) + "]";
@@ -66,72 +69,6 @@ void CheckGltfLimits(const ResultFile& file, double scale) {
   }
 }
 
-// True for a .glb path, false for .gltf (any case); InputError("path") for anything else.
-bool IsBinaryPath(const std::string& path) {
-  const size_t dot = path.rfind('.');
-  std::string ext = dot == std::string::npos ? "" : path.substr(dot + 1);
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (ext == "glb") return true;
-  if (ext == "gltf") return false;
-  throw InputError("path",
-                   "\"" + path +
-                       "\" has no .gltf or .glb extension; the extension "
-                       "chooses the format (.glb binary, .gltf JSON with an embedded buffer)");
-}
-
-// Appends arrays to the model's one buffer, one buffer view each, 4-byte aligned.
-class BufferWriter {
- public:
-  explicit BufferWriter(tinygltf::Model* model) : model_(model) { model_->buffers.resize(1); }
-
-  template <typename T>
-  int View(const std::vector<T>& values, int target, const std::string& name) {
-    std::vector<unsigned char>& data = model_->buffers[0].data;
-    data.resize((data.size() + 3) / 4 * 4, 0);
-    tinygltf::BufferView view;
-    view.name = name;
-    view.buffer = 0;
-    view.byteOffset = data.size();
-    view.byteLength = values.size() * sizeof(T);
-    if (target != 0) view.target = target;
-    const auto* bytes = reinterpret_cast<const unsigned char*>(values.data());
-    data.insert(data.end(), bytes, bytes + view.byteLength);
-    model_->bufferViews.push_back(view);
-    return static_cast<int>(model_->bufferViews.size() - 1);
-  }
-
-  // An accessor of `count` elements of `type` (TINYGLTF_TYPE_*) in `view` at `byte_offset`.
-  int Accessor(int view, size_t byte_offset, int component_type, int type, size_t count,
-               std::vector<double> min = {}, std::vector<double> max = {}) {
-    tinygltf::Accessor accessor;
-    accessor.bufferView = view;
-    accessor.byteOffset = byte_offset;
-    accessor.componentType = component_type;
-    accessor.type = type;
-    accessor.count = count;
-    accessor.minValues = std::move(min);
-    accessor.maxValues = std::move(max);
-    model_->accessors.push_back(accessor);
-    return static_cast<int>(model_->accessors.size() - 1);
-  }
-
- private:
-  tinygltf::Model* model_;
-};
-
-// Per-component minimum and maximum of float vectors of `width` components.
-void MinMax(const std::vector<float>& values, int width, std::vector<double>* min,
-            std::vector<double>* max) {
-  min->assign(width, HUGE_VAL);
-  max->assign(width, -HUGE_VAL);
-  for (size_t i = 0; i < values.size(); ++i) {
-    const int k = static_cast<int>(i % width);
-    (*min)[k] = std::min<double>((*min)[k], values[i]);
-    (*max)[k] = std::max<double>((*max)[k], values[i]);
-  }
-}
-
 // The keyframe times, seconds, as float32; InputError if two round to the same value.
 std::vector<float> KeyframeTimes(const RunResult& result, double steps_per_second) {
   std::vector<float> times;
@@ -149,14 +86,6 @@ std::vector<float> KeyframeTimes(const RunResult& result, double steps_per_secon
     }
   }
   return times;
-}
-
-// The "flexkin" node's linear map from flexkin's coordinates to the scene's: rotation R, scale s.
-Eigen::Matrix3d UpRotation(GltfUpAxis axis) {
-  Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
-  // (x, y, z) -> (x, z, -y): a quarter turn about x, clockwise seen from +x.
-  if (axis == GltfUpAxis::kZ) r << 1, 0, 0, 0, 0, 1, 0, -1, 0;
-  return r;
 }
 
 tinygltf::Value Extras(const ResultFile& file, const GltfOptions& options, GltfUpAxis axis) {
@@ -214,40 +143,8 @@ void AddMesh(const ResultFile& file, const GltfOptions& options, const Eigen::Ma
           ? gltf::MakeTube(arc, radius, options.tube_sides, to_scene)
           : gltf::MakeCapsuleTube(arc, CapsuleRadii(file.link_radii, radius), options.tube_sides,
                                   CapRings(options.tube_sides), to_scene);
-  const size_t vertices = tube.num_vertices();
-
-  tinygltf::Primitive primitive;
-  std::vector<double> min, max;
-  MinMax(tube.positions, 3, &min, &max);
-  primitive.attributes["POSITION"] =
-      buffer->Accessor(buffer->View(tube.positions, kArrayBuffer, "positions"), 0,
-                       TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, vertices, min, max);
-  primitive.attributes["NORMAL"] =
-      buffer->Accessor(buffer->View(tube.normals, kArrayBuffer, "normals"), 0,
-                       TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, vertices);
-  primitive.attributes["JOINTS_0"] =
-      buffer->Accessor(buffer->View(tube.joints, kArrayBuffer, "joints"), 0,
-                       TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC4, vertices);
-  primitive.attributes["WEIGHTS_0"] =
-      buffer->Accessor(buffer->View(tube.weights, kArrayBuffer, "weights"), 0,
-                       TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, vertices);
-  primitive.indices = buffer->Accessor(buffer->View(tube.indices, kElementArrayBuffer, "indices"),
-                                       0, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
-                                       TINYGLTF_TYPE_SCALAR, tube.indices.size());
-  primitive.mode = TINYGLTF_MODE_TRIANGLES;
-  primitive.material = 0;
-
-  tinygltf::Material material;
-  material.name = "rope";
-  material.pbrMetallicRoughness.baseColorFactor = {0.80, 0.45, 0.15, 1.0};
-  material.pbrMetallicRoughness.metallicFactor = 0.0;
-  material.pbrMetallicRoughness.roughnessFactor = 0.7;
-  model->materials.push_back(material);
-
-  tinygltf::Mesh mesh;
-  mesh.name = "chain";
-  mesh.primitives.push_back(primitive);
-  model->meshes.push_back(mesh);
+  gltf::AddSkinnedMesh(tube, "chain", gltf::MakeMaterial("rope", {0.80, 0.45, 0.15}, 0.7), buffer,
+                       model);
 
   // Inverse bind matrices: the rest pose puts joint j at (0, arc[j], 0) in the skeleton's space,
   // which the "flexkin" node maps to the scene by to_scene; the inverse, column-major.
@@ -266,21 +163,6 @@ void AddMesh(const ResultFile& file, const GltfOptions& options, const Eigen::Ma
                        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_MAT4, n + 1);
 }
 
-// A LINEAR sampler of `output` over the keyframe times `input`, driving `property` of `node`.
-void AddChannel(int input, int output, int node, const char* property,
-                tinygltf::Animation* animation) {
-  tinygltf::AnimationSampler sampler;
-  sampler.input = input;
-  sampler.output = output;
-  sampler.interpolation = "LINEAR";
-  animation->samplers.push_back(sampler);
-  tinygltf::AnimationChannel channel;
-  channel.sampler = static_cast<int>(animation->samplers.size() - 1);
-  channel.target_node = node;
-  channel.target_path = property;
-  animation->channels.push_back(channel);
-}
-
 // Each collider as a mesh node "collider_k" under the "flexkin" node (node 0), so in the chain's
 // up axis and scale: its surface (io/collider_mesh.h) in flexkin's coordinates, every vertex on
 // it; a half-space as a square of its plane, 20 times the motion's extent across, about the
@@ -295,11 +177,7 @@ std::vector<std::pair<int, size_t>> AddColliders(const ResultFile& file, BufferW
   BoundsOfMotion(file, &lo, &hi);
   const double extent = std::max((hi - lo).norm(), file.result.lengths.sum());
   const int material = static_cast<int>(model->materials.size());
-  tinygltf::Material stone;
-  stone.name = "collider";
-  stone.pbrMetallicRoughness.baseColorFactor = {0.62, 0.62, 0.60, 1.0};
-  stone.pbrMetallicRoughness.metallicFactor = 0.0;
-  stone.pbrMetallicRoughness.roughnessFactor = 0.9;
+  tinygltf::Material stone = gltf::MakeMaterial("collider", {0.62, 0.62, 0.60}, 0.9);
   stone.doubleSided = true;  // a half-space's square is seen from both sides
   model->materials.push_back(stone);
   for (size_t k = 0; k < file.colliders.size(); ++k) {
@@ -374,14 +252,12 @@ void WriteGltf(const ResultFile& file, const GltfOptions& options, const std::st
 void internal::WriteGltf(const CheckedDrawing& drawing, const GltfOptions& options,
                          const std::string& path) {
   const ResultFile& file = drawing.result;
-  const bool binary = IsBinaryPath(path);
+  const bool binary = gltf::IsBinaryPath(path);
   CheckGltfLimits(file, options.scale);
   const RunResult& result = file.result;
   const std::vector<float> times = KeyframeTimes(result, options.steps_per_second);
   const int n = static_cast<int>(result.lengths.size());
-  const GltfUpAxis axis = options.up_axis != GltfUpAxis::kAuto
-                              ? options.up_axis
-                              : (file.dim == 2 ? GltfUpAxis::kY : GltfUpAxis::kZ);
+  const GltfUpAxis axis = gltf::ResolvedUpAxis(options.up_axis, file.dim);
 
   std::vector<Points> frames;
   frames.reserve(result.frames.size());
@@ -400,10 +276,7 @@ void internal::WriteGltf(const CheckedDrawing& drawing, const GltfOptions& optio
 
   // Nodes: 0 the "flexkin" node (axes and scale), 1 + j joint j, n + 2 the tube, then the
   // colliders (children of node 0).
-  tinygltf::Node root;
-  root.name = "flexkin";
-  if (axis == GltfUpAxis::kZ) root.rotation = {-std::sqrt(0.5), 0.0, 0.0, std::sqrt(0.5)};
-  if (options.scale != 1.0) root.scale = {options.scale, options.scale, options.scale};
+  tinygltf::Node root = gltf::FlexkinRootNode(axis, options.scale);
   root.children = {1};
   model.nodes.push_back(root);
   tinygltf::Skin skin;
@@ -437,32 +310,14 @@ void internal::WriteGltf(const CheckedDrawing& drawing, const GltfOptions& optio
   // The animation: one input (the keyframe times), a translation and a rotation channel per joint.
   tinygltf::Animation animation;
   animation.name = "motion";
-  std::vector<double> min, max;
-  MinMax(times, 1, &min, &max);
-  const int input =
-      buffer.Accessor(buffer.View(times, 0, "keyframe times"), 0, TINYGLTF_COMPONENT_TYPE_FLOAT,
-                      TINYGLTF_TYPE_SCALAR, times.size(), min, max);
-  for (int j = 0; j <= n; ++j) {
-    const int translation = buffer.Accessor(
-        buffer.View(rig.translation[j], 0, "joint_" + std::to_string(j) + " translation"), 0,
-        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, times.size());
-    const int rotation =
-        buffer.Accessor(buffer.View(rig.rotation[j], 0, "joint_" + std::to_string(j) + " rotation"),
-                        0, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, times.size());
-    AddChannel(input, translation, j + 1, "translation", &animation);
-    AddChannel(input, rotation, j + 1, "rotation", &animation);
-  }
+  const int input = gltf::AddRigChannels(
+      rig, times, [](int j) { return "joint_" + std::to_string(j); }, &buffer, &animation);
   for (const auto& [node, k] : moving_colliders) {
     AddColliderMotion(file, file.colliders[k], node, input, &buffer, &animation);
   }
   model.animations.push_back(animation);
 
-  WriteFileAtomically(path, [&](std::ostream& out) {
-    tinygltf::TinyGLTF writer;
-    if (!writer.WriteGltfSceneToStream(&model, out, /*prettyPrint=*/!binary, binary)) {
-      throw std::runtime_error("tinygltf could not serialize the glTF model");
-    }
-  });
+  gltf::SaveModel(&model, binary, path);
 }
 
 }  // namespace flexkin

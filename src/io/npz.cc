@@ -741,7 +741,7 @@ NpyArray ReadNpyHeader(ZipReader::Member* member, const std::string& name,
     Malformed(name, ".npy descr '" + a.descr + "' is not supported; expected '" + descr + "'");
   }
   if (fortran) Malformed(name, ".npy fortran_order True is not supported; expected False");
-  const uint64_t item = descr == "<f4" ? 4 : 8;
+  const uint64_t item = descr == "<f4" ? 4 : descr == "|b1" ? 1 : 8;
   a.count = 1;
   for (uint64_t d : a.shape) {
     if (d != 0 && a.count > std::numeric_limits<uint64_t>::max() / 8 / d) {

@@ -137,8 +137,8 @@ struct NpyArray {
   uint64_t count = 0;  // product of shape
 };
 // Reads the header of the .npy member being read by `member` (left at the first data byte) and
-// checks that descr is `descr` ("<f8", "<i8" or "<f4") and that the member holds exactly count
-// items of that size after the header. InputError named `name`.
+// checks that descr is `descr` ("<f8", "<i8", "<f4" or "|b1") and that the member holds exactly
+// count items of that size after the header. InputError named `name`.
 NpyArray ReadNpyHeader(ZipReader::Member* member, const std::string& name,
                        const std::string& descr);
 // Throws InputError (`name`: "has shape (2, 3); expected (4, 3); not <file_kind>") unless the

@@ -1,0 +1,252 @@
+// Tree results read back (flexkin/tree_scenario.h ReadTreeResultFile; docs/trees.md "Results"):
+// the .npz form (tree.json beside frames.npy) and the JSON form, checked member by member.
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "flexkin/error.h"
+#include "flexkin/tree_scenario.h"
+#include "io/json_file.h"
+#include "io/json_values.h"
+#include "io/npz.h"
+
+namespace flexkin {
+namespace {
+
+using json = nlohmann::json;
+
+constexpr uint64_t kMaxTreeHeaderBytes = 64u << 20;
+constexpr int64_t kMaxTreePoints = 1 << 24;
+
+// The header's keys (both forms) and what the JSON form adds.
+class TreeResultReader : public json_internal::JsonReader {
+ public:
+  // The format, name, method, dim, parents, targets and fixed of `root`; `json_form`: the keys of
+  // the JSON form (frames and the reports per frame) are allowed too.
+  void ReadHeader(const json& root, bool json_form, TreeResultFile* out) {
+    if (!ExpectObject(root, "", "an object (a tree result, docs/trees.md)")) return;
+    std::vector<std::string> keys = {"format",  "name",  "method",           "dim",     "parents",
+                                     "targets", "fixed", "max_length_error", "failures"};
+    if (json_form) {
+      for (const char* k : {"frames", "passes", "residual", "reached", "converged"}) {
+        keys.push_back(k);
+      }
+    }
+    CheckKeys(root, "", keys);
+    if (const json* format =
+            Required(root, "", "format", "\"flexkin-tree-result\" (a tree result)")) {
+      if (!(format->is_string() && *format == "flexkin-tree-result")) {
+        ValueProblem(*format, "/format", "\"flexkin-tree-result\" (a tree result)");
+      }
+    }
+    Optional(
+        root, "", "name", [&](const json& v, const std::string& p) { return String(v, p); },
+        &out->name);
+    std::string method = NameOf(out->method);
+    Optional(
+        root, "", "method",
+        [&](const json& v, const std::string& p) {
+          return Choice(v, p, {"tractrix", "ftl", "min_rotation", "min_joint_angle", "overall"});
+        },
+        &method);
+    out->method = ParseName<Method>(method, "/method");
+    int64_t dim = 0;
+    Require(
+        root, "", "dim", "2 or 3",
+        [&](const json& v, const std::string& p) { return Integer(v, p, 2, 3); }, &dim);
+    out->dim = static_cast<int>(dim);
+    out->parents = Indices(root, "parents", -1, kMaxTreePoints, true);
+    const int last = static_cast<int>(out->parents.size()) - 1;
+    out->targets = Indices(root, "targets", 0, std::max(last, 0), false);
+    out->fixed = Indices(root, "fixed", 0, std::max(last, 0), false);
+  }
+
+  // The JSON form's frames, each (n+1) by dim, and "reached" and "converged" (F - 1 booleans).
+  void ReadJsonArrays(const json& root, TreeResultFile* out) {
+    const int rows = static_cast<int>(out->parents.size());
+    const json* frames = Required(root, "", "frames", "an array of frames");
+    if (frames == nullptr) return;
+    if (!frames->is_array() || frames->empty()) {
+      TypeProblem(*frames, "/frames", "an array of at least 1 frame");
+      return;
+    }
+    dimension_of_ = "the tree";
+    for (size_t f = 0; f < frames->size(); ++f) {
+      const std::string ptr = "/frames/" + std::to_string(f);
+      const auto p = PointList((*frames)[f], ptr, out->dim, rows, rows);
+      if (!p) return;
+      out->frames.push_back(*p);
+    }
+    std::vector<char> converged;
+    Flags(root, "reached", frames->size() - 1, &out->reached);
+    Flags(root, "converged", frames->size() - 1, &converged);
+    for (size_t k = 0; k < converged.size() && k < out->reached.size(); ++k) {
+      out->reached[k] = out->reached[k] && converged[k];
+    }
+  }
+
+ private:
+  std::vector<int> Indices(const json& root, const char* key, int64_t min, int64_t max,
+                           bool required) {
+    std::vector<int> out;
+    const std::string expected =
+        std::string("an array of point indices") + (min < 0 ? ", -1 for the root" : "");
+    const json* v = required ? Required(root, "", key, expected) : Find(root, key);
+    if (v == nullptr) return out;
+    const std::string ptr = std::string("/") + key;
+    if (!v->is_array() || (required && v->size() < 2)) {
+      TypeProblem(*v, ptr, required ? expected + " (at least 2)" : expected);
+      return out;
+    }
+    for (size_t k = 0; k < v->size(); ++k) {
+      if (auto i = Integer((*v)[k], ptr + "/" + std::to_string(k), min, max)) {
+        out.push_back(static_cast<int>(*i));
+      }
+    }
+    return out;
+  }
+
+  void Flags(const json& root, const char* key, size_t count, std::vector<char>* out) {
+    const std::string expected = "an array of " + std::to_string(count) + " booleans";
+    const json* v = Required(root, "", key, expected);
+    if (v == nullptr) return;
+    if (!v->is_array() || v->size() != count) {
+      TypeProblem(*v, std::string("/") + key, expected);
+      return;
+    }
+    for (size_t k = 0; k < count; ++k) {
+      if (!(*v)[k].is_boolean()) {
+        TypeProblem((*v)[k], std::string("/") + key + "/" + std::to_string(k), "a boolean");
+        return;
+      }
+      out->push_back((*v)[k].get<bool>() ? 1 : 0);
+    }
+  }
+};
+
+// `field` of the problem with `prefix` before it ("tree.json" + "/parents/4").
+[[noreturn]] void Rethrow(const InputError& e, const std::string& prefix) {
+  Problem p = e.problem();
+  p.field = prefix + p.field;
+  throw InputError(p);
+}
+
+// A 1-dimensional member of `descr` and `count` entries, whole.
+template <typename T>
+std::vector<T> ReadFlat(ZipReader* zip, const std::string& name, const char* descr,
+                        uint64_t count) {
+  ZipReader::Member member(zip, name);
+  const NpyArray a = ReadNpyHeader(&member, name, descr);
+  ExpectNpyShape(a, name, {count}, "a valid tree result");
+  std::vector<T> v(count);
+  member.Read(v.data(), sizeof(T) * count);
+  member.Finish();
+  return v;
+}
+
+TreeResultFile ReadNpz(const std::string& path) {
+  ZipReader zip(path, {"frames.npy", "parents.npy", "reached.npy", "converged.npy"});
+  if (!zip.Has("tree.json")) {
+    throw InputError("tree.json", "missing; a tree result's .npz holds tree.json and frames.npy");
+  }
+  TreeResultFile out;
+  TreeResultReader reader;
+  try {
+    reader.ReadHeader(ParseJsonText(zip.ReadWhole("tree.json", kMaxTreeHeaderBytes)), false, &out);
+    ThrowIfAny(reader.problems);
+  } catch (const InputError& e) {
+    Rethrow(e, "tree.json");
+  }
+  const uint64_t rows = out.parents.size(), dim = static_cast<uint64_t>(out.dim);
+  const std::vector<int64_t> parents = ReadFlat<int64_t>(&zip, "parents.npy", "<i8", rows);
+  for (uint64_t i = 0; i < rows; ++i) {
+    if (parents[i] != out.parents[i]) {
+      throw InputError("parents.npy",
+                       "entry " + std::to_string(i) + " is " + std::to_string(parents[i]) +
+                           " but tree.json's parents have " + std::to_string(out.parents[i]) +
+                           "; not a valid tree result");
+    }
+  }
+  ZipReader::Member frames(&zip, "frames.npy");
+  const NpyArray fa = ReadNpyHeader(&frames, "frames.npy", "<f8");
+  const uint64_t count = fa.shape.empty() ? 0 : fa.shape[0];
+  ExpectNpyShape(fa, "frames.npy", {count, rows, dim}, "a valid tree result");
+  if (count == 0) throw InputError("frames.npy", "has no frames; expected at least the start");
+  for (uint64_t f = 0; f < count; ++f) {
+    Points p(rows, dim);
+    frames.Read(p.data(), sizeof(double) * rows * dim);
+    out.frames.push_back(std::move(p));
+  }
+  frames.Finish();
+  const std::vector<char> reached = ReadFlat<char>(&zip, "reached.npy", "|b1", count - 1);
+  const std::vector<char> converged = ReadFlat<char>(&zip, "converged.npy", "|b1", count - 1);
+  for (uint64_t k = 0; k + 1 < count; ++k) out.reached.push_back(reached[k] && converged[k]);
+  return out;
+}
+
+TreeResultFile ReadJson(const std::string& path) {
+  const json root = ReadJsonFile(path);
+  TreeResultFile out;
+  TreeResultReader reader;
+  reader.ReadHeader(root, true, &out);
+  ThrowIfAny(reader.problems);
+  reader.ReadJsonArrays(root, &out);
+  ThrowIfAny(reader.problems);
+  return out;
+}
+
+// What both forms check once read: finite coordinates and a tree without links of length 0.
+// `frame_field(f, i, k)`: the name of coordinate k of point i of frame f in the file's form.
+void CheckTreeResult(const TreeResultFile& out, bool npz) {
+  auto point = [&](size_t f, Eigen::Index i) {
+    return npz ? "frames.npy[" + std::to_string(f) + "][" + std::to_string(i) + "]"
+               : "/frames/" + std::to_string(f) + "/" + std::to_string(i);
+  };
+  for (size_t f = 0; f < out.frames.size(); ++f) {
+    const Points& p = out.frames[f];
+    for (Eigen::Index i = 0; i < p.rows(); ++i) {
+      for (Eigen::Index k = 0; k < p.cols(); ++k) {
+        if (!std::isfinite(p(i, k))) {
+          throw InputError(npz ? point(f, i) + "[" + std::to_string(k) + "]"
+                               : point(f, i) + "/" + std::to_string(k),
+                           FormatNumber(p(i, k)) + " is not valid; expected a finite number");
+        }
+      }
+    }
+  }
+  try {
+    ValidateTree(Tree{out.frames.front(), out.parents}, "");
+  } catch (const InputError& e) {
+    Problem p = e.problem();
+    // "parents[4]" -> the parents' entry; "points[7]" -> point 7 of the first frame.
+    const size_t open = p.field.find('['), close = p.field.find(']');
+    const std::string index =
+        open == std::string::npos ? "" : p.field.substr(open + 1, close - open - 1);
+    if (p.field.rfind("points", 0) == 0) {
+      p.field = point(0, std::stol(index)) + p.field.substr(close + 1);
+    } else if (p.field.rfind("parents", 0) == 0) {
+      p.field = (npz ? "tree.json/parents/" : "/parents/") + index;
+    }
+    throw InputError(p);
+  }
+}
+
+}  // namespace
+
+TreeResultFile ReadTreeResultFile(const std::string& path) {
+  char magic[4] = {0, 0, 0, 0};
+  bool npz = false;
+  if (std::FILE* file = std::fopen(path.c_str(), "rb")) {
+    npz = std::fread(magic, 1, sizeof magic, file) == sizeof magic &&
+          std::memcmp(magic, "PK\x03\x04", 4) == 0;
+    std::fclose(file);
+  }
+  TreeResultFile out = npz ? ReadNpz(path) : ReadJson(path);
+  CheckTreeResult(out, npz);
+  return out;
+}
+
+}  // namespace flexkin
