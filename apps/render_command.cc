@@ -44,7 +44,8 @@ RenderCommand::RenderCommand(CLI::App* app, const std::string& footer) {
   for (const auto& entry : Vocabulary<OutputFormat>::kEntries)
     formats_help += std::string("\n  ") + entry.name + ": " + entry.summary;
   formats_help += "\n  (robot trajectories: " + FormatNamesOf(DrawnKind::kRobotTrajectory) +
-                  "; strand files: " + FormatNamesOf(DrawnKind::kStrandFile) + "; default svg,png)";
+                  "; strand files: " + FormatNamesOf(DrawnKind::kStrandFile) +
+                  "; tree results: " + FormatNamesOf(DrawnKind::kTreeResult) + "; default svg,png)";
   formats_ = command_->add_option("--formats", args_.formats, formats_help);
   command_->add_option("--every", args_.every,
                        "Figures: draw every K-th recorded frame (default: about 16 frames)");

@@ -73,7 +73,10 @@ echo "== trees (docs/trees.md): two arms on a spine whose hands go round circles
 echo "   (the passes between the targets), and a plant whose trunk sways (its canopy following)"
 for name in tree_two_arms tree_plant; do
   "$flexkin" run "examples/$name.json" -o "out/$name.npz"
+  # The figure, the animation, the viewer and the glTF (a bone per link) of the tree result.
+  "$flexkin" render "out/$name.npz" -o out --formats svg,mp4,gif,html,glb --quiet
 done
+# The passes and the residual of every frame beside a few frames (matplotlib).
 /usr/bin/python3 examples/python/tree_figure.py out/tree_two_arms.npz
 /usr/bin/python3 examples/python/tree_figure.py out/tree_plant.npz --view y
 echo "== a dynamic chain (docs/dynamics.md): a rope of 40 links released from horizontal, its"
@@ -107,4 +110,5 @@ echo "hair: out/groom_head.npz (docs/strands.md: numpy.load reads it), out/groom
 echo "pictures: out/*.{svg,png,pdf}, out/*_{path_length,link_angles,length_error}.{svg,png},"
 echo "  out/*.{mp4,gif}, out/*.html (open in a browser), out/*.glb (docs/rendering.md)"
 echo "Python examples' figures: out/python/*.png (docs/python-examples.md)"
-echo "trees: out/tree_*.npz (docs/trees.md, \"Results\") and their figures out/tree_*.png"
+echo "trees: out/tree_*.npz (docs/trees.md, \"Results\"), their figures out/tree_*.{svg,png},"
+echo "  animations out/tree_*.{mp4,gif}, viewers out/tree_*.html and glTF out/tree_*.glb (docs/trees.md, \"Pictures\")"

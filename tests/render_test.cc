@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "flexkin/error.h"
+#include "png_test_util.h"
 #include "render/snapshot.h"
 #include "render_test_util.h"
 #include "test_util.h"
@@ -36,28 +37,8 @@ using render_test::TempDir;
 // ---------------------------------------------------------------------------------------------
 // Golden images.
 
-struct Image {
-  int width = 0, height = 0;
-  std::vector<uint32_t> pixels;  // 0xXXRRGGBB
-};
-
-Image ReadPng(const std::string& path) {
-  Image image;
-  cairo_surface_t* s = cairo_image_surface_create_from_png(path.c_str());
-  if (cairo_surface_status(s) == CAIRO_STATUS_SUCCESS) {
-    cairo_surface_flush(s);
-    image.width = cairo_image_surface_get_width(s);
-    image.height = cairo_image_surface_get_height(s);
-    const unsigned char* data = cairo_image_surface_get_data(s);
-    const int stride = cairo_image_surface_get_stride(s);
-    for (int y = 0; y < image.height; ++y) {
-      const auto* row = reinterpret_cast<const uint32_t*>(data + static_cast<size_t>(y) * stride);
-      image.pixels.insert(image.pixels.end(), row, row + image.width);
-    }
-  }
-  cairo_surface_destroy(s);
-  return image;
-}
+using render_test::Image;
+using render_test::ReadPng;
 
 // Pixels whose red, green or blue differ by more than `tolerance` (of 255).
 int DifferingPixels(const Image& a, const Image& b, int tolerance) {

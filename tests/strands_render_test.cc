@@ -17,6 +17,7 @@
 
 #include "flexkin/strand_file.h"
 #include "flexkin/strands.h"
+#include "png_test_util.h"
 #include "render/canvas.h"
 #include "render/strands_scene.h"
 #include "render/style.h"
@@ -89,28 +90,8 @@ void WriteHairFile(const std::string& path, int num_strands, int links, int fram
   writer.Commit(StrandRunReport{});
 }
 
-struct Image {
-  int width = 0, height = 0;
-  std::vector<uint32_t> pixels;  // 0xXXRRGGBB
-};
-
-Image ReadPng(const std::string& path) {
-  Image image;
-  cairo_surface_t* s = cairo_image_surface_create_from_png(path.c_str());
-  if (cairo_surface_status(s) == CAIRO_STATUS_SUCCESS) {
-    cairo_surface_flush(s);
-    image.width = cairo_image_surface_get_width(s);
-    image.height = cairo_image_surface_get_height(s);
-    const unsigned char* data = cairo_image_surface_get_data(s);
-    const int stride = cairo_image_surface_get_stride(s);
-    for (int y = 0; y < image.height; ++y) {
-      const auto* row = reinterpret_cast<const uint32_t*>(data + static_cast<size_t>(y) * stride);
-      image.pixels.insert(image.pixels.end(), row, row + image.width);
-    }
-  }
-  cairo_surface_destroy(s);
-  return image;
-}
+using render_test::Image;
+using render_test::ReadPng;
 
 // Pixels of the shaded scalp: a light, slightly warm grey (red a little above blue, green
 // between), unlike the strands' purples and ambers and the white background.

@@ -328,22 +328,26 @@ TEST_F(TreeResultFileTest, TheCommandLineRunsAndValidatesTrees) {
     EXPECT_TRUE(std::filesystem::exists(dir_ / "out.npz"));
     EXPECT_NE(p.out().find("4 frames; 0 not reached"), std::string::npos) << p.out();
   }
-  {  // flexkin render says it does not draw trees yet, and what does (and is told the kind
-     // of a tree result, .npz or .json).
+  {  // flexkin render draws a tree result (.npz or .json) in the formats of trees, and names
+     // one it does not draw trees in.
     for (const char* name : {"out.npz", "out.json"}) {
       if (std::string(name) == "out.json") {
         CliProcess run(test_util::kCli, dir_.string(), {"run", scenario_, "-o", name});
         ASSERT_TRUE(run.Wait(60));
       }
       EXPECT_TRUE(IsTreeResultFile((dir_ / name).string()));
-      CliProcess p(test_util::kCli, dir_.string(), {"render", name, "-o", "."});
+      CliProcess p(test_util::kCli, dir_.string(),
+                   {"render", name, "-o", "drawn", "--formats", "svg,glb"});
       ASSERT_TRUE(p.Wait(60));
-      EXPECT_EQ(p.exit_code(), 1);
-      EXPECT_NE(p.err().find("is a tree result (docs/trees.md, \"Results\"); flexkin render "
-                             "does not draw trees yet"),
-                std::string::npos)
-          << p.err();
+      EXPECT_EQ(p.exit_code(), 0) << p.err();
+      EXPECT_TRUE(std::filesystem::exists(dir_ / "drawn" / "out.svg"));
+      EXPECT_TRUE(std::filesystem::exists(dir_ / "drawn" / "out.glb"));
     }
+    CliProcess p(test_util::kCli, dir_.string(), {"render", "out.npz", "--formats", "plots"});
+    ASSERT_TRUE(p.Wait(60));
+    EXPECT_NE(p.exit_code(), 0);
+    EXPECT_NE(p.err().find("format \"plots\" is not available for tree results"), std::string::npos)
+        << p.err();
     EXPECT_FALSE(IsTreeResultFile(scenario_));
   }
   {

@@ -22,6 +22,7 @@
 #include "flexkin/error.h"
 #include "flexkin/result_io.h"
 #include "flexkin/run.h"
+#include "flexkin/tree_scenario.h"
 #include "scenes/scenes.h"
 #include "test_util.h"
 
@@ -33,6 +34,37 @@ using test_util::ExpectInputError;
 
 // A run of a curved chain of `links` links whose leading end follows a smooth wavy path of
 // `steps` leader steps of about `step` each.
+// A tree result of `kind` (scenes::TreeShape) whose tips (scenes::TreeTips) go round circles for
+// `frames` frames, the root fixed where the tips are several, run by RunTree.
+TreeResultFile MakeTreeResult(scenes::TreeKind kind, int dim, int frames, const std::string& name) {
+  TreeScenario s;
+  s.name = name;
+  s.tree = scenes::TreeShape(kind, dim);
+  s.targets = scenes::TreeTips(kind);
+  if (kind == scenes::TreeKind::kBinary10) s.targets = {0};  // the root, driven: a plant
+  // TipCircles gives each frame's targets; a scenario holds each target's path.
+  const std::vector<Points> circles = scenes::TipCircles(s.tree, s.targets, frames);
+  s.paths.assign(s.targets.size(), Points(frames, dim));
+  for (int f = 0; f < frames; ++f) {
+    for (size_t k = 0; k < s.targets.size(); ++k) s.paths[k].row(f) = circles[f].row(k);
+  }
+  s.weights.assign(s.targets.size(), 1.0);
+  if (s.targets.size() > 1) s.fixed = {0};
+  const TreeRunResult run = RunTree(s);
+  TreeResultFile out;
+  out.name = name;
+  out.method = s.method;
+  out.dim = dim;
+  out.parents = s.tree.parents;
+  out.targets = s.targets;
+  out.fixed = s.fixed;
+  out.frames = run.frames;
+  for (size_t f = 0; f < run.reached.size(); ++f) {
+    out.reached.push_back(run.reached[f] && run.converged[f]);
+  }
+  return out;
+}
+
 ResultFile MakeResult(int dim, int links, int steps, double step, const std::string& name) {
   const Chain chain = scenes::CurvedChain(dim, links, 1.0, 2.5 / links);
   Points targets(steps, dim);
@@ -269,6 +301,12 @@ TEST_F(ViewerTest, PlaysScrubsAndMovesInHeadlessChromium) {
   ResultFile capsules_3d = MakeResult(3, 8, 120, 0.03, "capsules 3D");
   GiveLinkRadii(&capsules_3d);
   WriteViewerHtml(capsules_3d, options, Path("capsules_3d.html"));
+  // Trees: two arms reaching round circles (3D), and a binary tree of depth 10 driven at its
+  // root (2D, 2,046 links: the frame rate of a large tree).
+  WriteTreeViewerHtml(MakeTreeResult(scenes::TreeKind::kTwoArms, 3, 60, "two arms"), options,
+                      Path("tree_arms_3d.html"));
+  WriteTreeViewerHtml(MakeTreeResult(scenes::TreeKind::kBinary10, 2, 40, "binary tree"), options,
+                      Path("tree_binary_2d.html"));
   std::printf("page sizes: %ju, %ju, %ju bytes\n",
               static_cast<uintmax_t>(fs::file_size(Path("small_2d.html"))),
               static_cast<uintmax_t>(fs::file_size(Path("spatial_20x2650.html"))),
@@ -284,13 +322,15 @@ TEST_F(ViewerTest, PlaysScrubsAndMovesInHeadlessChromium) {
       RunCommand("node '" + source + "/tests/viewer/browser_check.mjs' '" + tools + "' '" + dir_ +
                      "' '" + Path("small_2d.html") + "' '" + Path("spatial_20x2650.html") + "' '" +
                      Path("planar_80x250.html") + "' '" + Path("capsules_2d.html") + "' '" +
-                     Path("capsules_3d.html") + "'",
+                     Path("capsules_3d.html") + "' '" + Path("tree_arms_3d.html") + "' '" +
+                     Path("tree_binary_2d.html") + "'",
                  &output);
   std::printf("%s", output.c_str());
   EXPECT_EQ(status, 0) << output;
   EXPECT_NE(output.find("all viewer checks passed"), std::string::npos);
-  for (const char* shot : {"small_2d-playing.png", "spatial_20x2650-trails.png",
-                           "planar_80x250-dragged.png", "capsules_3d-opened.png"}) {
+  for (const char* shot :
+       {"small_2d-playing.png", "spatial_20x2650-trails.png", "planar_80x250-dragged.png",
+        "capsules_3d-opened.png", "tree_arms_3d-playing.png", "tree_binary_2d-playing.png"}) {
     EXPECT_TRUE(fs::exists(Path(shot))) << shot;
   }
 }

@@ -20,7 +20,7 @@
 namespace flexkin {
 
 // What a file to draw holds.
-enum class DrawnKind { kChainResult, kRobotTrajectory, kStrandFile };
+enum class DrawnKind { kChainResult, kRobotTrajectory, kStrandFile, kTreeResult };
 
 // The options every component reads, and where the outputs go.
 struct DrawOptions {
@@ -83,6 +83,9 @@ std::string FormatNamesOf(DrawnKind kind);
 std::vector<std::string> Draw(const ResultFile& result, const DrawOptions& options);
 std::vector<std::string> Draw(const RobotTrajectoryFile& trajectory, const DrawOptions& options);
 std::vector<std::string> DrawStrandFile(const std::string& path, const DrawOptions& options);
+// A tree result (flexkin/tree_scenario.h) in svg, png, pdf, mp4, gif, gltf or glb; InputError
+// also for a tree ValidateTreeResult refuses.
+std::vector<std::string> Draw(const TreeResultFile& tree, const DrawOptions& options);
 
 // Whether a problem Draw, DrawStrandFile or DrawFile threw is one of the options (its field
 // "formats", a component's member such as "figure.width" or "strands.max_frames", or a writer's
@@ -90,8 +93,9 @@ std::vector<std::string> DrawStrandFile(const std::string& path, const DrawOptio
 // what is drawn.
 bool IsDrawOptionsProblem(const Problem& problem);
 
-// A file of any kind, told apart by its content (IsStrandFile, IsRobotTrajectoryFile, else a
-// result file, JSON or .npz), read once and drawn. A problem of the file is named by it
+// A file of any kind, told apart by its content (IsStrandFile, IsTreeResultFile,
+// IsRobotTrajectoryFile, else a result file, JSON or .npz), read once and drawn. A problem of the
+// file is named by it
 // ("r.json: /frames/3/points/2/1"); the options' problems by their member.
 DrawnKind KindOfDrawnFile(const std::string& path);
 std::vector<std::string> DrawFile(const std::string& path, const DrawOptions& options);

@@ -8,6 +8,7 @@
 
 #include "flexkin/result_io.h"
 #include "flexkin/robot_scenario.h"
+#include "flexkin/tree_scenario.h"
 #include "flexkin/vocabulary.h"
 
 namespace flexkin {
@@ -198,6 +199,17 @@ void WriteAnimation(const ResultFile& file, const AnimationOptions& options,
 // The same for a robot trajectory, drawn as its snapshot figure is.
 void WriteAnimation(const RobotTrajectoryFile& trajectory, const AnimationOptions& options,
                     const std::string& path);
+
+// Tree results (flexkin/tree_scenario.h; docs/trees.md, "Pictures"), drawn as a chain result's:
+// the figure shows every k-th frame fading from old to new, the first dashed, the last bold, each
+// link a line from its parent's point, the driven points' paths (show_leader_path) and the fixed
+// points' supports; the animation plays the frames with the driven points' paths so far. Throw
+// InputError for invalid options or a tree result ValidateTreeResult refuses, as the chain
+// writers do.
+void WriteTreeFigure(const TreeResultFile& tree, const FigureOptions& options,
+                     const std::string& path);
+void WriteTreeAnimation(const TreeResultFile& tree, const AnimationOptions& options,
+                        const std::string& path);
 
 namespace internal {
 

@@ -90,6 +90,10 @@ struct TreeResultFile {
 // pointer ("tree.json/parents/4", "frames.npy", "/frames/3/7/1") otherwise.
 TreeResultFile ReadTreeResultFile(const std::string& path);
 
+// The same checks of a tree result made in memory, each problem by its member ("frames[3][7][1]",
+// "parents[4]", "targets[0]", "reached"): what the pictures, animations and glTF of trees check.
+Problems ValidateTreeResult(const TreeResultFile& tree);
+
 // Whether the file at `path` is a tree result (.npz with tree.json and frames.npy, or JSON whose
 // "format" is "flexkin-tree-result"); false for anything else, unreadable files included.
 bool IsTreeResultFile(const std::string& path);

@@ -5,6 +5,7 @@
 
 #include "flexkin/result_io.h"
 #include "flexkin/robot_scenario.h"
+#include "flexkin/tree_scenario.h"
 
 namespace flexkin {
 
@@ -59,6 +60,17 @@ void WriteViewerHtml(const ResultFile& result, const ViewerOptions& options,
 // above.
 void WriteViewerHtml(const RobotTrajectoryFile& trajectory, const ViewerOptions& options,
                      const std::string& path);
+
+// The viewer page of a tree result (flexkin/tree_scenario.h; docs/trees.md, "Pictures"): each link
+// drawn from its parent's point, the driven points' paths where a chain's leading end's is,
+// supports under the fixed points; the panel gives the method, the points, the driven and fixed
+// points, the frames not reached and the largest relative link-length error against the first
+// frame's lengths (per frame too), the sparklines each point's path length and the distance the
+// points travel per frame. Throws InputError for invalid options, a trail point beyond the points
+// ("trail_points[i]") or a tree ValidateTreeResult refuses; std::system_error if the file cannot
+// be written. Written atomically.
+void WriteTreeViewerHtml(const TreeResultFile& tree, const ViewerOptions& options,
+                         const std::string& path);
 
 namespace internal {
 // The page of a drawing Draw (flexkin/draw.h) has checked, with options it has checked (the trail

@@ -311,7 +311,10 @@ keyframe: returns (times, positions), times (K,) float64 seconds and positions (
 float64, the world positions of the first skin's joints. For a file written by flexkin.render
 (formats gltf, glb) they are in flexkin's coordinates and length unit (the axis mapping and
 scale undone; dim the result's), one joint per point, leading end first: the frames to float32
-precision, at the times steps / GltfOptions.steps_per_second. Other files: glTF world
+precision, at the times steps / GltfOptions.steps_per_second. A tree result's file has a joint
+per link on the link's parent point, then a tip joint on each leaf (docs/gltf-export.md, "Trees";
+the file's asset.extras.flexkin.joint_points names each joint's point), frame f at
+f / steps_per_second. Other files: glTF world
 coordinates, metres, dim 3. Raises OSError for a file that cannot be read, InputError for one
 that is not valid glTF, has no skin, or uses what the reader does not support.
 )doc");
@@ -329,8 +332,8 @@ that is not valid glTF, has no skin, or uses what the reader does not support.
         py::arg("plot") = py::none(), py::arg("animation") = py::none(),
         py::arg("viewer") = py::none(), py::arg("gltf") = py::none(),
         (R"doc(
-Draws a Result, a RobotResult, or a file flexkin wrote (a result file, a robot trajectory or a
-strand file, told apart by content) as `flexkin render` draws it (docs/rendering.md), through the
+Draws a Result, a RobotResult, or a file flexkin wrote (a result file, a robot trajectory, a
+strand file or a tree result, told apart by content) as `flexkin render` draws it (docs/rendering.md), through the
 same library call, and returns the paths written.
 
 render(result, out_dir, formats=None, *, stem=None, every=None,

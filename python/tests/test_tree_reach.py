@@ -2,6 +2,8 @@
 targets"). The targets are reachable by construction (points of another configuration of the same
 tree), so every frame must reach them; one target with nothing fixed moves as move_tree moves the
 tree driven at that point, bit for bit; a target out of reach reports its residual."""
+import pathlib
+
 import numpy as np
 import pytest
 
@@ -132,3 +134,25 @@ def test_a_tree_scenario_runs_through_the_front_door(tmp_path):
     with pytest.raises(flexkin.InputError) as error:
         flexkin.run_scenario(scenario)
     assert error.value.field == "/fixed/1"
+
+
+def test_a_tree_result_is_drawn_by_render(tmp_path):
+    scenario = {
+        "format": "flexkin-tree",
+        "tree": {"points": ARMS.tolist(), "parents": ARM_PARENTS},
+        "targets": [{"point": 5, "path": [(ARMS[5] + [0.05 * k, 0.03 * k]).tolist()
+                                          for k in range(1, 6)]},
+                    {"point": 8, "path": [(ARMS[8] + [-0.04 * k, 0.05 * k]).tolist()
+                                          for k in range(1, 6)]}],
+        "fixed": [0],
+    }
+    result = flexkin.run_scenario(scenario, output=tmp_path / "tree.npz")
+    written = flexkin.render(tmp_path / "tree.npz", tmp_path / "drawn", "png,glb")
+    assert [pathlib.Path(p).name for p in written] == ["tree.png", "tree.glb"]
+    times, positions = flexkin.gltf_joint_positions(tmp_path / "drawn" / "tree.glb")
+    assert len(times) == len(result["frames"])
+    # Joint 0 sits on the root, point 0 (the fixed base).
+    np.testing.assert_allclose(positions[:, 0, :], result["frames"][:, 0, :], atol=1e-6)
+    with pytest.raises(flexkin.InputError) as error:
+        flexkin.render(tmp_path / "tree.npz", tmp_path / "drawn", "plots")
+    assert "is not available for tree results" in str(error.value)

@@ -22,6 +22,7 @@ struct Output {
   // What is drawn, checked (a chain result or a robot trajectory), or the strand file's path.
   std::optional<internal::CheckedDrawing> drawing;
   const std::string* strand_path = nullptr;
+  const TreeResultFile* tree = nullptr;      // a tree result, checked
   mutable std::vector<std::string> written;  // the paths, in order
 
   void Write(const std::string& path, const std::function<void()>& write) const {
@@ -95,6 +96,30 @@ void StrandOutput(const Output& o, OutputFormat format) {
   });
 }
 
+// A tree result's outputs (flexkin/render.h WriteTreeFigure, WriteTreeAnimation; flexkin/gltf.h
+// WriteTreeGltf).
+void TreeOutput(const Output& o, OutputFormat format) {
+  const std::string path = o.options.base + Extension(format);
+  o.Write(path, [&] {
+    switch (format) {
+      case OutputFormat::kMp4:
+      case OutputFormat::kGif:
+        WriteTreeAnimation(*o.tree, o.options.animation, path);
+        return;
+      case OutputFormat::kGltf:
+      case OutputFormat::kGlb:
+        WriteTreeGltf(*o.tree, o.options.gltf, path);
+        return;
+      case OutputFormat::kHtml:
+        WriteTreeViewerHtml(*o.tree, ViewerWithTitle(o.options), path);
+        return;
+      default:
+        WriteTreeFigure(*o.tree, o.options.figure, path);
+        return;
+    }
+  });
+}
+
 // The one table: for each format, its writer for each kind (null: not drawn in for that kind).
 // Add a format with one line here and one in the vocabulary (flexkin/render.h).
 struct FormatWriters {
@@ -102,19 +127,20 @@ struct FormatWriters {
   void (*chain)(const Output&, OutputFormat);
   void (*trajectory)(const Output&, OutputFormat);
   void (*strands)(const Output&, OutputFormat);
+  void (*tree)(const Output&, OutputFormat);
 };
 void PlotsOf(const Output& o, OutputFormat) { Plots(o); }
 void ViewerOf(const Output& o, OutputFormat) { Viewer(o); }
 constexpr FormatWriters kWriters[] = {
-    {OutputFormat::kSvg, Figure, Figure, StrandOutput},
-    {OutputFormat::kPng, Figure, Figure, StrandOutput},
-    {OutputFormat::kPdf, Figure, Figure, StrandOutput},
-    {OutputFormat::kPlots, PlotsOf, nullptr, nullptr},
-    {OutputFormat::kMp4, Animation, Animation, StrandOutput},
-    {OutputFormat::kGif, Animation, Animation, StrandOutput},
-    {OutputFormat::kHtml, ViewerOf, ViewerOf, StrandOutput},
-    {OutputFormat::kGltf, Gltf, nullptr, nullptr},
-    {OutputFormat::kGlb, Gltf, nullptr, nullptr},
+    {OutputFormat::kSvg, Figure, Figure, StrandOutput, TreeOutput},
+    {OutputFormat::kPng, Figure, Figure, StrandOutput, TreeOutput},
+    {OutputFormat::kPdf, Figure, Figure, StrandOutput, TreeOutput},
+    {OutputFormat::kPlots, PlotsOf, nullptr, nullptr, nullptr},
+    {OutputFormat::kMp4, Animation, Animation, StrandOutput, TreeOutput},
+    {OutputFormat::kGif, Animation, Animation, StrandOutput, TreeOutput},
+    {OutputFormat::kHtml, ViewerOf, ViewerOf, StrandOutput, TreeOutput},
+    {OutputFormat::kGltf, Gltf, nullptr, nullptr, TreeOutput},
+    {OutputFormat::kGlb, Gltf, nullptr, nullptr, TreeOutput},
 };
 static_assert(std::size(kWriters) == std::size(Vocabulary<OutputFormat>::kEntries),
               "every output format has a row of writers");
@@ -123,17 +149,49 @@ using Writer = void (*)(const Output&, OutputFormat);
 Writer WriterOf(DrawnKind kind, OutputFormat format) {
   for (const FormatWriters& w : kWriters) {
     if (w.format != format) continue;
-    return kind == DrawnKind::kChainResult       ? w.chain
-           : kind == DrawnKind::kRobotTrajectory ? w.trajectory
-                                                 : w.strands;
+    switch (kind) {
+      case DrawnKind::kChainResult:
+        return w.chain;
+      case DrawnKind::kRobotTrajectory:
+        return w.trajectory;
+      case DrawnKind::kStrandFile:
+        return w.strands;
+      case DrawnKind::kTreeResult:
+        return w.tree;
+    }
   }
   return nullptr;
 }
 
+constexpr DrawnKind kDrawnKinds[] = {DrawnKind::kChainResult, DrawnKind::kRobotTrajectory,
+                                     DrawnKind::kStrandFile, DrawnKind::kTreeResult};
+
 const char* KindName(DrawnKind kind) {
-  return kind == DrawnKind::kChainResult       ? "chain results"
-         : kind == DrawnKind::kRobotTrajectory ? "robot trajectories"
-                                               : "strand files";
+  switch (kind) {
+    case DrawnKind::kChainResult:
+      return "chain results";
+    case DrawnKind::kRobotTrajectory:
+      return "robot trajectories";
+    case DrawnKind::kStrandFile:
+      return "strand files";
+    case DrawnKind::kTreeResult:
+      return "tree results";
+  }
+  return "";
+}
+
+// "chain results only", "chain results and tree results": the kinds drawn in `format`.
+std::string KindsDrawnIn(OutputFormat format) {
+  std::vector<std::string> kinds;
+  for (const DrawnKind kind : kDrawnKinds) {
+    if (WriterOf(kind, format) != nullptr) kinds.push_back(KindName(kind));
+  }
+  if (kinds.size() == 1) return kinds[0] + " only";
+  std::string out;
+  for (size_t k = 0; k < kinds.size(); ++k) {
+    out += (k == 0 ? "" : k + 1 == kinds.size() ? " and " : ", ") + kinds[k];
+  }
+  return out;
 }
 
 void Prefixed(const Problems& problems, const std::string& prefix, Problems* out) {
@@ -144,11 +202,12 @@ void Prefixed(const Problems& problems, const std::string& prefix, Problems* out
 }
 
 // The viewer's trails name points of the drawing: at most its last point (n for a chain, the
-// base for a trajectory, point 0 its end effector).
+// base for a trajectory, point 0 its end effector; a tree's last point).
 void CheckTrailPoints(const Output& o) {
   const std::vector<int>& trails = o.options.viewer.trail_points;
-  if (!o.drawing) return;
-  const Eigen::Index last = o.drawing->result.result.lengths.size();
+  if (!o.drawing && o.tree == nullptr) return;
+  const Eigen::Index last = o.drawing ? o.drawing->result.result.lengths.size()
+                                      : static_cast<Eigen::Index>(o.tree->parents.size()) - 1;
   for (size_t i = 0; i < trails.size(); ++i) {
     if (trails[i] > last) {
       throw InputError(
@@ -234,13 +293,18 @@ Problems ValidateDrawOptions(DrawnKind kind, const DrawOptions& options) {
     const std::string name = NameOf(format);
     problems.push_back(Problem("formats",
                                "format \"" + name + "\" is not available for " + KindName(kind) +
-                                   " (it draws chain results only); expected formats among " +
-                                   valid,
+                                   " (it draws " + KindsDrawnIn(format) +
+                                   "); expected formats among " + valid,
                                "\"" + name + "\"", valid));
   }
   if (kind == DrawnKind::kStrandFile) {
     Prefixed(options.strands.Validate(), "strands.", &problems);
     Prefixed(options.strands_viewer.Validate(), "strands_viewer.", &problems);
+  } else if (kind == DrawnKind::kTreeResult) {
+    Prefixed(options.figure.Validate(), "figure.", &problems);
+    Prefixed(options.animation.Validate(), "animation.", &problems);
+    Prefixed(options.viewer.Validate(), "viewer.", &problems);
+    Prefixed(options.gltf.Validate(), "gltf.", &problems);
   } else {
     Prefixed(options.figure.Validate(), "figure.", &problems);
     Prefixed(options.animation.Validate(), "animation.", &problems);
@@ -311,6 +375,14 @@ std::vector<std::string> Draw(const RobotTrajectoryFile& trajectory, const DrawO
   return DrawChecked(DrawnKind::kRobotTrajectory, o);
 }
 
+std::vector<std::string> Draw(const TreeResultFile& tree, const DrawOptions& options) {
+  ThrowIfAny(ValidateDrawOptions(DrawnKind::kTreeResult, options));
+  ThrowIfAny(ValidateTreeResult(tree));
+  Output o(options);
+  o.tree = &tree;
+  return DrawChecked(DrawnKind::kTreeResult, o);
+}
+
 std::vector<std::string> DrawStrandFile(const std::string& path, const DrawOptions& options) {
   ThrowIfAny(ValidateDrawOptions(DrawnKind::kStrandFile, options));
   StrandFileReader check(path);  // the file's own problems before any output
@@ -331,22 +403,18 @@ bool IsDrawOptionsProblem(const Problem& problem) {
 
 DrawnKind KindOfDrawnFile(const std::string& path) {
   if (IsStrandFile(path)) return DrawnKind::kStrandFile;
+  if (IsTreeResultFile(path)) return DrawnKind::kTreeResult;
   if (IsRobotTrajectoryFile(path)) return DrawnKind::kRobotTrajectory;
   return DrawnKind::kChainResult;
 }
 
 std::vector<std::string> DrawFile(const std::string& path, const DrawOptions& options) {
-  if (IsTreeResultFile(path)) {
-    throw InputError(Problem(path,
-                             "is a tree result (docs/trees.md, \"Results\"); flexkin render "
-                             "does not draw trees yet: examples/python/tree_figure.py "
-                             "draws one"));
-  }
   const DrawnKind kind = KindOfDrawnFile(path);
   ThrowIfAny(ValidateDrawOptions(kind, options));  // the options' problems first, once
   Output o(options);
   ResultFile result;
   RobotTrajectoryFile trajectory;
+  TreeResultFile tree;
   try {
     // The file read once; its problems, found reading or drawing, are named by the file
     // ("r.json: /frames/3/points/2/1"), except an option found wrong only against the file
@@ -362,6 +430,10 @@ std::vector<std::string> DrawFile(const std::string& path, const DrawOptions& op
         trajectory = ReadRobotTrajectoryFile(path);
         result = TrajectoryAsCheckedResult(trajectory);
         o.drawing.emplace(internal::CheckedDrawing{result, &trajectory});
+        break;
+      case DrawnKind::kTreeResult:
+        tree = ReadTreeResultFile(path);  // .npz or JSON, checked by the reader
+        o.tree = &tree;
         break;
       case DrawnKind::kChainResult:
         result = ReadResultFile(path);  // JSON or .npz, by content; checked by the reader

@@ -187,6 +187,7 @@ void AddTreeMesh(const TreeResultFile& tree, const gltf::TreeSkeleton& skeleton,
 void WriteTreeGltf(const TreeResultFile& tree, const GltfOptions& options,
                    const std::string& path) {
   ThrowIfAny(options.Validate());
+  ThrowIfAny(ValidateTreeResult(tree));
   const bool binary = gltf::IsBinaryPath(path);
   const gltf::TreeSkeleton skeleton = gltf::MakeTreeSkeleton(tree.parents);
   CheckTreeGltfLimits(tree, skeleton, options);

@@ -198,21 +198,62 @@ TreeResultFile ReadJson(const std::string& path) {
   return out;
 }
 
-// What both forms check once read: finite coordinates and a tree without links of length 0.
-// `frame_field(f, i, k)`: the name of coordinate k of point i of frame f in the file's form.
-void CheckTreeResult(const TreeResultFile& out, bool npz) {
+// How a problem's place is named: a file's member or JSON pointer, or a member path.
+enum class Naming { kNpz, kJson, kMember };
+
+// A tree result's checks (ReadTreeResultFile after reading, ValidateTreeResult): shapes, finite
+// coordinates, the parents a tree without links of length 0 in the first frame, targets and
+// fixed points among the points, a report per frame after the first. The first problem found.
+Problems CheckTreeResult(const TreeResultFile& out, Naming naming) {
+  const bool member = naming == Naming::kMember, npz = naming == Naming::kNpz;
   auto point = [&](size_t f, Eigen::Index i) {
-    return npz ? "frames.npy[" + std::to_string(f) + "][" + std::to_string(i) + "]"
-               : "/frames/" + std::to_string(f) + "/" + std::to_string(i);
+    return member ? "frames[" + std::to_string(f) + "][" + std::to_string(i) + "]"
+           : npz  ? "frames.npy[" + std::to_string(f) + "][" + std::to_string(i) + "]"
+                  : "/frames/" + std::to_string(f) + "/" + std::to_string(i);
   };
+  auto coordinate = [&](size_t f, Eigen::Index i, Eigen::Index k) {
+    return naming == Naming::kJson ? point(f, i) + "/" + std::to_string(k)
+                                   : point(f, i) + "[" + std::to_string(k) + "]";
+  };
+  const Eigen::Index rows = static_cast<Eigen::Index>(out.parents.size());
+  if (member) {  // what the readers have checked already
+    if (out.dim != 2 && out.dim != 3) {
+      return {Problem::Invalid("dim", std::to_string(out.dim), "2 or 3")};
+    }
+    if (out.frames.empty()) return {Problem("frames", "is empty; expected at least the start")};
+    for (size_t f = 0; f < out.frames.size(); ++f) {
+      if (out.frames[f].rows() != rows || out.frames[f].cols() != out.dim) {
+        return {Problem("frames[" + std::to_string(f) + "]",
+                        "is " + std::to_string(out.frames[f].rows()) + " by " +
+                            std::to_string(out.frames[f].cols()) + "; expected " +
+                            std::to_string(rows) + " by " + std::to_string(out.dim) +
+                            " (a row per parent entry, dim columns)")};
+      }
+    }
+    if (out.reached.size() + 1 != out.frames.size()) {
+      return {Problem("reached", "has " + std::to_string(out.reached.size()) +
+                                     " entries; expected one per frame after the first (" +
+                                     std::to_string(out.frames.size() - 1) + ")")};
+    }
+    for (const auto& [name, points] :
+         {std::pair<const char*, const std::vector<int>*>{"targets", &out.targets},
+          {"fixed", &out.fixed}}) {
+      for (size_t k = 0; k < points->size(); ++k) {
+        if ((*points)[k] < 0 || (*points)[k] >= rows) {
+          return {Problem::Invalid(std::string(name) + "[" + std::to_string(k) + "]",
+                                   std::to_string((*points)[k]),
+                                   "a point from 0 to " + std::to_string(rows - 1))};
+        }
+      }
+    }
+  }
   for (size_t f = 0; f < out.frames.size(); ++f) {
     const Points& p = out.frames[f];
     for (Eigen::Index i = 0; i < p.rows(); ++i) {
       for (Eigen::Index k = 0; k < p.cols(); ++k) {
         if (!std::isfinite(p(i, k))) {
-          throw InputError(npz ? point(f, i) + "[" + std::to_string(k) + "]"
-                               : point(f, i) + "/" + std::to_string(k),
-                           FormatNumber(p(i, k)) + " is not valid; expected a finite number");
+          return {Problem(coordinate(f, i, k),
+                          FormatNumber(p(i, k)) + " is not valid; expected a finite number")};
         }
       }
     }
@@ -227,11 +268,12 @@ void CheckTreeResult(const TreeResultFile& out, bool npz) {
         open == std::string::npos ? "" : p.field.substr(open + 1, close - open - 1);
     if (p.field.rfind("points", 0) == 0) {
       p.field = point(0, std::stol(index)) + p.field.substr(close + 1);
-    } else if (p.field.rfind("parents", 0) == 0) {
+    } else if (p.field.rfind("parents", 0) == 0 && !member) {
       p.field = (npz ? "tree.json/parents/" : "/parents/") + index;
     }
-    throw InputError(p);
+    return {p};
   }
+  return {};
 }
 
 }  // namespace
@@ -245,8 +287,12 @@ TreeResultFile ReadTreeResultFile(const std::string& path) {
     std::fclose(file);
   }
   TreeResultFile out = npz ? ReadNpz(path) : ReadJson(path);
-  CheckTreeResult(out, npz);
+  ThrowIfAny(CheckTreeResult(out, npz ? Naming::kNpz : Naming::kJson));
   return out;
+}
+
+Problems ValidateTreeResult(const TreeResultFile& tree) {
+  return CheckTreeResult(tree, Naming::kMember);
 }
 
 }  // namespace flexkin

@@ -17,12 +17,12 @@
 #include "render/ffmpeg_pipe.h"
 #include "render/scene.h"
 #include "render/snapshot.h"
+#include "render/video.h"
 
 namespace flexkin {
 namespace {
 
 using render::ChainScene;
-using render::VideoFormat;
 
 // What stays the same in every picture: title, axes, the whole leader path faintly, the
 // initial configuration.
@@ -91,61 +91,31 @@ void DrawMoment(render::Canvas* canvas, const ChainScene& scene, const ResultFil
   }
   const Eigen::Vector2d head = scene.Pixel(file, f, 0);
   render::Disc(cr, head.x(), head.y(), 4.2 * ui, render::kFinal);
-  render::TextStyle counter;
-  counter.size = 12 * ui;
-  counter.halign = render::Align::kEnd;
-  counter.valign = render::Align::kEnd;
-  counter.color = render::kMuted;
-  render::DrawText(
-      cr, canvas->width() - 10 * ui, canvas->height() - 8 * ui,
-      "step " + std::to_string(frames[f].step) + " of " + std::to_string(file.result.num_steps),
-      counter);
+  render::DrawCounter(
+      cr, ui, canvas->width(), canvas->height(),
+      "step " + std::to_string(frames[f].step) + " of " + std::to_string(file.result.num_steps));
 }
 
 void DrawAnimation(const ResultFile& file, const render::Look& look,
                    const AnimationOptions& options, const std::string& path) {
-  const VideoFormat format = render::VideoFormatFromPath(path);
-  const int width = options.width + options.width % 2;
-  int height = options.height != 0
-                   ? options.height
-                   : render::AutoHeight(file, width, options.azimuth, options.elevation, 0.0);
-  height += height % 2;
-  const int num_frames = static_cast<int>(file.result.frames.size());
-  const int every_k =
-      options.every_k > 0
-          ? options.every_k
-          : std::max(1, (num_frames - 1 + options.max_frames - 2) / (options.max_frames - 1));
-  const std::vector<int> drawn = SnapshotFrames(num_frames, every_k);
-
+  int width = 0, height = 0;
+  render::AnimationSize(
+      options,
+      [&](int w) { return render::AutoHeight(file, w, options.azimuth, options.elevation, 0.0); },
+      &width, &height);
+  const std::vector<int> drawn =
+      render::AnimationFrames(static_cast<int>(file.result.frames.size()), options);
   const double ui = render::UiScale(width, height);
   const ChainScene scene(file, render::SceneArea(file.dim, width, height), ui, options.azimuth,
                          options.elevation);
   render::Canvas background(ImageFormat::kPng, width, height);
   DrawBackground(&background, scene, file, look, options.title);
-  cairo_surface_flush(background.surface());
-  render::Canvas picture(ImageFormat::kPng, width, height);
-
-  // Video frames per picture, so that short runs last min_seconds; the last one also holds
-  // for end_pause.
-  const int pictures = static_cast<int>(drawn.size());
-  const int repeat =
-      std::max(1, static_cast<int>(std::ceil(options.min_seconds * options.fps / pictures - 1e-9)));
-  const int pause = static_cast<int>(std::lround(options.end_pause * options.fps));
-  int d = 0;
-  render::WriteVideo(options.ffmpeg, format, width, height, options.fps, options.crf, path,
-                     [&](render::VideoPicture* out) {
-                       if (d == pictures) return false;
-                       if (options.progress) options.progress(d, pictures);
-                       cairo_t* cr = picture.cr();
-                       cairo_set_source_surface(cr, background.surface(), 0, 0);
-                       cairo_paint(cr);
-                       DrawMoment(&picture, scene, file, drawn, d);
-                       out->pixels = picture.Pixels();
-                       out->stride = picture.Stride();
-                       out->copies = repeat + (d == pictures - 1 ? pause : 0);
-                       ++d;
-                       return true;
-                     });
+  render::WritePictures(
+      options, background, static_cast<int>(drawn.size()),
+      [&](int d, render::Canvas* picture) {
+        DrawMoment(picture, scene, file, drawn, static_cast<size_t>(d));
+      },
+      path);
 }
 
 }  // namespace
@@ -164,6 +134,63 @@ void WriteAnimation(const RobotTrajectoryFile& trajectory, const AnimationOption
   render::CheckDrawable(result);
   internal::WriteAnimation({result, &trajectory}, options, path);
 }
+
+namespace render {
+
+std::vector<int> AnimationFrames(int num_frames, const AnimationOptions& options) {
+  const int every_k =
+      options.every_k > 0
+          ? options.every_k
+          : std::max(1, (num_frames - 1 + options.max_frames - 2) / (options.max_frames - 1));
+  return SnapshotFrames(num_frames, every_k);
+}
+
+void AnimationSize(const AnimationOptions& options, const std::function<int(int)>& auto_height,
+                   int* width, int* height) {
+  *width = options.width + options.width % 2;
+  *height = options.height != 0 ? options.height : auto_height(*width);
+  *height += *height % 2;
+}
+
+void WritePictures(const AnimationOptions& options, const Canvas& background, int pictures,
+                   const std::function<void(int d, Canvas* picture)>& moment,
+                   const std::string& path) {
+  const VideoFormat format = VideoFormatFromPath(path);
+  const int width = background.width(), height = background.height();
+  cairo_surface_flush(background.surface());
+  Canvas picture(ImageFormat::kPng, width, height);
+  // Video frames per picture, so that short runs last min_seconds; the last one also holds
+  // for end_pause.
+  const int repeat =
+      std::max(1, static_cast<int>(std::ceil(options.min_seconds * options.fps / pictures - 1e-9)));
+  const int pause = static_cast<int>(std::lround(options.end_pause * options.fps));
+  int d = 0;
+  WriteVideo(options.ffmpeg, format, width, height, options.fps, options.crf, path,
+             [&](VideoPicture* out) {
+               if (d == pictures) return false;
+               if (options.progress) options.progress(d, pictures);
+               cairo_t* cr = picture.cr();
+               cairo_set_source_surface(cr, background.surface(), 0, 0);
+               cairo_paint(cr);
+               moment(d, &picture);
+               out->pixels = picture.Pixels();
+               out->stride = picture.Stride();
+               out->copies = repeat + (d == pictures - 1 ? pause : 0);
+               ++d;
+               return true;
+             });
+}
+
+void DrawCounter(cairo_t* cr, double ui, int width, int height, const std::string& text) {
+  TextStyle counter;
+  counter.size = 12 * ui;
+  counter.halign = Align::kEnd;
+  counter.valign = Align::kEnd;
+  counter.color = kMuted;
+  DrawText(cr, width - 10 * ui, height - 8 * ui, text, counter);
+}
+
+}  // namespace render
 
 void internal::WriteAnimation(const CheckedDrawing& drawing, const AnimationOptions& options,
                               const std::string& path) {

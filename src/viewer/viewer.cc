@@ -96,6 +96,15 @@ void WriteViewerHtml(const ResultFile& result, const ViewerOptions& options,
   internal::WriteViewerHtml({result}, options, path);
 }
 
+void WriteTreeViewerHtml(const TreeResultFile& tree, const ViewerOptions& options,
+                         const std::string& path) {
+  CheckOptions(options);
+  ThrowIfAny(ValidateTreeResult(tree));
+  const ResultFile shown = viewer_internal::TreeAsViewerResult(tree);
+  viewer_internal::CheckResult(shown, options);  // the trail points among the tree's
+  WritePage(viewer_internal::ViewerDataJson(shown, options, nullptr, &tree), path);
+}
+
 void WriteViewerHtml(const RobotTrajectoryFile& trajectory, const ViewerOptions& options,
                      const std::string& path) {
   CheckOptions(options);

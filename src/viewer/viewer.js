@@ -31,6 +31,17 @@
   const options = data.options;
   // A robot trajectory (include/flexkin/viewer.h): point 0 the end effector, the last the fixed base.
   const robot = data.robot || null;
+  // A tree result (viewer_data.cc, "tree"): link k joins point linkA[k] (its parent, nearer the
+  // root) to point linkB[k]; a chain's link k joins points k and k+1.
+  const tree = data.tree || null;
+  const numLinks = numPoints - 1;
+  const linkA = new Int32Array(numLinks), linkB = new Int32Array(numLinks);
+  for (let k = 0; k < numLinks; ++k) {
+    linkA[k] = tree ? tree.parents[tree.link_points[k]] : k;
+    linkB[k] = tree ? tree.link_points[k] : k + 1;
+  }
+  // The points whose paths are drawn as the leader's: a tree's driven points, else point 0.
+  const leaders = tree ? tree.targets : [0];
 
   // Bounding box of the whole motion, its centre and the radius of its bounding sphere.
   const lo = [Infinity, Infinity, Infinity];
@@ -166,8 +177,9 @@
   }
   const screenX = new Float64Array(numPoints);
   const screenY = new Float64Array(numPoints);
-  const linkDepth = new Float64Array(numPoints);
-  const linkOrder = Array.from({ length: numPoints - 1 }, (_, i) => i);
+  const pointDepth = new Float64Array(numPoints);
+  const linkDepth = new Float64Array(numLinks);
+  const linkOrder = Array.from({ length: numLinks }, (_, i) => i);
   const byDepth = (a, b) => linkDepth[a] - linkDepth[b];
 
   // A round step (1, 2 or 5 times a power of ten) for about `count` grid lines over `range`.
@@ -272,7 +284,7 @@
       g.globalAlpha = 0.45;
       g.lineWidth = 1.25;
       g.setLineDash([5, 4]);
-      strokePath(g, 0, numFrames - 1);
+      for (const i of leaders) strokePath(g, i, numFrames - 1);
       g.setLineDash([]);
       g.globalAlpha = 1;
     }
@@ -359,8 +371,8 @@
   const capsuleDepth = new Float64Array(numPoints - 1);
   const capsuleByDepth = (a, b) => capsuleDepth[a] - capsuleDepth[b];
   function drawCapsules(g) {
-    for (let i = 0; i + 1 < numPoints; ++i) {
-      capsuleDepth[i] = 0.5 * (linkDepth[i] + linkDepth[i + 1]);
+    for (let i = 0; i < numLinks; ++i) {
+      capsuleDepth[i] = 0.5 * (pointDepth[linkA[i]] + pointDepth[linkB[i]]);
     }
     if (dim === 3) capsuleOrder.sort(capsuleByDepth);
     for (let j = 0; j < capsuleOrder.length; ++j) {
@@ -373,10 +385,37 @@
       g.strokeStyle = capsuleShades[Math.round(15 * t)];
       g.lineWidth = 2 * r * view.scale * f;
       g.beginPath();
-      g.moveTo(screenX[i], screenY[i]);
-      g.lineTo(screenX[i + 1], screenY[i + 1]);
+      g.moveTo(screenX[linkA[i]], screenY[linkA[i]]);
+      g.lineTo(screenX[linkB[i]], screenY[linkB[i]]);
       g.stroke();
     }
+  }
+
+  // A fixed point's support: a dark triangle, its apex on the point, standing on a ground line.
+  function drawSupport(g, bx, by) {
+    g.fillStyle = colors.tail;
+    g.beginPath();
+    g.moveTo(bx, by);
+    g.lineTo(bx + 7, by + 10);
+    g.lineTo(bx - 7, by + 10);
+    g.closePath();
+    g.fill();
+    g.strokeStyle = colors.tail;
+    g.lineWidth = 1.5;
+    g.beginPath();
+    g.moveTo(bx - 10, by + 10);
+    g.lineTo(bx + 10, by + 10);
+    g.stroke();
+  }
+
+  // A tree's links: one path of separate segments, parent to child.
+  function strokeTreeLinks(g, xOf, yOf) {
+    g.beginPath();
+    for (let k = 0; k < numLinks; ++k) {
+      g.moveTo(xOf(linkA[k]), yOf(linkA[k]));
+      g.lineTo(xOf(linkB[k]), yOf(linkB[k]));
+    }
+    g.stroke();
   }
 
   function drawChain(g, frame) {
@@ -384,7 +423,7 @@
       projectPoint(frame, i);
       screenX[i] = sx;
       screenY[i] = sy;
-      linkDepth[i] = sdepth;
+      pointDepth[i] = sdepth;
     }
     g.lineCap = 'round';
     g.lineJoin = 'round';
@@ -392,23 +431,40 @@
     if (dim === 2) {
       g.strokeStyle = '#2b4c8c';
       g.lineWidth = 3;
-      g.beginPath();
-      g.moveTo(screenX[0], screenY[0]);
-      for (let i = 1; i < numPoints; ++i) g.lineTo(screenX[i], screenY[i]);
-      g.stroke();
+      if (tree) {
+        strokeTreeLinks(g, (i) => screenX[i], (i) => screenY[i]);
+      } else {
+        g.beginPath();
+        g.moveTo(screenX[0], screenY[0]);
+        for (let i = 1; i < numPoints; ++i) g.lineTo(screenX[i], screenY[i]);
+        g.stroke();
+      }
     } else {
       // The chain's shadow on the floor grid, straight down: where it is over the floor.
       g.strokeStyle = colors.shadow;
       g.lineWidth = 2;
-      g.beginPath();
-      for (let i = 0; i < numPoints; ++i) {
-        const o = frame * frameStride + i * dim;
-        project(pos[o], pos[o + 1], lo[2]);
-        if (i === 0) g.moveTo(sx, sy); else g.lineTo(sx, sy);
+      if (tree) {
+        const shadowX = new Float64Array(numPoints), shadowY = new Float64Array(numPoints);
+        for (let i = 0; i < numPoints; ++i) {
+          const o = frame * frameStride + i * dim;
+          project(pos[o], pos[o + 1], lo[2]);
+          shadowX[i] = sx;
+          shadowY[i] = sy;
+        }
+        strokeTreeLinks(g, (i) => shadowX[i], (i) => shadowY[i]);
+      } else {
+        g.beginPath();
+        for (let i = 0; i < numPoints; ++i) {
+          const o = frame * frameStride + i * dim;
+          project(pos[o], pos[o + 1], lo[2]);
+          if (i === 0) g.moveTo(sx, sy); else g.lineTo(sx, sy);
+        }
+        g.stroke();
       }
-      g.stroke();
-      // Link i joins points i and i+1; far links first so near ones cover them.
-      for (let i = 0; i + 1 < numPoints; ++i) linkDepth[i] = 0.5 * (linkDepth[i] + linkDepth[i + 1]);
+      // Link k joins points linkA[k] and linkB[k]; far links first so near ones cover them.
+      for (let k = 0; k < numLinks; ++k) {
+        linkDepth[k] = 0.5 * (pointDepth[linkA[k]] + pointDepth[linkB[k]]);
+      }
       linkOrder.sort(byDepth);
       for (let j = 0; j < linkOrder.length; ++j) {
         const i = linkOrder[j];
@@ -416,8 +472,8 @@
         g.strokeStyle = shades[Math.round(15 * t)];
         g.lineWidth = 1.5 + 2.75 * t;
         g.beginPath();
-        g.moveTo(screenX[i], screenY[i]);
-        g.lineTo(screenX[i + 1], screenY[i + 1]);
+        g.moveTo(screenX[linkA[i]], screenY[linkA[i]]);
+        g.lineTo(screenX[linkB[i]], screenY[linkB[i]]);
         g.stroke();
       }
     }
@@ -428,30 +484,30 @@
       g.strokeStyle = '#2b4c8c';
       g.lineWidth = 1;
       const r = Math.min(3, linkPixels / 5);
-      for (let i = 1; i < numPoints - 1; ++i) {
+      for (let i = tree ? 0 : 1; i < numPoints - (tree ? 0 : 1); ++i) {
         g.beginPath();
         g.arc(screenX[i], screenY[i], r, 0, 2 * Math.PI);
         g.fill();
         g.stroke();
       }
     }
-    g.fillStyle = colors.tail;
-    g.beginPath();
+    if (tree) {
+      // The fixed points' supports and the driven points.
+      for (const i of tree.fixed) drawSupport(g, screenX[i], screenY[i]);
+      g.fillStyle = colors.lead;
+      for (const i of leaders) {
+        g.beginPath();
+        g.arc(screenX[i], screenY[i], 5, 0, 2 * Math.PI);
+        g.fill();
+      }
+      return;
+    }
     if (robot) {
-      // The fixed base: a support, its apex on the point, standing on a ground line.
-      const bx = screenX[numPoints - 1], by = screenY[numPoints - 1];
-      g.moveTo(bx, by);
-      g.lineTo(bx + 7, by + 10);
-      g.lineTo(bx - 7, by + 10);
-      g.closePath();
-      g.fill();
-      g.strokeStyle = colors.tail;
-      g.lineWidth = 1.5;
-      g.beginPath();
-      g.moveTo(bx - 10, by + 10);
-      g.lineTo(bx + 10, by + 10);
-      g.stroke();
+      // The fixed base.
+      drawSupport(g, screenX[numPoints - 1], screenY[numPoints - 1]);
     } else {
+      g.fillStyle = colors.tail;
+      g.beginPath();
       g.arc(screenX[numPoints - 1], screenY[numPoints - 1], 3.5, 0, 2 * Math.PI);
       g.fill();
     }
@@ -474,7 +530,7 @@
     if (state.showLeader && state.frame > 0) {
       g.strokeStyle = colors.leader;
       g.lineWidth = 2;
-      strokePath(g, 0, state.frame);
+      for (const i of leaders) strokePath(g, i, state.frame);
     }
     if (state.showTrails) {
       g.lineWidth = 1.5;
@@ -555,11 +611,50 @@
     $('title').textContent = data.title;
     if (robot) {
       buildRobotPanel();
+    } else if (tree) {
+      buildTreePanel();
     } else {
       buildChainPanel();
     }
     $('perspective-control').hidden = dim !== 3;
     common.showHint(dim, 'click a point: trail');
+  }
+
+  // A tree result's panel: its points, targets and fixed points, what was reached; the first
+  // driven point and the root for the leading and trailing ends.
+  function buildTreePanel() {
+    const count = (n, one, many) => n + ' ' + (n === 1 ? one : many);
+    $('subtitle').textContent = 'tree, ' + data.method + ', ' + dim + 'D, ' +
+        count(numPoints, 'point', 'points') + ', ' + count(tree.targets.length, 'target', 'targets') +
+        (tree.fixed.length > 0 ? ', ' + tree.fixed.length + ' fixed' : '') + ', ' +
+        (tree.not_reached > 0 ? tree.not_reached + ' frames not reached' : 'all reached');
+    const facts = $('facts');
+    if (data.scenario) addFact(facts, 'Scenario', data.scenario);
+    addFact(facts, 'Method', data.method);
+    addFact(facts, 'Dimension', dim + 'D');
+    addFact(facts, 'Points', String(numPoints));
+    addFact(facts, 'Links (total length)', numLinks + ' (' + fmt(totalLength) + ')');
+    addFact(facts, 'Driven points', tree.targets.join(', '));
+    if (tree.fixed.length > 0) addFact(facts, 'Fixed points', tree.fixed.join(', '));
+    addFact(facts, 'Frames', String(numFrames));
+    const missed = addFact(facts, 'Frames not reached', String(tree.not_reached));
+    if (tree.not_reached > 0) missed.style.color = colors.lead;
+    addFact(facts, 'Link-length error (max)', fmt(metrics.max_relative_length_error));
+    addFact(facts, 'L2 total', fmt(metrics.l2_total));
+    const now = $('now');
+    nowFields.step = addFact(now, 'Frame', '');
+    nowFields.error = addFact(now, 'Link-length error', '');
+    nowFields.lead = addFact(now, 'Point ' + leaders[0] + ' (driven)', '');
+    nowFields.tail = addFact(now, 'Point ' + tree.parents.indexOf(-1) + ' (root)', '');
+    const leader = $('leader').parentNode;
+    leader.title = 'The driven points\' paths (L)';
+    leader.lastChild.textContent = ' Driven paths';
+    const ends = document.querySelectorAll('#profile + .axis span');
+    if (ends.length === 2) {
+      ends[0].textContent = 'point 0';
+      ends[1].textContent = 'point ' + (numPoints - 1);
+    }
+    $('l2plot').previousElementSibling.textContent = 'L2 per frame';
   }
 
   function buildChainPanel() {
@@ -678,12 +773,12 @@
     shownFrame = state.frame;
     const f = state.frame;
     $('timeline').value = String(f);
-    $('counter').textContent = 'frame ' + (f + 1) + ' / ' + numFrames + ' \u00b7 step ' +
-        steps[f] + ' / ' + data.num_steps;
+    $('counter').textContent = 'frame ' + (f + 1) + ' / ' + numFrames +
+        (tree ? '' : ' \u00b7 step ' + steps[f] + ' / ' + data.num_steps);
     nowFields.step.textContent = String(steps[f]);
     if (nowFields.error) nowFields.error.textContent = fmt(data.frame_length_error[f]);
-    nowFields.lead.textContent = pointText(f, 0);
-    nowFields.tail.textContent = pointText(f, numPoints - 1);
+    nowFields.lead.textContent = pointText(f, leaders[0]);
+    nowFields.tail.textContent = pointText(f, tree ? tree.parents.indexOf(-1) : numPoints - 1);
     drawSparks();
   }
 
@@ -864,6 +959,8 @@
     numFrames,
     numPoints,
     dim,
+    // The links drawn, as pairs of points [a, b] (a chain's: [k, k + 1]).
+    links: Array.from(linkA, (a, k) => [a, linkB[k]]),
     stats,
     view,
     // Where point i of the current frame is drawn, CSS pixels from the canvas's top left.

@@ -71,14 +71,26 @@ void AppendExactArray(const Eigen::VectorXd& v, std::string* out) {
   out->push_back(']');
 }
 
-// Largest |(|x_i - x_{i-1}| - L_i)| / L_i of one frame, from the unrounded coordinates.
-double FrameLengthError(const Points& p, const Eigen::VectorXd& lengths) {
+// Largest |(|x_b - x_a| - L_k)| / L_k of one frame over its links k (from point a[k] to b[k]:
+// a chain's from k to k + 1, a tree's from a point's parent to it), from the unrounded
+// coordinates.
+double FrameLengthError(const Points& p, const Eigen::VectorXd& lengths, const std::vector<int>& a,
+                        const std::vector<int>& b) {
   double worst = 0.0;
-  for (Eigen::Index i = 1; i < p.rows(); ++i) {
-    const double d = (p.row(i) - p.row(i - 1)).norm();
-    worst = std::max(worst, std::abs(d - lengths[i - 1]) / lengths[i - 1]);
+  for (size_t k = 0; k < a.size(); ++k) {
+    const double d = (p.row(b[k]) - p.row(a[k])).norm();
+    worst = std::max(worst, std::abs(d - lengths[k]) / lengths[k]);
   }
   return worst;
+}
+
+void AppendInts(const std::vector<int>& v, std::string* out) {
+  out->push_back('[');
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (i > 0) out->push_back(',');
+    *out += std::to_string(v[i]);
+  }
+  out->push_back(']');
 }
 
 // The colliders: each in its scenario form (io/colliders_json.h) with "bounds" (the box the view
@@ -159,8 +171,51 @@ void AppendColliders(const ResultFile& file, int digits, std::string* out) {
 
 }  // namespace
 
+std::vector<int> TreeLinkPoints(const TreeResultFile& tree) {
+  std::vector<int> points;
+  for (size_t i = 0; i < tree.parents.size(); ++i) {
+    if (tree.parents[i] >= 0) points.push_back(static_cast<int>(i));
+  }
+  return points;
+}
+
+ResultFile TreeAsViewerResult(const TreeResultFile& tree) {
+  ResultFile file;
+  file.dim = tree.dim;
+  file.scenario_name = tree.name;
+  RunResult& r = file.result;
+  r.method = tree.method;
+  const std::vector<int> ends = TreeLinkPoints(tree);
+  const Points& first = tree.frames.front();
+  r.lengths.resize(static_cast<Eigen::Index>(ends.size()));
+  for (size_t k = 0; k < ends.size(); ++k) {
+    r.lengths[k] = (first.row(ends[k]) - first.row(tree.parents[ends[k]])).norm();
+  }
+  const size_t frames = tree.frames.size();
+  r.num_steps = static_cast<int64_t>(frames) - 1;
+  Metrics& m = r.metrics;
+  m.path_length = Eigen::VectorXd::Zero(first.rows());
+  m.l2_per_step = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(frames - 1));
+  m.l2_weighted_per_step = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(frames - 1));
+  for (size_t f = 0; f < frames; ++f) {
+    r.frames.Add(static_cast<int64_t>(f), tree.frames[f]);
+    for (size_t k = 0; k < ends.size(); ++k) {
+      const double d =
+          (tree.frames[f].row(ends[k]) - tree.frames[f].row(tree.parents[ends[k]])).norm();
+      m.max_relative_length_error =
+          std::max(m.max_relative_length_error, std::abs(d - r.lengths[k]) / r.lengths[k]);
+    }
+    if (f == 0) continue;
+    const Eigen::VectorXd moved = (tree.frames[f] - tree.frames[f - 1]).rowwise().norm();
+    m.path_length += moved;
+    m.l2_per_step[f - 1] = moved.sum();
+  }
+  m.l2_total = m.l2_per_step.sum();
+  return file;
+}
+
 std::string ViewerDataJson(const ResultFile& file, const ViewerOptions& options,
-                           const RobotTrajectoryFile* robot) {
+                           const RobotTrajectoryFile* robot, const TreeResultFile* tree) {
   const RunResult& r = file.result;
   const size_t num_frames = r.frames.size();
   std::string out = "{";
@@ -188,6 +243,30 @@ std::string ViewerDataJson(const ResultFile& file, const ViewerOptions& options,
     AppendExact(robot->max_ee_error, &out);
     out.push_back('}');
   }
+  // Link k from point a[k] to point b[k].
+  std::vector<int> link_a, link_b;
+  if (tree != nullptr) {
+    link_b = TreeLinkPoints(*tree);
+    for (const int c : link_b) link_a.push_back(tree->parents[c]);
+    AppendKey("tree", &out);
+    out.push_back('{');
+    AppendKey("parents", &out);
+    AppendInts(tree->parents, &out);
+    AppendKey("link_points", &out);
+    AppendInts(link_b, &out);
+    AppendKey("targets", &out);
+    AppendInts(tree->targets, &out);
+    AppendKey("fixed", &out);
+    AppendInts(tree->fixed, &out);
+    AppendKey("not_reached", &out);
+    out += std::to_string(std::count(tree->reached.begin(), tree->reached.end(), char(0)));
+    out.push_back('}');
+  } else {
+    for (Eigen::Index k = 0; k < r.lengths.size(); ++k) {
+      link_a.push_back(static_cast<int>(k));
+      link_b.push_back(static_cast<int>(k + 1));
+    }
+  }
   AppendKey("dim", &out);
   out += std::to_string(file.dim);
   AppendKey("num_links", &out);
@@ -213,7 +292,7 @@ std::string ViewerDataJson(const ResultFile& file, const ViewerOptions& options,
   out.push_back('[');
   for (size_t f = 0; f < num_frames; ++f) {
     if (f > 0) out.push_back(',');
-    AppendNumber(FrameLengthError(r.frames[f].points, r.lengths), 3, &out);
+    AppendNumber(FrameLengthError(r.frames[f].points, r.lengths, link_a, link_b), 3, &out);
   }
   out.push_back(']');
   // Frame after frame, point after point (leading end first), coordinate after coordinate.

@@ -1,7 +1,9 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
+#include "flexkin/tree_scenario.h"
 #include "flexkin/viewer.h"
 
 namespace flexkin::viewer_internal {
@@ -21,7 +23,22 @@ void CheckResult(const ResultFile& result, const ViewerOptions& options);
 // the chain's (and "links", the arm's n); null for a chain result.
 // "link_radii": the links' radii (one per link, link i from point i to point i + 1), with the
 // coordinates' `digits`, where the result has them; the page draws the links as their capsules.
+// `tree`: the tree result that `result` was made from (TreeAsViewerResult), whose topology goes
+// into a "tree" object (parents; link_points, the point each link ends at, link k of `result`
+// ending at link_points[k]; targets; fixed; not_reached, the frames not reached) and whose links
+// give each frame's length error; null for a chain result.
 std::string ViewerDataJson(const ResultFile& result, const ViewerOptions& options,
-                           const RobotTrajectoryFile* robot = nullptr);
+                           const RobotTrajectoryFile* robot = nullptr,
+                           const TreeResultFile* tree = nullptr);
+
+// The points other than the root, in index order: link k of a tree's viewer result ends at the
+// k-th of them.
+std::vector<int> TreeLinkPoints(const TreeResultFile& tree);
+
+// A checked tree result (ValidateTreeResult) as the result the viewer page shows: frame f at step
+// f; link k's length that of the link ending at TreeLinkPoints(tree)[k] in the first frame; the
+// metrics of the tree's motion from frame to frame (each point's path length, L2 per frame: the
+// sum of the points' distances, L2 total, the largest relative link-length error).
+ResultFile TreeAsViewerResult(const TreeResultFile& tree);
 
 }  // namespace flexkin::viewer_internal

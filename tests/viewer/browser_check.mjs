@@ -53,12 +53,10 @@ async function picture(page) {
   });
 }
 
-// A page whose result has link radii draws each link of the current frame as its capsule: a
-// round-capped stroke from point to point, 2 x radius wide in CSS pixels (view.scale CSS pixels
-// per length unit; in perspective the depth factor of the link's midpoint, between 0.75 and 1.5,
-// scales it). The strokes are recorded while the page draws a frame, and each link's must be
-// there. `perspective`: only the factor's range is checked.
-async function checkCapsules(page, name, perspective) {
+// The strokes the page makes while it draws a frame (one step on and back), each with its path
+// (the points of its moveTo and lineTo calls), width and cap; the points of the frame on screen,
+// the view's scale, the links drawn and the result's link radii.
+async function recordFrameStrokes(page) {
   await page.evaluate(() => {
     const proto = CanvasRenderingContext2D.prototype;
     const log = { strokes: [], path: [], saved: {} };
@@ -97,8 +95,19 @@ async function checkCapsules(page, name, perspective) {
     const data = JSON.parse(document.getElementById('flexkin-data').textContent);
     const points = [];
     for (let i = 0; i < v.numPoints; ++i) points.push(v.pointOnScreen(i));
-    return { strokes: log.strokes, points, scale: v.view.scale, radii: data.link_radii };
+    return { strokes: log.strokes, points, scale: v.view.scale, radii: data.link_radii,
+             links: v.links };
   });
+  return got;
+}
+
+// A page whose result has link radii draws each link of the current frame as its capsule: a
+// round-capped stroke from point to point, 2 x radius wide in CSS pixels (view.scale CSS pixels
+// per length unit; in perspective the depth factor of the link's midpoint, between 0.75 and 1.5,
+// scales it). The strokes are recorded while the page draws a frame, and each link's must be
+// there. `perspective`: only the factor's range is checked.
+async function checkCapsules(page, name, perspective) {
+  const got = await recordFrameStrokes(page);
   let worst = 0, missing = 0, drawn = 0;
   const near = (p, q) => Math.hypot(p[0] - q.x, p[1] - q.y) < 1e-6;
   for (let i = 0; i + 1 < got.points.length; ++i) {
@@ -125,6 +134,26 @@ async function checkCapsules(page, name, perspective) {
         `${name}: ${drawn} links drawn as capsules, stroke 2 x radius x scale ` +
         `${perspective ? '(perspective: x 0.75 to 1.5) ' : ''}(largest relative difference ` +
         `${worst.toExponential(1)}, ${missing} missing)`);
+}
+
+// A tree's page draws every link of the current frame from its parent's point to its child's: for
+// each of the page's links [a, b] (checked against the tree's parents), some stroke's path has a
+// moveTo at point a's pixel followed by a lineTo at point b's.
+async function checkTreeLinks(page, name, parents) {
+  const got = await recordFrameStrokes(page);
+  const near = (p, q) => Math.hypot(p[0] - q.x, p[1] - q.y) < 1e-6;
+  let missing = 0, wrong = 0;
+  const want = new Set();
+  parents.forEach((p, c) => { if (p >= 0) want.add(`${p}-${c}`); });
+  for (const [a, b] of got.links) if (!want.delete(`${a}-${b}`)) wrong += 1;
+  for (const [a, b] of got.links) {
+    const found = got.strokes.some((s) => s.path.some((q, k) => k + 1 < s.path.length &&
+        near(q, got.points[a]) && near(s.path[k + 1], got.points[b])));
+    if (!found) missing += 1;
+  }
+  check(missing === 0 && wrong === 0 && want.size === 0 && got.links.length > 0,
+        `${name}: the tree's ${got.links.length} links drawn parent to child (${missing} ` +
+        `missing, ${wrong + want.size} not the tree's)`);
 }
 
 const frame = (page) => page.evaluate(() => window.flexkinViewer.frame);
@@ -154,8 +183,10 @@ async function checkPage(browser, file) {
     const v = window.flexkinViewer;
     const data = JSON.parse(document.getElementById('flexkin-data').textContent);
     return { dim: v.dim, numFrames: v.numFrames, numPoints: v.numPoints, steps: data.steps,
-             linkRadii: Boolean(data.link_radii) };
+             linkRadii: Boolean(data.link_radii), tree: data.tree || null };
   });
+  // The point drawn as the leading end's red dot: a tree's first driven point.
+  const leadPoint = info.tree ? info.tree.targets[0] : 0;
   const n = info.numFrames;
   console.log(`--- ${name}: ${info.dim}D, ${info.numPoints - 1} links, ${n} frames`);
   check(await playing(page), `${name}: plays on opening (autoplay)`);
@@ -170,14 +201,15 @@ async function checkPage(browser, file) {
   const still2 = await picture(page);
   check(still1.hash === still2.hash, `${name}: paused picture stays still`);
   // Not blank: something drawn, and the leading end's red dot where the chain's first point is.
-  const lead = await page.evaluate(() => {
+  const lead = await page.evaluate((i) => {
     const v = window.flexkinViewer;
     const c = document.getElementById('view');
-    const at = v.pointOnScreen(0);
+    const at = v.pointOnScreen(i);
     const r = c.width / c.getBoundingClientRect().width;
     return Array.from(c.getContext('2d').getImageData(Math.round(at.x * r),
                                                       Math.round(at.y * r), 1, 1).data);
-  });
+  }, leadPoint);
+  if (info.tree) await checkTreeLinks(page, name, info.tree.parents);
   if (info.linkRadii) {
     await checkCapsules(page, name, false);
     if (info.dim === 3) {
@@ -215,7 +247,8 @@ async function checkPage(browser, file) {
   }, k);
   await sleep(50);
   const counter = await page.textContent('#counter');
-  check(counter.includes(`frame ${k + 1} / ${n}`) && counter.includes(`step ${info.steps[k]} /`),
+  check(counter.includes(`frame ${k + 1} / ${n}`) &&
+        (info.tree !== null || counter.includes(`step ${info.steps[k]} /`)),
         `${name}: scrubbed to frame ${k + 1}, counter says "${counter}"`);
   const box = await page.locator('#timeline').boundingBox();
   await page.mouse.click(box.x + 0.75 * box.width, box.y + box.height / 2);
