@@ -18,6 +18,7 @@
 #include "flexkin/robot_scenario.h"
 #include "flexkin/scenario.h"
 #include "flexkin/strand_file.h"
+#include "flexkin/tree_scenario.h"
 #include "flexkin/urdf.h"
 
 namespace flexkin::fuzz {
@@ -119,15 +120,22 @@ void ReadGroomScenario(const std::string& bytes) {
 
 void ReadResult(const std::string& bytes) {
   if (bytes.compare(0, 4, std::string("PK\x03\x04", 4)) != 0) {
-    // JSON: a robot trajectory (flexkin render tells it by its "format") or a chain result.
+    // JSON: a robot trajectory or a tree result (flexkin render tells them by their "format"),
+    // or a chain result.
     if (bytes.find("flexkin-robot-trajectory") != std::string::npos) {
       RobotTrajectoryFromText(bytes);
+    } else if (bytes.find("flexkin-tree-result") != std::string::npos) {
+      ReadTreeResultFile(WriteTemporary(bytes, "tree.json"));
     } else {
       ResultFromText(bytes);
     }
     return;
   }
   const std::string path = WriteTemporary(bytes, "result.npz");
+  if (IsTreeResultFile(path)) {
+    ReadTreeResultFile(path);
+    return;
+  }
   if (!IsStrandFile(path)) {
     ReadResultFile(path);
     return;

@@ -280,6 +280,17 @@ TEST(TreeOverallTest, RefusesTermsTreesDoNotTakeAndBadOptions) {
   Points points = tree.points;
   EXPECT_THROW(StepTreeOverall(reacher, wrong, TreeOverallOptions(), &points), InputError);
   EXPECT_TRUE(points == tree.points);
+  // Pointing goals are the passes' (docs/trees.md, "Pointing goals").
+  const TreeReacher looking =
+      MakeTreeReacher(tree, {7, 12}, {0}, {}, ReachOptions(), std::vector<char>{0, 1});
+  try {
+    StepTreeOverall(looking, targets, TreeOverallOptions(), &points);
+    ADD_FAILURE() << "a pointing goal was taken by the overall step";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "targets[1]");
+    EXPECT_NE(std::string(e.what()).find("takes position targets only"), std::string::npos);
+  }
+  EXPECT_TRUE(points == tree.points);
 }
 
 }  // namespace

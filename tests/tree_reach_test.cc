@@ -348,3 +348,96 @@ TEST(TreeReachTest, RefusesBadInputNamingTheField) {
 
 }  // namespace
 }  // namespace flexkin
+
+namespace flexkin {
+namespace {
+
+// The arms on a spine with a neck (point 9, on the shoulders, point 2) and a head (point 10).
+Tree Torso(int dim) {
+  Tree t = TwoArms(dim);
+  t.points.conservativeResize(11, dim);
+  t.points.bottomRows(2).setZero();
+  t.points(9, 1) = 2.4;
+  t.points(10, 1) = 2.9;
+  if (dim == 3) t.points(10, 2) = 0.1;
+  t.parents.push_back(2);
+  t.parents.push_back(9);
+  return t;
+}
+
+// Pointing goals: the torso's hands go round circles while its head (the link from the neck to
+// point 10) looks at a point moving round a wide circle in front of it. Every frame reaches the
+// hands to 1e-10 of the longest link and turns the head's link onto the point looked at to the
+// same, the lengths kept and the base fixed exactly; the motion has no jumps.
+TEST(TreeReachTest, PointingGoalsTurnTheirLinksOntoWhatTheyLookAt) {
+  for (const int dim : {2, 3}) {
+    const Tree tree = Torso(dim);
+    const std::vector<int> targets = {5, 8, 10};
+    for (const Method method : {Method::kTractrix, Method::kFollowTheLeader}) {
+      ReachOptions options;
+      options.method = method;
+      const TreeReacher reacher =
+          MakeTreeReacher(tree, targets, {0}, {}, options, std::vector<char>{0, 0, 1});
+      EXPECT_EQ(reacher.root, 0);
+      EXPECT_DOUBLE_EQ(reacher.look_length[2], (tree.points.row(10) - tree.points.row(9)).norm());
+      Points points = tree.points, previous = tree.points;
+      double worst_gaze = 0.0, largest_jump = 0.0;
+      const int frames = 120;
+      for (int f = 1; f <= frames; ++f) {
+        const double a = 2 * M_PI * f / frames;
+        Points goal = Rows(tree.points, targets);
+        for (int k = 0; k < 2; ++k) {
+          goal(k, 0) += 0.3 * (std::cos(a + k) - std::cos(double(k)));
+          goal(k, 1) += 0.3 * (std::sin(a + k) - std::sin(double(k)));
+        }
+        goal.row(2).setZero();
+        goal(2, 0) = 3.0 * std::sin(a);  // a point swinging from side to side above the head
+        goal(2, 1) = 5.0 + std::cos(a);
+        if (dim == 3) goal(2, 2) = 1.5;
+        const ReachReport report = ReachTargets(reacher, goal, &points);
+        SCOPED_TRACE(std::string(NameOf(method)) + " dim " + std::to_string(dim) + " frame " +
+                     std::to_string(f));
+        ASSERT_TRUE(report.reached) << report.residual << " after " << report.passes;
+        EXPECT_LE(Residual(points, {5, 8}, goal.topRows(2)), 1e-10 * reacher.longest_link);
+        const Eigen::RowVectorXd link = points.row(10) - points.row(9);
+        const Eigen::RowVectorXd look = goal.row(2) - points.row(9);
+        worst_gaze = std::max(worst_gaze, (link.normalized() - look.normalized()).norm());
+        EXPECT_EQ((points.row(0) - tree.points.row(0)).norm(), 0.0);
+        EXPECT_LE(MaxTreeLengthError(MakeTreeStepper(Method::kTractrix, tree, 0), points), 1e-13);
+        largest_jump = std::max(largest_jump, (points - previous).rowwise().norm().maxCoeff());
+        previous = points;
+      }
+      // The gaze to the reach's tolerance (of the longest link, over the head's length 0.5).
+      EXPECT_LE(worst_gaze, 1e-10 * reacher.longest_link / 0.5);
+      // The goals move at most 3 x 2 pi / 120 = 0.16 a frame: no point jumps much farther.
+      EXPECT_LE(largest_jump, 0.5);
+      std::printf("  %s, %dD: gaze within %.2g rad, largest jump of a point %.3f\n", NameOf(method),
+                  dim, worst_gaze, largest_jump);
+    }
+  }
+}
+
+TEST(TreeReachTest, RefusesPointingGoalsItCannotTake) {
+  const Tree tree = Torso(2);
+  auto field = [&](const std::vector<int>& targets, const std::vector<int>& fixed,
+                   const std::vector<char>& looks) {
+    try {
+      MakeTreeReacher(tree, targets, fixed, {}, ReachOptions(), looks);
+    } catch (const InputError& e) {
+      return e.field() + ": " + e.message();
+    }
+    return std::string("(accepted)");
+  };
+  // The root has no link from a parent to turn.
+  EXPECT_EQ(field({5, 0}, {}, {0, 1}).rfind("targets[1]: is point 0, the tree's root", 0), 0u);
+  // Pointing goals alone: nothing says where the body is.
+  EXPECT_EQ(field({10}, {}, {1}).rfind("targets: are all pointing goals", 0), 0u);
+  EXPECT_EQ(field({10, 5}, {}, {1, 0}), "(accepted)");  // a position target places the body
+  EXPECT_EQ(field({10}, {0}, {1}), "(accepted)");       // so does a fixed point
+  EXPECT_EQ(field({10, 5}, {0}, {1}).rfind("looks: has 1 entries for 2 targets", 0), 0u);
+  // With nothing fixed the passes hang the tree from the first position target.
+  EXPECT_EQ(MakeTreeReacher(tree, {10, 5}, {}, {}, ReachOptions(), {1, 0}).root, 5);
+}
+
+}  // namespace
+}  // namespace flexkin

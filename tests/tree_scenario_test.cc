@@ -63,6 +63,51 @@ TEST(TreeScenarioTest, ReadsAValidScenarioAsATree) {
   EXPECT_EQ(Read(j).kind, ScenarioKind::kTree);
 }
 
+// A pointing goal: "look_at" instead of "path", the point its link from its parent points at.
+TEST(TreeScenarioTest, ReadsAndRunsPointingGoals) {
+  json j = TwoHands();
+  // A head on a neck above the shoulder (points 6 and 7), looking at a point above the hands.
+  j["tree"]["points"].push_back({0, 1.4});
+  j["tree"]["points"].push_back({0, 1.8});
+  j["tree"]["parents"].push_back(1);
+  j["tree"]["parents"].push_back(6);
+  j["targets"].push_back({{"point", 7}, {"look_at", {{1, 3}, {0, 3}, {-1, 3}}}});
+  const AnyScenario s = Read(j);
+  ASSERT_TRUE(s.valid()) << s.problems.front().Text();
+  EXPECT_EQ(s.tree->looks, (std::vector<char>{0, 0, 1}));
+  EXPECT_NE(s.Summary().find("3 targets (1 pointing)"), std::string::npos) << s.Summary();
+  const TreeRunResult r = RunTree(*s.tree);
+  for (int f = 1; f <= 3; ++f) {
+    EXPECT_TRUE(r.reached[f - 1]) << f;
+    const Eigen::RowVector2d link = r.frames[f].row(7) - r.frames[f].row(6);
+    const Eigen::RowVector2d look = s.tree->paths[2].row(f - 1) - r.frames[f].row(6);
+    EXPECT_LT((link.normalized() - look.normalized()).norm(), 1e-9) << f;
+  }
+  // Problems: a path and a look_at, a pointing goal for method overall, one on the root.
+  auto with = [&](const std::function<void(json&)>& change) {
+    json k = j;
+    change(k);
+    return FirstProblem(k);
+  };
+  EXPECT_EQ(with([](json& k) {
+              k["targets"][2]["path"] = {{0, 1}, {0, 1}, {0, 1}};
+            }).rfind("/targets/2/look_at: is given with \"path\"", 0),
+            0u);
+  EXPECT_EQ(with([](json& k) {
+              k["method"] = "overall";
+            }).rfind("/targets/2/look_at: is a pointing goal; method \"overall\"", 0),
+            0u);
+  EXPECT_EQ(with([](json& k) {
+              k["targets"][2]["point"] = 0;
+              k["fixed"] = json::array();
+            }).rfind("/targets/2/point: is point 0, the tree's root", 0),
+            0u);
+  EXPECT_EQ(with([](json& k) {
+              k["targets"][2]["look_at"].erase(1);
+            }).rfind("/targets/2/look_at: has 2 points; every target's path", 0),
+            0u);
+}
+
 TEST(TreeScenarioTest, NamesEveryProblemByItsJsonPointer) {
   auto with = [](const std::function<void(json&)>& change) {
     json j = TwoHands();
@@ -280,6 +325,14 @@ TEST_F(TreeResultFileTest, ReadsBothFormsBackExactly) {
       EXPECT_EQ(back.frames[f], report.tree.frames[f]) << name << " frame " << f;  // bit for bit
     }
     ASSERT_EQ(back.reached.size(), back.frames.size() - 1);
+    // The goals: each frame's target positions, the scenario's paths.
+    ASSERT_EQ(back.goals.size(), back.frames.size() - 1) << name;
+    for (size_t f = 0; f < back.goals.size(); ++f) {
+      for (size_t k = 0; k < 2; ++k) {
+        EXPECT_EQ(back.goals[f].row(k), s.tree->paths[k].row(f)) << name;
+      }
+    }
+    EXPECT_EQ(back.looks, (std::vector<char>{0, 0}));
     for (size_t f = 0; f < back.reached.size(); ++f) {
       EXPECT_EQ(bool(back.reached[f]), report.tree.reached[f] && report.tree.converged[f]);
     }

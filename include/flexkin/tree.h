@@ -117,6 +117,8 @@ struct TreeReacher {
   int dim = 0;
   std::vector<int> parents;         // the tree's
   std::vector<int> target_points;   // as given
+  std::vector<char> looks;          // per target: a pointing goal (see MakeTreeReacher)
+  std::vector<double> look_length;  // per target: a pointing goal's link length (else 0)
   std::vector<double> weights;      // per target, then 1 per fixed point
   std::vector<int> fixed_points;    // as given
   Points fixed_positions;           // where the fixed points are held (one row each)
@@ -147,12 +149,24 @@ struct ReachReport {
 // and finite, a method other than tractrix and ftl, or a tolerance or max_passes out of range.
 // `weights` is empty (every target 1) or one per target. The fixed points are held where `tree`
 // has them.
+//
+// Pointing goals (docs/trees.md, "Pointing goals"): `looks` is empty (every target a position) or
+// one flag per target; a flagged target's row of ReachTargets's positions is a point that its
+// point's link from its parent must point at (a head looking at something, a tool aimed), not
+// where the point goes. Its point is then placed, at the start of every pass, on the link's
+// length from where its parent is, toward the point looked at: a position goal that moves with
+// the parent, reached when the passes settle, the residual the point's distance from it. Also
+// refused: a pointing goal on the tree's root ("targets[k]": it has no link from a parent), and
+// pointing goals with neither a position target nor a fixed point ("targets": the body could be
+// anywhere). The root of the passes is then the first fixed point, else the first position target.
 TreeReacher MakeTreeReacher(const Tree& tree, const std::vector<int>& targets,
                             const std::vector<int>& fixed, const std::vector<double>& weights = {},
-                            const ReachOptions& options = ReachOptions());
+                            const ReachOptions& options = ReachOptions(),
+                            const std::vector<char>& looks = {});
 
 // Moves `points` (the tree's shape: (n+1) by dim, each link at its length) so that target k's
-// point reaches row k of `positions` (one row per target, dim columns, finite). Throws
+// point reaches row k of `positions` (one row per target, dim columns, finite), or, for a pointing
+// goal, its link from its parent points at it. Throws
 // InputError on positions or points of the wrong shape or with non-finite values; a refused call
 // changes nothing.
 ReachReport ReachTargets(const TreeReacher& reacher, const Points& positions, Points* points);

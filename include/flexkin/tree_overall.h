@@ -44,7 +44,8 @@ struct TreeOverallReport {
 // of reach) or Newton does not converge in max_iterations, `points` is left as the passes leave
 // it for the whole move and the report says so. Throws InputError as ReachTargets does, on weights
 // that ObjectiveWeights::Validate refuses or that have an L2 or joint-angle term ("weights.l2"), or
-// on a tolerance or max_iterations out of range; a refused call changes nothing.
+// on a tolerance or max_iterations out of range, or on a reacher with pointing goals
+// ("targets[k]": the overall step takes position targets only); a refused call changes nothing.
 TreeOverallReport StepTreeOverall(const TreeReacher& reacher, const Points& positions,
                                   const TreeOverallOptions& options, Points* points);
 

@@ -22,7 +22,8 @@ struct TreeScenario {
   std::string name;                   // "name", "" if none
   Tree tree;                          // "tree"
   std::vector<int> targets;           // "targets"[k]."point"
-  std::vector<Points> paths;          // "targets"[k]."path": one row per frame, all as long
+  std::vector<Points> paths;          // "targets"[k]."path" (or "look_at"): a row per frame
+  std::vector<char> looks;            // per target: "look_at" given, a pointing goal (tree.h)
   std::vector<double> weights;        // "targets"[k]."weight" (1 if none)
   std::vector<int> fixed;             // "fixed"
   Method method = Method::kTractrix;  // "method"
@@ -32,7 +33,9 @@ struct TreeScenario {
 
   // One driven point and nothing fixed: moved by MoveTreePoint (any rule of trees); otherwise
   // by the passes (tractrix, ftl) or, with method "overall", by StepTreeOverall.
-  bool driven_at_one_point() const { return targets.size() == 1 && fixed.empty(); }
+  bool driven_at_one_point() const {
+    return targets.size() == 1 && fixed.empty() && (looks.empty() || !looks[0]);
+  }
   int frames() const { return paths.empty() ? 0 : static_cast<int>(paths[0].rows()); }
 };
 
@@ -81,6 +84,10 @@ struct TreeResultFile {
   std::vector<int> fixed;             // the fixed points
   std::vector<Points> frames;         // F >= 1 frames, each (n+1) by dim, finite
   std::vector<char> reached;          // F - 1: each frame after the start reached and converged
+  std::vector<char> looks;            // per target: a pointing goal (empty: none are)
+  // F - 1 frames (empty in files without "goals"): row k of frame f's the goal of target k at
+  // frame f + 1, the position it was driven to or the point it looked at.
+  std::vector<Points> goals;
 };
 
 // Reads a tree result (.npz or .json, told apart by content) and checks it: the format, the

@@ -187,8 +187,8 @@ py::array_t<double> MoveTree(ArrayLike points, IndexSequence parents, ArrayLike 
 // dim)), with a report per frame.
 py::tuple ReachTree(ArrayLike points, IndexSequence parents, IndexSequence targets, ArrayLike paths,
                     IndexSequence fixed, OptionalArray weights, const std::string& method,
-                    NameText branch_rule, double tolerance, int max_passes,
-                    OptionalWeights overall) {
+                    NameText branch_rule, double tolerance, int max_passes, OptionalWeights overall,
+                    const std::vector<bool>& looks) {
   Tree tree;
   tree.points = ReadPoints(points, "points", 2);
   tree.parents = IndexList(parents, "parents");
@@ -204,7 +204,8 @@ py::tuple ReachTree(ArrayLike points, IndexSequence parents, IndexSequence targe
     w.assign(array.data(), array.data() + array.size());
   }
   const TreeReacher reacher =
-      MakeTreeReacher(tree, IndexList(targets, "targets"), IndexList(fixed, "fixed"), w, options);
+      MakeTreeReacher(tree, IndexList(targets, "targets"), IndexList(fixed, "fixed"), w, options,
+                      std::vector<char>(looks.begin(), looks.end()));
   const bool exact = !overall.is_none();
   TreeOverallOptions overall_options;
   if (exact) overall_options.weights = WeightsArg(overall);
@@ -489,6 +490,7 @@ Chain(points, *, link_length=None, lengths=None)
         py::arg("weights") = py::none(), py::arg("method") = "tractrix",
         py::arg("branch_rule") = "centroid", py::arg("tolerance") = 1e-10,
         py::arg("max_passes") = 1000, py::arg("overall") = py::none(),
+        py::arg("looks") = std::vector<bool>(),
         "Several targets on a tree (docs/trees.md): the points `targets` (k point indices) reach, "
         "frame by frame, the positions of paths ((m, k, dim)) while the points `fixed` stay where "
         "they are, by passes of `method` (\"tractrix\" or \"ftl\") between them, with "
@@ -499,7 +501,10 @@ Chain(points, *, link_length=None, lengths=None)
         "reached, and root (the point the passes hang the tree from). overall: objective weights "
         "(ObjectiveWeights or a dict: squared, squared_weighted, rotation): each frame is then the "
         "exact least-motion step, from the passes by Newton's method (docs/trees.md), and the "
-        "report adds converged; the passes' points where it does not converge.");
+        "report adds converged; the passes' points where it does not converge. looks: one bool "
+        "per target (default none): a True target is a pointing goal, its paths' rows the point "
+        "its link from its parent points at (docs/trees.md, \"Pointing goals\"; the passes "
+        "only, not overall).");
   m.def(
       "overall_step",
       [](PointsOrChain points, ArrayLike head, OverallLike options) {

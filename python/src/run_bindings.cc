@@ -560,9 +560,9 @@ InputError if the frames do not fit the chain or the targets.
         "Writes `result` to `path` (.json or .npz by the extension), as Result.write.");
   m.def("validate_scenario", &ValidateScenario, py::arg("scenario"), py::kw_only(),
         py::arg("directory") = py::none(),
-        "The problems of a chain, robot or groom scenario (a path to a scenario file or a dict of "
-        "its "
-        "JSON form; a robot scenario is told apart as `flexkin validate` does) as `flexkin "
+        "The problems of a scenario of any kind, chain, robot, groom or tree (a path to a "
+        "scenario file or a dict of its JSON form; its kind told apart as `flexkin validate` "
+        "does) as `flexkin "
         "validate` finds them: a list of dicts (field, message, value, expected), empty if the "
         "scenario is valid. directory: where a robot scenario's relative \"urdf\" file is looked "
         "up (default: the file's directory, or the working directory for a dict). Raises OSError "

@@ -156,3 +156,21 @@ def test_a_tree_result_is_drawn_by_render(tmp_path):
     with pytest.raises(flexkin.InputError) as error:
         flexkin.render(tmp_path / "tree.npz", tmp_path / "drawn", "plots")
     assert "is not available for tree results" in str(error.value)
+
+
+def test_a_pointing_goal_turns_its_link_onto_what_it_looks_at():
+    # The arms' tree with the left arm's last link aimed: point 8's link from 7 points at a point.
+    look = np.array([[-3.0, 4.0], [-2.0, 4.5], [-1.0, 5.0]])
+    paths = [[ARMS[5] + [0.05 * k, 0.03 * k], look[k - 1]] for k in range(1, 4)]
+    frames, report = flexkin.reach_tree(ARMS, ARM_PARENTS, [5, 8], paths, fixed=[0],
+                                        looks=[False, True])
+    assert report["reached"].all()
+    for f in range(1, 4):
+        link = frames[f][8] - frames[f][7]
+        toward = look[f - 1] - frames[f][7]
+        np.testing.assert_allclose(link / np.linalg.norm(link), toward / np.linalg.norm(toward),
+                                   atol=1e-9)
+    with pytest.raises(flexkin.InputError) as error:
+        flexkin.reach_tree(ARMS, ARM_PARENTS, [5, 8], paths, fixed=[0], looks=[False, True],
+                           overall={"squared": 1.0})
+    assert error.value.field == "targets[1]"

@@ -28,10 +28,11 @@ class TreeResultReader : public json_internal::JsonReader {
   // the JSON form (frames and the reports per frame) are allowed too.
   void ReadHeader(const json& root, bool json_form, TreeResultFile* out) {
     if (!ExpectObject(root, "", "an object (a tree result, docs/trees.md)")) return;
-    std::vector<std::string> keys = {"format",  "name",  "method",           "dim",     "parents",
-                                     "targets", "fixed", "max_length_error", "failures"};
+    std::vector<std::string> keys = {"format",           "name",    "method", "dim",
+                                     "parents",          "targets", "looks",  "fixed",
+                                     "max_length_error", "failures"};
     if (json_form) {
-      for (const char* k : {"frames", "passes", "residual", "reached", "converged"}) {
+      for (const char* k : {"frames", "goals", "passes", "residual", "reached", "converged"}) {
         keys.push_back(k);
       }
     }
@@ -62,6 +63,7 @@ class TreeResultReader : public json_internal::JsonReader {
     const int last = static_cast<int>(out->parents.size()) - 1;
     out->targets = Indices(root, "targets", 0, std::max(last, 0), false);
     out->fixed = Indices(root, "fixed", 0, std::max(last, 0), false);
+    if (Find(root, "looks") != nullptr) Flags(root, "looks", out->targets.size(), &out->looks);
   }
 
   // The JSON form's frames, each (n+1) by dim, and "reached" and "converged" (F - 1 booleans).
@@ -79,6 +81,20 @@ class TreeResultReader : public json_internal::JsonReader {
       const auto p = PointList((*frames)[f], ptr, out->dim, rows, rows);
       if (!p) return;
       out->frames.push_back(*p);
+    }
+    if (const json* goals = Find(root, "goals")) {
+      if (!goals->is_array() || goals->size() + 1 != frames->size()) {
+        TypeProblem(*goals, "/goals",
+                    "an array of " + std::to_string(frames->size() - 1) +
+                        " frames of goals, one per frame after the first");
+        return;
+      }
+      const int k = static_cast<int>(out->targets.size());
+      for (size_t f = 0; f < goals->size(); ++f) {
+        const auto g = PointList((*goals)[f], "/goals/" + std::to_string(f), out->dim, k, k);
+        if (!g) return;
+        out->goals.push_back(*g);
+      }
     }
     std::vector<char> converged;
     Flags(root, "reached", frames->size() - 1, &out->reached);
@@ -148,7 +164,7 @@ std::vector<T> ReadFlat(ZipReader* zip, const std::string& name, const char* des
 }
 
 TreeResultFile ReadNpz(const std::string& path) {
-  ZipReader zip(path, {"frames.npy", "parents.npy", "reached.npy", "converged.npy"});
+  ZipReader zip(path, {"frames.npy", "parents.npy", "reached.npy", "converged.npy", "goals.npy"});
   if (!zip.Has("tree.json")) {
     throw InputError("tree.json", "missing; a tree result's .npz holds tree.json and frames.npy");
   }
@@ -181,6 +197,18 @@ TreeResultFile ReadNpz(const std::string& path) {
     out.frames.push_back(std::move(p));
   }
   frames.Finish();
+  if (zip.Has("goals.npy")) {
+    ZipReader::Member goals(&zip, "goals.npy");
+    const uint64_t k = out.targets.size();
+    ExpectNpyShape(ReadNpyHeader(&goals, "goals.npy", "<f8"), "goals.npy", {count - 1, k, dim},
+                   "a valid tree result");
+    for (uint64_t f = 0; f + 1 < count; ++f) {
+      Points g(k, dim);
+      goals.Read(g.data(), sizeof(double) * k * dim);
+      out.goals.push_back(std::move(g));
+    }
+    goals.Finish();
+  }
   const std::vector<char> reached = ReadFlat<char>(&zip, "reached.npy", "|b1", count - 1);
   const std::vector<char> converged = ReadFlat<char>(&zip, "converged.npy", "|b1", count - 1);
   for (uint64_t k = 0; k + 1 < count; ++k) out.reached.push_back(reached[k] && converged[k]);
@@ -234,6 +262,23 @@ Problems CheckTreeResult(const TreeResultFile& out, Naming naming) {
       return {Problem("reached", "has " + std::to_string(out.reached.size()) +
                                      " entries; expected one per frame after the first (" +
                                      std::to_string(out.frames.size() - 1) + ")")};
+    }
+    if (!out.looks.empty() && out.looks.size() != out.targets.size()) {
+      return {Problem("looks", "has " + std::to_string(out.looks.size()) +
+                                   " entries; expected one per target (" +
+                                   std::to_string(out.targets.size()) + ") or none")};
+    }
+    if (!out.goals.empty() && out.goals.size() + 1 != out.frames.size()) {
+      return {Problem("goals", "has " + std::to_string(out.goals.size()) +
+                                   " frames; expected one per frame after the first (" +
+                                   std::to_string(out.frames.size() - 1) + ") or none")};
+    }
+    for (size_t f = 0; f < out.goals.size(); ++f) {
+      if (out.goals[f].rows() != static_cast<Eigen::Index>(out.targets.size()) ||
+          out.goals[f].cols() != out.dim || !out.goals[f].allFinite()) {
+        return {Problem("goals[" + std::to_string(f) + "]",
+                        "is not one finite row per target of dim columns")};
+      }
     }
     for (const auto& [name, points] :
          {std::pair<const char*, const std::vector<int>*>{"targets", &out.targets},

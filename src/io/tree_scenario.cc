@@ -154,8 +154,10 @@ class TreeScenarioReader : public json_internal::JsonReader {
     for (size_t k = 0; k < targets->size(); ++k) {
       const std::string ptr = "/targets/" + std::to_string(k);
       const json& t = (*targets)[k];
-      if (!ExpectObject(t, ptr, "an object with \"point\" and \"path\"")) continue;
-      CheckKeys(t, ptr, {"point", "path", "weight"});
+      if (!ExpectObject(t, ptr, "an object with \"point\" and \"path\" (or \"look_at\")")) {
+        continue;
+      }
+      CheckKeys(t, ptr, {"point", "path", "look_at", "weight"});
       int64_t point = -1;
       Require(
           t, ptr, "point", "a point index",
@@ -164,8 +166,16 @@ class TreeScenarioReader : public json_internal::JsonReader {
           },
           &point);
       Points path;
+      const bool look = t.contains("look_at");
+      if (look && t.contains("path")) {
+        Add(ptr + "/look_at",
+            "is given with \"path\"; a target takes one: \"path\" (where its point goes) or "
+            "\"look_at\" (what its link from its parent points at)");
+      }
       Require(
-          t, ptr, "path", "an array of points, one per frame",
+          t, ptr, look ? "look_at" : "path",
+          look ? "an array of points looked at, one per frame"
+               : "an array of points, one per frame",
           [&](const json& v, const std::string& p) { return PointList(v, p, dim, 1, 1 << 24); },
           &path);
       double weight = 1.0;
@@ -177,6 +187,7 @@ class TreeScenarioReader : public json_internal::JsonReader {
           &weight);
       s->targets.push_back(static_cast<int>(point));
       s->paths.push_back(std::move(path));
+      s->looks.push_back(look ? 1 : 0);
       s->weights.push_back(weight);
     }
   }
@@ -209,13 +220,21 @@ class TreeScenarioReader : public json_internal::JsonReader {
   // What only the whole scenario can tell: the paths' lengths, the method against the targets,
   // and the library's own checks (a point driven twice, fixed and driven, ...).
   void CheckTogether(const json& root, TreeScenario* s) {
+    auto path_of = [&](size_t k) {
+      return "/targets/" + std::to_string(k) + (s->looks[k] ? "/look_at" : "/path");
+    };
     for (size_t k = 1; k < s->paths.size(); ++k) {
       if (s->paths[k].rows() != s->paths[0].rows()) {
-        Add("/targets/" + std::to_string(k) + "/path", "has " + std::to_string(s->paths[k].rows()) +
-                                                           " points; every target's path has one "
-                                                           "point per frame, " +
-                                                           std::to_string(s->paths[0].rows()) +
-                                                           " as /targets/0/path");
+        Add(path_of(k), "has " + std::to_string(s->paths[k].rows()) +
+                            " points; every target's path has one point per frame, " +
+                            std::to_string(s->paths[0].rows()) + " as " + path_of(0));
+      }
+    }
+    for (size_t k = 0; k < s->looks.size(); ++k) {
+      if (s->looks[k] && s->method == Method::kOverall) {
+        Add(path_of(k),
+            "is a pointing goal; method \"overall\" takes position targets only (the passes, "
+            "\"tractrix\" or \"ftl\", take pointing goals)");
       }
     }
     const bool one = s->driven_at_one_point();
@@ -234,7 +253,7 @@ class TreeScenarioReader : public json_internal::JsonReader {
     try {
       ReachOptions reach = s->reach;
       if (s->method == Method::kFollowTheLeader) reach.method = s->method;
-      MakeTreeReacher(s->tree, s->targets, s->fixed, s->weights, reach);
+      MakeTreeReacher(s->tree, s->targets, s->fixed, s->weights, reach, s->looks);
     } catch (const InputError& e) {
       Problem p = e.problem();
       p.field = TreePointer(p.field);
@@ -244,6 +263,15 @@ class TreeScenarioReader : public json_internal::JsonReader {
 };
 
 // The JSON of a result (and of an .npz's tree.json, without the arrays).
+// Whether the scenario's paths give every frame's goals (a scenario read from a file always does).
+bool HasGoals(const TreeScenario& s, const TreeRunResult& r) {
+  if (s.paths.size() != s.targets.size() || r.frames.empty()) return false;
+  for (const Points& path : s.paths) {
+    if (path.rows() + 1 != static_cast<Eigen::Index>(r.frames.size())) return false;
+  }
+  return true;
+}
+
 nlohmann::ordered_json TreeResultHeader(const TreeScenario& s, const TreeRunResult& r) {
   nlohmann::ordered_json j;
   j["format"] = "flexkin-tree-result";
@@ -252,6 +280,9 @@ nlohmann::ordered_json TreeResultHeader(const TreeScenario& s, const TreeRunResu
   j["dim"] = s.tree.points.cols();
   j["parents"] = s.tree.parents;
   j["targets"] = s.targets;
+  std::vector<bool> looks(s.targets.size(), false);  // a scenario built in C++ may leave it empty
+  for (size_t k = 0; k < s.looks.size() && k < looks.size(); ++k) looks[k] = s.looks[k] != 0;
+  j["looks"] = looks;
   j["fixed"] = s.fixed;
   j["max_length_error"] = r.max_length_error;
   j["failures"] = r.failures();
@@ -290,7 +321,10 @@ std::string TreeSummary(const TreeScenario& s) {
   const Eigen::Index n = s.tree.points.rows();
   out << "tree" << (s.name.empty() ? "" : " \"" + s.name + "\"") << ": " << n << " points ("
       << n - 1 << " links, " << s.tree.points.cols() << "D), " << s.targets.size()
-      << (s.targets.size() == 1 ? " target" : " targets") << ", " << s.fixed.size() << " fixed, ";
+      << (s.targets.size() == 1 ? " target" : " targets");
+  const auto pointing = std::count(s.looks.begin(), s.looks.end(), char(1));
+  if (pointing > 0) out << " (" << pointing << " pointing)";
+  out << ", " << s.fixed.size() << " fixed, ";
   if (s.driven_at_one_point() && s.method != Method::kOverall) {
     out << NameOf(s.method) << " driven at point " << s.targets[0] << " (" << s.substeps
         << (s.substeps == 1 ? " sub-step" : " sub-steps") << " a frame)";
@@ -319,7 +353,7 @@ TreeRunResult RunTree(const TreeScenario& s,
   if (one) {
     stepper = MakeTreeStepper(s.method, s.tree, s.targets[0]);
   } else {
-    reacher = MakeTreeReacher(s.tree, s.targets, s.fixed, s.weights, reach);
+    reacher = MakeTreeReacher(s.tree, s.targets, s.fixed, s.weights, reach, s.looks);
   }
   std::vector<double> lengths(s.tree.parents.size(), 0.0);  // each point's link to its parent
   for (size_t i = 0; i < lengths.size(); ++i) {
@@ -407,6 +441,16 @@ void WriteTreeResult(const std::string& path, const TreeScenario& s, const TreeR
       zip.AddMember(name, d);
     };
     ints("parents.npy", s.tree.parents);
+    // The goals: frame f's target k (f from 1), where it was driven or what it looked at.
+    if (HasGoals(s, r)) {
+      std::string goals = NpyHeader("<f8", {frames - 1, s.targets.size(), dim});
+      for (uint64_t f = 1; f < frames; ++f) {
+        for (const Points& path : s.paths) {
+          goals.append(reinterpret_cast<const char*>(path.row(f - 1).data()), sizeof(double) * dim);
+        }
+      }
+      zip.AddMember("goals.npy", goals);
+    }
     ints("passes.npy", r.passes);
     std::string res = NpyHeader("<f8", {r.residual.size()});
     res.append(reinterpret_cast<const char*>(r.residual.data()),
@@ -431,6 +475,16 @@ void WriteTreeResult(const std::string& path, const TreeScenario& s, const TreeR
       frames.push_back(std::move(rows));
     }
     header["frames"] = std::move(frames);
+    nlohmann::ordered_json goals = nlohmann::ordered_json::array();
+    for (size_t f = 1; f < r.frames.size() && HasGoals(s, r); ++f) {
+      nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+      for (const Points& path : s.paths) {
+        rows.push_back(
+            std::vector<double>(path.row(f - 1).data(), path.row(f - 1).data() + path.cols()));
+      }
+      goals.push_back(std::move(rows));
+    }
+    if (HasGoals(s, r)) header["goals"] = std::move(goals);
     header["passes"] = r.passes;
     header["residual"] = r.residual;
     header["reached"] = std::vector<bool>(r.reached.begin(), r.reached.end());

@@ -503,6 +503,13 @@ TreeOverallReport StepTreeOverall(const TreeReacher& reacher, const Points& posi
     throw InputError(Problem::Invalid("max_iterations", std::to_string(options.max_iterations),
                                       "an integer >= 1"));
   }
+  for (size_t k = 0; k < reacher.looks.size(); ++k) {
+    if (reacher.looks[k]) {
+      throw InputError(Problem("targets[" + std::to_string(k) + "]",
+                               "is a pointing goal; the overall step takes position targets "
+                               "only (the passes, tractrix or ftl, take pointing goals)"));
+    }
+  }
   TreeOverallReport report;
   {  // the positions' and points' checks, before anything changes
     Points probe = *points;

@@ -22,6 +22,7 @@ inline constexpr Rgb kInitial{0.25, 0.25, 0.25};     // the first configuration 
 inline constexpr Rgb kFinal{0.70, 0.09, 0.17};       // the last configuration
 inline constexpr Rgb kLeaderPath{0.90, 0.45, 0.05};  // the leading end's path
 inline constexpr Rgb kMarker{0.13, 0.40, 0.67};      // plot markers and lines
+inline constexpr Rgb kLookedAt{0.45, 0.22, 0.62};    // a tree's points looked at, and the gaze
 
 // Colliders: filled in a neutral stone grey under the chains, outlined a little darker.
 inline constexpr Rgb kColliderFill{0.80, 0.80, 0.78};

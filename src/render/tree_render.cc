@@ -49,13 +49,20 @@ std::vector<std::vector<int>> TreePolylines(const std::vector<int>& parents) {
 }
 
 // The tree's frames as a chain result's (what the scene fits, AutoHeight, MainTitle): frame f at
-// step f.
+// step f; then, so that the scene holds them too, a frame for each point looked at (every row
+// that point).
 ResultFile TreeShell(const TreeResultFile& tree) {
   ResultFile shell;
   shell.dim = tree.dim;
   shell.scenario_name = tree.name;
-  for (size_t f = 0; f < tree.frames.size(); ++f) {
-    shell.result.frames.Add(static_cast<int64_t>(f), tree.frames[f]);
+  int64_t step = 0;
+  for (const Points& frame : tree.frames) shell.result.frames.Add(step++, frame);
+  for (size_t k = 0; k < tree.looks.size() && !tree.goals.empty(); ++k) {
+    if (!tree.looks[k]) continue;
+    for (const Points& goal : tree.goals) {
+      const Points at = goal.row(static_cast<Eigen::Index>(k)).replicate(tree.frames[0].rows(), 1);
+      shell.result.frames.Add(step++, at);
+    }
   }
   return shell;
 }
@@ -72,6 +79,20 @@ class Batch {
       }
       Add(std::move(xy), static_cast<int>(line.size()), style);
     }
+  }
+  // The path of the goal of target k over frames 1..last (goals[f - 1]).
+  void AddGoalPath(const std::vector<Points>& goals, int k, int last, const ChainStyle& style) {
+    std::vector<double> xy;
+    for (int f = 1; f <= last; ++f) {
+      for (Eigen::Index c = 0; c < goals[f - 1].cols(); ++c) xy.push_back(goals[f - 1](k, c));
+    }
+    if (last >= 2) Add(std::move(xy), last, style);
+  }
+  // The segment from point `i` of `points` to the goal of target k in `goal`.
+  void AddGaze(const Points& points, int i, const Points& goal, int k, const ChainStyle& style) {
+    std::vector<double> xy(points.row(i).data(), points.row(i).data() + points.cols());
+    xy.insert(xy.end(), goal.row(k).data(), goal.row(k).data() + goal.cols());
+    Add(std::move(xy), 2, style);
   }
   // The path of point `i` over frames 0..last.
   void AddPath(const std::vector<Points>& frames, int i, int last, const ChainStyle& style) {
@@ -99,6 +120,32 @@ class Batch {
 };
 
 // "tree · tractrix passes · 3D · 2047 points · 1 target · 120 frames, all reached".
+// Whether target k of `tree` is a pointing goal whose goals the file holds.
+bool LooksAt(const TreeResultFile& tree, size_t k) {
+  return k < tree.looks.size() && tree.looks[k] && !tree.goals.empty();
+}
+
+// The points looked at: each pointing goal's path of goals up to frame `last`, and the gaze from
+// its point to its goal at frame `last` (> 0).
+void AddLooks(const TreeResultFile& tree, int last, double ui, Batch* batch) {
+  for (size_t k = 0; k < tree.targets.size() && last > 0; ++k) {
+    if (!LooksAt(tree, k)) continue;
+    const int kk = static_cast<int>(k);
+    batch->AddGoalPath(tree.goals, kk, last, {kLookedAt, 1.3 * ui, true});
+    batch->AddGaze(tree.frames[last], tree.targets[k], tree.goals[last - 1], kk,
+                   {Mix(kLookedAt, kWhite, 0.3), 1.0 * ui, true});
+  }
+}
+
+void DrawLookedAt(cairo_t* cr, const ChainScene& scene, const TreeResultFile& tree, int last,
+                  double ui) {
+  for (size_t k = 0; k < tree.targets.size() && last > 0; ++k) {
+    if (!LooksAt(tree, k)) continue;
+    const Eigen::Vector2d p = scene.Pixel(tree.goals[last - 1].row(k).data());
+    Ring(cr, p.x(), p.y(), 4.0 * ui, kLookedAt, 1.8 * ui);
+  }
+}
+
 std::string TreeResultSummary(const TreeResultFile& tree) {
   const bool passes = !(tree.targets.size() == 1 && tree.fixed.empty());
   std::string s = std::string("tree \u00b7 ") + MethodName(tree.method) +
@@ -167,7 +214,9 @@ void DrawTreeFigure(const TreeResultFile& tree, const FigureOptions& options,
     for (const int t : tree.targets) {
       batch.AddPath(tree.frames, t, num_frames - 1, {kLeaderPath, 1.5 * ui, false});
     }
+    AddLooks(tree, num_frames - 1, ui, &batch);
     batch.Draw(cr, scene);
+    DrawLookedAt(cr, scene, tree, num_frames - 1, ui);
     for (const int t : tree.targets) {
       std::vector<double> xy;
       for (const Points& p : tree.frames) {
@@ -207,6 +256,13 @@ void DrawTreeFigure(const TreeResultFile& tree, const FigureOptions& options,
            {kLeaderPath, 1.5 * ui, false},
            false,
            tree.targets.size() == 1 ? "driven point's path" : "driven points' paths"});
+    }
+    if (paths && std::count(tree.looks.begin(), tree.looks.end(), char(1)) > 0 &&
+        !tree.goals.empty()) {
+      entries.push_back({LegendEntry::kLine,
+                         {kLookedAt, 1.3 * ui, true},
+                         false,
+                         "points looked at, and the gaze"});
     }
     if (!tree.fixed.empty()) {
       entries.push_back(
@@ -278,8 +334,10 @@ void DrawTreeAnimation(const TreeResultFile& tree, const AnimationOptions& optio
                         {FadeColor(0.15 + 0.6 * (kGhosts - g) / kGhosts), 1.0 * ui, false});
         }
         batch.AddTree(tree.frames[f], lines, {kFinal, 2.2 * ui, false});
+        AddLooks(tree, f, ui, &batch);
         batch.Draw(cr, scene);
         DrawTreeJoints(cr, scene, tree, tree.frames[f], ui);
+        DrawLookedAt(cr, scene, tree, f, ui);
         DrawCounter(cr, ui, width, height,
                     "frame " + std::to_string(f) + " of " + std::to_string(num_frames - 1));
       },

@@ -64,8 +64,28 @@ ReachVec<Dim> ReachBranchPoint(BranchRule rule, const std::vector<ReachVec<Dim>>
   return m.llt().solve(rhs);
 }
 
+// The pointing goals' anchors where the points' parents are in `p`: each on its link's length
+// from the parent toward the point looked at (row k of `positions`); where the two coincide, the
+// point where it is.
+void PlaceLookAnchors(const TreeReacher& r, const Points& positions, const Points& p,
+                      Points* anchors) {
+  for (size_t k = 0; k < r.looks.size(); ++k) {
+    if (!r.looks[k]) continue;
+    const int c = r.target_points[k];
+    const Eigen::Index row = static_cast<Eigen::Index>(k);
+    const Eigen::RowVectorXd parent = p.row(r.parents[c]);
+    const Eigen::RowVectorXd toward = positions.row(row) - parent;
+    const double distance = toward.norm();
+    anchors->row(row) = distance > 0.0
+                            ? Eigen::RowVectorXd(parent + (r.look_length[k] / distance) * toward)
+                            : Eigen::RowVectorXd(p.row(c));
+  }
+}
+
 template <class Rule, int Dim>
-ReachReport ReachPasses(const TreeReacher& r, const Points& anchors, Points* points) {
+ReachReport ReachPasses(const TreeReacher& r, Points anchors, const Points& positions,
+                        Points* points) {
+  const bool looks = std::find(r.looks.begin(), r.looks.end(), 1) != r.looks.end();
   using V = ReachVec<Dim>;
   const int count = static_cast<int>(r.parents.size());
   // Rows of the points as the frame began (the free branches follow from them), as each pass
@@ -88,6 +108,7 @@ ReachReport ReachPasses(const TreeReacher& r, const Points& anchors, Points* poi
   int settled = 0;
   while (report.passes < r.options.max_passes) {
     ++report.passes;
+    if (looks) PlaceLookAnchors(r, positions, p, &anchors);
     for (int v : pulled) Eigen::Map<V>(row(start, v)) = at(p, v);
     // Gathering: every anchor but the root to its place, the points between it and the root after
     // it; a point with several pulled branches by the branch rule.
@@ -136,6 +157,7 @@ ReachReport ReachPasses(const TreeReacher& r, const Points& anchors, Points* poi
       internal::ApplyScalar<Rule, Dim>(lead_old, row(p, u), tail.data(), length, 1.0 / length);
       Eigen::Map<V>(row(p, v)) = tail;
     }
+    if (looks) PlaceLookAnchors(r, positions, p, &anchors);  // where the parents ended
     double residual = 0.0;
     for (int v : pulled) {
       if (r.anchor_of[v] >= 0) {
@@ -171,7 +193,7 @@ ReachReport ReachPasses(const TreeReacher& r, const Points& anchors, Points* poi
 
 TreeReacher MakeTreeReacher(const Tree& tree, const std::vector<int>& targets,
                             const std::vector<int>& fixed, const std::vector<double>& weights,
-                            const ReachOptions& options) {
+                            const ReachOptions& options, const std::vector<char>& looks) {
   ValidateTree(tree);
   const int count = static_cast<int>(tree.points.rows());
   if (options.method != Method::kTractrix && options.method != Method::kFollowTheLeader) {
@@ -201,6 +223,15 @@ TreeReacher MakeTreeReacher(const Tree& tree, const std::vector<int>& targets,
   r.parents = tree.parents;
   r.target_points = targets;
   r.fixed_points = fixed;
+  if (!looks.empty() && looks.size() != targets.size()) {
+    throw InputError("looks", "has " + std::to_string(looks.size()) + " entries for " +
+                                  std::to_string(targets.size()) +
+                                  " targets; give one per target, or none (every target a "
+                                  "position)");
+  }
+  r.looks.assign(targets.size(), 0);
+  r.look_length.assign(targets.size(), 0.0);
+  for (size_t k = 0; k < looks.size(); ++k) r.looks[k] = looks[k] ? 1 : 0;
   r.anchor_of.assign(count, -1);
   const std::string range = "a point of the tree, 0.." + std::to_string(count - 1);
   auto claim = [&](int point, const std::string& field) {
@@ -235,7 +266,25 @@ TreeReacher MakeTreeReacher(const Tree& tree, const std::vector<int>& targets,
     r.weights.push_back(1.0);
     r.fixed_positions.row(static_cast<Eigen::Index>(k)) = tree.points.row(fixed[k]);
   }
-  r.root = fixed.empty() ? targets[0] : fixed[0];
+  for (size_t k = 0; k < targets.size(); ++k) {
+    if (!r.looks[k]) continue;
+    const int c = targets[k];
+    if (tree.parents[c] < 0) {
+      throw InputError(Problem(ReachField("targets", k),
+                               "is point " + std::to_string(c) +
+                                   ", the tree's root: a pointing goal turns the link from a "
+                                   "point's parent, and the root has none",
+                               std::to_string(c), "a point other than the root"));
+    }
+    r.look_length[k] = (tree.points.row(c) - tree.points.row(tree.parents[c])).norm();
+  }
+  const auto position = std::find(r.looks.begin(), r.looks.end(), 0);
+  if (fixed.empty() && position == r.looks.end()) {
+    throw InputError("targets",
+                     "are all pointing goals and nothing is fixed: the body could be anywhere; "
+                     "give a position target or a fixed point");
+  }
+  r.root = fixed.empty() ? targets[position - r.looks.begin()] : fixed[0];
   // The tree hung from the root: breadth first over the links in both directions.
   std::vector<std::vector<int>> near(count);
   for (int i = 0; i < count; ++i) {
@@ -319,8 +368,10 @@ ReachReport ReachTargets(const TreeReacher& reacher, const Points& positions, Po
   ReachReport report;
   internal::DispatchRule<internal::kTreeEngine>(reacher.options.method, [&](auto rule) {
     using Rule = decltype(rule);
-    report = dim == 2 ? ReachPasses<typename Rule::template Step<2>, 2>(reacher, anchors, points)
-                      : ReachPasses<typename Rule::template Step<3>, 3>(reacher, anchors, points);
+    report =
+        dim == 2
+            ? ReachPasses<typename Rule::template Step<2>, 2>(reacher, anchors, positions, points)
+            : ReachPasses<typename Rule::template Step<3>, 3>(reacher, anchors, positions, points);
   });
   return report;
 }
