@@ -15,8 +15,10 @@
 
 #include "cli_process.h"
 #include "flexkin/any_scenario.h"
+#include "scenes/scenes.h"
 #include "schema_test_util.h"
 #include "test_util.h"
+#include "tree_test_util.h"
 
 namespace flexkin {
 namespace {
@@ -106,6 +108,41 @@ TEST(TreeScenarioTest, ReadsAndRunsPointingGoals) {
               k["targets"][2]["look_at"].erase(1);
             }).rfind("/targets/2/look_at: has 2 points; every target's path", 0),
             0u);
+}
+
+// "finish" (default true): stalled passes finished by the least correction (FinishTreeReach).
+TEST(TreeScenarioTest, ReadsTheFinishOption) {
+  EXPECT_TRUE(Read(TwoHands()).tree->finish);
+  json j = TwoHands();
+  j["finish"] = false;
+  EXPECT_FALSE(Read(j).tree->finish);
+  j["finish"] = 3;
+  EXPECT_EQ(
+      FirstProblem(j).rfind("/finish: value 3 (a number) is not valid; expected true or false", 0),
+      0u)
+      << FirstProblem(j);
+  // Every frame of the example reaches its targets: nothing to finish.
+  const TreeRunResult r = RunTree(*Read(TwoHands()).tree);
+  EXPECT_EQ(r.finished, (std::vector<char>{0, 0, 0}));
+  // A random tree whose passes stall (tree_reach_test): finished by default, not without.
+  TreeScenario stalls;
+  stalls.tree = scenes::RandomTree(40, 2, 6);
+  stalls.targets = test_util::Leaves(stalls.tree, 5);
+  const Points bent = test_util::Bent(stalls.tree, 0.25, 106);
+  for (const int leaf : stalls.targets) stalls.paths.push_back(bent.row(leaf));
+  stalls.weights.assign(5, 1.0);
+  stalls.fixed = {0};
+  const TreeRunResult finished = RunTree(stalls);
+  EXPECT_EQ(finished.finished, (std::vector<char>{1}));
+  EXPECT_EQ(finished.reached, (std::vector<char>{1}));
+  EXPECT_LE(finished.residual[0], 1e-10);
+  EXPECT_LE(finished.max_length_error, 1e-12);
+  EXPECT_NE(finished.BriefReport().find("1 frame of stalled passes finished"), std::string::npos);
+  stalls.finish = false;
+  const TreeRunResult stalled = RunTree(stalls);
+  EXPECT_EQ(stalled.finished, (std::vector<char>{0}));
+  EXPECT_EQ(stalled.reached, (std::vector<char>{0}));
+  EXPECT_GT(stalled.residual[0], 1e-5);
 }
 
 TEST(TreeScenarioTest, NamesEveryProblemByItsJsonPointer) {

@@ -141,6 +141,7 @@ struct ReachReport {
   double residual = 0.0;  // the largest distance of a target or fixed point from where it
                           // should be, after the last pass, as a fraction of the longest link
   bool reached = false;   // residual <= options.tolerance
+  bool finished = false;  // passes that stalled, completed by FinishTreeReach (tree_overall.h)
 };
 
 // Throws InputError naming the field ("targets[2]", "fixed[0]", "weights[1]", "method",

@@ -49,4 +49,17 @@ struct TreeOverallReport {
 TreeOverallReport StepTreeOverall(const TreeReacher& reacher, const Points& positions,
                                   const TreeOverallOptions& options, Points* points);
 
+// Completes passes that stalled short of reachable targets (docs/trees.md, "Finishing stalled
+// passes"): `passes` is ReachTargets's report for `positions`, `points` where it left them. Where
+// it did not reach them, but came within 0.05 of the longest link, the least correction of the
+// points (the squared metric: the smallest sum of squared displacements from where the passes
+// left them) that holds every target and fixed point exactly and keeps every length, by
+// StepTreeOverall's Newton's method in one step. Returns the report with reached, finished and the
+// residual (the targets' largest distance after the correction, of the longest link) where Newton
+// converged; otherwise `passes`, `points` unchanged (a target out of reach). A reacher with
+// pointing goals is returned unchanged: the correction takes position targets only. Throws
+// InputError as ReachTargets does on positions or points of the wrong shape.
+ReachReport FinishTreeReach(const TreeReacher& reacher, const Points& positions,
+                            const ReachReport& passes, Points* points);
+
 }  // namespace flexkin

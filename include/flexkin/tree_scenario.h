@@ -29,6 +29,7 @@ struct TreeScenario {
   Method method = Method::kTractrix;  // "method"
   int substeps = 1;                   // "substeps": one target and nothing fixed only
   ReachOptions reach;                 // "branch_rule", "tolerance", "max_passes"
+  bool finish = true;                 // "finish": FinishTreeReach after passes that stall
   TreeOverallOptions overall;         // "overall": the metric's weights (method "overall")
 
   // One driven point and nothing fixed: moved by MoveTreePoint (any rule of trees); otherwise
@@ -46,6 +47,7 @@ struct TreeRunResult {
   std::vector<double> residual;   // of the longest link (0 for a tree driven at one point)
   std::vector<char> reached;      // (1 for a tree driven at one point)
   std::vector<char> converged;    // the overall step's (method "overall"; else 1)
+  std::vector<char> finished;     // passes that stalled, completed by FinishTreeReach
   double max_length_error = 0.0;  // largest relative link-length error over the frames
 
   int failures() const;  // frames not reached or not converged

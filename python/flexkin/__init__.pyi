@@ -247,7 +247,8 @@ def reach_tree(points: ArrayLike, parents: Sequence[int], targets: Sequence[int]
                method: str = "tractrix", branch_rule: str = "centroid", tolerance: float = 1e-10,
                max_passes: int = 1000,
                overall: Union[None, "ObjectiveWeights", Dict[str, float]] = None,
-               looks: Sequence[bool] = ...) -> Tuple[Float64Array, Dict[str, Any]]: ...
+               looks: Sequence[bool] = ..., finish: bool = True
+               ) -> Tuple[Float64Array, Dict[str, Any]]: ...
 def overall_step(points: PointsArg, head: ArrayLike, *,
                  options: OverallArg = None) -> Tuple[Float64Array, OverallReport]: ...
 def run(points: PointsArg, leader_steps: ArrayLike, *, method: str = "tractrix",

@@ -188,7 +188,7 @@ py::array_t<double> MoveTree(ArrayLike points, IndexSequence parents, ArrayLike 
 py::tuple ReachTree(ArrayLike points, IndexSequence parents, IndexSequence targets, ArrayLike paths,
                     IndexSequence fixed, OptionalArray weights, const std::string& method,
                     NameText branch_rule, double tolerance, int max_passes, OptionalWeights overall,
-                    const std::vector<bool>& looks) {
+                    const std::vector<bool>& looks, bool finish) {
   Tree tree;
   tree.points = ReadPoints(points, "points", 2);
   tree.parents = IndexList(parents, "parents");
@@ -235,7 +235,7 @@ py::tuple ReachTree(ArrayLike points, IndexSequence parents, IndexSequence targe
   py::array_t<double> frames({count + 1, rows, dim});
   py::array_t<int> passes(count);
   py::array_t<double> residual(count);
-  py::array_t<bool> reached(count), converged(count);
+  py::array_t<bool> reached(count), converged(count), finished(count);
   double* out = frames.mutable_data();
   Points pts = tree.points, goal(k, dim);
   const size_t frame = static_cast<size_t>(rows) * dim;
@@ -251,7 +251,9 @@ py::tuple ReachTree(ArrayLike points, IndexSequence parents, IndexSequence targe
         converged.mutable_data()[i] = step.converged;
       } else {
         report = ReachTargets(reacher, goal, &pts);
+        if (finish) report = FinishTreeReach(reacher, goal, report, &pts);
       }
+      finished.mutable_data()[i] = report.finished;
       std::copy(pts.data(), pts.data() + frame, out + (i + 1) * frame);
       passes.mutable_data()[i] = report.passes;
       residual.mutable_data()[i] = report.residual;
@@ -264,6 +266,7 @@ py::tuple ReachTree(ArrayLike points, IndexSequence parents, IndexSequence targe
   report["reached"] = reached;
   report["root"] = reacher.root;
   if (exact) report["converged"] = converged;
+  if (!exact) report["finished"] = finished;
   return py::make_tuple(frames, report);
 }
 
@@ -485,26 +488,29 @@ Chain(points, *, link_length=None, lengths=None)
         "(\"tractrix\", \"ftl\", \"min_rotation\", \"min_joint_angle\"). Returns the frames, (m+1, "
         "n+1, dim): the start, then the "
         "tree after each target.");
-  m.def("reach_tree", &ReachTree, py::arg("points"), py::arg("parents"), py::arg("targets"),
-        py::arg("paths"), py::kw_only(), py::arg("fixed") = std::vector<int>(),
-        py::arg("weights") = py::none(), py::arg("method") = "tractrix",
-        py::arg("branch_rule") = "centroid", py::arg("tolerance") = 1e-10,
-        py::arg("max_passes") = 1000, py::arg("overall") = py::none(),
-        py::arg("looks") = std::vector<bool>(),
-        "Several targets on a tree (docs/trees.md): the points `targets` (k point indices) reach, "
-        "frame by frame, the positions of paths ((m, k, dim)) while the points `fixed` stay where "
-        "they are, by passes of `method` (\"tractrix\" or \"ftl\") between them, with "
-        "`branch_rule` (\"centroid\", FABRIK's, or \"keep_links\") where pulled branches meet; "
-        "each frame starts where the last ended. weights: one per target (default 1). tolerance: "
-        "of the longest link. Returns (frames, report): frames (m+1, n+1, dim), the start then "
-        "each frame; report a dict of per-frame arrays passes, residual (of the longest link) and "
-        "reached, and root (the point the passes hang the tree from). overall: objective weights "
-        "(ObjectiveWeights or a dict: squared, squared_weighted, rotation): each frame is then the "
-        "exact least-motion step, from the passes by Newton's method (docs/trees.md), and the "
-        "report adds converged; the passes' points where it does not converge. looks: one bool "
-        "per target (default none): a True target is a pointing goal, its paths' rows the point "
-        "its link from its parent points at (docs/trees.md, \"Pointing goals\"; the passes "
-        "only, not overall).");
+  m.def(
+      "reach_tree", &ReachTree, py::arg("points"), py::arg("parents"), py::arg("targets"),
+      py::arg("paths"), py::kw_only(), py::arg("fixed") = std::vector<int>(),
+      py::arg("weights") = py::none(), py::arg("method") = "tractrix",
+      py::arg("branch_rule") = "centroid", py::arg("tolerance") = 1e-10,
+      py::arg("max_passes") = 1000, py::arg("overall") = py::none(),
+      py::arg("looks") = std::vector<bool>(), py::arg("finish") = true,
+      "Several targets on a tree (docs/trees.md): the points `targets` (k point indices) reach, "
+      "frame by frame, the positions of paths ((m, k, dim)) while the points `fixed` stay where "
+      "they are, by passes of `method` (\"tractrix\" or \"ftl\") between them, with "
+      "`branch_rule` (\"centroid\", FABRIK's, or \"keep_links\") where pulled branches meet; "
+      "each frame starts where the last ended. weights: one per target (default 1). tolerance: "
+      "of the longest link. Returns (frames, report): frames (m+1, n+1, dim), the start then "
+      "each frame; report a dict of per-frame arrays passes, residual (of the longest link) and "
+      "reached, and root (the point the passes hang the tree from). overall: objective weights "
+      "(ObjectiveWeights or a dict: squared, squared_weighted, rotation): each frame is then the "
+      "exact least-motion step, from the passes by Newton's method (docs/trees.md), and the "
+      "report adds converged; the passes' points where it does not converge. looks: one bool "
+      "per target (default none): a True target is a pointing goal, its paths' rows the point "
+      "its link from its parent points at (docs/trees.md, \"Pointing goals\"; the passes "
+      "only, not overall). finish: passes that stall within 0.05 of the longest link are completed "
+      "by the least correction to the targets (docs/trees.md, \"Finishing stalled passes\"); "
+      "the report's finished says which frames.");
   m.def(
       "overall_step",
       [](PointsOrChain points, ArrayLike head, OverallLike options) {

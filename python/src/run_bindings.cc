@@ -364,13 +364,16 @@ py::dict RunTreeToDict(const AnyScenario& any, ProgressCallback progress, const 
   out["residual"] =
       py::array_t<double>(static_cast<py::ssize_t>(r.residual.size()), r.residual.data());
   py::array_t<bool> reached(static_cast<py::ssize_t>(r.reached.size())),
-      converged(static_cast<py::ssize_t>(r.converged.size()));
+      converged(static_cast<py::ssize_t>(r.converged.size())),
+      finished(static_cast<py::ssize_t>(r.finished.size()));
   for (size_t i = 0; i < r.reached.size(); ++i) {
     reached.mutable_data()[i] = r.reached[i] != 0;
     converged.mutable_data()[i] = r.converged[i] != 0;
+    finished.mutable_data()[i] = r.finished[i] != 0;
   }
   out["reached"] = reached;
   out["converged"] = converged;
+  out["finished"] = finished;
   out["max_length_error"] = r.max_length_error;
   return out;
 }

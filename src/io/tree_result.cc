@@ -32,7 +32,8 @@ class TreeResultReader : public json_internal::JsonReader {
                                      "parents",          "targets", "looks",  "fixed",
                                      "max_length_error", "failures"};
     if (json_form) {
-      for (const char* k : {"frames", "goals", "passes", "residual", "reached", "converged"}) {
+      for (const char* k :
+           {"frames", "goals", "passes", "residual", "reached", "converged", "finished"}) {
         keys.push_back(k);
       }
     }

@@ -46,7 +46,7 @@ class TreeScenarioReader : public json_internal::JsonReader {
     if (!ExpectObject(root, "", "an object (a tree scenario, docs/trees.md)")) return s;
     CheckKeys(root, "",
               {"format", "name", "tree", "targets", "fixed", "method", "substeps", "branch_rule",
-               "tolerance", "max_passes", "overall"});
+               "tolerance", "max_passes", "finish", "overall"});
     if (const json* format = Find(root, "format")) {
       if (!(format->is_string() && *format == "flexkin-tree")) {
         ValueProblem(*format, "/format", "\"flexkin-tree\"");
@@ -101,6 +101,14 @@ class TreeScenarioReader : public json_internal::JsonReader {
         [&](const json& v, const std::string& p) { return Integer(v, p, 1, 1 << 24); },
         &max_passes);
     s.reach.max_passes = static_cast<int>(max_passes);
+    Optional(
+        root, "", "finish",
+        [&](const json& v, const std::string& p) -> std::optional<bool> {
+          if (v.is_boolean()) return v.get<bool>();
+          TypeProblem(v, p, "true or false");
+          return std::nullopt;
+        },
+        &s.finish);
     if (const json* overall = Find(root, "overall")) ReadOverall(*overall, &s);
     if (problems.empty()) CheckTogether(root, &s);
     return s;
@@ -313,6 +321,11 @@ std::string TreeRunResult::BriefReport() const {
   out << frames.size() << " frames; " << failures() << " not reached or not converged; passes at "
       << "most " << worst_passes << "; residual at most " << worst << " of the longest link; "
       << "link lengths within " << max_length_error;
+  const auto completed = std::count(finished.begin(), finished.end(), char(1));
+  if (completed > 0) {
+    out << "; " << completed << (completed == 1 ? " frame" : " frames")
+        << " of stalled passes finished by the least correction";
+  }
   return out.str();
 }
 
@@ -365,7 +378,7 @@ TreeRunResult RunTree(const TreeScenario& s,
     for (size_t k = 0; k < s.targets.size(); ++k) goal.row(k) = s.paths[k].row(f);
     int passes = 0;
     double residual = 0.0;
-    char reached = 1, converged = 1;
+    char reached = 1, converged = 1, finished = 0;
     if (one) {
       MoveTreePoint(stepper, goal.row(0).transpose(), s.substeps, &points);
     } else if (s.method == Method::kOverall) {
@@ -375,15 +388,18 @@ TreeRunResult RunTree(const TreeScenario& s,
       reached = report.start.reached;
       converged = report.converged;
     } else {
-      const ReachReport report = ReachTargets(reacher, goal, &points);
+      ReachReport report = ReachTargets(reacher, goal, &points);
+      if (s.finish) report = FinishTreeReach(reacher, goal, report, &points);
       passes = report.passes;
       residual = report.residual;
       reached = report.reached;
+      finished = report.finished;
     }
     r.passes.push_back(passes);
     r.residual.push_back(residual);
     r.reached.push_back(reached);
     r.converged.push_back(converged);
+    r.finished.push_back(finished);
     r.frames.push_back(points);
     for (size_t i = 0; i < lengths.size(); ++i) {
       const int u = s.tree.parents[i];
@@ -458,7 +474,8 @@ void WriteTreeResult(const std::string& path, const TreeScenario& s, const TreeR
     zip.AddMember("residual.npy", res);
     for (const auto& [name, v] :
          {std::pair<const char*, const std::vector<char>*>{"reached.npy", &r.reached},
-          {"converged.npy", &r.converged}}) {
+          {"converged.npy", &r.converged},
+          {"finished.npy", &r.finished}}) {
       std::string d = NpyHeader("|b1", {v->size()});
       for (const char c : *v) d.push_back(c ? 1 : 0);
       zip.AddMember(name, d);
@@ -489,6 +506,7 @@ void WriteTreeResult(const std::string& path, const TreeScenario& s, const TreeR
     header["residual"] = r.residual;
     header["reached"] = std::vector<bool>(r.reached.begin(), r.reached.end());
     header["converged"] = std::vector<bool>(r.converged.begin(), r.converged.end());
+    header["finished"] = std::vector<bool>(r.finished.begin(), r.finished.end());
     file.stream() << header.dump() << "\n";
   }
   file.Check();

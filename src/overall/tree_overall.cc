@@ -541,4 +541,59 @@ TreeOverallReport StepTreeOverall(const TreeReacher& reacher, const Points& posi
   return result;
 }
 
+// FinishTreeReach's sub-steps and Newton iterations a sub-step.
+constexpr int kFinishSubsteps = 8;
+constexpr int kFinishIterations = 100;
+
+ReachReport FinishTreeReach(const TreeReacher& reacher, const Points& positions,
+                            const ReachReport& passes, Points* points) {
+  const Eigen::Index driven = static_cast<Eigen::Index>(reacher.target_points.size());
+  const int count = static_cast<int>(reacher.parents.size());
+  if (positions.rows() != driven || positions.cols() != reacher.dim || !positions.allFinite() ||
+      points->rows() != count || points->cols() != reacher.dim || !points->allFinite()) {
+    Points probe = *points;  // ReachTargets names the problem
+    ReachTargets(reacher, positions, &probe);
+  }
+  const bool looks =
+      std::find(reacher.looks.begin(), reacher.looks.end(), 1) != reacher.looks.end();
+  if (passes.reached || looks || !(passes.residual <= kNewtonAfterStall)) return passes;
+  TreeOverallOptions options;
+  options.weights = ObjectiveWeights();
+  options.weights.squared = 1.0;
+  options.max_iterations = kFinishIterations;
+  // The anchors move from where the passes left them to where they should be in sub-steps, each
+  // solved by Newton from the last solution, the metric measured from the passes' points.
+  Points p = *points;
+  const Points stalled = *points;
+  for (int j = 1; j <= kFinishSubsteps; ++j) {
+    const double f = static_cast<double>(j) / kFinishSubsteps;
+    for (int v = 0; v < count; ++v) {
+      const int a = reacher.anchor_of[v];
+      if (a < 0) continue;
+      const Eigen::RowVectorXd goal =
+          a < driven ? positions.row(a) : reacher.fixed_positions.row(a - driven);
+      p.row(v) = j == kFinishSubsteps
+                     ? goal
+                     : Eigen::RowVectorXd(stalled.row(v) + f * (goal - stalled.row(v)));
+    }
+    const int used = reacher.dim == 2
+                         ? TreeKkt<2>(reacher, options.weights, stalled).Solve(options, &p)
+                         : TreeKkt<3>(reacher, options.weights, stalled).Solve(options, &p);
+    if (used < 0) return passes;
+  }
+  ReachReport report = passes;
+  double residual = 0.0;
+  for (int v = 0; v < count; ++v) {
+    const int a = reacher.anchor_of[v];
+    if (a < 0) continue;
+    const auto goal = a < driven ? positions.row(a) : reacher.fixed_positions.row(a - driven);
+    residual = std::max(residual, (p.row(v) - goal).norm());
+  }
+  report.residual = residual / reacher.longest_link;
+  report.reached = report.residual <= reacher.options.tolerance;
+  report.finished = true;
+  *points = p;
+  return report;
+}
+
 }  // namespace flexkin
