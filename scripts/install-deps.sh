@@ -11,6 +11,7 @@ packages+=(clang-14 libclang-rt-14-dev)  # libFuzzer targets, ASan + UBSan (fuzz
 packages+=(liborocos-kdl-dev)  # the pseudo-inverse peer of the arm comparison (testing/kdl_peer.h)
 packages+=(libkdl-parser-dev)  # KDL chains from URDF text, the URDF snakes' peer (testing/kdl_urdf_peer.h)
 packages+=(chromium)         # the viewer's browser test (headless)
+packages+=(blender)          # glTF of trees imported by Blender, headless (tests/blender)
 packages+=(liburdfdom-dev libtinyxml-dev)  # URDF arms (src/urdf); TinyXML, the parser urdfdom uses
 packages+=(libfcl-dev)        # mesh colliders' hierarchy; the colliders' reference distances (tests/colliders_test.cc)
 packages+=(libassimp-dev)     # mesh colliders' STL and OBJ files (src/io/mesh_file.cc)
