@@ -103,6 +103,7 @@ TEST(TreeDrawTest, EveryFormatOfTreesIsWritten) {
     EXPECT_GT(missed, 0);
     EXPECT_EQ(data["tree"]["not_reached"].get<int64_t>(), missed);
     EXPECT_EQ(data["num_links"], 7);
+    EXPECT_TRUE(data["tree"]["looks"].empty());  // no pointing goal
     ASSERT_EQ(data["frame_length_error"].size(), tree.frames.size());
     for (const auto& e : data["frame_length_error"]) EXPECT_LT(e.get<double>(), 1e-12);
     // Each point's path length: the distances it moved from frame to frame.

@@ -18,6 +18,7 @@
 #include <sstream>
 #include <string>
 
+#include "flexkin/any_scenario.h"
 #include "flexkin/chain.h"
 #include "flexkin/error.h"
 #include "flexkin/result_io.h"
@@ -61,6 +62,30 @@ TreeResultFile MakeTreeResult(scenes::TreeKind kind, int dim, int frames, const 
   out.frames = run.frames;
   for (size_t f = 0; f < run.reached.size(); ++f) {
     out.reached.push_back(run.reached[f] && run.converged[f]);
+  }
+  return out;
+}
+
+// The torso example (examples/tree_torso.json) run, its goals and pointing goal kept: a page that
+// draws the point the head looks at.
+TreeResultFile TorsoResult() {
+  const AnyScenario any =
+      ReadScenarioFile(std::string(FLEXKIN_SOURCE_DIR) + "/examples/tree_torso.json");
+  const TreeScenario& s = *any.tree;
+  const TreeRunResult run = RunTree(s);
+  TreeResultFile out;
+  out.name = s.name;
+  out.dim = 3;
+  out.parents = s.tree.parents;
+  out.targets = s.targets;
+  out.fixed = s.fixed;
+  out.looks = s.looks;
+  out.frames = run.frames;
+  for (size_t f = 1; f < run.frames.size(); ++f) {
+    out.reached.push_back(run.reached[f - 1]);
+    Points goal(static_cast<Eigen::Index>(s.targets.size()), 3);
+    for (size_t k = 0; k < s.targets.size(); ++k) goal.row(k) = s.paths[k].row(f - 1);
+    out.goals.push_back(goal);
   }
   return out;
 }
@@ -307,6 +332,7 @@ TEST_F(ViewerTest, PlaysScrubsAndMovesInHeadlessChromium) {
                       Path("tree_arms_3d.html"));
   WriteTreeViewerHtml(MakeTreeResult(scenes::TreeKind::kBinary10, 2, 40, "binary tree"), options,
                       Path("tree_binary_2d.html"));
+  WriteTreeViewerHtml(TorsoResult(), options, Path("tree_torso.html"));
   std::printf("page sizes: %ju, %ju, %ju bytes\n",
               static_cast<uintmax_t>(fs::file_size(Path("small_2d.html"))),
               static_cast<uintmax_t>(fs::file_size(Path("spatial_20x2650.html"))),
@@ -323,7 +349,7 @@ TEST_F(ViewerTest, PlaysScrubsAndMovesInHeadlessChromium) {
                      "' '" + Path("small_2d.html") + "' '" + Path("spatial_20x2650.html") + "' '" +
                      Path("planar_80x250.html") + "' '" + Path("capsules_2d.html") + "' '" +
                      Path("capsules_3d.html") + "' '" + Path("tree_arms_3d.html") + "' '" +
-                     Path("tree_binary_2d.html") + "'",
+                     Path("tree_binary_2d.html") + "' '" + Path("tree_torso.html") + "'",
                  &output);
   std::printf("%s", output.c_str());
   EXPECT_EQ(status, 0) << output;

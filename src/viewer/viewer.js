@@ -42,6 +42,11 @@
   }
   // The points whose paths are drawn as the leader's: a tree's driven points, else point 0.
   const leaders = tree ? tree.targets : [0];
+  // A tree's pointing goals: the point that looks (its target's point) and the points it looked
+  // at, frames 1 to numFrames - 1 (dim numbers a frame).
+  const looks = tree && tree.looks ? tree.looks.map((l) => ({
+    point: tree.targets[l.target], goals: Float64Array.from(l.goals),
+  })) : [];
 
   // Bounding box of the whole motion, its centre and the radius of its bounding sphere.
   const lo = [Infinity, Infinity, Infinity];
@@ -50,6 +55,14 @@
     for (let k = 0; k < dim; ++k) {
       if (pos[j + k] < lo[k]) lo[k] = pos[j + k];
       if (pos[j + k] > hi[k]) hi[k] = pos[j + k];
+    }
+  }
+  for (const l of looks) {  // the view holds the points looked at too
+    for (let j = 0; j < l.goals.length; j += dim) {
+      for (let k = 0; k < dim; ++k) {
+        lo[k] = Math.min(lo[k], l.goals[j + k]);
+        hi[k] = Math.max(hi[k], l.goals[j + k]);
+      }
     }
   }
   if (dim === 2) { lo[2] = 0; hi[2] = 0; }
@@ -158,7 +171,7 @@
   const colors = {
     background: '#fbfbfd', grid: '#e6e9ef', gridLabel: '#8a93a5', axis: '#c9ced8',
     leader: '#e08a1e', lead: '#d62f2f', tail: '#1d2330', shadow: 'rgba(60, 70, 90, 0.18)',
-    collider: '#d2d2cc', colliderEdge: '#85857f',
+    collider: '#d2d2cc', colliderEdge: '#85857f', looked: '#73389e',
   };
   // Capsules by depth in 3D, far light, near darker (one colour in 2D: capsuleShades[15]).
   const capsuleShades = [];
@@ -362,6 +375,35 @@
     g.stroke();
   }
 
+  // The pointing goals at frame `frame` (> 0): the points looked at so far, a dashed gaze from the
+  // looking point to the point it looks at, and a ring there.
+  function drawLooks(g, frame) {
+    if (frame === 0) return;
+    const at = (l, f, k) => l.goals[(f - 1) * dim + k];
+    for (const l of looks) {
+      g.strokeStyle = colors.looked;
+      g.lineWidth = 1.25;
+      g.setLineDash([4, 3]);
+      g.beginPath();
+      for (let f = 1; f <= frame; ++f) {
+        project(at(l, f, 0), at(l, f, 1), dim === 3 ? at(l, f, 2) : 0);
+        if (f === 1) g.moveTo(sx, sy); else g.lineTo(sx, sy);
+      }
+      g.stroke();
+      projectPoint(frame, l.point);
+      const fromX = sx, fromY = sy;
+      project(at(l, frame, 0), at(l, frame, 1), dim === 3 ? at(l, frame, 2) : 0);
+      g.beginPath();
+      g.moveTo(fromX, fromY);
+      g.lineTo(sx, sy);
+      g.stroke();
+      g.setLineDash([]);
+      g.beginPath();
+      g.arc(sx, sy, 4, 0, 2 * Math.PI);
+      g.stroke();
+    }
+  }
+
   // Each link of a radius as its capsule, under the links' lines: a stroke from point to point
   // with round caps, 2 x radius wide, which is the outline of a capsule in 2D and the silhouette
   // of one in the orthographic 3D view. In perspective the radius is scaled as a point at the
@@ -539,6 +581,7 @@
         strokePath(g, state.trails[j], state.frame);
       }
     }
+    if (state.showLeader) drawLooks(g, state.frame);
     drawChain(g, state.frame);
     state.dirty = false;
     common.countDraw(stats, t0);

@@ -260,6 +260,25 @@ std::string ViewerDataJson(const ResultFile& file, const ViewerOptions& options,
     AppendInts(tree->fixed, &out);
     AppendKey("not_reached", &out);
     out += std::to_string(std::count(tree->reached.begin(), tree->reached.end(), char(0)));
+    // The pointing goals: each one's target index and the points it looked at, frames 1 to F-1
+    // (dim numbers a frame).
+    AppendKey("looks", &out);
+    out.push_back('[');
+    bool first_look = true;
+    for (size_t k = 0; k < tree->looks.size() && !tree->goals.empty(); ++k) {
+      if (!tree->looks[k]) continue;
+      if (!first_look) out.push_back(',');
+      first_look = false;
+      out += "{\"target\":" + std::to_string(k) + ",\"goals\":[";
+      for (size_t f = 0; f < tree->goals.size(); ++f) {
+        for (Eigen::Index c = 0; c < tree->goals[f].cols(); ++c) {
+          if (f > 0 || c > 0) out.push_back(',');
+          AppendNumber(tree->goals[f](static_cast<Eigen::Index>(k), c), options.digits, &out);
+        }
+      }
+      out += "]}";
+    }
+    out.push_back(']');
     out.push_back('}');
   } else {
     for (Eigen::Index k = 0; k < r.lengths.size(); ++k) {

@@ -25,7 +25,8 @@ void CheckResult(const ResultFile& result, const ViewerOptions& options);
 // coordinates' `digits`, where the result has them; the page draws the links as their capsules.
 // `tree`: the tree result that `result` was made from (TreeAsViewerResult), whose topology goes
 // into a "tree" object (parents; link_points, the point each link ends at, link k of `result`
-// ending at link_points[k]; targets; fixed; not_reached, the frames not reached) and whose links
+// ending at link_points[k]; targets; fixed; not_reached, the frames not reached; looks, for each
+// pointing goal its target index and the points it looked at, frames 1 to F-1) and whose links
 // give each frame's length error; null for a chain result.
 std::string ViewerDataJson(const ResultFile& result, const ViewerOptions& options,
                            const RobotTrajectoryFile* robot = nullptr,
