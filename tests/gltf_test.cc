@@ -32,6 +32,7 @@
 #include "io/json_file.h"  // ReadJsonFile, WriteFileAtomically
 #include "scenes/scenes.h"
 #include "test_util.h"
+#include "tree_test_util.h"
 
 namespace flexkin {
 namespace {
@@ -661,12 +662,7 @@ namespace {
 // A tree result: a random tree (root 0) driven at a leaf round a circle, `frames` frames.
 TreeResultFile MakeTreeResult(int dim, int count, int frames, unsigned seed) {
   const Tree tree = scenes::RandomTree(count, dim, seed);
-  std::vector<char> has_child(count, 0);
-  for (int p : tree.parents) {
-    if (p >= 0) has_child[p] = 1;
-  }
-  int leaf = count - 1;
-  while (has_child[leaf]) --leaf;
+  const int leaf = test_util::Leaves(tree, static_cast<size_t>(count)).back();
   const TreeStepper stepper = MakeTreeStepper(Method::kTractrix, tree, leaf);
   TreeResultFile file;
   file.name = "random tree";
@@ -694,12 +690,8 @@ void ExpectTreeRoundTrip(const TreeResultFile& tree, const GltfOptions& options,
   WriteTreeGltf(tree, options, path);
   const GltfJointMotion motion = ReadGltfJointPositions(path);
   EXPECT_EQ(motion.dim, tree.dim);
-  int leaves = 0;
-  std::vector<char> has_child(tree.parents.size(), 0);
-  for (int p : tree.parents) {
-    if (p >= 0) has_child[p] = 1;
-  }
-  for (char c : has_child) leaves += !c;
+  const size_t leaves =
+      test_util::Leaves(Tree{tree.frames[0], tree.parents}, tree.parents.size()).size();
   ASSERT_EQ(motion.joint_points.size(), tree.parents.size() + leaves);
   ASSERT_EQ(motion.positions.size(), tree.frames.size());
   double worst = 0.0, size = 0.0;

@@ -101,6 +101,9 @@ namespace internal {
 // The same for a drawing and options Draw (flexkin/draw.h) has checked: only glTF's own limits
 // (joints, float32, link directions) are checked here.
 void WriteGltf(const CheckedDrawing& drawing, const GltfOptions& options, const std::string& path);
+// The same for a tree and options Draw has checked (ValidateTreeResult, Validate): only glTF's own
+// limits and the path are checked here.
+void WriteTreeGltf(const TreeResultFile& tree, const GltfOptions& options, const std::string& path);
 }  // namespace internal
 
 // Joint positions read back from a glTF file.

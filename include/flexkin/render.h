@@ -219,6 +219,11 @@ void WritePlot(const CheckedDrawing& drawing, PlotKind kind, const PlotOptions& 
                const std::string& path);
 void WriteAnimation(const CheckedDrawing& drawing, const AnimationOptions& options,
                     const std::string& path);
+// The same for a tree and options Draw has checked (ValidateTreeResult, Validate): no check again.
+void WriteTreeFigure(const TreeResultFile& tree, const FigureOptions& options,
+                     const std::string& path);
+void WriteTreeAnimation(const TreeResultFile& tree, const AnimationOptions& options,
+                        const std::string& path);
 
 }  // namespace internal
 

@@ -33,6 +33,12 @@ void ValidateTree(const Tree& tree, const char* field = "tree");
 // The path of `chain` as a tree (point i hangs from point i - 1).
 Tree TreeOfChain(const Chain& chain);
 
+// Each point's children (the points that hang from it), in increasing order; `parents` as a
+// Tree's (-1 for the root).
+std::vector<std::vector<int>> TreeChildren(const std::vector<int>& parents);
+// The root of `parents` (the one entry -1); 0 if there is none.
+int TreeRoot(const std::vector<int>& parents);
+
 // A tree prepared for moves driven at one point: its links in the order a move visits them (each
 // link's leading end placed before its trailing end; depth first from the driven point), their
 // lengths as the tree's points give them, and the rule.

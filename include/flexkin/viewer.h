@@ -77,6 +77,10 @@ namespace internal {
 // points against the drawing included): nothing is checked again.
 void WriteViewerHtml(const CheckedDrawing& drawing, const ViewerOptions& options,
                      const std::string& path);
+// The same for a tree and options Draw has checked (ValidateTreeResult, Validate, the trail
+// points against the tree): nothing is checked again.
+void WriteTreeViewerHtml(const TreeResultFile& tree, const ViewerOptions& options,
+                         const std::string& path);
 }  // namespace internal
 
 }  // namespace flexkin

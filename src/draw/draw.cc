@@ -96,25 +96,25 @@ void StrandOutput(const Output& o, OutputFormat format) {
   });
 }
 
-// A tree result's outputs (flexkin/render.h WriteTreeFigure, WriteTreeAnimation; flexkin/gltf.h
-// WriteTreeGltf).
+// A tree result's outputs, by the internal:: writers (flexkin/render.h, viewer.h, gltf.h): the tree
+// was checked once, by Draw or by the reader, and the options by ValidateDrawOptions.
 void TreeOutput(const Output& o, OutputFormat format) {
   const std::string path = o.options.base + Extension(format);
   o.Write(path, [&] {
     switch (format) {
       case OutputFormat::kMp4:
       case OutputFormat::kGif:
-        WriteTreeAnimation(*o.tree, o.options.animation, path);
+        internal::WriteTreeAnimation(*o.tree, o.options.animation, path);
         return;
       case OutputFormat::kGltf:
       case OutputFormat::kGlb:
-        WriteTreeGltf(*o.tree, o.options.gltf, path);
+        internal::WriteTreeGltf(*o.tree, o.options.gltf, path);
         return;
       case OutputFormat::kHtml:
-        WriteTreeViewerHtml(*o.tree, ViewerWithTitle(o.options), path);
+        internal::WriteTreeViewerHtml(*o.tree, ViewerWithTitle(o.options), path);
         return;
       default:
-        WriteTreeFigure(*o.tree, o.options.figure, path);
+        internal::WriteTreeFigure(*o.tree, o.options.figure, path);
         return;
     }
   });

@@ -4,6 +4,8 @@
 #include <cassert>
 #include <cmath>
 
+#include "flexkin/tree.h"
+
 namespace flexkin::gltf {
 namespace {
 
@@ -118,15 +120,8 @@ namespace flexkin::gltf {
 
 TreeSkeleton MakeTreeSkeleton(const std::vector<int>& parents) {
   const int points = static_cast<int>(parents.size());
-  std::vector<std::vector<int>> children(points);
-  int root = 0;
-  for (int i = 0; i < points; ++i) {
-    if (parents[i] < 0) {
-      root = i;
-    } else {
-      children[parents[i]].push_back(i);
-    }
-  }
+  const std::vector<std::vector<int>> children = TreeChildren(parents);
+  const int root = TreeRoot(parents);
   // The points in breadth-first order from the root, each point's children in index order.
   std::vector<int> order = {root};
   for (size_t k = 0; k < order.size(); ++k) {

@@ -188,6 +188,11 @@ void WriteTreeGltf(const TreeResultFile& tree, const GltfOptions& options,
                    const std::string& path) {
   ThrowIfAny(options.Validate());
   ThrowIfAny(ValidateTreeResult(tree));
+  internal::WriteTreeGltf(tree, options, path);
+}
+
+void internal::WriteTreeGltf(const TreeResultFile& tree, const GltfOptions& options,
+                             const std::string& path) {
   const bool binary = gltf::IsBinaryPath(path);
   const gltf::TreeSkeleton skeleton = gltf::MakeTreeSkeleton(tree.parents);
   CheckTreeGltfLimits(tree, skeleton, options);

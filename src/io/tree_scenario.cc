@@ -437,6 +437,7 @@ bool IsTreeResultFile(const std::string& path) {
 
 void WriteTreeResult(const std::string& path, const TreeScenario& s, const TreeRunResult& r) {
   const bool npz = CheckTreeResultPath(path);
+  const bool goals = HasGoals(s, r);
   nlohmann::ordered_json header = TreeResultHeader(s, r);
   AtomicFile file(path);
   if (npz) {
@@ -458,14 +459,15 @@ void WriteTreeResult(const std::string& path, const TreeScenario& s, const TreeR
     };
     ints("parents.npy", s.tree.parents);
     // The goals: frame f's target k (f from 1), where it was driven or what it looked at.
-    if (HasGoals(s, r)) {
-      std::string goals = NpyHeader("<f8", {frames - 1, s.targets.size(), dim});
+    if (goals) {
+      std::string goal_data = NpyHeader("<f8", {frames - 1, s.targets.size(), dim});
       for (uint64_t f = 1; f < frames; ++f) {
         for (const Points& path : s.paths) {
-          goals.append(reinterpret_cast<const char*>(path.row(f - 1).data()), sizeof(double) * dim);
+          goal_data.append(reinterpret_cast<const char*>(path.row(f - 1).data()),
+                           sizeof(double) * dim);
         }
       }
-      zip.AddMember("goals.npy", goals);
+      zip.AddMember("goals.npy", goal_data);
     }
     ints("passes.npy", r.passes);
     std::string res = NpyHeader("<f8", {r.residual.size()});
@@ -492,16 +494,16 @@ void WriteTreeResult(const std::string& path, const TreeScenario& s, const TreeR
       frames.push_back(std::move(rows));
     }
     header["frames"] = std::move(frames);
-    nlohmann::ordered_json goals = nlohmann::ordered_json::array();
-    for (size_t f = 1; f < r.frames.size() && HasGoals(s, r); ++f) {
+    nlohmann::ordered_json goal_frames = nlohmann::ordered_json::array();
+    for (size_t f = 1; goals && f < r.frames.size(); ++f) {
       nlohmann::ordered_json rows = nlohmann::ordered_json::array();
       for (const Points& path : s.paths) {
         rows.push_back(
             std::vector<double>(path.row(f - 1).data(), path.row(f - 1).data() + path.cols()));
       }
-      goals.push_back(std::move(rows));
+      goal_frames.push_back(std::move(rows));
     }
-    if (HasGoals(s, r)) header["goals"] = std::move(goals);
+    if (goals) header["goals"] = std::move(goal_frames);
     header["passes"] = r.passes;
     header["residual"] = r.residual;
     header["reached"] = std::vector<bool>(r.reached.begin(), r.reached.end());

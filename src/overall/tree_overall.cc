@@ -422,6 +422,14 @@ double TreeConstraintError(const TreeReacher& r, const Points& p) {
 // trees where the passes stall at 7e-5 to 7e-3 it reaches the targets exactly (tests).
 constexpr double kNewtonAfterStall = 0.05;
 
+// Where anchor `a` (an index of TreeReacher::anchor_of) belongs: its target's row of `positions`,
+// or its fixed point's place.
+Eigen::RowVectorXd AnchorPlace(const TreeReacher& r, const Points& positions, int a) {
+  const int driven = static_cast<int>(r.target_points.size());
+  return a < driven ? Eigen::RowVectorXd(positions.row(a))
+                    : Eigen::RowVectorXd(r.fixed_positions.row(a - driven));
+}
+
 // StepTreeOverall's continuation, its input checked and reachable.
 template <int Dim>
 TreeOverallReport TreeContinuation(const TreeReacher& reacher, const Points& positions,
@@ -454,12 +462,7 @@ TreeOverallReport TreeContinuation(const TreeReacher& reacher, const Points& pos
     if (!report.start.reached && report.start.residual > kNewtonAfterStall) break;
     for (int v = 0; v < count; ++v) {  // the anchors exactly where they should be
       const int a = reacher.anchor_of[v];
-      if (a < 0) continue;
-      if (a < driven) {
-        p.row(v) = goal.row(a);
-      } else {
-        p.row(v) = reacher.fixed_positions.row(a - driven);
-      }
+      if (a >= 0) p.row(v) = AnchorPlace(reacher, goal, a);
     }
     const int used = kkt.Solve(options, &p);
     report.iterations += std::abs(used);
@@ -570,8 +573,7 @@ ReachReport FinishTreeReach(const TreeReacher& reacher, const Points& positions,
     for (int v = 0; v < count; ++v) {
       const int a = reacher.anchor_of[v];
       if (a < 0) continue;
-      const Eigen::RowVectorXd goal =
-          a < driven ? positions.row(a) : reacher.fixed_positions.row(a - driven);
+      const Eigen::RowVectorXd goal = AnchorPlace(reacher, positions, a);
       p.row(v) = j == kFinishSubsteps
                      ? goal
                      : Eigen::RowVectorXd(stalled.row(v) + f * (goal - stalled.row(v)));
@@ -585,9 +587,8 @@ ReachReport FinishTreeReach(const TreeReacher& reacher, const Points& positions,
   double residual = 0.0;
   for (int v = 0; v < count; ++v) {
     const int a = reacher.anchor_of[v];
-    if (a < 0) continue;
-    const auto goal = a < driven ? positions.row(a) : reacher.fixed_positions.row(a - driven);
-    residual = std::max(residual, (p.row(v) - goal).norm());
+    if (a >= 0)
+      residual = std::max(residual, (p.row(v) - AnchorPlace(reacher, positions, a)).norm());
   }
   report.residual = residual / reacher.longest_link;
   report.reached = report.residual <= reacher.options.tolerance;

@@ -23,18 +23,9 @@ namespace {
 // from the root through first children (lowest index) to a leaf; every other child c of a point
 // p on a polyline starts one at p, through c and its first children.
 std::vector<std::vector<int>> TreePolylines(const std::vector<int>& parents) {
-  const int count = static_cast<int>(parents.size());
-  std::vector<std::vector<int>> children(count);
-  int root = 0;
-  for (int i = 0; i < count; ++i) {
-    if (parents[i] < 0) {
-      root = i;
-    } else {
-      children[parents[i]].push_back(i);
-    }
-  }
+  const std::vector<std::vector<int>> children = TreeChildren(parents);
   std::vector<std::vector<int>> lines;
-  std::vector<std::pair<int, int>> starts = {{-1, root}};  // (from, first point)
+  std::vector<std::pair<int, int>> starts = {{-1, TreeRoot(parents)}};  // (from, first point)
   for (size_t s = 0; s < starts.size(); ++s) {
     std::vector<int> line;
     if (starts[s].first >= 0) line.push_back(starts[s].first);
@@ -257,8 +248,9 @@ void DrawTreeFigure(const TreeResultFile& tree, const FigureOptions& options,
            false,
            tree.targets.size() == 1 ? "driven point's path" : "driven points' paths"});
     }
-    if (paths && std::count(tree.looks.begin(), tree.looks.end(), char(1)) > 0 &&
-        !tree.goals.empty()) {
+    bool looks = false;
+    for (size_t k = 0; k < tree.targets.size(); ++k) looks = looks || LooksAt(tree, k);
+    if (paths && looks) {
       entries.push_back({LegendEntry::kLine,
                          {kLookedAt, 1.3 * ui, true},
                          false,
@@ -351,6 +343,11 @@ void WriteTreeFigure(const TreeResultFile& tree, const FigureOptions& options,
                      const std::string& path) {
   ThrowIfAny(options.Validate());
   ThrowIfAny(ValidateTreeResult(tree));
+  internal::WriteTreeFigure(tree, options, path);
+}
+
+void internal::WriteTreeFigure(const TreeResultFile& tree, const FigureOptions& options,
+                               const std::string& path) {
   render::DrawTreeFigure(tree, options, path);
 }
 
@@ -358,6 +355,11 @@ void WriteTreeAnimation(const TreeResultFile& tree, const AnimationOptions& opti
                         const std::string& path) {
   ThrowIfAny(options.Validate());
   ThrowIfAny(ValidateTreeResult(tree));
+  internal::WriteTreeAnimation(tree, options, path);
+}
+
+void internal::WriteTreeAnimation(const TreeResultFile& tree, const AnimationOptions& options,
+                                  const std::string& path) {
   render::DrawTreeAnimation(tree, options, path);
 }
 

@@ -3,6 +3,7 @@
 // the chain's one-pass sweep (propagate.cc) applies it.
 #include "flexkin/tree.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -37,15 +38,6 @@ std::string CycleThrough(const std::vector<int>& parents, int start) {
   std::string text = std::to_string(p);
   for (int q = parents[p]; q != p; q = parents[q]) text += " -> " + std::to_string(q);
   return text + " -> " + std::to_string(p);
-}
-
-// Each point's children, in increasing order.
-std::vector<std::vector<int>> ChildrenOf(const std::vector<int>& parents) {
-  std::vector<std::vector<int>> children(parents.size());
-  for (size_t i = 0; i < parents.size(); ++i) {
-    if (parents[i] >= 0) children[parents[i]].push_back(static_cast<int>(i));
-  }
-  return children;
 }
 
 template <class Rule, int Dim>
@@ -124,7 +116,7 @@ void ValidateTree(const Tree& tree, const char* field) {
                          CycleThrough(parents, 0));
   }
   // Every point reached from the root, else it lies on (or hangs from) a cycle.
-  const std::vector<std::vector<int>> children = ChildrenOf(parents);
+  const std::vector<std::vector<int>> children = TreeChildren(parents);
   std::vector<char> reached(count, 0);
   std::vector<int> stack{root};
   reached[root] = 1;
@@ -156,6 +148,19 @@ void ValidateTree(const Tree& tree, const char* field) {
   }
 }
 
+std::vector<std::vector<int>> TreeChildren(const std::vector<int>& parents) {
+  std::vector<std::vector<int>> children(parents.size());
+  for (size_t i = 0; i < parents.size(); ++i) {
+    if (parents[i] >= 0) children[parents[i]].push_back(static_cast<int>(i));
+  }
+  return children;
+}
+
+int TreeRoot(const std::vector<int>& parents) {
+  const auto root = std::find(parents.begin(), parents.end(), -1);
+  return root == parents.end() ? 0 : static_cast<int>(root - parents.begin());
+}
+
 Tree TreeOfChain(const Chain& chain) {
   Tree tree;
   tree.points = chain.points;
@@ -184,7 +189,7 @@ TreeStepper MakeTreeStepper(Method method, const Tree& tree, int driven) {
   t.parents = tree.parents;
   // Depth first from the driven point over the links in both directions (to a child, and to the
   // parent), children in increasing order: a path driven at point 0 visits its links in order.
-  const std::vector<std::vector<int>> children = ChildrenOf(tree.parents);
+  const std::vector<std::vector<int>> children = TreeChildren(tree.parents);
   std::vector<char> visited(count, 0);
   std::vector<int> placed_by(count, -1);  // the link whose trailing end a point is
   std::vector<int> stack{driven};

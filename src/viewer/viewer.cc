@@ -100,8 +100,13 @@ void WriteTreeViewerHtml(const TreeResultFile& tree, const ViewerOptions& option
                          const std::string& path) {
   CheckOptions(options);
   ThrowIfAny(ValidateTreeResult(tree));
+  viewer_internal::CheckResult(viewer_internal::TreeAsViewerResult(tree), options);  // trails
+  internal::WriteTreeViewerHtml(tree, options, path);
+}
+
+void internal::WriteTreeViewerHtml(const TreeResultFile& tree, const ViewerOptions& options,
+                                   const std::string& path) {
   const ResultFile shown = viewer_internal::TreeAsViewerResult(tree);
-  viewer_internal::CheckResult(shown, options);  // the trail points among the tree's
   WritePage(viewer_internal::ViewerDataJson(shown, options, nullptr, &tree), path);
 }
 

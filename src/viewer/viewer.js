@@ -191,6 +191,8 @@
   const screenX = new Float64Array(numPoints);
   const screenY = new Float64Array(numPoints);
   const pointDepth = new Float64Array(numPoints);
+  const shadowX = new Float64Array(numPoints);  // a tree's shadow on the floor grid
+  const shadowY = new Float64Array(numPoints);
   const linkDepth = new Float64Array(numLinks);
   const linkOrder = Array.from({ length: numLinks }, (_, i) => i);
   const byDepth = (a, b) => linkDepth[a] - linkDepth[b];
@@ -486,7 +488,6 @@
       g.strokeStyle = colors.shadow;
       g.lineWidth = 2;
       if (tree) {
-        const shadowX = new Float64Array(numPoints), shadowY = new Float64Array(numPoints);
         for (let i = 0; i < numPoints; ++i) {
           const o = frame * frameStride + i * dim;
           project(pos[o], pos[o + 1], lo[2]);
