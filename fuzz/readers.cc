@@ -111,8 +111,14 @@ void ReadGroomScenario(const std::string& bytes) {
     }
   }
   ValidateThenParse([&] { return ValidateGroomText(bytes); }, [&] { ParseGroomText(bytes); });
-  // The front door (flexkin/any_scenario.h) reads the same text, of any kind, once.
-  const AnyScenario any = ReadScenarioText(bytes);
+  // The front door (flexkin/any_scenario.h) reads the same text, of any kind, once; a robot tree
+  // ("robot") is the arm above read as a tree.
+  ScenarioReadOptions options;
+  options.robot.urdf_tree_loader = [](const std::string&, const std::string& base_link,
+                                      const std::vector<UrdfTool>& tools) {
+    return RobotTreeFromUrdf(kUrdf, base_link, tools);
+  };
+  const AnyScenario any = ReadScenarioText(bytes, options);
   if (any.valid() != (any.chain || any.groom || any.robot || any.tree)) {
     throw std::logic_error("the front door's problems and its scenario disagree");
   }

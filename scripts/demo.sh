@@ -71,8 +71,10 @@ for name in rope_round_post rope_post_floor rope_swept snake_pegs snake_pegs_tra
 done
 echo "== trees (docs/trees.md): two arms on a spine whose hands go round circles, the base fixed"
 echo "   (the passes between the targets), a plant whose trunk sways (its canopy following), and a"
-echo "   torso reaching with both hands while its head follows a ball (a pointing goal)"
-for name in tree_two_arms tree_plant tree_torso; do
+echo "   torso reaching with both hands while its head follows a ball (a pointing goal), and a"
+echo "   two-armed URDF robot (15 revolute joints with limits) whose hands go round two circles while"
+echo "   its head camera watches the left hand (the joints solved in joint space, docs/trees.md)"
+for name in tree_two_arms tree_plant tree_torso tree_robot_two_arms; do
   "$flexkin" run "examples/$name.json" -o "out/$name.npz"
   # The figure, the animation, the viewer and the glTF (a bone per link) of the tree result.
   "$flexkin" render "out/$name.npz" -o out --formats svg,mp4,gif,html,glb --quiet

@@ -11,6 +11,7 @@
 #include <kdl/frames.hpp>
 #include <kdl/segment.hpp>
 #include <kdl/tree.hpp>
+#include <kdl/treefksolverpos_recursive.hpp>
 #include <kdl_parser/kdl_parser.hpp>
 #include <limits>
 #include <memory>
@@ -205,6 +206,47 @@ KdlUrdfTrajectory TrackUrdfPathWithKdl(const KdlUrdfChain& chain, const Eigen::V
   }
   result.mean_iterations = total_iterations / static_cast<double>(path.rows());
   return result;
+}
+
+KdlUrdfTree KdlTreeFromUrdf(const std::string& urdf_text) {
+  KdlUrdfTree out;
+  if (!kdl_parser::treeFromString(urdf_text, out.tree)) {
+    throw std::runtime_error("kdl_parser could not read the URDF");
+  }
+  out.joint_names.resize(out.tree.getNrOfJoints());
+  for (const auto& [name, element] : out.tree.getSegments()) {
+    const KDL::Segment& segment = GetTreeElementSegment(element);
+    if (segment.getJoint().getType() != KDL::Joint::None) {
+      out.joint_names.at(GetTreeElementQNr(element)) = segment.getJoint().getName();
+    }
+  }
+  return out;
+}
+
+KDL::JntArray KdlTreeJoints(const KdlUrdfTree& tree, const std::vector<std::string>& names,
+                            const Eigen::VectorXd& angles) {
+  KDL::JntArray q(tree.num_joints());
+  for (int i = 0; i < tree.num_joints(); ++i) {
+    for (size_t j = 0; j < names.size(); ++j) {
+      if (names[j] == tree.joint_names[i]) q(i) = angles[static_cast<Eigen::Index>(j)];
+    }
+  }
+  return q;
+}
+
+KdlLinkPose KdlTreeLinkPose(const KdlUrdfTree& tree, const KDL::JntArray& q,
+                            const std::string& link) {
+  KDL::TreeFkSolverPos_recursive fk(tree.tree);
+  KDL::Frame frame;
+  if (fk.JntToCart(q, frame, link) < 0) throw std::runtime_error("KDL has no link " + link);
+  return {FromKdl(frame.M), FromKdl(frame.p)};
+}
+
+std::string KdlTreeChildLink(const KdlUrdfTree& tree, const std::string& joint) {
+  for (const auto& [name, element] : tree.tree.getSegments()) {
+    if (GetTreeElementSegment(element).getJoint().getName() == joint) return name;
+  }
+  return "";
 }
 
 }  // namespace flexkin::peers

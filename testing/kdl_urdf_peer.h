@@ -37,6 +37,7 @@
 #include <Eigen/Core>
 #include <kdl/chain.hpp>
 #include <kdl/jntarray.hpp>
+#include <kdl/tree.hpp>
 #include <string>
 #include <vector>
 
@@ -126,5 +127,28 @@ KdlUrdfTrajectory TrackUrdfPathWithKdl(const KdlUrdfChain& chain, const Eigen::V
                                        const Points& path, KdlUrdfSolver solver,
                                        const KdlUrdfOptions& options,
                                        const std::vector<Eigen::Matrix3d>& target_rotations = {});
+
+// Robot trees (flexkin/robot_tree.h): kdl_parser's tree of the whole URDF text (a segment per
+// link, named by the link; each segment's joint named by the URDF joint to it), and its forward
+// kinematics by KDL's TreeFkSolverPos_recursive. Throws std::runtime_error if kdl_parser cannot
+// read the text.
+struct KdlUrdfTree {
+  KDL::Tree tree;
+  std::vector<std::string> joint_names;  // indexed by KDL's joint numbers (q_nr)
+  int num_joints() const { return static_cast<int>(joint_names.size()); }
+};
+KdlUrdfTree KdlTreeFromUrdf(const std::string& urdf_text);
+// KDL's joint array of angles given by name (joints not named stay 0).
+KDL::JntArray KdlTreeJoints(const KdlUrdfTree& tree, const std::vector<std::string>& names,
+                            const Eigen::VectorXd& angles);
+// Link `link`'s frame in the root's frame at `q`: its rotation and origin.
+struct KdlLinkPose {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+};
+KdlLinkPose KdlTreeLinkPose(const KdlUrdfTree& tree, const KDL::JntArray& q,
+                            const std::string& link);
+// The link whose segment's joint is the URDF joint `joint` ("" if none).
+std::string KdlTreeChildLink(const KdlUrdfTree& tree, const std::string& joint);
 
 }  // namespace flexkin::peers

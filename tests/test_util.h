@@ -128,4 +128,14 @@ class TempDirTest : public ::testing::Test {
   std::string dir_;
 };
 
+#ifdef FLEXKIN_SOURCE_DIR
+// The text of a file of the source tree ("examples/robot_two_arms.urdf"); "" if it cannot be read.
+inline std::string SourceFileText(const std::string& file) {
+  std::ifstream in(std::string(FLEXKIN_SOURCE_DIR) + "/" + file);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+#endif
+
 }  // namespace flexkin::test_util

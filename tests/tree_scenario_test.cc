@@ -282,7 +282,13 @@ TEST(TreeScenarioTest, TheSchemaAndTheReaderAgree) {
   doc["overall"] = {{"squared", 1}};
   EXPECT_EQ(AcceptedKeys(doc, ""), SchemaKeys(schema));
   EXPECT_EQ(AcceptedKeys(doc, "/tree"), SchemaKeys(schema["properties"]["tree"]));
-  EXPECT_EQ(AcceptedKeys(doc, "/targets/0"), SchemaKeys(schema["properties"]["targets"]["items"]));
+  // A target of a tree of points or of a robot tree ("robot", docs/trees.md "Robot trees").
+  const json robot = json::parse(R"({"format": "flexkin-tree", "robot": {"urdf": "r.urdf"},
+      "targets": [{"link": "hand", "path": [[0, 0, 1]]}]})");
+  std::set<std::string> target_keys = AcceptedKeys(doc, "/targets/0");
+  for (const std::string& key : AcceptedKeys(robot, "/targets/0")) target_keys.insert(key);
+  EXPECT_EQ(target_keys, SchemaKeys(schema["properties"]["targets"]["items"]));
+  EXPECT_EQ(AcceptedKeys(robot, "/robot"), SchemaKeys(schema["properties"]["robot"]));
   EXPECT_EQ(AcceptedKeys(doc, "/overall"), SchemaKeys(schema["properties"]["overall"]));
   EXPECT_EQ(schema["properties"]["branch_rule"]["enum"].get<std::vector<std::string>>(),
             NamesOf<BranchRule>());

@@ -28,6 +28,7 @@
 #include "flexkin/chain.h"
 #include "flexkin/error.h"
 #include "flexkin/result_io.h"
+#include "flexkin/robot_tree.h"
 
 namespace flexkin {
 
@@ -45,12 +46,19 @@ struct UrdfChain {
 // valid arm, std::system_error for a file that cannot be read.
 using UrdfArmLoader = std::function<ArmModel(const std::string& path, const UrdfChain& chain)>;
 
+// Reads the robot tree of the URDF file at `path` below `base_link` with `tools` (flexkin/urdf.h:
+// RobotTreeFromUrdfFile), for tree scenarios with "robot" (docs/trees.md, "Robot trees").
+using UrdfTreeLoader = std::function<RobotTree(
+    const std::string& path, const std::string& base_link, const std::vector<UrdfTool>& tools)>;
+
 struct RobotScenarioOptions {
   // Reads the arm of a scenario that names a URDF file ("urdf"). Empty (the default): such
   // scenarios are refused with an InputError at "/urdf". The URDF component (flexkin_urdf,
   // flexkin/urdf.h) provides UrdfRobotScenarioOptions(), which sets it to ArmFromUrdfFile; the
   // core library does not depend on a URDF parser.
   UrdfArmLoader urdf_loader;
+  // The same for robot trees (tree scenarios with "robot"); UrdfRobotScenarioOptions() sets it.
+  UrdfTreeLoader urdf_tree_loader;
   // The directory that a relative "urdf" file name is taken relative to. "": the scenario file's
   // directory for LoadRobotScenarioFile and ValidateRobotScenarioFile, the working directory for
   // the *Text functions.

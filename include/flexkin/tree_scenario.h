@@ -9,10 +9,12 @@
 //    "targets": [{"point": 7, "path": [[...], ...]}, {"point": 12, "path": [[...], ...]}],
 //    "fixed": [0], "method": "tractrix"}
 
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "flexkin/overall.h"
+#include "flexkin/robot_tree.h"
 #include "flexkin/tree.h"
 #include "flexkin/tree_overall.h"
 
@@ -31,11 +33,16 @@ struct TreeScenario {
   ReachOptions reach;                 // "branch_rule", "tolerance", "max_passes"
   bool finish = true;                 // "finish": FinishTreeReach after passes that stall
   TreeOverallOptions overall;         // "overall": the metric's weights (method "overall")
+  // A URDF robot tree ("robot", docs/trees.md "Robot trees") rather than a tree of points: `tree`
+  // is its layout (RobotTreeLayout) at the start, targets[k] the point of its tool k (the link of
+  // "targets"[k]), `fixed` the base; its joints are solved by RobotTreeSolver with
+  // reach.tolerance and reach.max_passes (iterations a frame). Null: a tree of points.
+  std::shared_ptr<const RobotTree> robot;
 
   // One driven point and nothing fixed: moved by MoveTreePoint (any rule of trees); otherwise
   // by the passes (tractrix, ftl) or, with method "overall", by StepTreeOverall.
   bool driven_at_one_point() const {
-    return targets.size() == 1 && fixed.empty() && (looks.empty() || !looks[0]);
+    return !robot && targets.size() == 1 && fixed.empty() && (looks.empty() || !looks[0]);
   }
   int frames() const { return paths.empty() ? 0 : static_cast<int>(paths[0].rows()); }
 };
@@ -49,6 +56,7 @@ struct TreeRunResult {
   std::vector<char> converged;    // the overall step's (method "overall"; else 1)
   std::vector<char> finished;     // passes that stalled, completed by FinishTreeReach
   double max_length_error = 0.0;  // largest relative link-length error over the frames
+  std::vector<Eigen::VectorXd> angles;  // a robot tree's joint angles, every frame
 
   int failures() const;  // frames not reached or not converged
   std::string BriefReport() const;
@@ -90,6 +98,9 @@ struct TreeResultFile {
   // F - 1 frames (empty in files without "goals"): row k of frame f's the goal of target k at
   // frame f + 1, the position it was driven to or the point it looked at.
   std::vector<Points> goals;
+  bool robot = false;                   // a robot tree's result ("method": "newton")
+  std::vector<std::string> joints;      // a robot tree's joint names
+  std::vector<Eigen::VectorXd> angles;  // a robot tree's joint angles, every frame (or none)
 };
 
 // Reads a tree result (.npz or .json, told apart by content) and checks it: the format, the

@@ -20,9 +20,11 @@
 // handler, which it replaces during a parse to quote urdfdom's reason, is held under a lock.
 
 #include <string>
+#include <vector>
 
 #include "flexkin/arm.h"
 #include "flexkin/robot_scenario.h"  // UrdfChain, RobotScenarioOptions
+#include "flexkin/robot_tree.h"
 
 namespace flexkin {
 
@@ -36,6 +38,19 @@ namespace flexkin {
 // reason); a file that cannot be read throws std::system_error.
 ArmModel ArmFromUrdf(const std::string& urdf_text, const UrdfChain& chain = {});
 ArmModel ArmFromUrdfFile(const std::string& path, const UrdfChain& chain = {});
+
+// A robot tree (flexkin/robot_tree.h) from URDF text / a URDF file: every joint below
+// `base_link` ("" : the URDF's root link), revolute or continuous (fixed joints merged into their
+// links), each after its parent, at the zero pose in the frame of the URDF's root link; limits
+// as ArmFromUrdf reads them; the tools in the order asked, each the point `offset` of its link's
+// frame. Throws InputError naming the element ("base_link", "tools[1].link", "joint \"elbow\"")
+// for prismatic, floating or planar joints below the base, a tool link not below the base or
+// below no movable joint, an axis of zero length, and what ArmFromUrdf refuses of the text; a
+// file that cannot be read throws std::system_error.
+RobotTree RobotTreeFromUrdf(const std::string& urdf_text, const std::string& base_link,
+                            const std::vector<UrdfTool>& tools);
+RobotTree RobotTreeFromUrdfFile(const std::string& path, const std::string& base_link,
+                                const std::vector<UrdfTool>& tools);
 
 // A URDF of the arm (links "base_link", "link_1".."link_n", "tip_link"; joints "joint_0".. and
 // the fixed "tip_joint"), with every joint revolute (limits given) or continuous; ArmFromUrdf

@@ -330,7 +330,7 @@ AnyScenario AnyScenarioArg(py::handle scenario) {
 
 // A tree scenario (docs/trees.md): run (into `files.result` where given, .npz or .json) and
 // returned as a dict of arrays: frames (F, n+1, dim), parents (n+1,), and per frame after the
-// start passes, residual, reached, converged.
+// start passes, residual, reached, converged; a robot tree's angles (F, joints) and joints too.
 py::dict RunTreeToDict(const AnyScenario& any, ProgressCallback progress, const RunFiles& files) {
   if (!files.csv.empty()) {
     ThrowInput("csv", "is not written for a tree scenario", Quoted(files.csv), "None");
@@ -375,6 +375,16 @@ py::dict RunTreeToDict(const AnyScenario& any, ProgressCallback progress, const 
   out["converged"] = converged;
   out["finished"] = finished;
   out["max_length_error"] = r.max_length_error;
+  if (any.tree->robot) {  // a robot tree: its joints' names and angles, every frame
+    const RobotTree& robot = *any.tree->robot;
+    const py::ssize_t n = robot.joints();
+    py::array_t<double> angles({count, n});
+    for (py::ssize_t f = 0; f < count; ++f) {
+      std::copy(r.angles[f].data(), r.angles[f].data() + n, angles.mutable_data() + f * n);
+    }
+    out["angles"] = angles;
+    out["joints"] = robot.joint_names;
+  }
   return out;
 }
 

@@ -200,3 +200,13 @@ def test_tree_figure_draws_a_tree_result(tmp_path, flexkin_cli):
     assert out.returncode == 0, out.stderr
     assert_png(tmp_path / "tree.png")
     assert "61 frames" in out.stdout
+
+
+def test_the_robot_tree_example_is_what_its_script_writes(tmp_path):
+    """examples/robot_two_arms.urdf and examples/tree_robot_two_arms.json are written by
+    examples/python/make_robot_two_arms.py: run again, it writes the same bytes."""
+    result = subprocess.run([sys.executable, str(SCRIPTS / "make_robot_two_arms.py"), str(tmp_path)],
+                            cwd=SOURCE_DIR, capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    for name in ["robot_two_arms.urdf", "tree_robot_two_arms.json"]:
+        assert (tmp_path / name).read_bytes() == (EXAMPLES / name).read_bytes(), name

@@ -174,3 +174,21 @@ def test_a_pointing_goal_turns_its_link_onto_what_it_looks_at():
         flexkin.reach_tree(ARMS, ARM_PARENTS, [5, 8], paths, fixed=[0], looks=[False, True],
                            overall={"squared": 1.0})
     assert error.value.field == "targets[1]"
+
+
+def test_a_robot_tree_runs_through_the_front_door(tmp_path):
+    """A URDF robot tree (docs/trees.md, "Robot trees"): the two-armed robot's hands on their
+    paths and its camera on the left hand, with the joint angles of every frame."""
+    from conftest import EXAMPLES
+    result = flexkin.run_scenario(EXAMPLES / "tree_robot_two_arms.json",
+                                  output=tmp_path / "robot.npz")
+    assert result["frames"].shape == (181, 17, 3)
+    assert result["angles"].shape == (181, 15)
+    assert result["joints"][0] == "waist"
+    assert result["reached"].all()
+    assert result["max_length_error"] < 1e-14
+    # No flips: the joints move little between frames.
+    assert np.abs(np.diff(result["angles"], axis=0)).max() < 0.15
+    with np.load(tmp_path / "robot.npz") as archive:
+        np.testing.assert_array_equal(archive["angles"], result["angles"])
+        np.testing.assert_array_equal(archive["frames"], result["frames"])

@@ -89,7 +89,7 @@ tinygltf::Value TreeExtras(const TreeResultFile& tree, const gltf::TreeSkeleton&
   info["scale"] = tinygltf::Value(options.scale);
   info["steps_per_second"] = tinygltf::Value(options.steps_per_second);
   info["num_points"] = tinygltf::Value(static_cast<int>(tree.parents.size()));
-  info["method"] = tinygltf::Value(std::string(MethodName(tree.method)));
+  info["method"] = tinygltf::Value(std::string(tree.robot ? "newton" : MethodName(tree.method)));
   tinygltf::Value::Array parents, heads;
   for (const int p : tree.parents) parents.emplace_back(p);
   for (const int h : skeleton.head) heads.emplace_back(h);

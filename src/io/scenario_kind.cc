@@ -19,7 +19,7 @@ ScenarioKind KindOf(const json& root) {
              !root.contains("leader")) {
     return ScenarioKind::kRobot;
   }
-  if (root.contains("tree")) return ScenarioKind::kTree;
+  if (root.contains("tree") || root.contains("robot")) return ScenarioKind::kTree;
   if (root.contains("groom") || root.contains("strands")) return ScenarioKind::kGroom;
   return ScenarioKind::kChain;
 }

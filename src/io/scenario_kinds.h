@@ -17,7 +17,8 @@ namespace flexkin::internal {
 
 // The one place kinds are told apart (docs/scenario-format.md): a robot has "format":
 // "flexkin-robot", or "arm" or "urdf" and neither "curve" nor "leader"; a tree has "format":
-// "flexkin-tree", or "tree"; a groom has "groom" or "strands"; anything else is a chain scenario.
+// "flexkin-tree", or "tree" or "robot"; a groom has "groom" or "strands"; anything else is a chain
+// scenario.
 ScenarioKind KindOf(const nlohmann::json& root);  // scenario_kind.cc
 
 // A mesh collider's relative "file" is taken from `directory` ("" : the working directory).
@@ -26,7 +27,11 @@ Scenario ReadChainScenario(const nlohmann::json& root, Problems* problems,
 // Relative "urdf" paths are taken from `directory` ("" : the working directory).
 RobotScenario ReadRobotScenario(const nlohmann::json& root, const RobotScenarioOptions& options,
                                 const std::string& directory,
-                                Problems* problems);                            // robot_scenario.cc
-TreeScenario ReadTreeScenario(const nlohmann::json& root, Problems* problems);  // tree_scenario.cc
+                                Problems* problems);  // robot_scenario.cc
+// A robot tree's relative "urdf" path is taken from `directory` ("" : the working directory) and
+// read with options.urdf_tree_loader.
+TreeScenario ReadTreeScenario(const nlohmann::json& root, const RobotScenarioOptions& options,
+                              const std::string& directory,
+                              Problems* problems);  // tree_scenario.cc
 
 }  // namespace flexkin::internal

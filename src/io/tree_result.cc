@@ -28,12 +28,12 @@ class TreeResultReader : public json_internal::JsonReader {
   // the JSON form (frames and the reports per frame) are allowed too.
   void ReadHeader(const json& root, bool json_form, TreeResultFile* out) {
     if (!ExpectObject(root, "", "an object (a tree result, docs/trees.md)")) return;
-    std::vector<std::string> keys = {"format",           "name",    "method", "dim",
-                                     "parents",          "targets", "looks",  "fixed",
-                                     "max_length_error", "failures"};
+    std::vector<std::string> keys = {"format",           "name",     "method", "dim",
+                                     "parents",          "targets",  "looks",  "fixed",
+                                     "max_length_error", "failures", "joints"};
     if (json_form) {
-      for (const char* k :
-           {"frames", "goals", "passes", "residual", "reached", "converged", "finished"}) {
+      for (const char* k : {"frames", "goals", "angles", "passes", "residual", "reached",
+                            "converged", "finished"}) {
         keys.push_back(k);
       }
     }
@@ -51,10 +51,23 @@ class TreeResultReader : public json_internal::JsonReader {
     Optional(
         root, "", "method",
         [&](const json& v, const std::string& p) {
-          return Choice(v, p, {"tractrix", "ftl", "min_rotation", "min_joint_angle", "overall"});
+          return Choice(
+              v, p, {"tractrix", "ftl", "min_rotation", "min_joint_angle", "overall", "newton"});
         },
         &method);
-    out->method = ParseName<Method>(method, "/method");
+    out->robot = method == "newton";  // a robot tree's joints solved in joint space
+    if (!out->robot) out->method = ParseName<Method>(method, "/method");
+    if (const json* joints = Find(root, "joints")) {
+      if (!joints->is_array()) {
+        TypeProblem(*joints, "/joints", "an array of joint names");
+      } else {
+        for (size_t k = 0; k < joints->size(); ++k) {
+          if (auto name = String((*joints)[k], "/joints/" + std::to_string(k))) {
+            out->joints.push_back(*name);
+          }
+        }
+      }
+    }
     int64_t dim = 0;
     Require(
         root, "", "dim", "2 or 3",
@@ -95,6 +108,30 @@ class TreeResultReader : public json_internal::JsonReader {
         const auto g = PointList((*goals)[f], "/goals/" + std::to_string(f), out->dim, k, k);
         if (!g) return;
         out->goals.push_back(*g);
+      }
+    }
+    if (const json* angles = Find(root, "angles")) {
+      const int n = static_cast<int>(out->joints.size());
+      if (!angles->is_array() || angles->size() != frames->size()) {
+        TypeProblem(*angles, "/angles",
+                    "an array of " + std::to_string(frames->size()) +
+                        " arrays of joint angles, one per frame");
+        return;
+      }
+      for (size_t f = 0; f < angles->size(); ++f) {
+        const std::string ptr = "/angles/" + std::to_string(f);
+        const json& a = (*angles)[f];
+        if (!a.is_array() || static_cast<int>(a.size()) != n) {
+          TypeProblem(a, ptr, "an array of " + std::to_string(n) + " angles (one per joint)");
+          return;
+        }
+        Eigen::VectorXd q(n);
+        for (int j = 0; j < n; ++j) {
+          const auto x = Number(a[j], ptr + "/" + std::to_string(j), json_internal::Range::kAny);
+          if (!x) return;
+          q[j] = *x;
+        }
+        out->angles.push_back(q);
       }
     }
     std::vector<char> converged;
@@ -165,7 +202,8 @@ std::vector<T> ReadFlat(ZipReader* zip, const std::string& name, const char* des
 }
 
 TreeResultFile ReadNpz(const std::string& path) {
-  ZipReader zip(path, {"frames.npy", "parents.npy", "reached.npy", "converged.npy", "goals.npy"});
+  ZipReader zip(path, {"frames.npy", "parents.npy", "reached.npy", "converged.npy", "goals.npy",
+                       "angles.npy"});
   if (!zip.Has("tree.json")) {
     throw InputError("tree.json", "missing; a tree result's .npz holds tree.json and frames.npy");
   }
@@ -209,6 +247,23 @@ TreeResultFile ReadNpz(const std::string& path) {
       out.goals.push_back(std::move(g));
     }
     goals.Finish();
+  }
+  if (zip.Has("angles.npy")) {  // a robot tree's joints, every frame
+    ZipReader::Member angles(&zip, "angles.npy");
+    const uint64_t n = out.joints.size();
+    ExpectNpyShape(ReadNpyHeader(&angles, "angles.npy", "<f8"), "angles.npy", {count, n},
+                   "a valid tree result (a row of joint angles per frame)");
+    for (uint64_t f = 0; f < count; ++f) {
+      Eigen::VectorXd q(n);
+      angles.Read(q.data(), sizeof(double) * n);
+      if (!q.allFinite()) {
+        throw InputError("angles.npy", "frame " + std::to_string(f) +
+                                           " has an angle that is not finite; expected finite "
+                                           "numbers");
+      }
+      out.angles.push_back(std::move(q));
+    }
+    angles.Finish();
   }
   const std::vector<char> reached = ReadFlat<char>(&zip, "reached.npy", "|b1", count - 1);
   const std::vector<char> converged = ReadFlat<char>(&zip, "converged.npy", "|b1", count - 1);

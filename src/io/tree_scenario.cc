@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -39,14 +41,28 @@ std::string TreePointer(const std::string& field) {
   return out;
 }
 
+// The solver options of a robot tree scenario.
+RobotTreeOptions RobotTreeOptionsOf(const TreeScenario& s) {
+  RobotTreeOptions o;
+  o.tolerance = s.reach.tolerance;
+  o.angle_tolerance = s.reach.tolerance;
+  o.max_iterations = s.reach.max_passes;
+  o.looks = s.looks;
+  o.weights = s.weights;
+  return o;
+}
+
 class TreeScenarioReader : public json_internal::JsonReader {
  public:
+  TreeScenarioReader(const RobotScenarioOptions& options, std::string directory)
+      : options_(options), directory_(std::move(directory)) {}
+
   TreeScenario Read(const json& root) {
     TreeScenario s;
     if (!ExpectObject(root, "", "an object (a tree scenario, docs/trees.md)")) return s;
     CheckKeys(root, "",
-              {"format", "name", "tree", "targets", "fixed", "method", "substeps", "branch_rule",
-               "tolerance", "max_passes", "finish", "overall"});
+              {"format", "name", "tree", "robot", "targets", "fixed", "method", "substeps",
+               "branch_rule", "tolerance", "max_passes", "finish", "overall"});
     if (const json* format = Find(root, "format")) {
       if (!(format->is_string() && *format == "flexkin-tree")) {
         ValueProblem(*format, "/format", "\"flexkin-tree\"");
@@ -55,10 +71,11 @@ class TreeScenarioReader : public json_internal::JsonReader {
     Optional(
         root, "", "name", [&](const json& v, const std::string& p) { return String(v, p); },
         &s.name);
+    if (Find(root, "robot") != nullptr) return ReadRobot(root, std::move(s));
     const bool tree_ok = ReadTree(root, &s.tree);
     const int count = tree_ok ? static_cast<int>(s.tree.points.rows()) : 0;
     const int dim = tree_ok ? static_cast<int>(s.tree.points.cols()) : 0;
-    ReadTargets(root, count, dim, &s);
+    ReadTargets(root, count, dim, &s, nullptr);
     if (const json* fixed = Find(root, "fixed")) {
       if (!fixed->is_array()) {
         TypeProblem(*fixed, "/fixed", "an array of point indices");
@@ -89,18 +106,7 @@ class TreeScenarioReader : public json_internal::JsonReader {
         [&](const json& v, const std::string& p) { return Choice(v, p, NamesOf<BranchRule>()); },
         &rule);
     s.reach.branch_rule = ParseName<BranchRule>(rule, "/branch_rule");
-    Optional(
-        root, "", "tolerance",
-        [&](const json& v, const std::string& p) {
-          return Number(v, p, json_internal::Range::kPositive);
-        },
-        &s.reach.tolerance);
-    int64_t max_passes = s.reach.max_passes;
-    Optional(
-        root, "", "max_passes",
-        [&](const json& v, const std::string& p) { return Integer(v, p, 1, 1 << 24); },
-        &max_passes);
-    s.reach.max_passes = static_cast<int>(max_passes);
+    ReadTolerances(root, &s.reach);
     Optional(
         root, "", "finish",
         [&](const json& v, const std::string& p) -> std::optional<bool> {
@@ -115,6 +121,107 @@ class TreeScenarioReader : public json_internal::JsonReader {
   }
 
  private:
+  const RobotScenarioOptions& options_;
+  std::string directory_;
+
+  void ReadTolerances(const json& root, ReachOptions* reach) {
+    Optional(
+        root, "", "tolerance",
+        [&](const json& v, const std::string& p) {
+          return Number(v, p, json_internal::Range::kPositive);
+        },
+        &reach->tolerance);
+    int64_t max_passes = reach->max_passes;
+    Optional(
+        root, "", "max_passes",
+        [&](const json& v, const std::string& p) { return Integer(v, p, 1, 1 << 24); },
+        &max_passes);
+    reach->max_passes = static_cast<int>(max_passes);
+  }
+
+  // A robot tree: "robot" {"urdf", "base_link"}, targets on links (docs/trees.md, "Robot trees").
+  TreeScenario ReadRobot(const json& root, TreeScenario s) {
+    for (const char* key :
+         {"tree", "fixed", "method", "substeps", "branch_rule", "finish", "overall"}) {
+      if (Find(root, key) != nullptr) {
+        Add(std::string("/") + key,
+            std::string("is not an option of a robot tree (\"robot\"); ") +
+                (std::string(key) == "tree"
+                     ? "give \"tree\" (points) or \"robot\" (a URDF), not both"
+                     : "its base is fixed and its joints solved in joint space; it takes "
+                       "\"targets\", \"tolerance\" and \"max_passes\""));
+      }
+    }
+    const json& robot = *Find(root, "robot");
+    std::string file, base_link;
+    if (ExpectObject(robot, "/robot", "an object with \"urdf\" and optionally \"base_link\"")) {
+      CheckKeys(robot, "/robot", {"urdf", "base_link"});
+      Require(
+          robot, "/robot", "urdf", "a URDF file name",
+          [&](const json& v, const std::string& p) { return String(v, p); }, &file);
+      if (Find(robot, "urdf") != nullptr && file.empty() && robot["urdf"].is_string()) {
+        ValueProblem(robot["urdf"], "/robot/urdf", "a URDF file name");
+      }
+      Optional(
+          robot, "/robot", "base_link",
+          [&](const json& v, const std::string& p) { return String(v, p); }, &base_link);
+    }
+    std::vector<UrdfTool> tools;
+    ReadTargets(root, 0, 3, &s, &tools);
+    ReadTolerances(root, &s.reach);
+    if (!problems.empty()) return s;
+    if (!options_.urdf_tree_loader) {
+      Add("/robot/urdf",
+          "names a URDF file, but this reader has no URDF loader; expected a "
+          "reader given RobotScenarioOptions::urdf_tree_loader (the URDF "
+          "component's UrdfRobotScenarioOptions(), flexkin/urdf.h)");
+      return s;
+    }
+    std::filesystem::path path(file);
+    if (path.is_relative() && !directory_.empty()) path = std::filesystem::path(directory_) / path;
+    try {
+      auto model =
+          std::make_shared<RobotTree>(options_.urdf_tree_loader(path.string(), base_link, tools));
+      const RobotTreeLayout layout = MakeRobotTreeLayout(*model);
+      s.tree.points = RobotTreePoints(*model, layout, model->initial);
+      s.tree.parents = layout.parents;
+      s.targets = layout.tool_point;
+      s.fixed = {0};
+      s.robot = model;
+      RobotTreeSolver check(*model, RobotTreeOptionsOf(s));
+      (void)check;
+    } catch (const InputError& e) {
+      Problem p = e.problem();
+      const std::string& f = p.field;
+      if (f.rfind("tools[", 0) == 0) {  // tools[k].link -> /targets/k/link
+        const size_t close = f.find(']');
+        p.field = "/targets/" + f.substr(6, close - 6) + "/" +
+                  (close + 2 < f.size() ? f.substr(close + 2) : std::string("link"));
+      } else if (f == "base_link") {
+        p.field = "/robot/base_link";
+      } else {
+        p.message = path.string() + ": " + p.Text();
+        p.field = "/robot/urdf";
+      }
+      problems.push_back(std::move(p));
+    }
+    if (problems.empty()) CheckPathLengths(&s);
+    return s;
+  }
+
+  void CheckPathLengths(const TreeScenario* s) {
+    auto path_of = [&](size_t k) {
+      return "/targets/" + std::to_string(k) + (s->looks[k] ? "/look_at" : "/path");
+    };
+    for (size_t k = 1; k < s->paths.size(); ++k) {
+      if (s->paths[k].rows() != s->paths[0].rows()) {
+        Add(path_of(k), "has " + std::to_string(s->paths[k].rows()) +
+                            " points; every target's path has one point per frame, " +
+                            std::to_string(s->paths[0].rows()) + " as " + path_of(0));
+      }
+    }
+  }
+
   bool ReadTree(const json& root, Tree* tree) {
     const json* t = Required(root, "", "tree", "an object with \"points\" and \"parents\"");
     if (t == nullptr || !ExpectObject(*t, "/tree", "an object with \"points\" and \"parents\"")) {
@@ -150,7 +257,10 @@ class TreeScenarioReader : public json_internal::JsonReader {
     return true;
   }
 
-  void ReadTargets(const json& root, int count, int dim, TreeScenario* s) {
+  // With `tools` (a robot tree), each target names a link ("link", "offset", "axis") instead of
+  // a point.
+  void ReadTargets(const json& root, int count, int dim, TreeScenario* s,
+                   std::vector<UrdfTool>* tools) {
     const json* targets =
         Required(root, "", "targets", "an array of {\"point\": i, \"path\": [...]}, at least one");
     if (targets == nullptr) return;
@@ -165,14 +275,38 @@ class TreeScenarioReader : public json_internal::JsonReader {
       if (!ExpectObject(t, ptr, "an object with \"point\" and \"path\" (or \"look_at\")")) {
         continue;
       }
-      CheckKeys(t, ptr, {"point", "path", "look_at", "weight"});
       int64_t point = -1;
-      Require(
-          t, ptr, "point", "a point index",
-          [&](const json& v, const std::string& p) {
-            return Integer(v, p, 0, count > 0 ? count - 1 : (1 << 30));
-          },
-          &point);
+      if (tools != nullptr) {
+        CheckKeys(t, ptr, {"link", "offset", "axis", "path", "look_at", "weight"});
+        UrdfTool tool;
+        Require(
+            t, ptr, "link", "the name of a link of the robot",
+            [&](const json& v, const std::string& p) { return String(v, p); }, &tool.link);
+        std::optional<Eigen::VectorXd> v;
+        Optional(
+            t, ptr, "offset", [&](const json& x, const std::string& p) { return Vector(x, p, 3); },
+            &v);
+        if (v) tool.offset = *v;
+        v.reset();
+        Optional(
+            t, ptr, "axis", [&](const json& x, const std::string& p) { return Vector(x, p, 3); },
+            &v);
+        if (v) {
+          if (!(v->norm() > 0.0)) {
+            ValueProblem(t["axis"], ptr + "/axis", "a non-zero direction in the link's frame");
+          }
+          tool.axis = *v;
+        }
+        tools->push_back(tool);
+      } else {
+        CheckKeys(t, ptr, {"point", "path", "look_at", "weight"});
+        Require(
+            t, ptr, "point", "a point index",
+            [&](const json& v, const std::string& p) {
+              return Integer(v, p, 0, count > 0 ? count - 1 : (1 << 30));
+            },
+            &point);
+      }
       Points path;
       const bool look = t.contains("look_at");
       if (look && t.contains("path")) {
@@ -231,13 +365,7 @@ class TreeScenarioReader : public json_internal::JsonReader {
     auto path_of = [&](size_t k) {
       return "/targets/" + std::to_string(k) + (s->looks[k] ? "/look_at" : "/path");
     };
-    for (size_t k = 1; k < s->paths.size(); ++k) {
-      if (s->paths[k].rows() != s->paths[0].rows()) {
-        Add(path_of(k), "has " + std::to_string(s->paths[k].rows()) +
-                            " points; every target's path has one point per frame, " +
-                            std::to_string(s->paths[0].rows()) + " as " + path_of(0));
-      }
-    }
+    CheckPathLengths(s);
     for (size_t k = 0; k < s->looks.size(); ++k) {
       if (s->looks[k] && s->method == Method::kOverall) {
         Add(path_of(k),
@@ -284,7 +412,8 @@ nlohmann::ordered_json TreeResultHeader(const TreeScenario& s, const TreeRunResu
   nlohmann::ordered_json j;
   j["format"] = "flexkin-tree-result";
   j["name"] = s.name;
-  j["method"] = NameOf(s.method);
+  j["method"] = s.robot ? "newton" : NameOf(s.method);
+  if (s.robot) j["joints"] = s.robot->joint_names;
   j["dim"] = s.tree.points.cols();
   j["parents"] = s.tree.parents;
   j["targets"] = s.targets;
@@ -300,8 +429,9 @@ nlohmann::ordered_json TreeResultHeader(const TreeScenario& s, const TreeRunResu
 }  // namespace
 
 namespace internal {
-TreeScenario ReadTreeScenario(const json& root, Problems* problems) {
-  TreeScenarioReader reader;
+TreeScenario ReadTreeScenario(const json& root, const RobotScenarioOptions& options,
+                              const std::string& directory, Problems* problems) {
+  TreeScenarioReader reader(options, directory);
   TreeScenario s = reader.Read(root);
   for (Problem& p : reader.problems) problems->push_back(std::move(p));
   return s;
@@ -332,6 +462,15 @@ std::string TreeRunResult::BriefReport() const {
 std::string TreeSummary(const TreeScenario& s) {
   std::ostringstream out;
   const Eigen::Index n = s.tree.points.rows();
+  if (s.robot) {
+    const auto pointing = std::count(s.looks.begin(), s.looks.end(), char(1));
+    out << "robot tree" << (s.name.empty() ? "" : " \"" + s.name + "\"") << ": "
+        << s.robot->joints() << " joints, " << n << " points, " << s.targets.size()
+        << (s.targets.size() == 1 ? " tool" : " tools");
+    if (pointing > 0) out << " (" << pointing << " pointing)";
+    out << ", joint-space Gauss-Newton (newton), " << s.frames() << " frames";
+    return out.str();
+  }
   out << "tree" << (s.name.empty() ? "" : " \"" + s.name + "\"") << ": " << n << " points ("
       << n - 1 << " links, " << s.tree.points.cols() << "D), " << s.targets.size()
       << (s.targets.size() == 1 ? " target" : " targets");
@@ -350,8 +489,54 @@ std::string TreeSummary(const TreeScenario& s) {
   return out.str();
 }
 
+namespace {
+
+// The largest relative change of the tree's link lengths from `start` to `points`.
+double TreeLinkLengthError(const Tree& start, const Points& points) {
+  double worst = 0.0;
+  for (size_t i = 0; i < start.parents.size(); ++i) {
+    const int u = start.parents[i];
+    if (u < 0) continue;
+    const double length = (start.points.row(i) - start.points.row(u)).norm();
+    worst = std::max(worst, std::abs((points.row(i) - points.row(u)).norm() - length) / length);
+  }
+  return worst;
+}
+
+// A robot tree: every frame's joints solved from the last frame's.
+TreeRunResult RunRobotTree(const TreeScenario& s,
+                           const std::function<void(int64_t, int64_t)>& progress) {
+  const RobotTree& robot = *s.robot;
+  const RobotTreeSolver solver(robot, RobotTreeOptionsOf(s));
+  const int frames = s.frames();
+  TreeRunResult r;
+  Eigen::VectorXd q = robot.initial;
+  r.frames.push_back(RobotTreePoints(robot, solver.layout(), q));
+  r.angles.push_back(q);
+  Points goals(s.targets.size(), 3);
+  const double longest = solver.layout().longest_link;
+  for (int f = 0; f < frames; ++f) {
+    for (size_t k = 0; k < s.targets.size(); ++k) goals.row(k) = s.paths[k].row(f);
+    const RobotTreeSolve solve = solver.Solve(q, goals);
+    q = solve.angles;
+    r.frames.push_back(RobotTreePoints(robot, solver.layout(), q));
+    r.angles.push_back(q);
+    r.passes.push_back(solve.iterations);
+    r.residual.push_back(std::max(solve.residual / longest, solve.angle_residual));
+    r.reached.push_back(solve.converged);
+    r.converged.push_back(1);
+    r.finished.push_back(0);
+    r.max_length_error = std::max(r.max_length_error, TreeLinkLengthError(s.tree, r.frames.back()));
+    if (progress) progress(f + 1, frames);
+  }
+  return r;
+}
+
+}  // namespace
+
 TreeRunResult RunTree(const TreeScenario& s,
                       const std::function<void(int64_t, int64_t)>& progress) {
+  if (s.robot) return RunRobotTree(s, progress);
   TreeRunResult r;
   const int frames = s.frames();
   const int dim = static_cast<int>(s.tree.points.cols());
@@ -367,11 +552,6 @@ TreeRunResult RunTree(const TreeScenario& s,
     stepper = MakeTreeStepper(s.method, s.tree, s.targets[0]);
   } else {
     reacher = MakeTreeReacher(s.tree, s.targets, s.fixed, s.weights, reach, s.looks);
-  }
-  std::vector<double> lengths(s.tree.parents.size(), 0.0);  // each point's link to its parent
-  for (size_t i = 0; i < lengths.size(); ++i) {
-    const int u = s.tree.parents[i];
-    if (u >= 0) lengths[i] = (s.tree.points.row(i) - s.tree.points.row(u)).norm();
   }
   Points goal(s.targets.size(), dim);
   for (int f = 0; f < frames; ++f) {
@@ -401,13 +581,7 @@ TreeRunResult RunTree(const TreeScenario& s,
     r.converged.push_back(converged);
     r.finished.push_back(finished);
     r.frames.push_back(points);
-    for (size_t i = 0; i < lengths.size(); ++i) {
-      const int u = s.tree.parents[i];
-      if (u < 0) continue;
-      r.max_length_error =
-          std::max(r.max_length_error,
-                   std::abs((points.row(i) - points.row(u)).norm() - lengths[i]) / lengths[i]);
-    }
+    r.max_length_error = std::max(r.max_length_error, TreeLinkLengthError(s.tree, points));
     if (progress) progress(f + 1, frames);
   }
   return r;
@@ -469,6 +643,14 @@ void WriteTreeResult(const std::string& path, const TreeScenario& s, const TreeR
       }
       zip.AddMember("goals.npy", goal_data);
     }
+    if (s.robot && r.angles.size() == r.frames.size()) {  // a robot's joints, every frame
+      const uint64_t n = s.robot->joints();
+      std::string angles = NpyHeader("<f8", {frames, n});
+      for (const Eigen::VectorXd& q : r.angles) {
+        angles.append(reinterpret_cast<const char*>(q.data()), sizeof(double) * n);
+      }
+      zip.AddMember("angles.npy", angles);
+    }
     ints("passes.npy", r.passes);
     std::string res = NpyHeader("<f8", {r.residual.size()});
     res.append(reinterpret_cast<const char*>(r.residual.data()),
@@ -504,6 +686,13 @@ void WriteTreeResult(const std::string& path, const TreeScenario& s, const TreeR
       goal_frames.push_back(std::move(rows));
     }
     if (goals) header["goals"] = std::move(goal_frames);
+    if (s.robot && r.angles.size() == r.frames.size()) {
+      nlohmann::ordered_json angles = nlohmann::ordered_json::array();
+      for (const Eigen::VectorXd& q : r.angles) {
+        angles.push_back(std::vector<double>(q.data(), q.data() + q.size()));
+      }
+      header["angles"] = std::move(angles);
+    }
     header["passes"] = r.passes;
     header["residual"] = r.residual;
     header["reached"] = std::vector<bool>(r.reached.begin(), r.reached.end());

@@ -139,10 +139,14 @@ void DrawLookedAt(cairo_t* cr, const ChainScene& scene, const TreeResultFile& tr
 
 std::string TreeResultSummary(const TreeResultFile& tree) {
   const bool passes = !(tree.targets.size() == 1 && tree.fixed.empty());
-  std::string s = std::string("tree \u00b7 ") + MethodName(tree.method) +
-                  (passes && tree.method != Method::kOverall ? " passes" : "") + " \u00b7 " +
-                  std::to_string(tree.dim) + "D \u00b7 " + std::to_string(tree.parents.size()) +
-                  " points \u00b7 " + std::to_string(tree.targets.size()) +
+  const std::string method =
+      tree.robot ? std::string("robot tree \u00b7 ") + std::to_string(tree.joints.size()) +
+                       " joints, joint-space Gauss-Newton"
+                 : std::string("tree \u00b7 ") + MethodName(tree.method) +
+                       (passes && tree.method != Method::kOverall ? " passes" : "");
+  std::string s = method + " \u00b7 " + std::to_string(tree.dim) + "D \u00b7 " +
+                  std::to_string(tree.parents.size()) + " points \u00b7 " +
+                  std::to_string(tree.targets.size()) +
                   (tree.targets.size() == 1 ? " target" : " targets");
   if (!tree.fixed.empty()) s += " \u00b7 " + std::to_string(tree.fixed.size()) + " fixed";
   const int missed =

@@ -48,7 +48,7 @@ AnyScenario Read(const std::string& text, const ScenarioReadOptions& options,
       break;
     }
     case ScenarioKind::kTree: {
-      TreeScenario s = internal::ReadTreeScenario(root, &out.problems);
+      TreeScenario s = internal::ReadTreeScenario(root, options.robot, directory, &out.problems);
       if (out.problems.empty()) out.tree = std::move(s);
       break;
     }

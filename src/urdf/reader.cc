@@ -373,7 +373,8 @@ ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
   return model;
 }
 
-ArmModel ArmFromUrdfFile(const std::string& path, const UrdfChain& chain) {
+namespace {
+std::string ReadUrdfText(const std::string& path) {
   std::ifstream in(path);
   if (!in) {
     throw std::system_error(std::make_error_code(std::errc::no_such_file_or_directory),
@@ -381,7 +382,145 @@ ArmModel ArmFromUrdfFile(const std::string& path, const UrdfChain& chain) {
   }
   std::stringstream text;
   text << in.rdbuf();
-  return ArmFromUrdf(text.str(), chain);
+  return text.str();
+}
+}  // namespace
+
+ArmModel ArmFromUrdfFile(const std::string& path, const UrdfChain& chain) {
+  return ArmFromUrdf(ReadUrdfText(path), chain);
+}
+
+RobotTree RobotTreeFromUrdf(const std::string& text, const std::string& base_link,
+                            const std::vector<UrdfTool>& tools) {
+  const urdf::ModelInterfaceSharedPtr robot = Parse(text);
+  urdf::LinkConstSharedPtr base = robot->getRoot();
+  if (!base_link.empty()) {
+    base = robot->getLink(base_link);
+    if (!base) {
+      throw InputError("base_link", "link " + Quote(base_link) +
+                                        " is not in the URDF; expected one of its links");
+    }
+  }
+  Eigen::Isometry3d base_pose = Eigen::Isometry3d::Identity();
+  for (urdf::LinkConstSharedPtr link = base; link->parent_joint; link = link->getParent()) {
+    base_pose = Transform(link->parent_joint->parent_to_joint_origin_transform) * base_pose;
+  }
+  RobotTree tree;
+  tree.base = base_pose.translation();
+  std::vector<Eigen::Vector3d> origins, axes;
+  std::vector<double> lower, upper;
+  struct LinkAt {
+    Eigen::Isometry3d pose;  // at the zero pose
+    int joint;               // the last movable joint above it (-1: none)
+  };
+  std::map<std::string, LinkAt> links;
+  // Depth first from the base, each joint after its parent.
+  std::vector<std::pair<urdf::LinkConstSharedPtr, LinkAt>> stack{{base, {base_pose, -1}}};
+  while (!stack.empty()) {
+    auto [link, at] = stack.back();
+    stack.pop_back();
+    links.emplace(link->name, at);
+    for (auto c = link->child_joints.rbegin(); c != link->child_joints.rend(); ++c) {
+      const urdf::JointConstSharedPtr& joint = *c;
+      const urdf::LinkConstSharedPtr child = robot->getLink(joint->child_link_name);
+      if (!child) continue;  // urdfdom refuses such a joint
+      const std::string field = "joint " + Quote(joint->name);
+      LinkAt next{at.pose * Transform(joint->parent_to_joint_origin_transform), at.joint};
+      if (joint->type != urdf::Joint::FIXED) {
+        if (joint->type != urdf::Joint::REVOLUTE && joint->type != urdf::Joint::CONTINUOUS) {
+          const char* type = joint->type == urdf::Joint::PRISMATIC  ? "prismatic"
+                             : joint->type == urdf::Joint::FLOATING ? "floating"
+                             : joint->type == urdf::Joint::PLANAR   ? "planar"
+                                                                    : "unknown";
+          throw InputError(field, std::string("has type ") + type +
+                                      "; robot trees take revolute, continuous and fixed joints "
+                                      "(a serial arm, scenario kind \"robot\", takes prismatic "
+                                      "ones); make it fixed or start the tree below it "
+                                      "(base_link)");
+        }
+        const Eigen::Vector3d axis(joint->axis.x, joint->axis.y, joint->axis.z);
+        if (!(axis.norm() > 0.0) || !axis.allFinite()) {
+          throw InputError(field, "axis is zero; expected a direction");
+        }
+        double lo = -kInf, hi = kInf;
+        if (joint->type == urdf::Joint::REVOLUTE && joint->limits) {
+          lo = joint->limits->lower;
+          hi = joint->limits->upper;
+          if (!(lo <= hi)) {
+            throw InputError(field, "limit lower " + FormatNumber(lo) + " > upper " +
+                                        FormatNumber(hi) + "; expected lower <= upper");
+          }
+        }
+        origins.push_back(next.pose.translation());
+        axes.push_back((next.pose.linear() * axis).normalized());
+        lower.push_back(lo);
+        upper.push_back(hi);
+        tree.joint_names.push_back(joint->name);
+        tree.joint_parents.push_back(at.joint);
+        next.joint = static_cast<int>(tree.joint_parents.size()) - 1;
+      }
+      stack.push_back({child, next});
+    }
+  }
+  const int n = static_cast<int>(origins.size());
+  if (n == 0) {
+    throw InputError("base_link", "link " + Quote(base->name) +
+                                      " has no revolute or continuous joint below it; expected "
+                                      "the link a robot tree is bolted to");
+  }
+  tree.origins.resize(n, 3);
+  tree.axes.resize(n, 3);
+  tree.joint_min.resize(n);
+  tree.joint_max.resize(n);
+  tree.initial.resize(n);
+  for (int j = 0; j < n; ++j) {
+    tree.origins.row(j) = origins[j].transpose();
+    tree.axes.row(j) = axes[j].transpose();
+    tree.joint_min[j] = lower[j];
+    tree.joint_max[j] = upper[j];
+    tree.initial[j] = std::clamp(0.0, lower[j], upper[j]);
+  }
+  for (size_t k = 0; k < tools.size(); ++k) {
+    const std::string field = "tools[" + std::to_string(k) + "]";
+    const UrdfTool& want = tools[k];
+    const auto at = links.find(want.link);
+    if (at == links.end()) {
+      throw InputError(field + ".link", "link " + Quote(want.link) +
+                                            (robot->getLink(want.link)
+                                                 ? " is not below base link " + Quote(base->name)
+                                                 : std::string(" is not in the URDF")) +
+                                            "; expected a link below the base");
+    }
+    if (at->second.joint < 0) {
+      throw InputError(field + ".link", "link " + Quote(want.link) +
+                                            " is below no revolute or continuous joint; expected "
+                                            "a link that the joints move");
+    }
+    if (!want.offset.allFinite()) {
+      throw InputError(field + ".offset", "is not finite; expected a point of the link's frame");
+    }
+    if (!(want.axis.norm() > 0.0) || !want.axis.allFinite()) {
+      throw InputError(field + ".axis",
+                       "is zero or not finite; expected a direction in the "
+                       "link's frame");
+    }
+    RobotTree::Tool tool;
+    tool.link = want.link;
+    tool.joint = at->second.joint;
+    tool.point = at->second.pose * want.offset;
+    tool.frame = at->second.pose.linear();
+    tool.axis = want.axis.normalized();
+    tree.tools.push_back(tool);
+  }
+  if (const Problems problems = tree.Validate(); !problems.empty()) {
+    throw InputError("urdf", problems.front().Text());
+  }
+  return tree;
+}
+
+RobotTree RobotTreeFromUrdfFile(const std::string& path, const std::string& base_link,
+                                const std::vector<UrdfTool>& tools) {
+  return RobotTreeFromUrdf(ReadUrdfText(path), base_link, tools);
 }
 
 }  // namespace flexkin

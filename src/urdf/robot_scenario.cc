@@ -13,6 +13,10 @@ RobotScenarioOptions UrdfRobotScenarioOptions() {
   options.urdf_loader = [](const std::string& path, const UrdfChain& chain) {
     return ArmFromUrdfFile(path, chain);
   };
+  options.urdf_tree_loader = [](const std::string& path, const std::string& base_link,
+                                const std::vector<UrdfTool>& tools) {
+    return RobotTreeFromUrdfFile(path, base_link, tools);
+  };
   return options;
 }
 

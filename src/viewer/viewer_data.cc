@@ -229,7 +229,11 @@ std::string ViewerDataJson(const ResultFile& file, const ViewerOptions& options,
   AppendKey("scenario", &out);
   AppendString(file.scenario_name, &out);
   AppendKey("method", &out);
-  AppendString(robot != nullptr ? robot->method : std::string(MethodName(r.method)), &out);
+  AppendString(robot != nullptr ? robot->method
+               : tree != nullptr && tree->robot
+                   ? "joint-space Gauss-Newton (" + std::to_string(tree->joints.size()) + " joints)"
+                   : std::string(MethodName(r.method)),
+               &out);
   if (robot != nullptr) {
     AppendKey("robot", &out);
     out.push_back('{');

@@ -14,7 +14,7 @@ declare -A header_layer=(
   [link_step]=sequential [propagate]=sequential [tree]=sequential [tree_overall]=overall [tree_scenario]=io
   [overall]=overall
   [run]=run [frames]=run [dynamics]=dynamics
-  [arm]=arm [strands]=strands [groom]=groom [strand_file]=io
+  [arm]=arm [robot_tree]=arm [strands]=strands [groom]=groom [strand_file]=io
   [scenario]=io [result_io]=io [robot_scenario]=io [scenario_kind]=io [any_scenario]=scenario
   [flexkin]=umbrella
   [render]=render [strands_render]=render [viewer]=viewer [strands_viewer]=viewer [gltf]=gltf

@@ -1,0 +1,381 @@
+// Robot trees (flexkin/robot_tree.h, docs/trees.md "Robot trees"): the URDF reader, the layout of
+// points, the joint-space solve of several tools (reached to the tolerance, within the limits,
+// the least weighted motion to first order, looking goals) and the tree scenario with "robot"
+// through the front door. Forward kinematics against KDL: robot_tree_kdl_test.cc.
+#include "flexkin/robot_tree.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "flexkin/any_scenario.h"
+#include "flexkin/tree_scenario.h"
+#include "flexkin/urdf.h"
+#include "test_util.h"
+
+namespace flexkin {
+namespace {
+
+using test_util::SourceFileText;
+
+const std::string& TwoArms() {
+  static const std::string text = SourceFileText("examples/robot_two_arms.urdf");
+  return text;
+}
+
+RobotTree TwoArmRobot(bool camera = false) {
+  std::vector<UrdfTool> tools = {{"l_tool"}, {"r_tool"}};
+  if (camera) tools.push_back({"camera"});
+  return RobotTreeFromUrdf(TwoArms(), "", tools);
+}
+
+// Random angles within the limits, `spread` rad about 0 at most.
+Eigen::VectorXd RandomAngles(const RobotTree& robot, std::mt19937* rng, double spread) {
+  std::uniform_real_distribution<double> u(-spread, spread);
+  Eigen::VectorXd q(robot.joints());
+  for (int j = 0; j < robot.joints(); ++j) {
+    q[j] = std::clamp(u(*rng), robot.joint_min[j], robot.joint_max[j]);
+  }
+  return q;
+}
+
+TEST(RobotTreeUrdf, ReadsTheJointsAsATreeWithTheirLimits) {
+  const RobotTree robot = TwoArmRobot();
+  ASSERT_EQ(robot.joints(), 15);
+  EXPECT_TRUE(robot.Validate().empty());
+  for (int j = 0; j < robot.joints(); ++j) {
+    EXPECT_LT(robot.joint_parents[j], j);
+    EXPECT_NEAR(robot.axes.row(j).norm(), 1.0, 1e-15);
+  }
+  auto index = [&](const std::string& name) {
+    const auto at = std::find(robot.joint_names.begin(), robot.joint_names.end(), name);
+    return static_cast<int>(at - robot.joint_names.begin());
+  };
+  const int waist = index("waist"), elbow = index("l_elbow"), tilt = index("neck_tilt");
+  EXPECT_EQ(robot.joint_parents[waist], -1);
+  EXPECT_EQ(robot.joint_parents[index("l_shoulder_roll")], waist);
+  EXPECT_EQ(robot.joint_parents[index("r_shoulder_roll")], waist);
+  EXPECT_EQ(robot.joint_parents[tilt], index("neck_pan"));
+  // As written in the URDF: the elbow at (0, 0.22 + 0.05 + 0.15 + 0.15, 0.5 + 0.55) about z.
+  EXPECT_NEAR((robot.origins.row(elbow) - Eigen::RowVector3d(0, 0.57, 1.05)).norm(), 0, 1e-15);
+  EXPECT_EQ(robot.axes.row(elbow), Eigen::RowVector3d(0, 0, 1));
+  EXPECT_EQ(robot.joint_min[elbow], -2.6);
+  EXPECT_EQ(robot.joint_max[waist], 1.6);
+  // The tools: the hands' fixed links, 0.1 beyond the wrists, which are 0.3 ahead of the elbows.
+  ASSERT_EQ(robot.tools.size(), 2u);
+  EXPECT_EQ(robot.tools[0].joint, index("l_wrist_flex"));
+  EXPECT_NEAR((robot.tools[0].point - Eigen::Vector3d(0.4, 0.57, 1.05)).norm(), 0, 1e-15);
+  EXPECT_NEAR((robot.tools[1].point - Eigen::Vector3d(0.4, -0.57, 1.05)).norm(), 0, 1e-15);
+}
+
+TEST(RobotTreeUrdf, RefusesWhatItCannotDriveNamingIt) {
+  auto message = [](const std::string& text, const std::string& base,
+                    const std::vector<UrdfTool>& tools) {
+    try {
+      RobotTreeFromUrdf(text, base, tools);
+    } catch (const InputError& e) {
+      return e.problem().field + " | " + e.problem().message;
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(
+      message(TwoArms(), "", {{"l_tol"}}).rfind("tools[0].link | link \"l_tol\" is not in", 0), 0u);
+  EXPECT_EQ(message(TwoArms(), "torsoo", {{"l_tool"}}).rfind("base_link", 0), 0u);
+  // A tool above the base: not below it.
+  EXPECT_NE(message(TwoArms(), "l_forearm", {{"r_tool"}}).find("is not below base link"),
+            std::string::npos);
+  // The base link itself moves with no joint.
+  EXPECT_NE(message(TwoArms(), "", {{"base_link"}}).find("below no revolute"), std::string::npos);
+  std::string prismatic = TwoArms();
+  const std::string revolute = "\"l_elbow\" type=\"revolute\"";
+  const size_t at = prismatic.find(revolute);
+  ASSERT_NE(at, std::string::npos);
+  prismatic.replace(at, revolute.size(), "\"l_elbow\" type=\"prismatic\"");
+  EXPECT_EQ(message(prismatic, "", {{"l_tool"}}).rfind("joint \"l_elbow\" | has type prismatic", 0),
+            0u);
+  EXPECT_EQ(message("<robot", "", {{"l_tool"}}).rfind("urdf |", 0), 0u);
+}
+
+TEST(RobotTreeLayout, MergesJointsOnOnePointAndKeepsEveryLinkLength) {
+  const RobotTree robot = TwoArmRobot(true);
+  const RobotTreeLayout layout = MakeRobotTreeLayout(robot);
+  // 15 joints: the two wrists' flex joints share the wrists' points and the neck's pan and the
+  // waist have their own; 3 tools: the hands and the camera (off the tilt joint's point).
+  EXPECT_EQ(layout.parents.size(), 1u + 15u - 2u + 3u);
+  Tree tree{RobotTreePoints(robot, layout, robot.initial), layout.parents};
+  EXPECT_NO_THROW(ValidateTree(tree, "tree"));
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 50; ++trial) {
+    const Points p = RobotTreePoints(robot, layout, RandomAngles(robot, &rng, 3.0));
+    for (size_t i = 1; i < layout.parents.size(); ++i) {
+      const int u = layout.parents[i];
+      const double length = (tree.points.row(i) - tree.points.row(u)).norm();
+      EXPECT_NEAR((p.row(i) - p.row(u)).norm(), length, 4e-16 * 4) << "link " << i;
+    }
+  }
+}
+
+// The position misses of the tools at q (largest).
+double Miss(const RobotTree& robot, const Eigen::VectorXd& q, const Points& goals) {
+  Points tools, axes;
+  RobotTreeTools(robot, q, &tools, &axes);
+  return (tools - goals).rowwise().norm().maxCoeff();
+}
+
+TEST(RobotTreeSolver, ReachesReachableGoalsToTheToleranceWithinTheLimits) {
+  const RobotTree robot = TwoArmRobot();
+  const RobotTreeSolver solver(robot);
+  std::mt19937 rng(3);
+  int reached = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const Eigen::VectorXd from = RandomAngles(robot, &rng, 1.0);
+    // Goals the robot reaches: its tools at other angles not far away.
+    const Eigen::VectorXd there =
+        (from + RandomAngles(robot, &rng, 0.3)).cwiseMax(robot.joint_min).cwiseMin(robot.joint_max);
+    Points goals, axes;
+    RobotTreeTools(robot, there, &goals, &axes);
+    const RobotTreeSolve s = solver.Solve(from, goals);
+    reached += s.converged;
+    EXPECT_TRUE(s.converged) << "trial " << trial << ": miss " << s.residual;
+    EXPECT_LE(Miss(robot, s.angles, goals), 1e-10 * solver.layout().longest_link);
+    EXPECT_EQ(s.residual, Miss(robot, s.angles, goals));
+    for (int j = 0; j < robot.joints(); ++j) {
+      EXPECT_GE(s.angles[j], robot.joint_min[j]);
+      EXPECT_LE(s.angles[j], robot.joint_max[j]);
+    }
+  }
+  EXPECT_EQ(reached, 40);
+}
+
+TEST(RobotTreeSolver, JointsWithNoToolBelowThemDoNotMove) {
+  const RobotTree robot = TwoArmRobot();  // the neck carries no tool
+  const RobotTreeSolver solver(robot);
+  std::mt19937 rng(5);
+  const Eigen::VectorXd from = RandomAngles(robot, &rng, 0.8);
+  Points goals, axes;
+  RobotTreeTools(robot, from, &goals, &axes);
+  goals.row(0) += Eigen::RowVector3d(0.05, -0.02, 0.03);
+  goals.row(1) += Eigen::RowVector3d(-0.03, 0.02, 0.04);
+  const RobotTreeSolve s = solver.Solve(from, goals);
+  ASSERT_TRUE(s.converged);
+  for (const char* neck : {"neck_pan", "neck_tilt"}) {
+    const auto j = std::find(robot.joint_names.begin(), robot.joint_names.end(), neck) -
+                   robot.joint_names.begin();
+    EXPECT_EQ(s.angles[j], from[j]) << neck;
+  }
+}
+
+// A small move is, to first order, the smallest joint motion in the weighted norm that takes the
+// tools there: dq = W^-1 J' (J W^-1 J')^-1 dx, with J by central differences of the tools' points
+// (not the solver's analytic Jacobian).
+TEST(RobotTreeSolver, ASmallMoveIsTheLeastWeightedJointMotion) {
+  const RobotTree robot = TwoArmRobot();
+  const RobotTreeSolver solver(robot);
+  const int n = robot.joints();
+  std::mt19937 rng(11);
+  const Eigen::VectorXd from = RandomAngles(robot, &rng, 0.7);
+  Points at, axes;
+  RobotTreeTools(robot, from, &at, &axes);
+  Eigen::MatrixXd jac(6, n);
+  const double h = 1e-6;
+  for (int j = 0; j < n; ++j) {
+    Eigen::VectorXd plus = from, minus = from;
+    plus[j] += h;
+    minus[j] -= h;
+    Points a, b;
+    RobotTreeTools(robot, plus, &a, &axes);
+    RobotTreeTools(robot, minus, &b, &axes);
+    const Points d = (a - b) / (2 * h);
+    jac.col(j) << d.row(0).transpose(), d.row(1).transpose();
+  }
+  Eigen::VectorXd dx(6);
+  dx << 1, -2, 0.5, -1, 1.5, 2;
+  dx *= 1e-6;
+  Points goals = at;
+  goals.row(0) += dx.head<3>().transpose();
+  goals.row(1) += dx.tail<3>().transpose();
+  const Eigen::VectorXd winv = solver.inverse_weights();
+  const Eigen::MatrixXd weighted = winv.asDiagonal() * jac.transpose();
+  const Eigen::VectorXd expected = weighted * (jac * weighted).ldlt().solve(dx);
+  const RobotTreeSolve s = solver.Solve(from, goals);
+  ASSERT_TRUE(s.converged);
+  const Eigen::VectorXd dq = s.angles - from;
+  // Second-order terms: |dq|^2 ~ 1e-11 against |dq| ~ 1e-5.
+  EXPECT_LT((dq - expected).norm(), 1e-4 * expected.norm());
+  // The weights favour the joints near the hands: the wrists move more than the waist.
+  EXPECT_GT(winv[std::find(robot.joint_names.begin(), robot.joint_names.end(), "l_wrist_pitch") -
+                 robot.joint_names.begin()],
+            winv[0]);
+}
+
+TEST(RobotTreeSolver, HoldsJointsOnTheirLimits) {
+  const RobotTree free = TwoArmRobot();
+  auto index = [&](const char* name) {
+    return static_cast<int>(std::find(free.joint_names.begin(), free.joint_names.end(), name) -
+                            free.joint_names.begin());
+  };
+  const int elbow = index("l_elbow");
+  // Goals the left arm reaches with its elbow straight: its hand where these angles put it.
+  Eigen::VectorXd there = free.initial;
+  there[index("l_shoulder_roll")] = 0.3;
+  there[index("l_shoulder_yaw")] = -0.5;
+  there[index("l_upper_arm_twist")] = 0.4;
+  there[index("l_wrist_pitch")] = 0.3;
+  Points goals, axes;
+  RobotTreeTools(free, there, &goals, &axes);
+  // Without limits on it, the elbow (near the hand, so cheap to move) takes part of the motion.
+  const RobotTreeSolve unlimited = RobotTreeSolver(free).Solve(free.initial, goals);
+  ASSERT_TRUE(unlimited.converged);
+  const double bend = std::abs(unlimited.angles[elbow]);
+  ASSERT_GT(bend, 0.01);
+  // The elbow allowed a third of that: it is held on its limit and the other joints reach.
+  RobotTree robot = free;
+  robot.joint_min[elbow] = -bend / 3;
+  robot.joint_max[elbow] = bend / 3;
+  const RobotTreeSolver solver(robot);
+  const RobotTreeSolve s = solver.Solve(robot.initial, goals);
+  EXPECT_EQ(std::abs(s.angles[elbow]), bend / 3);
+  EXPECT_TRUE(s.limited);
+  EXPECT_TRUE(s.converged) << s.residual;  // the other joints reach it
+  EXPECT_LE(Miss(robot, s.angles, goals), 1e-10 * solver.layout().longest_link);
+  for (int j = 0; j < robot.joints(); ++j) {
+    EXPECT_GE(s.angles[j], robot.joint_min[j]);
+    EXPECT_LE(s.angles[j], robot.joint_max[j]);
+  }
+}
+
+TEST(RobotTreeSolver, TurnsALookingToolToItsGoalPoint) {
+  const RobotTree robot = TwoArmRobot(true);
+  RobotTreeOptions options;
+  options.looks = {0, 0, 1};
+  const RobotTreeSolver solver(robot, options);
+  Points goals(3, 3);
+  goals << 0.3, 0.4, 1.2, 0.35, -0.35, 0.95, 0.3, 0.4, 1.2;  // the camera watches the left hand
+  const RobotTreeSolve s = solver.Solve(robot.initial, goals);
+  ASSERT_TRUE(s.converged) << s.residual << " " << s.angle_residual;
+  Points tools, axes;
+  RobotTreeTools(robot, s.angles, &tools, &axes);
+  const Eigen::Vector3d want = (goals.row(2) - tools.row(2)).transpose();
+  const Eigen::Vector3d axis = axes.row(2).transpose();
+  EXPECT_LT(std::atan2(want.cross(axis).norm(), want.dot(axis)), 1e-9);
+  EXPECT_LE(s.angle_residual, 1e-10);
+  EXPECT_LE((tools.topRows(2) - goals.topRows(2)).rowwise().norm().maxCoeff(),
+            1e-10 * solver.layout().longest_link);
+}
+
+TEST(RobotTreeSolver, RefusesBadGoalsAndOptions) {
+  const RobotTree robot = TwoArmRobot();
+  const RobotTreeSolver solver(robot);
+  Points goals = Points::Zero(2, 3);
+  goals(1, 2) = std::nan("");
+  try {
+    solver.Solve(robot.initial, goals);
+    FAIL() << "accepted a NaN goal";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "goals[1]");
+  }
+  EXPECT_THROW(solver.Solve(robot.initial, Points::Zero(3, 3)), InputError);
+  RobotTreeOptions bad;
+  bad.weights = {1.0, -1.0};
+  try {
+    RobotTreeSolver s(robot, bad);
+    FAIL() << "accepted a negative weight";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "weights[1]");
+  }
+}
+
+TEST(RobotTreeScenario, RunsTheExampleThroughTheFrontDoor) {
+  ScenarioReadOptions read;
+  read.robot = UrdfRobotScenarioOptions();
+  const AnyScenario s = ReadScenarioFile(
+      std::string(FLEXKIN_SOURCE_DIR) + "/examples/tree_robot_two_arms.json", read);
+  ASSERT_TRUE(s.valid()) << s.problems.front().Text();
+  ASSERT_TRUE(s.tree.has_value());
+  ASSERT_TRUE(s.tree->robot);
+  EXPECT_NE(s.Summary().find("robot tree \"two-armed robot\": 15 joints"), std::string::npos)
+      << s.Summary();
+  const TreeRunResult r = RunTree(*s.tree);
+  ASSERT_EQ(r.frames.size(), 181u);
+  EXPECT_EQ(r.failures(), 0) << r.BriefReport();
+  EXPECT_LT(r.max_length_error, 1e-14);
+  // Every frame: the hands on their paths, the camera on the left hand's path, to the tolerance.
+  const RobotTree& robot = *s.tree->robot;
+  for (size_t f = 1; f < r.frames.size(); ++f) {
+    Points tools, axes;
+    RobotTreeTools(robot, r.angles[f], &tools, &axes);
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_LE((tools.row(k) - s.tree->paths[k].row(f - 1)).norm(), 1e-10);
+      EXPECT_EQ(r.frames[f].row(s.tree->targets[k]), tools.row(k));
+    }
+    const Eigen::Vector3d look = (s.tree->paths[2].row(f - 1) - tools.row(2)).transpose();
+    const Eigen::Vector3d axis = axes.row(2).transpose();
+    EXPECT_LT(std::atan2(look.cross(axis).norm(), look.dot(axis)), 1e-9);
+  }
+  // No flips: the joints move little from frame to frame.
+  double step = 0.0;
+  for (size_t f = 1; f < r.angles.size(); ++f) {
+    step = std::max(step, (r.angles[f] - r.angles[f - 1]).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(step, 0.15);
+  // Written and read back, with the joint angles.
+  const std::string dir = ::testing::TempDir();
+  for (const char* name : {"robot_tree.npz", "robot_tree.json"}) {
+    const std::string path = dir + "/" + name;
+    WriteTreeResult(path, *s.tree, r);
+    const TreeResultFile back = ReadTreeResultFile(path);
+    EXPECT_TRUE(back.robot);
+    EXPECT_EQ(back.joints, robot.joint_names);
+    ASSERT_EQ(back.angles.size(), r.angles.size());
+    EXPECT_EQ(back.angles.back(), r.angles.back());
+    EXPECT_EQ(back.frames.back(), r.frames.back());
+    EXPECT_EQ(back.parents, s.tree->tree.parents);
+    std::filesystem::remove(path);
+  }
+}
+
+TEST(RobotTreeScenario, NamesEveryProblemByItsJsonPointer) {
+  ScenarioReadOptions read;
+  read.robot = UrdfRobotScenarioOptions();
+  read.robot.directory = std::string(FLEXKIN_SOURCE_DIR) + "/examples";
+  auto first = [&](const std::string& text) {
+    const AnyScenario s = ReadScenarioText(text, read);
+    return s.valid() ? std::string("valid") : s.problems.front().Text();
+  };
+  const std::string head =
+      R"({"format": "flexkin-tree", "robot": {"urdf": "robot_two_arms.urdf"}, )";
+  EXPECT_EQ(first(head + R"("targets": [{"link": "l_tool", "path": [[0, 0.97, 1.05]]}]})"),
+            "valid");
+  EXPECT_EQ(first(head + R"("targets": [{"link": "l_tool", "path": [[0, 0.97, 1.05]]},
+      {"link": "r_toool", "path": [[0, -0.97, 1.05]]}]})")
+                .rfind("/targets/1/link: link \"r_toool\" is not in the URDF", 0),
+            0u);
+  EXPECT_EQ(first(head + R"("targets": [{"link": "l_tool", "path": [[0, 0.97, 1.05]]}],
+      "fixed": [0]})")
+                .rfind("/fixed: is not an option of a robot tree", 0),
+            0u);
+  EXPECT_EQ(first(head + R"("targets": [{"point": 3, "path": [[0, 0.97, 1.05]]}]})")
+                .rfind("/targets/0", 0),
+            0u);
+  EXPECT_EQ(first(head + R"("targets": [{"link": "l_tool", "path": [[0, 0.97]]}]})")
+                .rfind("/targets/0/path/0", 0),
+            0u);
+  EXPECT_EQ(first(head + R"("targets": [{"link": "camera", "axis": [0, 0, 0],
+      "look_at": [[1, 0, 1]]}]})")
+                .rfind("/targets/0/axis", 0),
+            0u);
+  EXPECT_THROW(ReadScenarioText(R"({"format": "flexkin-tree", "robot": {"urdf": "missing.urdf"},
+      "targets": [{"link": "l_tool", "path": [[0, 0.97, 1.05]]}]})",
+                                read),
+               std::system_error);
+}
+
+}  // namespace
+}  // namespace flexkin
