@@ -251,6 +251,26 @@ TEST(RobotTreeSolver, HoldsJointsOnTheirLimits) {
   }
 }
 
+TEST(RobotTreeSolver, EndsNearTheGoalsItCannotReachAndSaysSo) {
+  const RobotTree robot = TwoArmRobot();
+  const RobotTreeSolver solver(robot);
+  Points goals(2, 3);
+  goals << 3.0, 3.0, 3.0, 0.4, -0.57, 1.05;  // the left hand's far out of reach
+  const RobotTreeSolve s = solver.Solve(robot.initial, goals);
+  EXPECT_FALSE(s.converged);
+  EXPECT_LT(s.iterations, 200);
+  EXPECT_EQ(s.residual, Miss(robot, s.angles, goals));
+  // No closer than the left shoulder's distance to the goal less the arm's reach (0.75)...
+  const Eigen::Vector3d shoulder(0, 0.22, 1.05), goal(3, 3, 3);
+  EXPECT_GE(s.residual, (goal - shoulder).norm() - 0.75 - 0.22);
+  // ...and well on the way: within 1% of the best a straight arm from the torso can do.
+  EXPECT_LT(s.residual, 1.01 * ((goal - Eigen::Vector3d(0, 0, 1.05)).norm() - 0.97));
+  for (int j = 0; j < robot.joints(); ++j) {
+    EXPECT_GE(s.angles[j], robot.joint_min[j]);
+    EXPECT_LE(s.angles[j], robot.joint_max[j]);
+  }
+}
+
 TEST(RobotTreeSolver, TurnsALookingToolToItsGoalPoint) {
   const RobotTree robot = TwoArmRobot(true);
   RobotTreeOptions options;

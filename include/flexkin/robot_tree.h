@@ -123,8 +123,9 @@ class RobotTreeSolver {
   // point looked at): Gauss-Newton steps, each the smallest weighted joint motion that cancels
   // the weighted misses to first order (a looking goal's miss is its angle times the mean link),
   // joints that would leave their limits put on them and held; a backtracking line search, and
-  // Levenberg-Marquardt damping where full steps fail. Ends at the nearest configuration found
-  // where the goals cannot be met. Throws InputError for goals of the wrong shape or not finite.
+  // Levenberg-Marquardt damping where full steps fail. Where the goals cannot be met, ends once
+  // ten iterations gain less than 1e-4 of the squared misses, at the configuration found. Throws
+  // InputError for goals of the wrong shape or not finite.
   RobotTreeSolve Solve(const Eigen::VectorXd& from, const Points& goals) const;
 
  private:

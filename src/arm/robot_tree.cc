@@ -374,8 +374,15 @@ RobotTreeSolve RobotTreeSolver::Solve(const Eigen::VectorXd& from, const Points&
   RobotMisses misses = evaluate(out.angles, &w.frames, &w.e, &w.jac);
   double merit = w.e.squaredNorm();
   double damping = 0.0;
+  // Goals out of reach: the steps creep along the limits toward the nearest configuration; ten
+  // iterations that gain less than 1e-4 of the squared misses end the solve where it is.
+  double ten_ago = merit;
   int iteration = 0;
   for (; iteration < options_.max_iterations && !done(misses); ++iteration) {
+    if (iteration % 10 == 0 && iteration > 0) {
+      if (ten_ago - merit <= 1e-4 * ten_ago) break;
+      ten_ago = merit;
+    }
     // The smallest weighted step that cancels the misses to first order; joints that it would
     // carry past a limit are put on the limit and held, and the others solved again.
     std::fill(w.held.begin(), w.held.end(), 0);
