@@ -19,7 +19,7 @@ PYTHON     ?= /usr/bin/python3
 FORMAT_FILES = $(shell git ls-files '*.cc' '*.h' 2>/dev/null)
 
 .PHONY: all deps build demo test test-release test-sanitize test-thread test-fuzz fuzz fuzz-build bench install \
-	clean format format-check
+	blender-addon clean format format-check
 
 all: build
 
@@ -88,6 +88,13 @@ format-check: deps
 
 install: build
 	@cmake --install $(BUILD) --prefix $(PREFIX)
+
+# The add-on for Blender (blender/flexkin_blender, docs/blender.md) as the zip that Blender's
+# Preferences > Add-ons > Install... takes.
+blender-addon: build
+	@rm -f $(BUILD)/flexkin_blender.zip
+	@cd blender && /usr/bin/python3 -m zipfile -c $(abspath $(BUILD))/flexkin_blender.zip flexkin_blender
+	@echo "wrote $(BUILD)/flexkin_blender.zip"
 
 clean:
 	@rm -rf $(BUILD) $(BUILD_SAN) $(BUILD_TSAN) $(BUILD_FUZZ) out
