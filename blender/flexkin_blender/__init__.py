@@ -1,5 +1,5 @@
-"""flexkin inside Blender (docs/blender.md): natural, length-preserving motion of bone chains,
-computed by flexkin's Python module and baked into keyframes.
+"""flexkin inside Blender (docs/blender.md): natural, length-preserving motion of bone chains and
+trees, computed by flexkin's Python module and baked into keyframes.
 
 Install: Edit > Preferences > Add-ons > Install... and choose the zip that `make blender-addon`
 writes (build/flexkin_blender.zip), or add the repository's blender/ folder to Blender's script
@@ -85,7 +85,7 @@ class FLEXKIN_OT_bake_chain(bpy.types.Operator):
         try:
             flexkin = import_flexkin(context)
             chain = bake.selected_chain(armature)
-            data = bake.gather(context, armature, chain, self.target)
+            data = bake.gather(context, armature, chain, [self.target or None])
             count = len(data["frames"])
             wm.progress_begin(0, count)
             try:
@@ -100,8 +100,95 @@ class FLEXKIN_OT_bake_chain(bpy.types.Operator):
             self.report({'ERROR'}, str(error))
             return {'CANCELLED'}
         bake.write_keys(armature, chain, data["frames"], keys)
-        self.report({'INFO'}, f"flexkin: baked {len(chain)} bones over {count} frames "
+        self.report({'INFO'}, f"flexkin: baked {len(chain.bones)} bones over {count} frames "
                               f"({self.method}) in {time.perf_counter() - started:.2f} s")
+        return {'FINISHED'}
+
+
+class FlexkinTarget(bpy.types.PropertyGroup):
+    """A target of a tree bake: a bone whose tail follows an object."""
+    bone: bpy.props.StringProperty(name="Bone", description="The bone whose tail is driven")
+    target: bpy.props.PointerProperty(name="Target", type=bpy.types.Object,
+                                      description="The object whose motion drives the bone's tail")
+
+
+class FLEXKIN_OT_target_add(bpy.types.Operator):
+    """Add a target of the tree bake: a bone and the object its tail follows"""
+    bl_idname = "flexkin.target_add"
+    bl_label = "Add target"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    def execute(self, context):
+        item = context.scene.flexkin_targets.add()
+        bone = context.active_pose_bone or context.active_bone
+        if bone is not None:
+            item.bone = bone.name
+        return {'FINISHED'}
+
+
+class FLEXKIN_OT_target_remove(bpy.types.Operator):
+    """Remove a target of the tree bake"""
+    bl_idname = "flexkin.target_remove"
+    bl_label = "Remove target"
+    bl_options = {'REGISTER', 'UNDO'}
+    index: bpy.props.IntProperty(default=-1)
+
+    def execute(self, context):
+        targets = context.scene.flexkin_targets
+        if 0 <= self.index < len(targets):
+            targets.remove(self.index)
+        return {'FINISHED'}
+
+
+class FLEXKIN_OT_bake_tree(bpy.types.Operator):
+    """Bake the natural motion of the selected bones (a tree: a spine with arms, a plant), the
+    tails of the scene's target bones (flexkin targets) following their objects, the root's
+    head fixed or free, over the scene's frame range"""
+    bl_idname = "flexkin.bake_tree"
+    bl_label = "Bake bone tree"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    method: bpy.props.EnumProperty(name="Method", items=bake.METHODS, default="tractrix")
+    fix_root: bpy.props.BoolProperty(
+        name="Fix the root", default=True,
+        description="Hold the root bone's head where it is in the armature (a base)")
+
+    def execute(self, context):
+        started = time.perf_counter()
+        armature = context.active_object
+        try:
+            flexkin = import_flexkin(context)
+            body = bake.selected_tree(armature)
+            targets, names = [], []
+            for k, item in enumerate(context.scene.flexkin_targets):
+                point = body.point_of_tail(item.bone)
+                if point is None:
+                    raise bake.BakeError(f"target {k + 1}: bone '{item.bone}' is not among the "
+                                         "selected bones; select it or remove the target")
+                if item.target is None:
+                    raise bake.BakeError(f"target {k + 1} (bone '{item.bone}') has no object; "
+                                         "choose the object its tail follows")
+                targets.append(point)
+                names.append(item.target.name)
+            if not targets:
+                raise bake.BakeError("the tree has no target: add one (a bone and the object its "
+                                     "tail follows) in the flexkin panel")
+            data = bake.gather(context, armature, body, names)
+            try:
+                points, report = bake.run_flexkin_tree(flexkin, data, body, targets, self.method,
+                                                       self.fix_root)
+            except flexkin.InputError as error:
+                raise bake.BakeError(f"flexkin refused the tree: {error}") from error
+            keys = bake.pose_keys(armature, body, data, points)
+        except bake.BakeError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        bake.write_keys(armature, body, data["frames"], keys)
+        missed = int((~report["reached"]).sum())
+        self.report({'WARNING'} if missed else {'INFO'},
+                    f"flexkin: baked {len(body.bones)} bones over {len(data['frames'])} frames "
+                    f"({self.method}) in {time.perf_counter() - started:.2f} s"
+                    + (f"; {missed} frames did not reach their targets" if missed else ""))
         return {'FINISHED'}
 
 
@@ -123,9 +210,26 @@ class FLEXKIN_PT_panel(bpy.types.Panel):
         op.method = scene.flexkin_method
         op.target = scene.flexkin_target.name if scene.flexkin_target else ""
         op.substeps = scene.flexkin_substeps
+        layout.separator()
+        layout.label(text="Bone tree")
+        armature = context.active_object
+        for k, item in enumerate(scene.flexkin_targets):
+            row = layout.row(align=True)
+            if armature is not None and armature.type == 'ARMATURE':
+                row.prop_search(item, "bone", armature.data, "bones", text="")
+            else:
+                row.prop(item, "bone", text="")
+            row.prop(item, "target", text="")
+            row.operator(FLEXKIN_OT_target_remove.bl_idname, text="", icon='X').index = k
+        layout.operator(FLEXKIN_OT_target_add.bl_idname, icon='ADD')
+        layout.prop(scene, "flexkin_fix_root")
+        op = layout.operator(FLEXKIN_OT_bake_tree.bl_idname)
+        op.method = scene.flexkin_method
+        op.fix_root = scene.flexkin_fix_root
 
 
-CLASSES = (FlexkinPreferences, FLEXKIN_OT_bake_chain, FLEXKIN_PT_panel)
+CLASSES = (FlexkinPreferences, FLEXKIN_OT_bake_chain, FlexkinTarget, FLEXKIN_OT_target_add,
+           FLEXKIN_OT_target_remove, FLEXKIN_OT_bake_tree, FLEXKIN_PT_panel)
 
 
 def register():
@@ -139,10 +243,15 @@ def register():
                     "animation)")
     bpy.types.Scene.flexkin_substeps = bpy.props.IntProperty(
         name="Sub-steps", default=1, min=1, max=1024)
+    bpy.types.Scene.flexkin_targets = bpy.props.CollectionProperty(type=FlexkinTarget)
+    bpy.types.Scene.flexkin_fix_root = bpy.props.BoolProperty(
+        name="Fix the root", default=True,
+        description="Hold the root bone's head where it is in the armature (a base)")
 
 
 def unregister():
-    for name in ("flexkin_method", "flexkin_target", "flexkin_substeps"):
+    for name in ("flexkin_method", "flexkin_target", "flexkin_substeps", "flexkin_targets",
+                 "flexkin_fix_root"):
         delattr(bpy.types.Scene, name)
     for cls in reversed(CLASSES):
         bpy.utils.unregister_class(cls)

@@ -18,46 +18,79 @@ METHODS = [
 ]
 
 
+class Body:
+    """Selected bones as a tree of points: `bones` parent first, bone i from point heads[i] to
+    point tails[i], up[i] the index in `bones` of its parent (-1: not among them), `parents` the
+    points' parents (-1 for the first bone's head)."""
+
+    def __init__(self, bones, heads, tails, up):
+        self.bones, self.heads, self.tails, self.up = bones, heads, tails, up
+        self.parents = [-1] * (len(bones) + 1)
+        for i in range(len(bones)):
+            self.parents[tails[i]] = heads[i]
+
+    def point_of_tail(self, name):
+        for bone, tail in zip(self.bones, self.tails):
+            if bone.name == name:
+                return tail
+        return None
+
+
 def selected_chain(armature):
-    """The selected bones of `armature` as a chain, root first: each the child of the one before
-    and starting at its tail (connected). Raises BakeError naming what is wrong."""
+    """The selected bones as a chain (a tree without branches), root first. Raises BakeError."""
+    return selected_tree(armature, "chain")
+
+
+def _check_bone(bone):
+    if not bone.length > 1e-9:
+        raise BakeError(f"bone '{bone.name}' has length {bone.length:g}; every bone needs a "
+                        "positive length")
+    if not bone.use_inherit_rotation or bone.inherit_scale != 'FULL':
+        raise BakeError(f"bone '{bone.name}' does not inherit its parent's rotation and "
+                        "scale (Bone Properties > Relations); the bake needs both")
+
+
+def selected_tree(armature, kind="tree"):
+    """The selected bones of `armature` as a tree: one of them (the root) whose parent is not
+    selected, every other connected to its selected parent (its head on the parent's tail).
+    Point 0 is the root's head and point i + 1 the tail of bones[i]; bones parent first, depth
+    first. Raises BakeError (`kind` names what the selection should be)."""
     if armature is None or armature.type != 'ARMATURE':
         what = "none" if armature is None else \
             f"'{armature.name}', of type {armature.type.lower()}"
         raise BakeError(f"select an armature (the active object is {what})")
-    bones = [b for b in armature.data.bones if b.select]
-    if not bones:
-        raise BakeError(f"select the bones of a chain in '{armature.name}' (none is selected)")
-    selected = set(b.name for b in bones)
-    roots = [b for b in bones if b.parent is None or b.parent.name not in selected]
+    selected = [b for b in armature.data.bones if b.select]
+    if not selected:
+        raise BakeError(f"select the bones of a {kind} in '{armature.name}' (none is selected)")
+    names = set(b.name for b in selected)
+    roots = [b for b in selected if b.parent is None or b.parent.name not in names]
     if len(roots) != 1:
-        raise BakeError("the selected bones are not one chain: "
+        raise BakeError(f"the selected bones are not one {kind}: "
                         f"{len(roots)} of them have no selected parent ("
                         + ", ".join(sorted(b.name for b in roots)) + ")")
-    chain = [roots[0]]
-    while True:
-        children = [c for c in chain[-1].children if c.name in selected]
-        if len(children) > 1:
-            raise BakeError(f"the selected bones branch at '{chain[-1].name}' ("
-                            + ", ".join(sorted(c.name for c in children))
-                            + "); select one chain")
-        if not children:
-            break
-        chain.append(children[0])
-    if len(chain) != len(bones):
-        raise BakeError("the selected bones are not one chain")
-    for bone in chain:
-        if not bone.length > 1e-9:
-            raise BakeError(f"bone '{bone.name}' has length {bone.length:g}; every bone of the "
-                            "chain needs a positive length")
-        if not bone.use_inherit_rotation or bone.inherit_scale != 'FULL':
-            raise BakeError(f"bone '{bone.name}' does not inherit its parent's rotation and "
-                            "scale (Bone Properties > Relations); the bake needs both")
-    for parent, child in zip(chain, chain[1:]):
-        if (child.head_local - parent.tail_local).length > 1e-6 * max(1.0, parent.length):
-            raise BakeError(f"bone '{child.name}' does not start at the tail of '{parent.name}'; "
-                            "the chain's bones must be connected")
-    return chain
+    bones, up, stack = [], [], [(roots[0], -1)]
+    while stack:
+        bone, parent = stack.pop()
+        bones.append(bone)
+        up.append(parent)
+        here = len(bones) - 1
+        for child in sorted(bone.children, key=lambda c: c.name, reverse=True):
+            if child.name in names:
+                stack.append((child, here))
+    if kind == "chain":
+        for i, bone in enumerate(bones):
+            children = sorted(b.name for b, u in zip(bones, up) if u == i)
+            if len(children) > 1:
+                raise BakeError(f"the selected bones branch at '{bone.name}' ("
+                                + ", ".join(children) + "); select one chain")
+    for bone, parent in zip(bones, up):
+        _check_bone(bone)
+        if parent >= 0 and (bone.head_local - bones[parent].tail_local).length > \
+                1e-6 * max(1.0, bones[parent].length):
+            raise BakeError(f"bone '{bone.name}' does not start at the tail of "
+                            f"'{bones[parent].name}'; the bones must be connected")
+    heads = [0 if parent < 0 else parent + 1 for parent in up]
+    return Body(bones, heads, [i + 1 for i in range(len(bones))], up)
 
 
 def _frames(scene):
@@ -67,48 +100,75 @@ def _frames(scene):
     return list(range(scene.frame_start, scene.frame_end + 1))
 
 
-def gather(context, armature, chain, target_name):
-    """Everything the bake needs from the scene, frame by frame: the chain's points at the first
-    frame (world), the driven end's path, the armature's world matrix and the pose of the chain's
-    parent bone (outside the chain) at every frame. Restores the current frame."""
+def gather(context, armature, body, targets):
+    """Everything a bake needs from the scene, frame by frame: the armature's world matrix, the
+    pose of the first bone's parent (outside the body), and each target's world position (a
+    target None: the first bone's head as animated); and at the first frame the body's points
+    (world and armature space) and its bones' pose rotations. Restores the current frame."""
     scene = context.scene
     frames = _frames(scene)
-    target = None
-    if target_name:
-        target = bpy.data.objects.get(target_name)
+    objects = []
+    for name in targets:
+        if name is None:
+            objects.append(None)
+            continue
+        target = bpy.data.objects.get(name) if name else None
         if target is None:
-            raise BakeError(f"target '{target_name}' is not an object of this file; choose the "
-                            "object (an Empty) whose motion drives the chain, or none to follow "
-                            "the first bone's own animation")
+            raise BakeError(f"target '{name}' is not an object of this file; choose the object "
+                            "(an Empty) whose motion drives the bone")
+        objects.append(target)
     pose = armature.pose.bones
-    parent = chain[0].parent
+    first = body.bones[0]
+    parent = first.parent
     current = scene.frame_current
-    data = {"frames": frames, "world": [], "parent_pose": [], "path": []}
+    data = {"frames": frames, "world": [], "parent_pose": [], "paths": [[] for _ in targets]}
     try:
         for f in frames:
             scene.frame_set(f)
             world = armature.matrix_world.copy()
             data["world"].append(world)
             data["parent_pose"].append(pose[parent.name].matrix.copy() if parent else None)
-            head = world @ pose[chain[0].name].head
-            data["path"].append(target.matrix_world.translation.copy() if target else head)
+            for k, target in enumerate(objects):
+                data["paths"][k].append(target.matrix_world.translation.copy() if target
+                                        else world @ pose[first.name].head)
             if f == frames[0]:
-                points = [world @ pose[b.name].head for b in chain]
-                points.append(world @ pose[chain[-1].name].tail)
-                data["points"] = points
-                data["start_rotations"] = [pose[b.name].matrix.to_quaternion() for b in chain]
+                local = [None] * (len(body.bones) + 1)
+                for i, bone in enumerate(body.bones):
+                    local[body.heads[i]] = pose[bone.name].head.copy()
+                    local[body.tails[i]] = pose[bone.name].tail.copy()
+                data["local_points"] = local
+                data["points"] = [world @ p for p in local]
+                data["start_rotations"] = [pose[b.name].matrix.to_quaternion()
+                                           for b in body.bones]
     finally:
         scene.frame_set(current)
     return data
 
 
 def run_flexkin(flexkin, data, method, substeps, progress=None):
-    """flexkin.run of the chain's first-frame points, its first point driven along the path (the
-    frames after the first). Returns the frames' points, (F, n+1, 3) in world space."""
+    """flexkin.run of the chain's first-frame points (world space), its first point driven along
+    the path (the frames after the first). Returns every frame's points in the armature's
+    space."""
     points = [list(p) for p in data["points"]]
-    path = [list(p) for p in data["path"][1:]]
+    path = [list(p) for p in data["paths"][0][1:]]
     result = flexkin.run(points, path, method=method, substeps=substeps, progress=progress)
-    return result.frames
+    # In the armature's space, frame by frame.
+    return [[data["world"][f].inverted() @ Vector(tuple(x)) for x in frame]
+            for f, frame in enumerate(result.frames)]
+
+
+def run_flexkin_tree(flexkin, data, body, targets, method, fix_root):
+    """flexkin.reach_tree of the body's points in the armature's space, the tail of each target
+    bone driven along its target's path (in the armature's space at each frame), the root's head
+    fixed or not. Returns the frames' points in the armature's space and the report."""
+    points = [list(p) for p in data["local_points"]]
+    paths = [[list(data["world"][f].inverted() @ data["paths"][k][f])
+              for k in range(len(targets))] for f in range(1, len(data["frames"]))]
+    frames, report = flexkin.reach_tree(points, body.parents, targets, paths,
+                                        fixed=[0] if fix_root else [],
+                                        method="tractrix" if method == "overall" else method,
+                                        overall={"squared": 1.0} if method == "overall" else None)
+    return [[Vector(tuple(x)) for x in frame] for frame in frames], report
 
 
 def _aligned(rotation, direction):
@@ -117,23 +177,29 @@ def _aligned(rotation, direction):
     return (y.rotation_difference(direction.normalized()) @ rotation).normalized()
 
 
-def pose_keys(armature, chain, data, frames_points):
+def pose_keys(armature, body, data, frames_points):
     """The pose of every bone at every frame that puts its head on its point and its tail toward
-    the next, each bone's roll carried from frame to frame by the least rotation: per bone, its
-    matrix_basis's rotation (quaternions) and, for the chain's first bone, its location."""
-    rest = [b.matrix_local.copy() for b in chain]
-    parent = chain[0].parent
-    parent_rest = parent.matrix_local.copy() if parent else None
+    its tail's point (`frames_points`: every frame's points in the armature's space), each bone's
+    roll carried from frame to frame by the least rotation: per bone, its matrix_basis's rotation
+    (quaternions) and location."""
+    bones = body.bones
+    rest = [b.matrix_local.copy() for b in bones]
+    outside = bones[0].parent
+    outside_rest = outside.matrix_local.copy() if outside else None
     rotations = list(data["start_rotations"])
-    keys = {b.name: {"rotation": [], "location": []} for b in chain}
+    keys = {b.name: {"rotation": [], "location": []} for b in bones}
     for f in range(len(data["frames"])):
-        to_armature = data["world"][f].inverted()
-        p = [to_armature @ Vector(tuple(x)) for x in frames_points[f]]
-        above = data["parent_pose"][f]
-        above_rest = parent_rest
-        for i, bone in enumerate(chain):
-            rotations[i] = _aligned(rotations[i], p[i + 1] - p[i])
-            matrix = Matrix.Translation(p[i]) @ rotations[i].to_matrix().to_4x4()
+        p = frames_points[f]
+        matrices = []
+        for i, bone in enumerate(bones):
+            head, tail = p[body.heads[i]], p[body.tails[i]]
+            rotations[i] = _aligned(rotations[i], tail - head)
+            matrix = Matrix.Translation(head) @ rotations[i].to_matrix().to_4x4()
+            matrices.append(matrix)
+            if body.up[i] >= 0:
+                above, above_rest = matrices[body.up[i]], rest[body.up[i]]
+            else:
+                above, above_rest = data["parent_pose"][f], outside_rest
             if above is None:
                 basis = rest[i].inverted() @ matrix
             else:
@@ -144,7 +210,6 @@ def pose_keys(armature, chain, data, frames_points):
                 rotation.negate()  # the same rotation, on the side of the last key
             previous.append(rotation)
             keys[bone.name]["location"].append(location)
-            above, above_rest = matrix, rest[i]
     return keys
 
 
@@ -172,7 +237,7 @@ def _axis_angle(q):
     return [2.0 * math.atan2(sine, q.w), q.x / sine, q.y / sine, q.z / sine]
 
 
-def write_keys(armature, chain, frames, keys):
+def write_keys(armature, body, frames, keys):
     """The keys into the armature's action (made if it has none): each bone's rotation in its
     rotation mode and the first bone's location, one key per frame, replacing the curves of
     those channels."""
@@ -181,7 +246,7 @@ def write_keys(armature, chain, frames, keys):
     if armature.animation_data.action is None:
         armature.animation_data.action = bpy.data.actions.new(armature.name + "Action")
     action = armature.animation_data.action
-    for i, bone in enumerate(chain):
+    for i, bone in enumerate(body.bones):
         pb = armature.pose.bones[bone.name]
         base = f'pose.bones["{bpy.utils.escape_identifier(bone.name)}"]'
         rotations = keys[bone.name]["rotation"]

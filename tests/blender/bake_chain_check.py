@@ -1,4 +1,4 @@
-"""The flexkin add-on's bone-chain bake in headless Blender (docs/blender.md; run by
+"""The flexkin add-on's bakes of bone chains and trees in headless Blender (docs/blender.md; run by
 tests/blender/addon.sh):
 
   blender -b --factory-startup --python tests/blender/bake_chain_check.py -- ADDON_ZIP MODULE_DIR
@@ -162,12 +162,111 @@ def case_parent_animation():
             [f"b{i:02d}" for i in range(n)], expected, n * length + 0.3)
 
 
-def expect_report(case, words, **kwargs):
+# A body: a spine of 3 bones from the base, two arms of 3 from its top, a head.
+BODY = [  # name, parent, tail (the head is the parent's tail, the spine's first at the origin)
+    ("spine0", None, (0.0, 0.0, 0.3)), ("spine1", "spine0", (0.0, 0.0, 0.6)),
+    ("spine2", "spine1", (0.0, 0.0, 0.9)),
+    ("arm.L0", "spine2", (0.25, 0.0, 0.95)), ("arm.L1", "arm.L0", (0.5, 0.0, 0.9)),
+    ("arm.L2", "arm.L1", (0.7, 0.0, 0.95)),
+    ("arm.R0", "spine2", (-0.25, 0.0, 0.95)), ("arm.R1", "arm.R0", (-0.5, 0.0, 0.9)),
+    ("arm.R2", "arm.R1", (-0.7, 0.0, 0.95)),
+    ("head", "spine2", (0.0, 0.05, 1.15)),
+]
+
+
+def make_body(location, rotation_z):
+    data = bpy.data.armatures.new("Body")
+    obj = bpy.data.objects.new("Body", data)
+    bpy.context.scene.collection.objects.link(obj)
+    obj.location = location
+    obj.rotation_euler = (0.0, 0.0, rotation_z)
+    bpy.context.view_layer.objects.active = obj
+    bpy.ops.object.mode_set(mode='EDIT')
+    for name, parent, tail in BODY:
+        b = data.edit_bones.new(name)
+        b.head = data.edit_bones[parent].tail if parent else (0.0, 0.0, 0.0)
+        b.tail = tail
+        if parent:
+            b.parent = data.edit_bones[parent]
+            b.use_connect = True
+    bpy.ops.object.mode_set(mode='OBJECT')
+    for b in data.bones:
+        b.select = True
+    return obj
+
+
+def case_tree(method):
+    """Two hands of a body driven by two Empties, the base fixed (flexkin.reach_tree)."""
+    frames = 50
+    new_scene(frames)
+    location, turn = Vector((0.5, -0.2, 0.0)), math.radians(20)
+    arm = make_body(location, turn)
+    to_world = Matrix.Translation(location) @ Matrix.Rotation(turn, 4, 'Z')
+    # The test's own points: the base, then each bone's tail in BODY's order.
+    index = {name: i + 1 for i, (name, _, _) in enumerate(BODY)}
+    points = [(0.0, 0.0, 0.0)] + [tail for _, _, tail in BODY]
+    parents = [-1] + [index[parent] if parent else 0 for _, parent, _ in BODY]
+    local_paths = []
+    for f in range(frames):
+        t = 0.08 * f
+        # From where the hands are, inward and round (within their reach).
+        local_paths.append([
+            (0.7 - 0.2 * (1 - math.cos(t)), 0.2 * math.sin(t), 0.95 + 0.08 * math.sin(2 * t)),
+            (-0.7 + 0.15 * (1 - math.cos(t)), 0.15 * math.sin(t), 0.95 - 0.08 * math.sin(t))])
+    for k, name in enumerate(("Hand.L", "Hand.R")):
+        empty_on_path(name, [to_world @ Vector(p[k]) for p in local_paths])
+    scene = bpy.context.scene
+    scene.flexkin_targets.clear()
+    for bone, target in (("arm.L2", "Hand.L"), ("arm.R2", "Hand.R")):
+        item = scene.flexkin_targets.add()
+        item.bone, item.target = bone, bpy.data.objects[target]
+    bpy.context.view_layer.objects.active = arm
+    if bpy.ops.flexkin.bake_tree(method=method, fix_root=True) != {'FINISHED'}:
+        fail(f"tree/{method}: the bake did not finish")
+    kwargs = {"overall": {"squared": 1.0}} if method == "overall" else {"method": method}
+    expected, report = flexkin.reach_tree(points, parents, [index["arm.L2"], index["arm.R2"]],
+                                          local_paths[1:], fixed=[0], **kwargs)
+    if not report["reached"].all():
+        fail(f"tree/{method}: flexkin did not reach the test's targets")
+    # Compare in the world: the test's points through the armature's world matrix.
+    worst, pose = 0.0, arm.pose.bones
+    heads = {name: parents[index[name]] for name, _, _ in BODY}
+    for f in range(1, frames + 1):
+        scene.frame_set(f)
+        for name, _, _ in BODY:
+            for got, i in ((pose[name].head, heads[name]), (pose[name].tail, index[name])):
+                want = to_world @ Vector(tuple(expected[f - 1][i]))
+                worst = max(worst, (arm.matrix_world @ got - want).length)
+    size = 2.0
+    if not worst <= TOLERANCE * size:
+        fail(f"tree/{method}: a baked point is {worst:.3g} from flexkin's")
+    print(f"blender {bpy.app.version_string}: tree, {method}: {len(BODY)} bones x {frames} frames, "
+          f"two hands driven, the base fixed, largest distance of a baked head or tail from "
+          f"flexkin's point {worst:.3g} (scene size {size:.3g}, {worst / size:.2g} of it)",
+          flush=True)
+    return arm
+
+
+def tree_reports():
+    arm = case_tree("tractrix")
+    scene = bpy.context.scene
+    scene.flexkin_targets[0].bone = "nope"
+    expect_report("tree target not selected", "bone 'nope' is not among the selected bones",
+                  operator=bpy.ops.flexkin.bake_tree)
+    scene.flexkin_targets.clear()
+    expect_report("tree without targets", "the tree has no target", operator=bpy.ops.flexkin.bake_tree)
+    bpy.context.view_layer.objects.active = arm
+    for b in arm.data.bones:
+        b.select = b.name in ("spine0", "arm.L1")
+    expect_report("tree in pieces", "not one tree", operator=bpy.ops.flexkin.bake_tree)
+
+
+def expect_report(case, words, operator=None, **kwargs):
     action = bpy.context.active_object.animation_data.action \
         if bpy.context.active_object and bpy.context.active_object.animation_data else None
     before = len(action.fcurves) if action else 0
     try:
-        bake(**kwargs)
+        (operator or bpy.ops.flexkin.bake_chain)(**kwargs)
     except RuntimeError as error:
         if words not in str(error):
             fail(f"{case}: the report is '{error}', without '{words}'")
@@ -239,7 +338,10 @@ try:
     for method in ("tractrix", "ftl", "overall"):
         case_target(method)
     case_parent_animation()
+    case_tree("tractrix")
+    case_tree("overall")
     bad_inputs()
+    tree_reports()
     timing()
 except SystemExit:
     raise
