@@ -105,6 +105,59 @@ class FLEXKIN_OT_bake_chain(bpy.types.Operator):
         return {'FINISHED'}
 
 
+class FLEXKIN_OT_bake_rope(bpy.types.Operator):
+    """Bake the natural motion of the active curve object as a rope of links of one length, its
+    first point following a target object, over the scene's frame range, into a new poly curve
+    whose points are keyed at every frame"""
+    bl_idname = "flexkin.bake_rope"
+    bl_label = "Bake rope"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    method: bpy.props.EnumProperty(name="Method", items=bake.METHODS, default="tractrix")
+    target: bpy.props.StringProperty(
+        name="Target", description="The object whose motion drives the rope's first point")
+    link_length: bpy.props.FloatProperty(
+        name="Link length", default=0.0, min=0.0, subtype='DISTANCE',
+        description="The length of the rope's links (0: the curve's length over 32)")
+    substeps: bpy.props.IntProperty(
+        name="Sub-steps", description="Steps of the driven end between two frames",
+        default=1, min=1, max=1024)
+
+    def execute(self, context):
+        started = time.perf_counter()
+        curve = context.active_object
+        wm = context.window_manager
+        try:
+            flexkin = import_flexkin(context)
+            polyline = bake.curve_polyline(context, curve)
+            if not self.target:
+                raise bake.BakeError("the rope has no target: choose the object whose motion "
+                                     "drives its first point")
+            total = sum((b - a).length for a, b in zip(polyline, polyline[1:]))
+            link = self.link_length if self.link_length > 0.0 else total / 32.0
+            points = bake.resample(polyline, link)
+            data = bake.gather_path(context, self.target)
+            count = len(data["frames"])
+            wm.progress_begin(0, count)
+            try:
+                result = flexkin.run([list(p) for p in points],
+                                     [list(p) for p in data["path"][1:]], method=self.method,
+                                     substeps=self.substeps,
+                                     progress=lambda done, total: wm.progress_update(done))
+            except flexkin.InputError as error:
+                raise bake.BakeError(f"flexkin refused the rope: {error}") from error
+            finally:
+                wm.progress_end()
+        except bake.BakeError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        rope = bake.write_rope(context, curve, data["frames"], result.frames)
+        self.report({'INFO'}, f"flexkin: baked '{rope.name}', {len(points) - 1} links of "
+                              f"{link:.4g} over {count} frames ({self.method}) in "
+                              f"{time.perf_counter() - started:.2f} s")
+        return {'FINISHED'}
+
+
 class FlexkinTarget(bpy.types.PropertyGroup):
     """A target of a tree bake: a bone whose tail follows an object."""
     bone: bpy.props.StringProperty(name="Bone", description="The bone whose tail is driven")
@@ -226,9 +279,18 @@ class FLEXKIN_PT_panel(bpy.types.Panel):
         op = layout.operator(FLEXKIN_OT_bake_tree.bl_idname)
         op.method = scene.flexkin_method
         op.fix_root = scene.flexkin_fix_root
+        layout.separator()
+        layout.label(text="Rope (the active curve)")
+        layout.prop(scene, "flexkin_link_length")
+        op = layout.operator(FLEXKIN_OT_bake_rope.bl_idname)
+        op.method = scene.flexkin_method
+        op.target = scene.flexkin_target.name if scene.flexkin_target else ""
+        op.link_length = scene.flexkin_link_length
+        op.substeps = scene.flexkin_substeps
 
 
-CLASSES = (FlexkinPreferences, FLEXKIN_OT_bake_chain, FlexkinTarget, FLEXKIN_OT_target_add,
+CLASSES = (FlexkinPreferences, FLEXKIN_OT_bake_chain, FLEXKIN_OT_bake_rope, FlexkinTarget,
+           FLEXKIN_OT_target_add,
            FLEXKIN_OT_target_remove, FLEXKIN_OT_bake_tree, FLEXKIN_PT_panel)
 
 
@@ -244,6 +306,9 @@ def register():
     bpy.types.Scene.flexkin_substeps = bpy.props.IntProperty(
         name="Sub-steps", default=1, min=1, max=1024)
     bpy.types.Scene.flexkin_targets = bpy.props.CollectionProperty(type=FlexkinTarget)
+    bpy.types.Scene.flexkin_link_length = bpy.props.FloatProperty(
+        name="Link length", default=0.0, min=0.0, subtype='DISTANCE',
+        description="The rope's link length (0: the curve's length over 32)")
     bpy.types.Scene.flexkin_fix_root = bpy.props.BoolProperty(
         name="Fix the root", default=True,
         description="Hold the root bone's head where it is in the armature (a base)")
@@ -251,7 +316,7 @@ def register():
 
 def unregister():
     for name in ("flexkin_method", "flexkin_target", "flexkin_substeps", "flexkin_targets",
-                 "flexkin_fix_root"):
+                 "flexkin_fix_root", "flexkin_link_length"):
         delattr(bpy.types.Scene, name)
     for cls in reversed(CLASSES):
         bpy.utils.unregister_class(cls)

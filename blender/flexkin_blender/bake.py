@@ -145,6 +145,27 @@ def gather(context, armature, body, targets):
     return data
 
 
+def gather_path(context, target_name):
+    """A rope's driving path: the target object's world position at every frame of the scene's
+    range (the run moves the rope's first point to the second frame's position, and so on).
+    Restores the current frame."""
+    scene = context.scene
+    frames = _frames(scene)
+    target = bpy.data.objects.get(target_name)
+    if target is None:
+        raise BakeError(f"target '{target_name}' is not an object of this file; choose the "
+                        "object (an Empty) whose motion drives the rope's first point")
+    current = scene.frame_current
+    path = []
+    try:
+        for f in frames:
+            scene.frame_set(f)
+            path.append(target.matrix_world.translation.copy())
+    finally:
+        scene.frame_set(current)
+    return {"frames": frames, "path": path}
+
+
 def run_flexkin(flexkin, data, method, substeps, progress=None):
     """flexkin.run of the chain's first-frame points (world space), its first point driven along
     the path (the frames after the first). Returns every frame's points in the armature's
@@ -272,3 +293,107 @@ def write_keys(armature, body, frames, keys):
             for k in range(3):
                 _set_curve(action, base + ".location", k, bone.name, frames,
                            [v[k] for v in keys[bone.name]["location"]])
+
+
+def curve_polyline(context, curve):
+    """The first spline of a curve object as Blender evaluates it (its resolution, modifiers
+    not applied), in world space: the points of a poly spline, or a Bezier or NURBS spline
+    sampled by Blender. Raises BakeError for an object that is not a curve with a spline."""
+    if curve is None or curve.type != 'CURVE':
+        what = "none" if curve is None else f"'{curve.name}', of type {curve.type.lower()}"
+        raise BakeError(f"select a curve object (the active object is {what})")
+    if len(curve.data.splines) != 1:
+        raise BakeError(f"curve '{curve.name}' has {len(curve.data.splines)} splines; a rope is "
+                        "one spline")
+    spline = curve.data.splines[0]
+    world = curve.matrix_world
+    if spline.type == 'POLY':
+        points = [world @ Vector(p.co[:3]) for p in spline.points]
+    else:
+        # Blender's own sampling of the spline (its resolution), through a mesh of the curve
+        # without its bevel: the vertices in order along it.
+        depsgraph = context.evaluated_depsgraph_get()
+        saved = (curve.data.bevel_depth, curve.data.extrude, curve.data.bevel_mode)
+        curve.data.bevel_depth, curve.data.extrude, curve.data.bevel_mode = 0.0, 0.0, 'ROUND'
+        try:
+            depsgraph.update()
+            evaluated = curve.evaluated_get(depsgraph)
+            mesh = evaluated.to_mesh()
+            points = [world @ v.co for v in mesh.vertices]
+            evaluated.to_mesh_clear()
+        finally:
+            curve.data.bevel_depth, curve.data.extrude, curve.data.bevel_mode = saved
+            depsgraph.update()
+    if len(points) < 2:
+        raise BakeError(f"curve '{curve.name}' has fewer than 2 points")
+    return points
+
+
+def resample(points, link):
+    """Points along the polyline `points` whose consecutive distances are exactly `link` (the
+    chain's links: each next point where the sphere of radius `link` about the last one leaves
+    the polyline), from its first point; the rest shorter than a link is dropped. Raises
+    BakeError where not one link fits."""
+    out = [Vector(points[0])]
+    segment = 0
+    while True:
+        center = out[-1]
+        found = None
+        for s in range(segment, len(points) - 1):
+            a, b = Vector(points[s]), Vector(points[s + 1])
+            d = b - a
+            if d.length == 0.0:
+                continue
+            # |a + t d - center| = link for the largest t in [0, 1] (farther along the line).
+            f = a - center
+            qa, qb, qc = d.dot(d), 2.0 * f.dot(d), f.dot(f) - link * link
+            disc = qb * qb - 4.0 * qa * qc
+            if disc < 0.0:
+                continue
+            t = (-qb + math.sqrt(disc)) / (2.0 * qa)
+            if 0.0 <= t <= 1.0 and (s > segment or t > 0.0):
+                found, segment = a + t * d, s
+                break
+        if found is None:
+            break
+        # Exactly `link` from the last point (the intersection, rounded, may be off by 1e-16).
+        found = center + (found - center).normalized() * link
+        out.append(found)
+    if len(out) < 2:
+        raise BakeError(f"the curve is shorter than one link ({link:g}); choose a shorter link")
+    return out
+
+
+def write_rope(context, curve, frames, frames_points):
+    """A poly curve object '<curve>.flexkin' (replacing an earlier one) with a point per rope
+    point, each point's coordinates keyed at every frame (world space: the object at the
+    origin), with the source curve's bevel and materials. Returns it."""
+    name = curve.name + ".flexkin"
+    old = bpy.data.objects.get(name)
+    if old is not None:
+        data = old.data
+        bpy.data.objects.remove(old)
+        if data is not None and data.users == 0:
+            bpy.data.curves.remove(data)
+    data = bpy.data.curves.new(name, 'CURVE')
+    data.dimensions = '3D'
+    for attribute in ("bevel_depth", "bevel_resolution", "resolution_u", "use_fill_caps"):
+        setattr(data, attribute, getattr(curve.data, attribute))
+    for material in curve.data.materials:
+        data.materials.append(material)
+    spline = data.splines.new('POLY')
+    count = len(frames_points[0])
+    spline.points.add(count - 1)
+    for i, p in enumerate(frames_points[0]):
+        spline.points[i].co = (p[0], p[1], p[2], 1.0)
+    obj = bpy.data.objects.new(name, data)
+    for collection in curve.users_collection:
+        collection.objects.link(obj)
+    data.animation_data_create()
+    action = bpy.data.actions.new(name + "Action")
+    data.animation_data.action = action
+    for i in range(count):
+        for k in range(3):
+            _set_curve(action, f"splines[0].points[{i}].co", k, f"point {i}", frames,
+                       [frame[i][k] for frame in frames_points])
+    return obj

@@ -261,6 +261,118 @@ def tree_reports():
     expect_report("tree in pieces", "not one tree", operator=bpy.ops.flexkin.bake_tree)
 
 
+def rope_points(rope, frame):
+    """The baked rope's points at `frame`, from Blender's evaluated curve (world space)."""
+    bpy.context.scene.frame_set(frame)
+    evaluated = rope.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    return [rope.matrix_world @ Vector(p.co[:3]) for p in evaluated.data.splines[0].points]
+
+
+def make_curve(name, kind, points, location):
+    data = bpy.data.curves.new(name, 'CURVE')
+    data.dimensions = '3D'
+    data.bevel_depth = 0.01
+    spline = data.splines.new(kind)
+    if kind == 'POLY':
+        spline.points.add(len(points) - 1)
+        for p, co in zip(spline.points, points):
+            p.co = (co[0], co[1], co[2], 1.0)
+    else:  # a Bezier arc: its two ends and their handles
+        spline.bezier_points.add(1)
+        (a, ha), (b, hb) = points
+        spline.bezier_points[0].co, spline.bezier_points[0].handle_right = a, ha
+        spline.bezier_points[0].handle_left = 2 * Vector(a) - Vector(ha)
+        spline.bezier_points[1].co, spline.bezier_points[1].handle_left = b, hb
+        spline.bezier_points[1].handle_right = 2 * Vector(b) - Vector(hb)
+        spline.resolution_u = 64
+    obj = bpy.data.objects.new(name, data)
+    obj.location = location
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    return obj
+
+
+def case_rope_poly():
+    """A straight poly rope of 10 links of 0.1 on a moved object, its first point on an Empty:
+    the baked points against flexkin.run of the test's own points."""
+    frames, n, link = 60, 10, 0.1
+    new_scene(frames)
+    location = Vector((0.0, 1.0, 0.5))
+    make_curve("Rope", 'POLY', [(i * link, 0.0, 0.0) for i in range(n + 1)], location)
+    path = [location + Vector((-0.3 * math.sin(0.06 * f), 0.4 * (1 - math.cos(0.06 * f)), 0.0))
+            for f in range(frames)]
+    empty_on_path("Anchor", path)
+    bpy.context.view_layer.objects.active = bpy.data.objects["Rope"]
+    if bpy.ops.flexkin.bake_rope(method="tractrix", target="Anchor", link_length=link) \
+            != {'FINISHED'}:
+        fail("rope: the bake did not finish")
+    points = [location + Vector((i * link, 0.0, 0.0)) for i in range(n + 1)]
+    expected = flexkin.run([list(p) for p in points], [list(p) for p in path[1:]]).frames
+    rope = bpy.data.objects["Rope.flexkin"]
+    worst = 0.0
+    for f in range(1, frames + 1):
+        for got, want in zip(rope_points(rope, f), expected[f - 1]):
+            worst = max(worst, (got - Vector(tuple(want))).length)
+    size = 2.0
+    if not worst <= TOLERANCE * size:
+        fail(f"rope: a baked point is {worst:.3g} from flexkin's")
+    print(f"blender {bpy.app.version_string}: rope, poly: {n} links x {frames} frames, largest "
+          f"distance of a baked point from flexkin's {worst:.3g} (scene size {size:.3g}, "
+          f"{worst / size:.2g} of it)", flush=True)
+
+
+def case_rope_bezier():
+    """A Bezier arc resampled to links of 0.05: at the first frame every point on the curve as
+    Blender samples it, at every frame every link 0.05 long and the first point on the Empty,
+    and the frames those of flexkin.run from the rope's first frame."""
+    frames, link = 40, 0.05
+    new_scene(frames)
+    curve = make_curve("Arc", 'BEZIER', [((0, 0, 0), (0.3, 0.0, 0.3)), ((1, 0, 0), (0.7, 0.0, 0.3))],
+                       Vector((0, 0, 0)))
+    path = [Vector((0.2 * math.sin(0.1 * f), 0.0, -0.3 * math.sin(0.05 * f))) for f in range(frames)]
+    empty_on_path("Hand", path)
+    bpy.context.view_layer.objects.active = curve
+    if bpy.ops.flexkin.bake_rope(method="ftl", target="Hand", link_length=link) != {'FINISHED'}:
+        fail("bezier rope: the bake did not finish")
+    rope = bpy.data.objects["Arc.flexkin"]
+    first = rope_points(rope, 1)
+    # On the arc: within 2e-4 of the cubic Bezier (dense sampling): the rope follows the
+    # polyline Blender samples the arc with (resolution 64: its chords are 0.019 long and sag
+    # up to 1e-4 from the arc).
+    a, b, c, d = (Vector((0, 0, 0)), Vector((0.3, 0, 0.3)), Vector((0.7, 0, 0.3)),
+                  Vector((1, 0, 0)))
+    dense = [(1 - t) ** 3 * a + 3 * (1 - t) ** 2 * t * b + 3 * (1 - t) * t * t * c + t ** 3 * d
+             for t in (k / 20000 for k in range(20001))]
+    off = max(min((p - q).length for q in dense) for p in first)
+    if not off <= 2e-4:
+        fail(f"bezier rope: a first-frame point is {off:.3g} off the arc")
+    expected = flexkin.run([list(p) for p in first], [list(p) for p in path[1:]],
+                           method="ftl").frames
+    worst = worst_link = 0.0
+    for f in range(1, frames + 1):
+        got = rope_points(rope, f)
+        worst_link = max(worst_link, max(abs((q - p).length - link) for p, q in zip(got, got[1:])))
+        for g, want in zip(got, expected[f - 1]):
+            worst = max(worst, (g - Vector(tuple(want))).length)
+    if not (worst <= TOLERANCE and worst_link <= TOLERANCE):
+        fail(f"bezier rope: {worst:.3g} from flexkin's, links off by {worst_link:.3g}")
+    print(f"blender {bpy.app.version_string}: rope, Bezier arc: {len(first) - 1} links of {link} "
+          f"x {frames} frames, first frame within {off:.2g} of the arc, links within "
+          f"{worst_link:.2g} of their length, largest distance from flexkin's {worst:.3g}",
+          flush=True)
+
+
+def rope_reports():
+    case_rope_poly()
+    expect_report("rope without target", "the rope has no target",
+                  operator=bpy.ops.flexkin.bake_rope)
+    expect_report("rope link too long", "shorter than one link",
+                  operator=bpy.ops.flexkin.bake_rope, target="Anchor", link_length=5.0)
+    bpy.context.view_layer.objects.active = bpy.data.objects["Anchor"]
+    expect_report("rope not a curve", "select a curve object", operator=bpy.ops.flexkin.bake_rope,
+                  target="Anchor")
+
+
 def expect_report(case, words, operator=None, **kwargs):
     action = bpy.context.active_object.animation_data.action \
         if bpy.context.active_object and bpy.context.active_object.animation_data else None
@@ -342,6 +454,8 @@ try:
     case_tree("overall")
     bad_inputs()
     tree_reports()
+    case_rope_bezier()
+    rope_reports()
     timing()
 except SystemExit:
     raise
