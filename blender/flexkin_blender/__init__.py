@@ -87,14 +87,7 @@ class FLEXKIN_OT_bake_chain(bpy.types.Operator):
             chain = bake.selected_chain(armature)
             data = bake.gather(context, armature, chain, [self.target or None])
             count = len(data["frames"])
-            wm.progress_begin(0, count)
-            try:
-                points = bake.run_flexkin(flexkin, data, self.method, self.substeps,
-                                          progress=lambda done, total: wm.progress_update(done))
-            except flexkin.InputError as error:
-                raise bake.BakeError(f"flexkin refused the chain: {error}") from error
-            finally:
-                wm.progress_end()
+            points = bake.chain_frames(flexkin, data, self.method, self.substeps, wm)
             keys = bake.pose_keys(armature, chain, data, points)
         except bake.BakeError as error:
             self.report({'ERROR'}, str(error))
@@ -138,20 +131,12 @@ class FLEXKIN_OT_bake_rope(bpy.types.Operator):
             points = bake.resample(polyline, link)
             data = bake.gather_path(context, self.target)
             count = len(data["frames"])
-            wm.progress_begin(0, count)
-            try:
-                result = flexkin.run([list(p) for p in points],
-                                     [list(p) for p in data["path"][1:]], method=self.method,
-                                     substeps=self.substeps,
-                                     progress=lambda done, total: wm.progress_update(done))
-            except flexkin.InputError as error:
-                raise bake.BakeError(f"flexkin refused the rope: {error}") from error
-            finally:
-                wm.progress_end()
+            frames = bake.run_chain(flexkin, points, data["path"][1:], self.method,
+                                    self.substeps, wm, "rope")
         except bake.BakeError as error:
             self.report({'ERROR'}, str(error))
             return {'CANCELLED'}
-        rope = bake.write_rope(context, curve, data["frames"], result.frames)
+        rope = bake.write_rope(context, curve, data["frames"], frames)
         self.report({'INFO'}, f"flexkin: baked '{rope.name}', {len(points) - 1} links of "
                               f"{link:.4g} over {count} frames ({self.method}) in "
                               f"{time.perf_counter() - started:.2f} s")

@@ -166,16 +166,31 @@ def gather_path(context, target_name):
     return {"frames": frames, "path": path}
 
 
-def run_flexkin(flexkin, data, method, substeps, progress=None):
-    """flexkin.run of the chain's first-frame points (world space), its first point driven along
-    the path (the frames after the first). Returns every frame's points in the armature's
-    space."""
-    points = [list(p) for p in data["points"]]
-    path = [list(p) for p in data["paths"][0][1:]]
-    result = flexkin.run(points, path, method=method, substeps=substeps, progress=progress)
-    # In the armature's space, frame by frame.
+def run_chain(flexkin, points, path, method, substeps, window_manager=None, what="chain"):
+    """flexkin.run of `points` (world space), the first driven along `path` (a point per frame
+    after the first), with the window manager's progress where given. Returns the frames'
+    points (world space); BakeError where flexkin refuses them."""
+    if window_manager is not None:
+        window_manager.progress_begin(0, len(path) + 1)
+    try:
+        return flexkin.run([list(p) for p in points], [list(p) for p in path], method=method,
+                           substeps=substeps,
+                           progress=(lambda done, total: window_manager.progress_update(done))
+                           if window_manager is not None else None).frames
+    except flexkin.InputError as error:
+        raise BakeError(f"flexkin refused the {what}: {error}") from error
+    finally:
+        if window_manager is not None:
+            window_manager.progress_end()
+
+
+def chain_frames(flexkin, data, method, substeps, window_manager=None):
+    """The chain's frames (run_chain from its first-frame points along its path), every frame's
+    points in the armature's space."""
+    frames = run_chain(flexkin, data["points"], data["paths"][0][1:], method, substeps,
+                       window_manager)
     return [[data["world"][f].inverted() @ Vector(tuple(x)) for x in frame]
-            for f, frame in enumerate(result.frames)]
+            for f, frame in enumerate(frames)]
 
 
 def run_flexkin_tree(flexkin, data, body, targets, method, fix_root):
