@@ -143,6 +143,92 @@ class FLEXKIN_OT_bake_rope(bpy.types.Operator):
         return {'FINISHED'}
 
 
+class FLEXKIN_OT_bake_hair(bpy.types.Operator):
+    """Bake the natural motion of the active hair curves object's strands as its object (the
+    head it is parented to) moves over the scene's frame range: flexkin's strand engine, the
+    roots held on the head; the strands play back as a mesh from a cache file"""
+    bl_idname = "flexkin.bake_hair"
+    bl_label = "Bake hair"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    method: bpy.props.EnumProperty(name="Method", items=bake.METHODS[:2], default="tractrix")
+    substeps: bpy.props.IntProperty(
+        name="Sub-steps", description="Steps of the head between two frames",
+        default=1, min=1, max=1024)
+    cache: bpy.props.StringProperty(
+        name="Cache", subtype='FILE_PATH',
+        description="The .npz the strands' frames go to (empty: '<hair>.flexkin.npz' beside the "
+                    ".blend file, or in the temporary folder for a file not saved)")
+
+    def execute(self, context):
+        import os
+        started = time.perf_counter()
+        hair = context.active_object
+        try:
+            flexkin = import_flexkin(context)
+            points, offsets = bake.hair_strands(hair)
+            frames, poses = bake.gather_poses(context, hair)
+            poses = bake.rigid_poses(hair.name, frames, poses)
+            path = self.cache or (
+                f"//{hair.name}.flexkin.npz" if bpy.data.filepath
+                else os.path.join(bpy.app.tempdir, f"{hair.name}.flexkin.npz"))
+            points_at = bake.run_hair(flexkin, points, offsets, poses, self.method,
+                                      self.substeps, context.window_manager)
+            bake.write_strand_cache(bpy.path.abspath(path), points_at, offsets,
+                                    [f - frames[0] for f in frames])
+        except bake.BakeError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        collection = hair.users_collection[0] if hair.users_collection else \
+            context.scene.collection
+        mesh = bake.strand_mesh(hair.name + ".flexkin", points_at, offsets, path, frames[0],
+                                collection)
+        bake.play_strands(context.scene)
+        self.report({'INFO'}, f"flexkin: baked {len(offsets) - 1} strands ({len(points)} points) "
+                              f"over {len(frames)} frames into '{mesh.name}' (cache {path}) in "
+                              f"{time.perf_counter() - started:.2f} s")
+        return {'FINISHED'}
+
+
+class FLEXKIN_OT_import_strands(bpy.types.Operator):
+    """Import a strand file written by `flexkin run` (or a hair bake's cache) as a mesh of the
+    strands that plays its frames back from the scene's current frame on"""
+    bl_idname = "flexkin.import_strands"
+    bl_label = "Import flexkin strands (.npz)"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    filepath: bpy.props.StringProperty(subtype='FILE_PATH')
+    filter_glob: bpy.props.StringProperty(default="*.npz", options={'HIDDEN'})
+
+    def invoke(self, context, event):
+        context.window_manager.fileselect_add(self)
+        return {'RUNNING_MODAL'}
+
+    def execute(self, context):
+        import os
+        try:
+            points, offsets, frames = bake.read_strand_cache(bpy.path.abspath(self.filepath))
+        except bake.BakeError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        name = os.path.splitext(os.path.basename(self.filepath))[0]
+        mesh = bake.strand_mesh(name, points, offsets, self.filepath, context.scene.frame_current,
+                                context.scene.collection)
+        bake.play_strands(context.scene)
+        self.report({'INFO'}, f"flexkin: '{mesh.name}': {len(offsets) - 1} strands, "
+                              f"{len(frames)} frames")
+        return {'FINISHED'}
+
+
+def menu_import(self, context):
+    self.layout.operator(FLEXKIN_OT_import_strands.bl_idname, text="flexkin strands (.npz)")
+
+
+@bpy.app.handlers.persistent
+def on_frame_change(scene, depsgraph=None):
+    bake.play_strands(scene)
+
+
 class FlexkinTarget(bpy.types.PropertyGroup):
     """A target of a tree bake: a bone whose tail follows an object."""
     bone: bpy.props.StringProperty(name="Bone", description="The bone whose tail is driven")
@@ -272,9 +358,16 @@ class FLEXKIN_PT_panel(bpy.types.Panel):
         op.target = scene.flexkin_target.name if scene.flexkin_target else ""
         op.link_length = scene.flexkin_link_length
         op.substeps = scene.flexkin_substeps
+        layout.separator()
+        layout.label(text="Hair (the active hair curves)")
+        op = layout.operator(FLEXKIN_OT_bake_hair.bl_idname)
+        op.method = scene.flexkin_method if scene.flexkin_method != "overall" else "tractrix"
+        op.substeps = scene.flexkin_substeps
+        layout.operator(FLEXKIN_OT_import_strands.bl_idname)
 
 
-CLASSES = (FlexkinPreferences, FLEXKIN_OT_bake_chain, FLEXKIN_OT_bake_rope, FlexkinTarget,
+CLASSES = (FlexkinPreferences, FLEXKIN_OT_bake_chain, FLEXKIN_OT_bake_rope, FLEXKIN_OT_bake_hair,
+           FLEXKIN_OT_import_strands, FlexkinTarget,
            FLEXKIN_OT_target_add,
            FLEXKIN_OT_target_remove, FLEXKIN_OT_bake_tree, FLEXKIN_PT_panel)
 
@@ -282,6 +375,8 @@ CLASSES = (FlexkinPreferences, FLEXKIN_OT_bake_chain, FLEXKIN_OT_bake_rope, Flex
 def register():
     for cls in CLASSES:
         bpy.utils.register_class(cls)
+    bpy.types.TOPBAR_MT_file_import.append(menu_import)
+    bpy.app.handlers.frame_change_post.append(on_frame_change)
     bpy.types.Scene.flexkin_method = bpy.props.EnumProperty(
         name="Method", items=bake.METHODS, default="tractrix")
     bpy.types.Scene.flexkin_target = bpy.props.PointerProperty(
@@ -300,6 +395,9 @@ def register():
 
 
 def unregister():
+    if on_frame_change in bpy.app.handlers.frame_change_post:
+        bpy.app.handlers.frame_change_post.remove(on_frame_change)
+    bpy.types.TOPBAR_MT_file_import.remove(menu_import)
     for name in ("flexkin_method", "flexkin_target", "flexkin_substeps", "flexkin_targets",
                  "flexkin_fix_root", "flexkin_link_length"):
         delattr(bpy.types.Scene, name)

@@ -379,17 +379,22 @@ def resample(points, link):
     return out
 
 
-def write_rope(context, curve, frames, frames_points):
-    """A poly curve object '<curve>.flexkin' (replacing an earlier one) with a point per rope
-    point, each point's coordinates keyed at every frame (world space: the object at the
-    origin), with the source curve's bevel and materials. Returns it."""
-    name = curve.name + ".flexkin"
+def _remove_object(name, datablocks):
+    """An earlier bake's object of the name, and its data where nothing else uses it."""
     old = bpy.data.objects.get(name)
     if old is not None:
         data = old.data
         bpy.data.objects.remove(old)
         if data is not None and data.users == 0:
-            bpy.data.curves.remove(data)
+            datablocks.remove(data)
+
+
+def write_rope(context, curve, frames, frames_points):
+    """A poly curve object '<curve>.flexkin' (replacing an earlier one) with a point per rope
+    point, each point's coordinates keyed at every frame (world space: the object at the
+    origin), with the source curve's bevel and materials. Returns it."""
+    name = curve.name + ".flexkin"
+    _remove_object(name, bpy.data.curves)
     data = bpy.data.curves.new(name, 'CURVE')
     data.dimensions = '3D'
     for attribute in ("bevel_depth", "bevel_resolution", "resolution_u", "use_fill_caps"):
@@ -412,3 +417,183 @@ def write_rope(context, curve, frames, frames_points):
             _set_curve(action, f"splines[0].points[{i}].co", k, f"point {i}", frames,
                        [frame[i][k] for frame in frames_points])
     return obj
+
+
+# Hair: strands of a hair curves object moved with its object (the head) by flexkin's strand
+# engine, written to a cache of every frame's points that a mesh of the strands plays back.
+
+def hair_strands(hair):
+    """The strands of a hair curves object at the current frame, in world space: (P, 3) points
+    and (S+1,) offsets (strand i is rows offsets[i] to offsets[i+1]-1, its root first)."""
+    import numpy as np
+    if hair is None or hair.type != 'CURVES':
+        what = "none" if hair is None else f"'{hair.name}', of type {hair.type.lower()}"
+        raise BakeError(f"select a hair curves object (the active object is {what})")
+    data = hair.data
+    if len(data.curves) == 0:
+        raise BakeError(f"hair '{hair.name}' has no strands")
+    local = np.empty(len(data.points) * 3, dtype=np.float32)
+    data.position_data.foreach_get("vector", local)
+    offsets = np.array([c.first_point_index for c in data.curves] + [len(data.points)],
+                       dtype=np.int64)
+    short = np.nonzero(np.diff(offsets) < 2)[0]
+    if len(short):
+        raise BakeError(f"strand {int(short[0])} of '{hair.name}' has fewer than 2 points; "
+                        "every strand needs a link")
+    world = np.array(hair.matrix_world, dtype=np.float64)
+    local = local.reshape(-1, 3).astype(np.float64)
+    points = local @ world[:3, :3].T + world[:3, 3]
+    return points, offsets
+
+
+def gather_poses(context, obj):
+    """The object's world matrix (4 by 4, numpy) at every frame of the scene's range."""
+    import numpy as np
+    scene = context.scene
+    frames = _frames(scene)
+    current = scene.frame_current
+    poses = []
+    try:
+        for f in frames:
+            scene.frame_set(f)
+            poses.append(np.array(obj.matrix_world, dtype=np.float64))
+    finally:
+        scene.frame_set(current)
+    return frames, poses
+
+
+def rigid_poses(name, frames, poses):
+    """The poses as rotations and translations in double precision: Blender's matrices are single
+    precision (their rotations orthonormal to about 1e-7), so each is taken to its nearest
+    rotation. Raises BakeError for a scaled or sheared pose (the strands move rigidly)."""
+    import numpy as np
+    out = []
+    for f, pose in zip(frames, poses):
+        u, singular, vt = np.linalg.svd(pose[:3, :3])
+        if np.abs(singular - 1.0).max() > 1e-5 or np.linalg.det(pose[:3, :3]) <= 0.0:
+            raise BakeError(f"'{name}' is scaled at frame {f} (scale "
+                            + ", ".join(f"{x:.6g}" for x in singular)
+                            + "); strands move rigidly with their object: apply its scale "
+                            "(and its parents') or keep it 1")
+        rigid = np.eye(4)
+        rigid[:3, :3] = u @ vt
+        rigid[:3, 3] = pose[:3, 3]
+        out.append(rigid)
+    return out
+
+
+def run_hair(flexkin, points, offsets, poses, method, substeps, window_manager=None):
+    """The strand engine (flexkin.StrandBatch) on the strands given at the first pose, their
+    roots pinned to the body, the body at each later pose: (F, P, 3) float32 points."""
+    import numpy as np
+    strands = [points[offsets[i]:offsets[i + 1]] for i in range(len(offsets) - 1)]
+    out = np.empty((len(poses), len(points), 3), dtype=np.float32)
+    out[0] = points
+    if window_manager is not None:
+        window_manager.progress_begin(0, len(poses))
+    try:
+        batch = flexkin.StrandBatch(strands, method=method, substeps=substeps, pinned=1,
+                                    rest=poses[0])
+        for f in range(1, len(poses)):
+            batch.step(poses[f])
+            out[f] = np.concatenate(batch.points())
+            if window_manager is not None:
+                window_manager.progress_update(f)
+    except flexkin.InputError as error:
+        raise BakeError(f"flexkin refused the strands: {error}") from error
+    finally:
+        if window_manager is not None:
+            window_manager.progress_end()
+    return out
+
+
+def write_strand_cache(path, points, offsets, frames):
+    """The cache: an .npz whose points (F, P, 3), offsets (S+1,) and frames (F,) members are laid
+    out as in flexkin's strand files (docs/strands.md), written whole (to a temporary file
+    renamed over `path`)."""
+    import os
+    import numpy as np
+    temporary = path + ".part.npz"
+    try:
+        np.savez(temporary, points=points, offsets=offsets, frames=np.asarray(frames, np.int64))
+        os.replace(temporary, path)
+    except OSError as error:
+        if os.path.exists(temporary):
+            os.remove(temporary)
+        raise BakeError(f"cannot write the strand cache '{path}': {error.strerror}") from error
+
+
+_CACHES = {}  # absolute path -> (modification time, points, frames)
+
+
+def read_strand_cache(path):
+    """points (F, P, 3), offsets and frames of a strand cache or a strand file, cached by its
+    modification time. Raises BakeError for a file that is not one."""
+    import os
+    import numpy as np
+    try:
+        stamp = os.path.getmtime(path)
+    except OSError as error:
+        raise BakeError(f"cannot read '{path}': {error.strerror}") from error
+    cached = _CACHES.get(path)
+    if cached is not None and cached[0] == stamp:
+        return cached[1:]
+    try:
+        with np.load(path) as archive:
+            points = np.asarray(archive["points"], dtype=np.float32)
+            offsets = np.asarray(archive["offsets"], dtype=np.int64)
+            frames = np.asarray(archive["frames"], dtype=np.int64)
+    except (OSError, KeyError, ValueError) as error:
+        raise BakeError(f"'{path}' is not a strand file (points, offsets and frames; "
+                        f"docs/strands.md): {error}") from error
+    if points.ndim != 3 or points.shape[2] not in (2, 3) or len(frames) != points.shape[0] or \
+            len(offsets) < 2 or offsets[0] != 0 or offsets[-1] != points.shape[1] or \
+            np.any(np.diff(offsets) < 1):
+        raise BakeError(f"'{path}' is not a valid strand file: points {points.shape}, offsets of "
+                        f"{len(offsets)}, frames of {len(frames)}")
+    if points.shape[2] == 2:
+        points = np.concatenate([points, np.zeros(points.shape[:2] + (1,), np.float32)], axis=2)
+    _CACHES[path] = (stamp, points, offsets, frames)
+    return points, offsets, frames
+
+
+def strand_mesh(name, points, offsets, cache, first_frame, collection):
+    """A mesh of the strands (a vertex per point, an edge per link) at the first frame, playing
+    the cache back (its `flexkin_cache` and `flexkin_first_frame` properties; the add-on's frame
+    handler sets its vertices). Replaces an earlier object of the name."""
+    import numpy as np
+    _remove_object(name, bpy.data.meshes)
+    mesh = bpy.data.meshes.new(name)
+    count = points.shape[1]
+    linked = np.ones(count, dtype=bool)  # a point with a next point in its strand
+    linked[np.asarray(offsets[1:]) - 1] = False
+    starts = np.nonzero(linked)[0].astype(np.int32)
+    mesh.vertices.add(count)
+    mesh.vertices.foreach_set("co", points[0].ravel())
+    mesh.edges.add(len(starts))
+    mesh.edges.foreach_set("vertices", np.stack([starts, starts + 1], axis=1).ravel())
+    mesh.update()
+    obj = bpy.data.objects.new(name, mesh)
+    obj["flexkin_cache"] = cache
+    obj["flexkin_first_frame"] = int(first_frame)
+    collection.objects.link(obj)
+    return obj
+
+
+def play_strands(scene):
+    """Every strand mesh of the scene at the scene's frame: its cache's record of the frame
+    (the last recorded at or before it; the first before the cache starts)."""
+    import numpy as np
+    for obj in scene.objects:
+        path = obj.get("flexkin_cache") if obj.type == 'MESH' else None
+        if not path:
+            continue
+        try:
+            points, _, frames = read_strand_cache(bpy.path.abspath(path))
+        except BakeError:
+            continue
+        at = scene.frame_current - int(obj.get("flexkin_first_frame", 0))
+        k = max(0, int(np.searchsorted(frames, at, side="right")) - 1)
+        if len(obj.data.vertices) == points.shape[1]:
+            obj.data.vertices.foreach_set("co", points[k].ravel())
+            obj.data.update()

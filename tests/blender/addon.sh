@@ -16,7 +16,7 @@ rm -f "$out/flexkin_blender.zip"
 # The add-on is installed into a user folder of the test's own, not the machine's.
 export BLENDER_USER_SCRIPTS="$out/scripts" BLENDER_USER_CONFIG="$out/config"
 log=$(blender -b --factory-startup --python "$source/tests/blender/bake_chain_check.py" -- \
-  "$out/flexkin_blender.zip" "$module" 2>&1) || { echo "$log" >&2; echo "FAIL: bake_chain_check" >&2; exit 1; }
+  "$out/flexkin_blender.zip" "$module" "$source" "$out" 2>&1) || { echo "$log" >&2; echo "FAIL: bake_chain_check" >&2; exit 1; }
 echo "$log" | grep -E '^(blender |report: |timing: )'
 if ! echo "$log" | grep -q '^ok$'; then
   echo "$log" >&2

@@ -1,7 +1,8 @@
 """The flexkin add-on's bakes of bone chains and trees in headless Blender (docs/blender.md; run by
 tests/blender/addon.sh):
 
-  blender -b --factory-startup --python tests/blender/bake_chain_check.py -- ADDON_ZIP MODULE_DIR
+  blender -b --factory-startup --python tests/blender/bake_chain_check.py -- ADDON_ZIP MODULE_DIR \
+      SOURCE_DIR OUT_DIR
 
 installs the add-on from its zip and enables it, builds scenes of armatures and driving objects,
 runs the bake operator, and checks frame by frame that every baked bone's head and tail (read back
@@ -19,7 +20,7 @@ import bpy
 from mathutils import Matrix, Vector
 
 argv = sys.argv[sys.argv.index("--") + 1:]
-ADDON_ZIP, MODULE_DIR = argv[0], argv[1]
+ADDON_ZIP, MODULE_DIR, SOURCE_DIR, OUT_DIR = argv[0], argv[1], argv[2], argv[3]
 sys.path.insert(0, MODULE_DIR)
 import flexkin  # noqa: E402  (the module the add-on finds on the same path)
 
@@ -40,6 +41,7 @@ def new_scene(frames):
             collection.remove(item)
     scene = bpy.context.scene
     scene.frame_start, scene.frame_end = 1, frames
+    scene.frame_set(1)
     return scene
 
 
@@ -88,6 +90,16 @@ def baked_points(armature, names, frame):
     points = [world @ pose[n].head for n in names]
     points.append(world @ pose[names[-1]].tail)
     return points
+
+
+def within(case, what, part, worst, size):
+    """Fails unless `worst` (the largest difference from flexkin's) is within TOLERANCE of the
+    scene's `size`; prints the case's line."""
+    if not worst <= TOLERANCE * size:
+        fail(f"{case}: {part} is {worst:.3g} from flexkin's ({worst / size:.3g} of the scene, "
+             f"more than {TOLERANCE:g})")
+    print(f"blender {bpy.app.version_string}: {case}: {what}, largest difference of {part} from "
+          f"flexkin's {worst:.3g} (scene size {size:.3g}, {worst / size:.2g} of it)", flush=True)
 
 
 def compare(case, armature, names, expected, size):
@@ -313,12 +325,7 @@ def case_rope_poly():
     for f in range(1, frames + 1):
         for got, want in zip(rope_points(rope, f), expected[f - 1]):
             worst = max(worst, (got - Vector(tuple(want))).length)
-    size = 2.0
-    if not worst <= TOLERANCE * size:
-        fail(f"rope: a baked point is {worst:.3g} from flexkin's")
-    print(f"blender {bpy.app.version_string}: rope, poly: {n} links x {frames} frames, largest "
-          f"distance of a baked point from flexkin's {worst:.3g} (scene size {size:.3g}, "
-          f"{worst / size:.2g} of it)", flush=True)
+    within("rope, poly", f"{n} links x {frames} frames", "a baked point", worst, 2.0)
 
 
 def case_rope_bezier():
@@ -371,6 +378,145 @@ def rope_reports():
     bpy.context.view_layer.objects.active = bpy.data.objects["Anchor"]
     expect_report("rope not a curve", "select a curve object", operator=bpy.ops.flexkin.bake_rope,
                   target="Anchor")
+
+
+def make_hair(name, strands):
+    """A hair curves object of `strands` (lists of points), made as Blender users make one from
+    a curve (Object > Convert > Curves)."""
+    data = bpy.data.curves.new(name, 'CURVE')
+    data.dimensions = '3D'
+    for strand in strands:
+        spline = data.splines.new('POLY')
+        spline.points.add(len(strand) - 1)
+        for p, co in zip(spline.points, strand):
+            p.co = (co[0], co[1], co[2], 1.0)
+    obj = bpy.data.objects.new(name, data)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    bpy.ops.object.convert(target='CURVES')
+    return bpy.context.active_object
+
+
+def scalp(count, points, link, radius=0.1):
+    """Strands straight out of a sphere's upper half (a Fibonacci spiral of roots)."""
+    out = []
+    for i in range(count):
+        z = 1.0 - (i + 0.5) / count  # upper half
+        r, a = math.sqrt(max(0.0, 1.0 - z * z)), i * math.pi * (3.0 - math.sqrt(5.0))
+        n = Vector((r * math.cos(a), r * math.sin(a), z))
+        out.append([tuple(radius * n + k * link * n) for k in range(points)])
+    return out
+
+
+def head_motion(f):
+    """The head's location and XYZ Euler angles at frame f (1-based): turning, nodding and
+    moving sideways."""
+    return (0.1 * math.sin(0.05 * f), 0.0, 0.0), (0.3 * math.sin(0.07 * f), 0.0,
+                                                  0.5 * math.sin(0.1 * f))
+
+
+def head_pose(f):
+    """The head's pose at frame f as a 4 by 4 numpy matrix in double precision (an XYZ Euler
+    rotation is Rz Ry Rx)."""
+    import numpy as np
+    (tx, ty, tz), (x, y, z) = head_motion(f)
+    rx = np.array([[1, 0, 0], [0, math.cos(x), -math.sin(x)], [0, math.sin(x), math.cos(x)]])
+    ry = np.array([[math.cos(y), 0, math.sin(y)], [0, 1, 0], [-math.sin(y), 0, math.cos(y)]])
+    rz = np.array([[math.cos(z), -math.sin(z), 0], [math.sin(z), math.cos(z), 0], [0, 0, 1]])
+    pose = np.eye(4)
+    pose[:3, :3] = rz @ ry @ rx
+    pose[:3, 3] = (tx, ty, tz)
+    return pose
+
+
+def case_hair(out_dir):
+    """Strands on a head that turns, nods and moves (their object parented to an animated
+    Empty): the strand mesh at every frame against flexkin.run_strands of the test's own strands
+    and head poses."""
+    frames, count, points, link = 40, 60, 6, 0.02
+    new_scene(frames)
+    head = bpy.data.objects.new("Head", None)
+    bpy.context.scene.collection.objects.link(head)
+    head.rotation_mode = 'XYZ'
+    for f in range(1, frames + 1):
+        head.location, head.rotation_euler = head_motion(f)
+        head.keyframe_insert("location", frame=f)
+        head.keyframe_insert("rotation_euler", frame=f)
+    strands = scalp(count, points, link)
+    hair = make_hair("Hair", strands)
+    hair.parent = head
+    bpy.context.scene.frame_set(1)
+    bpy.context.view_layer.objects.active = hair
+    cache = os.path.join(out_dir, "hair.flexkin.npz")
+    if bpy.ops.flexkin.bake_hair(method="tractrix", cache=cache) != {'FINISHED'}:
+        fail("hair: the bake did not finish")
+    import numpy as np
+    rest = head_pose(1)
+    at_rest = np.array([[rest[:3, :3] @ np.array(p) + rest[:3, 3] for p in strand]
+                        for strand in strands])
+    poses = np.array([head_pose(f) for f in range(2, frames + 1)])
+    expected = flexkin.run_strands(at_rest, poses, rest=rest)
+    mesh = bpy.data.objects["Hair.flexkin"]
+    worst = 0.0
+    for f in range(1, frames + 1):
+        bpy.context.scene.frame_set(f)
+        got = np.array([tuple(v.co) for v in mesh.data.vertices])
+        worst = max(worst, float(np.abs(got - expected[f - 1].reshape(-1, 3)).max()))
+    within("hair", f"{count} strands of {points - 1} links x {frames} frames on a moving head",
+           "a strand point's coordinate", worst, 0.4)
+
+
+def case_import(source_dir, out_dir):
+    """A strand file written by flexkin (run_groom of examples/groom_grass_2d.json): imported, its
+    mesh at every frame on the file's points."""
+    import numpy as np
+    new_scene(200)
+    path = os.path.join(out_dir, "grass.npz")
+    flexkin.run_groom(os.path.join(source_dir, "examples", "groom_grass_2d.json"), path)
+    if bpy.ops.flexkin.import_strands(filepath=path) != {'FINISHED'}:
+        fail("import: did not finish")
+    mesh = bpy.data.objects["grass"]
+    with np.load(path) as archive:
+        points, frames = archive["points"], archive["frames"]
+    worst = 0.0
+    for k, step in enumerate(frames):
+        bpy.context.scene.frame_set(1 + int(step))
+        got = np.array([tuple(v.co) for v in mesh.data.vertices])
+        worst = max(worst, float(np.abs(got[:, :2] - points[k]).max()), float(np.abs(got[:, 2]).max()))
+    if not worst <= 1e-6:
+        fail(f"import: a vertex is {worst:.3g} from the file's point")
+    print(f"blender {bpy.app.version_string}: import: {len(archive_offsets(path)) - 1} strands x "
+          f"{len(frames)} frames of a strand file from flexkin.run_groom, largest difference "
+          f"{worst:.3g}", flush=True)
+
+
+def archive_offsets(path):
+    import numpy as np
+    with np.load(path) as archive:
+        return archive["offsets"]
+
+
+def hair_timing(out_dir):
+    """The bake time of 5,000 strands of 24 links over 120 frames (the issue's figure)."""
+    frames = 120
+    new_scene(frames)
+    head = bpy.data.objects.new("Head", None)
+    bpy.context.scene.collection.objects.link(head)
+    for f in range(1, frames + 1):
+        head.rotation_euler = (0.3 * math.sin(0.07 * f), 0.0, 0.5 * math.sin(0.1 * f))
+        head.keyframe_insert("rotation_euler", frame=f)
+    hair = make_hair("Hair", scalp(5000, 25, 0.006))
+    hair.parent = head
+    bpy.context.view_layer.objects.active = hair
+    started = time.perf_counter()
+    if bpy.ops.flexkin.bake_hair(cache=os.path.join(out_dir, "hair5000.npz")) != {'FINISHED'}:
+        fail("hair timing: the bake did not finish")
+    seconds = time.perf_counter() - started
+    size = os.path.getsize(os.path.join(out_dir, "hair5000.npz"))
+    os.remove(os.path.join(out_dir, "hair5000.npz"))  # 180 MB
+    print(f"timing: 5000 strands x 24 links x 120 frames baked in {seconds:.2f} s (cache "
+          f"{size / 1e6:.0f} MB)", flush=True)
 
 
 def expect_report(case, words, operator=None, **kwargs):
@@ -456,6 +602,12 @@ try:
     tree_reports()
     case_rope_bezier()
     rope_reports()
+    case_hair(OUT_DIR)
+    bpy.context.view_layer.objects.active = bpy.data.objects["Head"]
+    expect_report("hair not a curves object", "select a hair curves object",
+                  operator=bpy.ops.flexkin.bake_hair)
+    case_import(SOURCE_DIR, OUT_DIR)
+    hair_timing(OUT_DIR)
     timing()
 except SystemExit:
     raise
