@@ -77,6 +77,10 @@ class FLEXKIN_OT_bake_chain(bpy.types.Operator):
     substeps: bpy.props.IntProperty(
         name="Sub-steps", description="Steps of the driven end between two frames",
         default=1, min=1, max=1024)
+    fixed_base: bpy.props.BoolProperty(
+        name="Fixed base", default=False,
+        description="Hold the chain's first bone's head where it is in the armature and drive "
+                    "the last bone's tail to the target instead (a hyper-redundant arm)")
 
     def execute(self, context):
         started = time.perf_counter()
@@ -85,16 +89,28 @@ class FLEXKIN_OT_bake_chain(bpy.types.Operator):
         try:
             flexkin = import_flexkin(context)
             chain = bake.selected_chain(armature)
+            if self.fixed_base and not self.target:
+                raise bake.BakeError("the fixed-base mode drives the chain's tip: choose the "
+                                     "target object it follows")
             data = bake.gather(context, armature, chain, [self.target or None])
             count = len(data["frames"])
-            points = bake.chain_frames(flexkin, data, self.method, self.substeps, wm)
+            if self.fixed_base:
+                # The chain as a tree: its root's head fixed, its last tail the one target.
+                points, report = bake.run_flexkin_tree(flexkin, data, chain, [len(chain.bones)],
+                                                       self.method, True)
+            else:
+                points = bake.chain_frames(flexkin, data, self.method, self.substeps, wm)
             keys = bake.pose_keys(armature, chain, data, points)
         except bake.BakeError as error:
             self.report({'ERROR'}, str(error))
             return {'CANCELLED'}
         bake.write_keys(armature, chain, data["frames"], keys)
-        self.report({'INFO'}, f"flexkin: baked {len(chain.bones)} bones over {count} frames "
-                              f"({self.method}) in {time.perf_counter() - started:.2f} s")
+        missed = int((~report["reached"]).sum()) if self.fixed_base else 0
+        self.report({'WARNING'} if missed else {'INFO'},
+                    f"flexkin: baked {len(chain.bones)} bones over {count} frames "
+                    f"({self.method}{', fixed base' if self.fixed_base else ''}) in "
+                    f"{time.perf_counter() - started:.2f} s"
+                    + (f"; {missed} frames did not reach the target" if missed else ""))
         return {'FINISHED'}
 
 
@@ -330,10 +346,12 @@ class FLEXKIN_PT_panel(bpy.types.Panel):
         layout.prop(scene, "flexkin_method")
         layout.prop(scene, "flexkin_target")
         layout.prop(scene, "flexkin_substeps")
+        layout.prop(scene, "flexkin_fixed_base")
         op = layout.operator(FLEXKIN_OT_bake_chain.bl_idname)
         op.method = scene.flexkin_method
         op.target = scene.flexkin_target.name if scene.flexkin_target else ""
         op.substeps = scene.flexkin_substeps
+        op.fixed_base = scene.flexkin_fixed_base
         layout.separator()
         layout.label(text="Bone tree")
         armature = context.active_object
@@ -389,6 +407,9 @@ def register():
     bpy.types.Scene.flexkin_link_length = bpy.props.FloatProperty(
         name="Link length", default=0.0, min=0.0, subtype='DISTANCE',
         description="The rope's link length (0: the curve's length over 32)")
+    bpy.types.Scene.flexkin_fixed_base = bpy.props.BoolProperty(
+        name="Fixed base", default=False,
+        description="Hold the chain's root and drive its tip to the target")
     bpy.types.Scene.flexkin_fix_root = bpy.props.BoolProperty(
         name="Fix the root", default=True,
         description="Hold the root bone's head where it is in the armature (a base)")
@@ -399,7 +420,7 @@ def unregister():
         bpy.app.handlers.frame_change_post.remove(on_frame_change)
     bpy.types.TOPBAR_MT_file_import.remove(menu_import)
     for name in ("flexkin_method", "flexkin_target", "flexkin_substeps", "flexkin_targets",
-                 "flexkin_fix_root", "flexkin_link_length"):
+                 "flexkin_fix_root", "flexkin_link_length", "flexkin_fixed_base"):
         delattr(bpy.types.Scene, name)
     for cls in reversed(CLASSES):
         bpy.utils.unregister_class(cls)

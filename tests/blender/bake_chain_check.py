@@ -141,6 +141,33 @@ def case_target(method):
     return arm
 
 
+def case_fixed_base():
+    """The fixed-base mode: the chain's root held, its tip on an Empty (flexkin.reach_tree of
+    the chain with point 0 fixed and its last point the target), in the armature's space."""
+    frames, n, length = 50, 8, 0.25
+    new_scene(frames)
+    location, turn = Vector((0.3, 0.0, 0.2)), math.radians(-25)
+    arm = make_chain("Arm", n, length, location, turn)
+    to_world = Matrix.Translation(location) @ Matrix.Rotation(turn, 4, 'Z')
+    tip = Vector((0.0, 0.0, n * length))
+    local = [tip + Vector((0.5 * math.sin(0.05 * f), 0.3 * (1 - math.cos(0.05 * f)),
+                           -0.4 * math.sin(0.03 * f))) for f in range(frames)]
+    empty_on_path("Goal", [to_world @ p for p in local])
+    bpy.context.view_layer.objects.active = arm
+    if bpy.ops.flexkin.bake_chain(method="tractrix", target="Goal", fixed_base=True) \
+            != {'FINISHED'}:
+        fail("fixed base: the bake did not finish")
+    points = [(0.0, 0.0, i * length) for i in range(n + 1)]
+    expected, report = flexkin.reach_tree(points, [-1] + list(range(n)), [n],
+                                          [[list(p)] for p in local[1:]], fixed=[0])
+    if not report["reached"].all():
+        fail("fixed base: flexkin did not reach the test's targets")
+    world = [[to_world @ Vector(tuple(p)) for p in frame] for frame in expected]
+    compare("fixed base, tractrix", arm, [f"b{i:02d}" for i in range(n)], world, n * length + 1.0)
+    expect_report("fixed base without target", "the fixed-base mode drives the chain's tip",
+                  fixed_base=True)
+
+
 def case_parent_animation():
     """A chain hanging from an animated 'hips' bone, its first bone driven by its own head (the
     hips turning), some bones in Euler modes: the keys are in each bone's rotation mode."""
@@ -596,6 +623,7 @@ try:
     for method in ("tractrix", "ftl", "overall"):
         case_target(method)
     case_parent_animation()
+    case_fixed_base()
     case_tree("tractrix")
     case_tree("overall")
     bad_inputs()
