@@ -250,6 +250,10 @@ class FlexkinTarget(bpy.types.PropertyGroup):
     bone: bpy.props.StringProperty(name="Bone", description="The bone whose tail is driven")
     target: bpy.props.PointerProperty(name="Target", type=bpy.types.Object,
                                       description="The object whose motion drives the bone's tail")
+    look: bpy.props.BoolProperty(
+        name="Look", default=False,
+        description="Turn the bone to point at the object (a head looking) rather than move its "
+                    "tail onto it")
 
 
 class FLEXKIN_OT_target_add(bpy.types.Operator):
@@ -299,7 +303,7 @@ class FLEXKIN_OT_bake_tree(bpy.types.Operator):
         try:
             flexkin = import_flexkin(context)
             body = bake.selected_tree(armature)
-            targets, names = [], []
+            targets, names, looks = [], [], []
             for k, item in enumerate(context.scene.flexkin_targets):
                 point = body.point_of_tail(item.bone)
                 if point is None:
@@ -310,15 +314,13 @@ class FLEXKIN_OT_bake_tree(bpy.types.Operator):
                                          "choose the object its tail follows")
                 targets.append(point)
                 names.append(item.target.name)
+                looks.append(bool(item.look))
             if not targets:
                 raise bake.BakeError("the tree has no target: add one (a bone and the object its "
                                      "tail follows) in the flexkin panel")
             data = bake.gather(context, armature, body, names)
-            try:
-                points, report = bake.run_flexkin_tree(flexkin, data, body, targets, self.method,
-                                                       self.fix_root)
-            except flexkin.InputError as error:
-                raise bake.BakeError(f"flexkin refused the tree: {error}") from error
+            points, report = bake.run_flexkin_tree(flexkin, data, body, targets, self.method,
+                                                   self.fix_root, looks)
             keys = bake.pose_keys(armature, body, data, points)
         except bake.BakeError as error:
             self.report({'ERROR'}, str(error))
@@ -362,6 +364,7 @@ class FLEXKIN_PT_panel(bpy.types.Panel):
             else:
                 row.prop(item, "bone", text="")
             row.prop(item, "target", text="")
+            row.prop(item, "look", text="", icon='HIDE_OFF')
             row.operator(FLEXKIN_OT_target_remove.bl_idname, text="", icon='X').index = k
         layout.operator(FLEXKIN_OT_target_add.bl_idname, icon='ADD')
         layout.prop(scene, "flexkin_fix_root")

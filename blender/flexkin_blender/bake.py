@@ -193,17 +193,22 @@ def chain_frames(flexkin, data, method, substeps, window_manager=None):
             for f, frame in enumerate(frames)]
 
 
-def run_flexkin_tree(flexkin, data, body, targets, method, fix_root):
+def run_flexkin_tree(flexkin, data, body, targets, method, fix_root, looks=None):
     """flexkin.reach_tree of the body's points in the armature's space, the tail of each target
-    bone driven along its target's path (in the armature's space at each frame), the root's head
-    fixed or not. Returns the frames' points in the armature's space and the report."""
+    bone driven along its target's path (in the armature's space at each frame), or with
+    looks[k] the bone turned to point at it, the root's head fixed or not. Returns the frames'
+    points in the armature's space and the report."""
     points = [list(p) for p in data["local_points"]]
     paths = [[list(data["world"][f].inverted() @ data["paths"][k][f])
               for k in range(len(targets))] for f in range(1, len(data["frames"]))]
-    frames, report = flexkin.reach_tree(points, body.parents, targets, paths,
-                                        fixed=[0] if fix_root else [],
-                                        method="tractrix" if method == "overall" else method,
-                                        overall={"squared": 1.0} if method == "overall" else None)
+    try:
+        frames, report = flexkin.reach_tree(
+            points, body.parents, targets, paths, fixed=[0] if fix_root else [],
+            method="tractrix" if method == "overall" else method,
+            overall={"squared": 1.0} if method == "overall" else None,
+            looks=looks if looks is not None else [False] * len(targets))
+    except flexkin.InputError as error:
+        raise BakeError(f"flexkin refused the tree: {error}") from error
     return [[Vector(tuple(x)) for x in frame] for frame in frames], report
 
 

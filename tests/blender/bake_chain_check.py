@@ -234,8 +234,9 @@ def make_body(location, rotation_z):
     return obj
 
 
-def case_tree(method):
-    """Two hands of a body driven by two Empties, the base fixed (flexkin.reach_tree)."""
+def case_tree(method, look=False):
+    """Two hands of a body driven by two Empties, the base fixed (flexkin.reach_tree); with
+    `look`, the head bone turned to point at a third (a pointing goal)."""
     frames = 50
     new_scene(frames)
     location, turn = Vector((0.5, -0.2, 0.0)), math.radians(20)
@@ -251,20 +252,24 @@ def case_tree(method):
         # From where the hands are, inward and round (within their reach).
         local_paths.append([
             (0.7 - 0.2 * (1 - math.cos(t)), 0.2 * math.sin(t), 0.95 + 0.08 * math.sin(2 * t)),
-            (-0.7 + 0.15 * (1 - math.cos(t)), 0.15 * math.sin(t), 0.95 - 0.08 * math.sin(t))])
-    for k, name in enumerate(("Hand.L", "Hand.R")):
+            (-0.7 + 0.15 * (1 - math.cos(t)), 0.15 * math.sin(t), 0.95 - 0.08 * math.sin(t)),
+            (0.6 * math.sin(t), 0.8, 1.3 - 0.3 * math.sin(0.5 * t))])  # the ball the head watches
+    names = ("Hand.L", "Hand.R", "Ball")
+    for k, name in enumerate(names):
         empty_on_path(name, [to_world @ Vector(p[k]) for p in local_paths])
     scene = bpy.context.scene
     scene.flexkin_targets.clear()
-    for bone, target in (("arm.L2", "Hand.L"), ("arm.R2", "Hand.R")):
+    bones = ["arm.L2", "arm.R2"] + (["head"] if look else [])
+    for k, bone in enumerate(bones):
         item = scene.flexkin_targets.add()
-        item.bone, item.target = bone, bpy.data.objects[target]
+        item.bone, item.target, item.look = bone, bpy.data.objects[names[k]], bone == "head"
     bpy.context.view_layer.objects.active = arm
     if bpy.ops.flexkin.bake_tree(method=method, fix_root=True) != {'FINISHED'}:
         fail(f"tree/{method}: the bake did not finish")
     kwargs = {"overall": {"squared": 1.0}} if method == "overall" else {"method": method}
-    expected, report = flexkin.reach_tree(points, parents, [index["arm.L2"], index["arm.R2"]],
-                                          local_paths[1:], fixed=[0], **kwargs)
+    expected, report = flexkin.reach_tree(points, parents, [index[b] for b in bones],
+                                          [p[:len(bones)] for p in local_paths[1:]], fixed=[0],
+                                          looks=[b == "head" for b in bones], **kwargs)
     if not report["reached"].all():
         fail(f"tree/{method}: flexkin did not reach the test's targets")
     # Compare in the world: the test's points through the armature's world matrix.
@@ -279,8 +284,20 @@ def case_tree(method):
     size = 2.0
     if not worst <= TOLERANCE * size:
         fail(f"tree/{method}: a baked point is {worst:.3g} from flexkin's")
+    if look:  # the baked head points at the ball (to Blender's single precision)
+        gaze = 0.0
+        for f in range(2, frames + 1):
+            scene.frame_set(f)
+            head = pose["head"]
+            ball = arm.matrix_world.inverted() @ bpy.data.objects["Ball"].matrix_world.translation
+            gaze = max(gaze, (head.tail - head.head).angle(ball - head.head))
+        if not gaze <= 1e-5:
+            fail(f"tree/{method}: the head is {gaze:.3g} rad off the ball")
+        print(f"blender {bpy.app.version_string}: tree, {method}: the head's largest angle from "
+              f"the ball {gaze:.2g} rad", flush=True)
     print(f"blender {bpy.app.version_string}: tree, {method}: {len(BODY)} bones x {frames} frames, "
-          f"two hands driven, the base fixed, largest distance of a baked head or tail from "
+          f"two hands driven{', the head watching a ball' if look else ''}, the base fixed, "
+          f"largest distance of a baked head or tail from "
           f"flexkin's point {worst:.3g} (scene size {size:.3g}, {worst / size:.2g} of it)",
           flush=True)
     return arm
@@ -624,7 +641,7 @@ try:
         case_target(method)
     case_parent_animation()
     case_fixed_base()
-    case_tree("tractrix")
+    case_tree("tractrix", look=True)
     case_tree("overall")
     bad_inputs()
     tree_reports()
