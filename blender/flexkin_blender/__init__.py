@@ -236,8 +236,62 @@ class FLEXKIN_OT_import_strands(bpy.types.Operator):
         return {'FINISHED'}
 
 
+class FLEXKIN_OT_run_groom(bpy.types.Operator):
+    """Run a flexkin groom file (docs/groom-format.md: strands grown on a scalp and the body's
+    keyframed motion) with flexkin's strand engine, and import its strands as a mesh that plays
+    the run back from the scene's current frame on"""
+    bl_idname = "flexkin.run_groom"
+    bl_label = "Run flexkin groom (.json)"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    filepath: bpy.props.StringProperty(subtype='FILE_PATH')
+    filter_glob: bpy.props.StringProperty(default="*.json", options={'HIDDEN'})
+    cache: bpy.props.StringProperty(
+        name="Cache", subtype='FILE_PATH',
+        description="The strand file the run writes (empty: '<groom>.flexkin.npz' beside the "
+                    ".blend file, or in the temporary folder for a file not saved)")
+
+    def invoke(self, context, event):
+        context.window_manager.fileselect_add(self)
+        return {'RUNNING_MODAL'}
+
+    def execute(self, context):
+        import os
+        started = time.perf_counter()
+        name = os.path.splitext(os.path.basename(self.filepath))[0]
+        cache = self.cache or (f"//{name}.flexkin.npz" if bpy.data.filepath
+                               else os.path.join(bpy.app.tempdir, f"{name}.flexkin.npz"))
+        wm = context.window_manager
+        try:
+            flexkin = import_flexkin(context)
+            wm.progress_begin(0, 1)
+            try:
+                report = flexkin.run_groom(bpy.path.abspath(self.filepath),
+                                           bpy.path.abspath(cache),
+                                           progress=lambda done, total:
+                                           wm.progress_update(done / max(total, 1)))
+            except flexkin.InputError as error:
+                raise bake.BakeError(f"flexkin refused the groom: {error}") from error
+            except OSError as error:
+                raise bake.BakeError(f"cannot run the groom: {error}") from error
+            finally:
+                wm.progress_end()
+            points, offsets, frames = bake.read_strand_cache(bpy.path.abspath(cache))
+        except bake.BakeError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        mesh = bake.strand_mesh(name, points, offsets, cache, context.scene.frame_current,
+                                context.scene.collection)
+        bake.play_strands(context.scene)
+        self.report({'INFO'}, f"flexkin: '{mesh.name}': {len(offsets) - 1} strands, "
+                              f"{len(frames)} frames ({report.engine}) in "
+                              f"{time.perf_counter() - started:.2f} s")
+        return {'FINISHED'}
+
+
 def menu_import(self, context):
     self.layout.operator(FLEXKIN_OT_import_strands.bl_idname, text="flexkin strands (.npz)")
+    self.layout.operator(FLEXKIN_OT_run_groom.bl_idname, text="flexkin groom (.json, run)")
 
 
 @bpy.app.handlers.persistent
@@ -385,10 +439,11 @@ class FLEXKIN_PT_panel(bpy.types.Panel):
         op.method = scene.flexkin_method if scene.flexkin_method != "overall" else "tractrix"
         op.substeps = scene.flexkin_substeps
         layout.operator(FLEXKIN_OT_import_strands.bl_idname)
+        layout.operator(FLEXKIN_OT_run_groom.bl_idname)
 
 
 CLASSES = (FlexkinPreferences, FLEXKIN_OT_bake_chain, FLEXKIN_OT_bake_rope, FLEXKIN_OT_bake_hair,
-           FLEXKIN_OT_import_strands, FlexkinTarget,
+           FLEXKIN_OT_import_strands, FLEXKIN_OT_run_groom, FlexkinTarget,
            FLEXKIN_OT_target_add,
            FLEXKIN_OT_target_remove, FLEXKIN_OT_bake_tree, FLEXKIN_PT_panel)
 

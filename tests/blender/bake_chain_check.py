@@ -535,6 +535,33 @@ def case_import(source_dir, out_dir):
           f"{worst:.3g}", flush=True)
 
 
+def case_groom(source_dir, out_dir):
+    """A groom file run inside Blender (bpy.ops.flexkin.run_groom): its mesh at every frame on
+    the points of the strand file that flexkin.run_groom writes for the same groom here."""
+    import numpy as np
+    new_scene(200)
+    groom = os.path.join(source_dir, "examples", "groom_grass_2d.json")
+    cache = os.path.join(out_dir, "grass_blender.npz")
+    if bpy.ops.flexkin.run_groom(filepath=groom, cache=cache) != {'FINISHED'}:
+        fail("groom: did not finish")
+    reference = os.path.join(out_dir, "grass_reference.npz")
+    flexkin.run_groom(groom, reference)
+    mesh = bpy.data.objects["groom_grass_2d"]
+    with np.load(reference) as archive:
+        points, frames = archive["points"], archive["frames"]
+    worst = 0.0
+    for k, step in enumerate(frames):
+        bpy.context.scene.frame_set(1 + int(step))
+        got = np.array([tuple(v.co) for v in mesh.data.vertices])
+        worst = max(worst, float(np.abs(got[:, :2] - points[k]).max()))
+    if not worst <= 1e-6:
+        fail(f"groom: a vertex is {worst:.3g} from flexkin's point")
+    print(f"blender {bpy.app.version_string}: groom file run in Blender: {len(frames)} frames, "
+          f"largest difference from flexkin.run_groom's {worst:.3g}", flush=True)
+    expect_report("groom not found", "cannot run the groom", operator=bpy.ops.flexkin.run_groom,
+                  filepath=os.path.join(out_dir, "missing.json"), cache=cache)
+
+
 def archive_offsets(path):
     import numpy as np
     with np.load(path) as archive:
@@ -652,6 +679,7 @@ try:
     expect_report("hair not a curves object", "select a hair curves object",
                   operator=bpy.ops.flexkin.bake_hair)
     case_import(SOURCE_DIR, OUT_DIR)
+    case_groom(SOURCE_DIR, OUT_DIR)
     hair_timing(OUT_DIR)
     timing()
 except SystemExit:
