@@ -514,31 +514,37 @@ def case_hair(out_dir):
 def case_import(source_dir, out_dir):
     """A strand file written by flexkin (run_groom of examples/groom_grass_2d.json): imported, its
     mesh at every frame on the file's points."""
-    import numpy as np
     new_scene(200)
     path = os.path.join(out_dir, "grass.npz")
     flexkin.run_groom(os.path.join(source_dir, "examples", "groom_grass_2d.json"), path)
     if bpy.ops.flexkin.import_strands(filepath=path) != {'FINISHED'}:
         fail("import: did not finish")
-    mesh = bpy.data.objects["grass"]
+    worst, frames, strands = plays_strand_file(bpy.data.objects["grass"], path)
+    if not worst <= 1e-6:
+        fail(f"import: a vertex is {worst:.3g} from the file's point")
+    print(f"blender {bpy.app.version_string}: import: {strands} strands x {frames} frames of a "
+          f"strand file from flexkin.run_groom, largest difference {worst:.3g}", flush=True)
+
+
+def plays_strand_file(mesh, path):
+    """The largest difference of the strand mesh's vertices, at the scene frame of each record
+    of the 2D strand file at `path` (from frame 1), from its points (z from 0); the records and
+    strands."""
+    import numpy as np
     with np.load(path) as archive:
-        points, frames = archive["points"], archive["frames"]
+        points, frames, offsets = archive["points"], archive["frames"], archive["offsets"]
     worst = 0.0
     for k, step in enumerate(frames):
         bpy.context.scene.frame_set(1 + int(step))
         got = np.array([tuple(v.co) for v in mesh.data.vertices])
-        worst = max(worst, float(np.abs(got[:, :2] - points[k]).max()), float(np.abs(got[:, 2]).max()))
-    if not worst <= 1e-6:
-        fail(f"import: a vertex is {worst:.3g} from the file's point")
-    print(f"blender {bpy.app.version_string}: import: {len(archive_offsets(path)) - 1} strands x "
-          f"{len(frames)} frames of a strand file from flexkin.run_groom, largest difference "
-          f"{worst:.3g}", flush=True)
+        worst = max(worst, float(np.abs(got[:, :2] - points[k]).max()),
+                    float(np.abs(got[:, 2]).max()))
+    return worst, len(frames), len(offsets) - 1
 
 
 def case_groom(source_dir, out_dir):
     """A groom file run inside Blender (bpy.ops.flexkin.run_groom): its mesh at every frame on
     the points of the strand file that flexkin.run_groom writes for the same groom here."""
-    import numpy as np
     new_scene(200)
     groom = os.path.join(source_dir, "examples", "groom_grass_2d.json")
     cache = os.path.join(out_dir, "grass_blender.npz")
@@ -546,26 +552,13 @@ def case_groom(source_dir, out_dir):
         fail("groom: did not finish")
     reference = os.path.join(out_dir, "grass_reference.npz")
     flexkin.run_groom(groom, reference)
-    mesh = bpy.data.objects["groom_grass_2d"]
-    with np.load(reference) as archive:
-        points, frames = archive["points"], archive["frames"]
-    worst = 0.0
-    for k, step in enumerate(frames):
-        bpy.context.scene.frame_set(1 + int(step))
-        got = np.array([tuple(v.co) for v in mesh.data.vertices])
-        worst = max(worst, float(np.abs(got[:, :2] - points[k]).max()))
+    worst, frames, _ = plays_strand_file(bpy.data.objects["groom_grass_2d"], reference)
     if not worst <= 1e-6:
         fail(f"groom: a vertex is {worst:.3g} from flexkin's point")
-    print(f"blender {bpy.app.version_string}: groom file run in Blender: {len(frames)} frames, "
+    print(f"blender {bpy.app.version_string}: groom file run in Blender: {frames} frames, "
           f"largest difference from flexkin.run_groom's {worst:.3g}", flush=True)
     expect_report("groom not found", "cannot run the groom", operator=bpy.ops.flexkin.run_groom,
                   filepath=os.path.join(out_dir, "missing.json"), cache=cache)
-
-
-def archive_offsets(path):
-    import numpy as np
-    with np.load(path) as archive:
-        return archive["offsets"]
 
 
 def hair_timing(out_dir):
