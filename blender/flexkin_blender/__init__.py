@@ -162,7 +162,9 @@ class FLEXKIN_OT_bake_rope(bpy.types.Operator):
 class FLEXKIN_OT_bake_hair(bpy.types.Operator):
     """Bake the natural motion of the active hair curves object's strands as its object (the
     head it is parented to) moves over the scene's frame range: flexkin's strand engine, the
-    roots held on the head; the strands play back as a mesh from a cache file"""
+    roots held on the head; the strands play back as a mesh from a cache file. From the
+    interface the bake runs frame by frame with its progress in the status bar, and Esc cancels
+    it with nothing written"""
     bl_idname = "flexkin.bake_hair"
     bl_label = "Bake hair"
     bl_options = {'REGISTER', 'UNDO'}
@@ -176,33 +178,93 @@ class FLEXKIN_OT_bake_hair(bpy.types.Operator):
         description="The .npz the strands' frames go to (empty: '<hair>.flexkin.npz' beside the "
                     ".blend file, or in the temporary folder for a file not saved)")
 
-    def execute(self, context):
+    def _start(self, context):
+        """Everything read and checked, and the engine's steps ready (self._steps)."""
         import os
-        started = time.perf_counter()
-        hair = context.active_object
+        self._started = time.perf_counter()
+        self._hair = context.active_object
+        flexkin = import_flexkin(context)
+        self._points, self._offsets = bake.hair_strands(self._hair)
+        self._frames, poses = bake.gather_poses(context, self._hair)
+        poses = bake.rigid_poses(self._hair.name, self._frames, poses)
+        self._path = self.cache or (
+            f"//{self._hair.name}.flexkin.npz" if bpy.data.filepath
+            else os.path.join(bpy.app.tempdir, f"{self._hair.name}.flexkin.npz"))
+        self._steps = bake.hair_steps(flexkin, self._points, self._offsets, poses, self.method,
+                                      self.substeps)
+
+    def _finish(self, context, points_at):
+        bake.write_strand_cache(bpy.path.abspath(self._path), points_at, self._offsets,
+                                [f - self._frames[0] for f in self._frames])
+        hair = self._hair
+        collection = hair.users_collection[0] if hair.users_collection else \
+            context.scene.collection
+        mesh = bake.strand_mesh(hair.name + ".flexkin", points_at, self._offsets, self._path,
+                                self._frames[0], collection)
+        bake.play_strands(context.scene)
+        self.report({'INFO'}, f"flexkin: baked {len(self._offsets) - 1} strands "
+                              f"({len(self._points)} points) over {len(self._frames)} frames into "
+                              f"'{mesh.name}' (cache {self._path}) in "
+                              f"{time.perf_counter() - self._started:.2f} s")
+
+    def execute(self, context):
         try:
-            flexkin = import_flexkin(context)
-            points, offsets = bake.hair_strands(hair)
-            frames, poses = bake.gather_poses(context, hair)
-            poses = bake.rigid_poses(hair.name, frames, poses)
-            path = self.cache or (
-                f"//{hair.name}.flexkin.npz" if bpy.data.filepath
-                else os.path.join(bpy.app.tempdir, f"{hair.name}.flexkin.npz"))
-            points_at = bake.run_hair(flexkin, points, offsets, poses, self.method,
-                                      self.substeps, context.window_manager)
-            bake.write_strand_cache(bpy.path.abspath(path), points_at, offsets,
-                                    [f - frames[0] for f in frames])
+            self._start(context)
+            points_at = bake.run_steps(self._steps, context.window_manager,
+                                       len(self._frames))
+            self._finish(context, points_at)
         except bake.BakeError as error:
             self.report({'ERROR'}, str(error))
             return {'CANCELLED'}
-        collection = hair.users_collection[0] if hair.users_collection else \
-            context.scene.collection
-        mesh = bake.strand_mesh(hair.name + ".flexkin", points_at, offsets, path, frames[0],
-                                collection)
-        bake.play_strands(context.scene)
-        self.report({'INFO'}, f"flexkin: baked {len(offsets) - 1} strands ({len(points)} points) "
-                              f"over {len(frames)} frames into '{mesh.name}' (cache {path}) in "
-                              f"{time.perf_counter() - started:.2f} s")
+        return {'FINISHED'}
+
+    def invoke(self, context, event):
+        try:
+            self._start(context)
+        except bake.BakeError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        wm = context.window_manager
+        self._timer = wm.event_timer_add(0.01, window=context.window)
+        wm.progress_begin(0, len(self._frames))
+        wm.modal_handler_add(self)
+        return {'RUNNING_MODAL'}
+
+    def _stop(self, context):
+        wm = context.window_manager
+        wm.event_timer_remove(self._timer)
+        wm.progress_end()
+        context.workspace.status_text_set(None)
+
+    def modal(self, context, event):
+        if event.type == 'ESC':
+            self._stop(context)
+            self.report({'WARNING'}, "flexkin: hair bake cancelled; nothing was written")
+            return {'CANCELLED'}
+        if event.type != 'TIMER':
+            return {'PASS_THROUGH'}
+        deadline = time.perf_counter() + 0.1  # frames for a tenth of a second, then the UI
+        done, points_at = 0, None
+        try:
+            while time.perf_counter() < deadline:
+                done = next(self._steps)
+        except StopIteration as end:
+            points_at = end.value
+        except bake.BakeError as error:
+            self._stop(context)
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        if points_at is None:
+            context.window_manager.progress_update(done)
+            context.workspace.status_text_set(
+                f"flexkin: hair, frame {done} of {len(self._frames)} (Esc cancels)")
+            return {'RUNNING_MODAL'}
+        self._stop(context)
+        try:
+            self._finish(context, points_at)
+        except bake.BakeError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
         return {'FINISHED'}
 
 

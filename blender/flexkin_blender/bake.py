@@ -487,29 +487,41 @@ def rigid_poses(name, frames, poses):
     return out
 
 
-def run_hair(flexkin, points, offsets, poses, method, substeps, window_manager=None):
+def hair_steps(flexkin, points, offsets, poses, method, substeps):
     """The strand engine (flexkin.StrandBatch) on the strands given at the first pose, their
-    roots pinned to the body, the body at each later pose: (F, P, 3) float32 points."""
+    roots pinned to the body, the body at each later pose, as a generator: it yields the number
+    of frames done after each frame, and returns the (F, P, 3) float32 points (StopIteration's
+    value), so that a caller may stop between frames (a cancelled bake) with nothing written."""
     import numpy as np
     strands = [points[offsets[i]:offsets[i + 1]] for i in range(len(offsets) - 1)]
     out = np.empty((len(poses), len(points), 3), dtype=np.float32)
     out[0] = points
-    if window_manager is not None:
-        window_manager.progress_begin(0, len(poses))
     try:
         batch = flexkin.StrandBatch(strands, method=method, substeps=substeps, pinned=1,
                                     rest=poses[0])
         for f in range(1, len(poses)):
             batch.step(poses[f])
             out[f] = np.concatenate(batch.points())
-            if window_manager is not None:
-                window_manager.progress_update(f)
+            yield f + 1
     except flexkin.InputError as error:
         raise BakeError(f"flexkin refused the strands: {error}") from error
+    return out
+
+
+def run_steps(steps, window_manager=None, total=0):
+    """A generator of steps (hair_steps) run to its end, with the window manager's progress."""
+    if window_manager is not None:
+        window_manager.progress_begin(0, total)
+    try:
+        while True:
+            done = next(steps)
+            if window_manager is not None:
+                window_manager.progress_update(done)
+    except StopIteration as end:
+        return end.value
     finally:
         if window_manager is not None:
             window_manager.progress_end()
-    return out
 
 
 def write_strand_cache(path, points, offsets, frames):
