@@ -105,6 +105,13 @@ if [ -d "$build/python/flexkin" ] && ls "$build"/python/flexkin/_flexkin*.so >/d
   # clearance plot and its joints checked against the URDF's limits (docs/colliders.md).
   PYTHONPATH="$build/python" "$python" scripts/snake_robot_demo.py --build "$build" \
     --out out/snake_robot
+  # The Blender add-on (docs/blender.md): a tail and a rope baked and rendered by Blender itself.
+  if command -v blender > /dev/null; then
+    echo "== Blender: a tail carried by an animated Empty and a rope swung by a hand, baked by the"
+    echo "   add-on and rendered headless (out/blender_tail.png, out/blender_rope.png)"
+    blender -b --factory-startup --python blender/examples/walkthrough.py -- \
+      "$build/python" out 2>&1 | grep '^wrote' || { echo "the Blender walkthrough failed" >&2; exit 1; }
+  fi
 else
   echo "skipped: the Python module is not built ($build/python/flexkin; docs/python.md)"
 fi
