@@ -96,7 +96,7 @@ class FLEXKIN_OT_bake_chain(bpy.types.Operator):
             count = len(data["frames"])
             if self.fixed_base:
                 # The chain as a tree: its root's head fixed, its last tail the one target.
-                points, report = bake.run_flexkin_tree(flexkin, data, chain, [len(chain.bones)],
+                points, report = bake.run_flexkin_tree(flexkin, data, chain, [chain.tails[-1]],
                                                        self.method, True)
             else:
                 points = bake.chain_frames(flexkin, data, self.method, self.substeps, wm)

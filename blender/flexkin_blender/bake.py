@@ -21,13 +21,13 @@ METHODS = [
 class Body:
     """Selected bones as a tree of points: `bones` parent first, bone i from point heads[i] to
     point tails[i], up[i] the index in `bones` of its parent (-1: not among them), `parents` the
-    points' parents (-1 for the first bone's head)."""
+    points' parents (-1 for the first bone's head). A bone connected to its parent starts on the
+    parent's tail point; one that is not (or the first) has a head point of its own, hanging from
+    the parent's tail point by a link of the offset's length."""
 
-    def __init__(self, bones, heads, tails, up):
+    def __init__(self, bones, heads, tails, up, parents):
         self.bones, self.heads, self.tails, self.up = bones, heads, tails, up
-        self.parents = [-1] * (len(bones) + 1)
-        for i in range(len(bones)):
-            self.parents[tails[i]] = heads[i]
+        self.parents = parents
 
     def point_of_tail(self, name):
         for bone, tail in zip(self.bones, self.tails):
@@ -51,10 +51,9 @@ def _check_bone(bone):
 
 
 def selected_tree(armature, kind="tree"):
-    """The selected bones of `armature` as a tree: one of them (the root) whose parent is not
-    selected, every other connected to its selected parent (its head on the parent's tail).
-    Point 0 is the root's head and point i + 1 the tail of bones[i]; bones parent first, depth
-    first. Raises BakeError (`kind` names what the selection should be)."""
+    """The selected bones of `armature` as a tree (Body): one of them (the root) whose parent is
+    not selected, every other below it; bones parent first, depth first, point 0 the root's
+    head. Raises BakeError (`kind` names what the selection should be)."""
     if armature is None or armature.type != 'ARMATURE':
         what = "none" if armature is None else \
             f"'{armature.name}', of type {armature.type.lower()}"
@@ -83,14 +82,22 @@ def selected_tree(armature, kind="tree"):
             if len(children) > 1:
                 raise BakeError(f"the selected bones branch at '{bone.name}' ("
                                 + ", ".join(children) + "); select one chain")
+    heads, tails, parents = [], [], []
     for bone, parent in zip(bones, up):
         _check_bone(bone)
-        if parent >= 0 and (bone.head_local - bones[parent].tail_local).length > \
-                1e-6 * max(1.0, bones[parent].length):
-            raise BakeError(f"bone '{bone.name}' does not start at the tail of "
-                            f"'{bones[parent].name}'; the bones must be connected")
-    heads = [0 if parent < 0 else parent + 1 for parent in up]
-    return Body(bones, heads, [i + 1 for i in range(len(bones))], up)
+        if parent < 0 or not bone.use_connect:
+            if parent >= 0 and not (bone.head_local - bones[parent].tail_local).length > 1e-6 * \
+                    max(1.0, bones[parent].length):
+                raise BakeError(f"bone '{bone.name}' starts on the tail of "
+                                f"'{bones[parent].name}' without being connected to it; connect "
+                                "it (Bone Properties > Relations > Connected)")
+            parents.append(-1 if parent < 0 else tails[parent])  # a head point of its own
+            heads.append(len(parents) - 1)
+        else:
+            heads.append(tails[parent])
+        parents.append(heads[-1])
+        tails.append(len(parents) - 1)
+    return Body(bones, heads, tails, up, parents)
 
 
 def _frames(scene):
@@ -132,7 +139,7 @@ def gather(context, armature, body, targets):
                 data["paths"][k].append(target.matrix_world.translation.copy() if target
                                         else world @ pose[first.name].head)
             if f == frames[0]:
-                local = [None] * (len(body.bones) + 1)
+                local = [None] * len(body.parents)
                 for i, bone in enumerate(body.bones):
                     local[body.heads[i]] = pose[bone.name].head.copy()
                     local[body.tails[i]] = pose[bone.name].tail.copy()
@@ -309,7 +316,7 @@ def write_keys(armature, body, frames, keys):
             for k in range(3):
                 _set_curve(action, base + ".rotation_euler", k, bone.name, frames,
                            [e[k] for e in eulers])
-        if i == 0:
+        if i == 0 or not bone.use_connect:  # a head that moves relative to its parent
             for k in range(3):
                 _set_curve(action, base + ".location", k, bone.name, frames,
                            [v[k] for v in keys[bone.name]["location"]])

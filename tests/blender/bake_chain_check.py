@@ -201,16 +201,34 @@ def case_parent_animation():
             [f"b{i:02d}" for i in range(n)], expected, n * length + 0.3)
 
 
-# A body: a spine of 3 bones from the base, two arms of 3 from its top, a head.
-BODY = [  # name, parent, tail (the head is the parent's tail, the spine's first at the origin)
-    ("spine0", None, (0.0, 0.0, 0.3)), ("spine1", "spine0", (0.0, 0.0, 0.6)),
-    ("spine2", "spine1", (0.0, 0.0, 0.9)),
-    ("arm.L0", "spine2", (0.25, 0.0, 0.95)), ("arm.L1", "arm.L0", (0.5, 0.0, 0.9)),
-    ("arm.L2", "arm.L1", (0.7, 0.0, 0.95)),
-    ("arm.R0", "spine2", (-0.25, 0.0, 0.95)), ("arm.R1", "arm.R0", (-0.5, 0.0, 0.9)),
-    ("arm.R2", "arm.R1", (-0.7, 0.0, 0.95)),
-    ("head", "spine2", (0.0, 0.05, 1.15)),
+# A body: a spine of 3 bones from the base, two arms of 3 from its top, a head. The arms start
+# away from the spine's tail (shoulders offset: not connected); the other bones are connected.
+BODY = [  # name, parent, head (None: the parent's tail, connected), tail
+    ("spine0", None, (0.0, 0.0, 0.0), (0.0, 0.0, 0.3)),
+    ("spine1", "spine0", None, (0.0, 0.0, 0.6)), ("spine2", "spine1", None, (0.0, 0.0, 0.9)),
+    ("arm.L0", "spine2", (0.08, 0.0, 0.93), (0.25, 0.0, 0.95)),
+    ("arm.L1", "arm.L0", None, (0.5, 0.0, 0.9)), ("arm.L2", "arm.L1", None, (0.7, 0.0, 0.95)),
+    ("arm.R0", "spine2", (-0.08, 0.0, 0.93), (-0.25, 0.0, 0.95)),
+    ("arm.R1", "arm.R0", None, (-0.5, 0.0, 0.9)), ("arm.R2", "arm.R1", None, (-0.7, 0.0, 0.95)),
+    ("head", "spine2", None, (0.0, 0.05, 1.15)),
 ]
+
+
+def body_points():
+    """The test's own points of BODY: each bone's own head where it has one (hanging from its
+    parent's tail), then its tail; with the parents, and each bone's head and tail point."""
+    points, parents, head_of, tail_of = [], [], {}, {}
+    for name, parent, head, tail in BODY:
+        if head is not None:
+            points.append(head)
+            parents.append(tail_of[parent] if parent else -1)
+            head_of[name] = len(points) - 1
+        else:
+            head_of[name] = tail_of[parent]
+        points.append(tail)
+        parents.append(head_of[name])
+        tail_of[name] = len(points) - 1
+    return points, parents, head_of, tail_of
 
 
 def make_body(location, rotation_z):
@@ -221,13 +239,13 @@ def make_body(location, rotation_z):
     obj.rotation_euler = (0.0, 0.0, rotation_z)
     bpy.context.view_layer.objects.active = obj
     bpy.ops.object.mode_set(mode='EDIT')
-    for name, parent, tail in BODY:
+    for name, parent, head, tail in BODY:
         b = data.edit_bones.new(name)
-        b.head = data.edit_bones[parent].tail if parent else (0.0, 0.0, 0.0)
+        b.head = data.edit_bones[parent].tail if head is None else head
         b.tail = tail
         if parent:
             b.parent = data.edit_bones[parent]
-            b.use_connect = True
+            b.use_connect = head is None
     bpy.ops.object.mode_set(mode='OBJECT')
     for b in data.bones:
         b.select = True
@@ -242,10 +260,7 @@ def case_tree(method, look=False):
     location, turn = Vector((0.5, -0.2, 0.0)), math.radians(20)
     arm = make_body(location, turn)
     to_world = Matrix.Translation(location) @ Matrix.Rotation(turn, 4, 'Z')
-    # The test's own points: the base, then each bone's tail in BODY's order.
-    index = {name: i + 1 for i, (name, _, _) in enumerate(BODY)}
-    points = [(0.0, 0.0, 0.0)] + [tail for _, _, tail in BODY]
-    parents = [-1] + [index[parent] if parent else 0 for _, parent, _ in BODY]
+    points, parents, head_of, index = body_points()
     local_paths = []
     for f in range(frames):
         t = 0.08 * f
@@ -274,11 +289,10 @@ def case_tree(method, look=False):
         fail(f"tree/{method}: flexkin did not reach the test's targets")
     # Compare in the world: the test's points through the armature's world matrix.
     worst, pose = 0.0, arm.pose.bones
-    heads = {name: parents[index[name]] for name, _, _ in BODY}
     for f in range(1, frames + 1):
         scene.frame_set(f)
-        for name, _, _ in BODY:
-            for got, i in ((pose[name].head, heads[name]), (pose[name].tail, index[name])):
+        for name, _, _, _ in BODY:
+            for got, i in ((pose[name].head, head_of[name]), (pose[name].tail, index[name])):
                 want = to_world @ Vector(tuple(expected[f - 1][i]))
                 worst = max(worst, (arm.matrix_world @ got - want).length)
     size = 2.0
@@ -296,7 +310,7 @@ def case_tree(method, look=False):
         print(f"blender {bpy.app.version_string}: tree, {method}: the head's largest angle from "
               f"the ball {gaze:.2g} rad", flush=True)
     print(f"blender {bpy.app.version_string}: tree, {method}: {len(BODY)} bones x {frames} frames, "
-          f"two hands driven{', the head watching a ball' if look else ''}, the base fixed, "
+          f"shoulders offset, two hands driven{', the head watching a ball' if look else ''}, the base fixed, "
           f"largest distance of a baked head or tail from "
           f"flexkin's point {worst:.3g} (scene size {size:.3g}, {worst / size:.2g} of it)",
           flush=True)
