@@ -62,9 +62,83 @@ def import_flexkin(context):
         "set its folder (build/python) in Edit > Preferences > Add-ons > flexkin")
 
 
-class FLEXKIN_OT_bake_chain(bpy.types.Operator):
+class _Bake:
+    """What every bake does with its work: `_work(context)` is a generator that reads and checks
+    the scene, yields (frames done, frames) as flexkin runs, and returns the function that writes
+    the result. From a script (execute) the work runs to its end; from the interface (invoke) it
+    runs between the interface's events, its progress in the status bar, and Esc cancels it with
+    nothing written (the result is written only when the work is done). One undo step."""
+
+    def execute(self, context):
+        self._started = time.perf_counter()
+        try:
+            finish = bake.run_steps(self._work(context), context.window_manager)
+            finish()
+        except bake.BakeError as error:
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        return {'FINISHED'}
+
+    def invoke(self, context, event):
+        if context.window is None:
+            return self.execute(context)
+        self._started = time.perf_counter()
+        self._steps = self._work(context)
+        wm = context.window_manager
+        self._timer = wm.event_timer_add(0.01, window=context.window)
+        self._progress = False
+        wm.modal_handler_add(self)
+        return {'RUNNING_MODAL'}
+
+    def _stop(self, context):
+        wm = context.window_manager
+        wm.event_timer_remove(self._timer)
+        if self._progress:
+            wm.progress_end()
+        context.workspace.status_text_set(None)
+
+    def modal(self, context, event):
+        if event.type == 'ESC':
+            self._stop(context)
+            self.report({'WARNING'}, f"flexkin: {self.bl_label.lower()} cancelled; nothing was "
+                                     "written")
+            return {'CANCELLED'}
+        if event.type != 'TIMER':
+            return {'PASS_THROUGH'}
+        deadline = time.perf_counter() + 0.1  # work for a tenth of a second, then the interface
+        done = total = 0
+        try:
+            while time.perf_counter() < deadline:
+                done, total = next(self._steps)
+        except StopIteration as end:
+            self._stop(context)
+            try:
+                end.value()
+            except bake.BakeError as error:
+                self.report({'ERROR'}, str(error))
+                return {'CANCELLED'}
+            return {'FINISHED'}
+        except bake.BakeError as error:
+            self._stop(context)
+            self.report({'ERROR'}, str(error))
+            return {'CANCELLED'}
+        wm = context.window_manager
+        if not self._progress:
+            wm.progress_begin(0, total)
+            self._progress = True
+        wm.progress_update(done)
+        context.workspace.status_text_set(
+            f"flexkin: {self.bl_label.lower()}, frame {done} of {total} (Esc cancels)")
+        return {'RUNNING_MODAL'}
+
+    def _took(self):
+        return f"in {time.perf_counter() - self._started:.2f} s"
+
+
+class FLEXKIN_OT_bake_chain(_Bake, bpy.types.Operator):
     """Bake the natural motion of the selected bone chain, its first bone driven by a target
-    object or by its own animation, over the scene's frame range"""
+    object or by its own animation (or, with a fixed base, its tip driven), over the scene's
+    frame range"""
     bl_idname = "flexkin.bake_chain"
     bl_label = "Bake bone chain"
     bl_options = {'REGISTER', 'UNDO'}
@@ -82,39 +156,36 @@ class FLEXKIN_OT_bake_chain(bpy.types.Operator):
         description="Hold the chain's first bone's head where it is in the armature and drive "
                     "the last bone's tail to the target instead (a hyper-redundant arm)")
 
-    def execute(self, context):
-        started = time.perf_counter()
-        wm = context.window_manager
+    def _work(self, context):
         armature = context.active_object
-        try:
-            flexkin = import_flexkin(context)
-            chain = bake.selected_chain(armature)
-            if self.fixed_base and not self.target:
-                raise bake.BakeError("the fixed-base mode drives the chain's tip: choose the "
-                                     "target object it follows")
-            data = bake.gather(context, armature, chain, [self.target or None])
-            count = len(data["frames"])
-            if self.fixed_base:
-                # The chain as a tree: its root's head fixed, its last tail the one target.
-                points, report = bake.run_flexkin_tree(flexkin, data, chain, [chain.tails[-1]],
-                                                       self.method, True)
-            else:
-                points = bake.chain_frames(flexkin, data, self.method, self.substeps, wm)
-            keys = bake.pose_keys(armature, chain, data, points)
-        except bake.BakeError as error:
-            self.report({'ERROR'}, str(error))
-            return {'CANCELLED'}
-        bake.write_keys(armature, chain, data["frames"], keys)
-        missed = int((~report["reached"]).sum()) if self.fixed_base else 0
-        self.report({'WARNING'} if missed else {'INFO'},
-                    f"flexkin: baked {len(chain.bones)} bones over {count} frames "
-                    f"({self.method}{', fixed base' if self.fixed_base else ''}) in "
-                    f"{time.perf_counter() - started:.2f} s"
-                    + (f"; {missed} frames did not reach the target" if missed else ""))
-        return {'FINISHED'}
+        flexkin = import_flexkin(context)
+        chain = bake.selected_chain(armature)
+        if self.fixed_base and not self.target:
+            raise bake.BakeError("the fixed-base mode drives the chain's tip: choose the target "
+                                 "object it follows")
+        data = bake.gather(context, armature, chain, [self.target or None])
+        missed = 0
+        if self.fixed_base:
+            # The chain as a tree: its root's head fixed, its last tail the one target.
+            points, missed = yield from bake.tree_steps(flexkin, data, chain, [chain.tails[-1]],
+                                                        self.method, True)
+        else:
+            world = yield from bake.chain_steps(flexkin, data["points"], data["paths"][0][1:],
+                                                self.method, self.substeps)
+            points = bake.in_armature(data, world)
+        keys = bake.pose_keys(armature, chain, data, points)
+
+        def finish():
+            bake.write_keys(armature, chain, data["frames"], keys)
+            self.report({'WARNING'} if missed else {'INFO'},
+                        f"flexkin: baked {len(chain.bones)} bones over {len(data['frames'])} "
+                        f"frames ({self.method}{', fixed base' if self.fixed_base else ''}) "
+                        + self._took()
+                        + (f"; {missed} frames did not reach the target" if missed else ""))
+        return finish
 
 
-class FLEXKIN_OT_bake_rope(bpy.types.Operator):
+class FLEXKIN_OT_bake_rope(_Bake, bpy.types.Operator):
     """Bake the natural motion of the active curve object as a rope of links of one length, its
     first point following a target object, over the scene's frame range, into a new poly curve
     whose points are keyed at every frame"""
@@ -132,39 +203,32 @@ class FLEXKIN_OT_bake_rope(bpy.types.Operator):
         name="Sub-steps", description="Steps of the driven end between two frames",
         default=1, min=1, max=1024)
 
-    def execute(self, context):
-        started = time.perf_counter()
+    def _work(self, context):
         curve = context.active_object
-        wm = context.window_manager
-        try:
-            flexkin = import_flexkin(context)
-            polyline = bake.curve_polyline(context, curve)
-            if not self.target:
-                raise bake.BakeError("the rope has no target: choose the object whose motion "
-                                     "drives its first point")
-            total = sum((b - a).length for a, b in zip(polyline, polyline[1:]))
-            link = self.link_length if self.link_length > 0.0 else total / 32.0
-            points = bake.resample(polyline, link)
-            data = bake.gather_path(context, self.target)
-            count = len(data["frames"])
-            frames = bake.run_chain(flexkin, points, data["path"][1:], self.method,
-                                    self.substeps, wm, "rope")
-        except bake.BakeError as error:
-            self.report({'ERROR'}, str(error))
-            return {'CANCELLED'}
-        rope = bake.write_rope(context, curve, data["frames"], frames)
-        self.report({'INFO'}, f"flexkin: baked '{rope.name}', {len(points) - 1} links of "
-                              f"{link:.4g} over {count} frames ({self.method}) in "
-                              f"{time.perf_counter() - started:.2f} s")
-        return {'FINISHED'}
+        flexkin = import_flexkin(context)
+        polyline = bake.curve_polyline(context, curve)
+        if not self.target:
+            raise bake.BakeError("the rope has no target: choose the object whose motion "
+                                 "drives its first point")
+        total = sum((b - a).length for a, b in zip(polyline, polyline[1:]))
+        link = self.link_length if self.link_length > 0.0 else total / 32.0
+        points = bake.resample(polyline, link)
+        data = bake.gather_path(context, self.target)
+        frames = yield from bake.chain_steps(flexkin, points, data["path"][1:], self.method,
+                                             self.substeps, "rope")
+
+        def finish():
+            rope = bake.write_rope(context, curve, data["frames"], frames)
+            self.report({'INFO'}, f"flexkin: baked '{rope.name}', {len(points) - 1} links of "
+                                  f"{link:.4g} over {len(data['frames'])} frames ({self.method}) "
+                                  + self._took())
+        return finish
 
 
-class FLEXKIN_OT_bake_hair(bpy.types.Operator):
+class FLEXKIN_OT_bake_hair(_Bake, bpy.types.Operator):
     """Bake the natural motion of the active hair curves object's strands as its object (the
     head it is parented to) moves over the scene's frame range: flexkin's strand engine, the
-    roots held on the head; the strands play back as a mesh from a cache file. From the
-    interface the bake runs frame by frame with its progress in the status bar, and Esc cancels
-    it with nothing written"""
+    roots held on the head; the strands play back as a mesh from a cache file"""
     bl_idname = "flexkin.bake_hair"
     bl_label = "Bake hair"
     bl_options = {'REGISTER', 'UNDO'}
@@ -178,94 +242,30 @@ class FLEXKIN_OT_bake_hair(bpy.types.Operator):
         description="The .npz the strands' frames go to (empty: '<hair>.flexkin.npz' beside the "
                     ".blend file, or in the temporary folder for a file not saved)")
 
-    def _start(self, context):
-        """Everything read and checked, and the engine's steps ready (self._steps)."""
+    def _work(self, context):
         import os
-        self._started = time.perf_counter()
-        self._hair = context.active_object
+        hair = context.active_object
         flexkin = import_flexkin(context)
-        self._points, self._offsets = bake.hair_strands(self._hair)
-        self._frames, poses = bake.gather_poses(context, self._hair)
-        poses = bake.rigid_poses(self._hair.name, self._frames, poses)
-        self._path = self.cache or (
-            f"//{self._hair.name}.flexkin.npz" if bpy.data.filepath
-            else os.path.join(bpy.app.tempdir, f"{self._hair.name}.flexkin.npz"))
-        self._steps = bake.hair_steps(flexkin, self._points, self._offsets, poses, self.method,
-                                      self.substeps)
+        points, offsets = bake.hair_strands(hair)
+        frames, poses = bake.gather_poses(context, hair)
+        poses = bake.rigid_poses(hair.name, frames, poses)
+        path = self.cache or (f"//{hair.name}.flexkin.npz" if bpy.data.filepath
+                              else os.path.join(bpy.app.tempdir, f"{hair.name}.flexkin.npz"))
+        points_at = yield from bake.hair_steps(flexkin, points, offsets, poses, self.method,
+                                               self.substeps)
 
-    def _finish(self, context, points_at):
-        bake.write_strand_cache(bpy.path.abspath(self._path), points_at, self._offsets,
-                                [f - self._frames[0] for f in self._frames])
-        hair = self._hair
-        collection = hair.users_collection[0] if hair.users_collection else \
-            context.scene.collection
-        mesh = bake.strand_mesh(hair.name + ".flexkin", points_at, self._offsets, self._path,
-                                self._frames[0], collection)
-        bake.play_strands(context.scene)
-        self.report({'INFO'}, f"flexkin: baked {len(self._offsets) - 1} strands "
-                              f"({len(self._points)} points) over {len(self._frames)} frames into "
-                              f"'{mesh.name}' (cache {self._path}) in "
-                              f"{time.perf_counter() - self._started:.2f} s")
-
-    def execute(self, context):
-        try:
-            self._start(context)
-            points_at = bake.run_steps(self._steps, context.window_manager,
-                                       len(self._frames))
-            self._finish(context, points_at)
-        except bake.BakeError as error:
-            self.report({'ERROR'}, str(error))
-            return {'CANCELLED'}
-        return {'FINISHED'}
-
-    def invoke(self, context, event):
-        try:
-            self._start(context)
-        except bake.BakeError as error:
-            self.report({'ERROR'}, str(error))
-            return {'CANCELLED'}
-        wm = context.window_manager
-        self._timer = wm.event_timer_add(0.01, window=context.window)
-        wm.progress_begin(0, len(self._frames))
-        wm.modal_handler_add(self)
-        return {'RUNNING_MODAL'}
-
-    def _stop(self, context):
-        wm = context.window_manager
-        wm.event_timer_remove(self._timer)
-        wm.progress_end()
-        context.workspace.status_text_set(None)
-
-    def modal(self, context, event):
-        if event.type == 'ESC':
-            self._stop(context)
-            self.report({'WARNING'}, "flexkin: hair bake cancelled; nothing was written")
-            return {'CANCELLED'}
-        if event.type != 'TIMER':
-            return {'PASS_THROUGH'}
-        deadline = time.perf_counter() + 0.1  # frames for a tenth of a second, then the UI
-        done, points_at = 0, None
-        try:
-            while time.perf_counter() < deadline:
-                done = next(self._steps)
-        except StopIteration as end:
-            points_at = end.value
-        except bake.BakeError as error:
-            self._stop(context)
-            self.report({'ERROR'}, str(error))
-            return {'CANCELLED'}
-        if points_at is None:
-            context.window_manager.progress_update(done)
-            context.workspace.status_text_set(
-                f"flexkin: hair, frame {done} of {len(self._frames)} (Esc cancels)")
-            return {'RUNNING_MODAL'}
-        self._stop(context)
-        try:
-            self._finish(context, points_at)
-        except bake.BakeError as error:
-            self.report({'ERROR'}, str(error))
-            return {'CANCELLED'}
-        return {'FINISHED'}
+        def finish():
+            bake.write_strand_cache(bpy.path.abspath(path), points_at, offsets,
+                                    [f - frames[0] for f in frames])
+            collection = hair.users_collection[0] if hair.users_collection else \
+                context.scene.collection
+            mesh = bake.strand_mesh(hair.name + ".flexkin", points_at, offsets, path, frames[0],
+                                    collection)
+            bake.play_strands(context.scene)
+            self.report({'INFO'}, f"flexkin: baked {len(offsets) - 1} strands ({len(points)} "
+                                  f"points) over {len(frames)} frames into '{mesh.name}' (cache "
+                                  f"{path}) " + self._took())
+        return finish
 
 
 class FLEXKIN_OT_import_strands(bpy.types.Operator):
@@ -400,7 +400,7 @@ class FLEXKIN_OT_target_remove(bpy.types.Operator):
         return {'FINISHED'}
 
 
-class FLEXKIN_OT_bake_tree(bpy.types.Operator):
+class FLEXKIN_OT_bake_tree(_Bake, bpy.types.Operator):
     """Bake the natural motion of the selected bones (a tree: a spine with arms, a plant), the
     tails of the scene's target bones (flexkin targets) following their objects, the root's
     head fixed or free, over the scene's frame range"""
@@ -413,41 +413,37 @@ class FLEXKIN_OT_bake_tree(bpy.types.Operator):
         name="Fix the root", default=True,
         description="Hold the root bone's head where it is in the armature (a base)")
 
-    def execute(self, context):
-        started = time.perf_counter()
+    def _work(self, context):
         armature = context.active_object
-        try:
-            flexkin = import_flexkin(context)
-            body = bake.selected_tree(armature)
-            targets, names, looks = [], [], []
-            for k, item in enumerate(context.scene.flexkin_targets):
-                point = body.point_of_tail(item.bone)
-                if point is None:
-                    raise bake.BakeError(f"target {k + 1}: bone '{item.bone}' is not among the "
-                                         "selected bones; select it or remove the target")
-                if item.target is None:
-                    raise bake.BakeError(f"target {k + 1} (bone '{item.bone}') has no object; "
-                                         "choose the object its tail follows")
-                targets.append(point)
-                names.append(item.target.name)
-                looks.append(bool(item.look))
-            if not targets:
-                raise bake.BakeError("the tree has no target: add one (a bone and the object its "
-                                     "tail follows) in the flexkin panel")
-            data = bake.gather(context, armature, body, names)
-            points, report = bake.run_flexkin_tree(flexkin, data, body, targets, self.method,
-                                                   self.fix_root, looks)
-            keys = bake.pose_keys(armature, body, data, points)
-        except bake.BakeError as error:
-            self.report({'ERROR'}, str(error))
-            return {'CANCELLED'}
-        bake.write_keys(armature, body, data["frames"], keys)
-        missed = int((~report["reached"]).sum())
-        self.report({'WARNING'} if missed else {'INFO'},
-                    f"flexkin: baked {len(body.bones)} bones over {len(data['frames'])} frames "
-                    f"({self.method}) in {time.perf_counter() - started:.2f} s"
-                    + (f"; {missed} frames did not reach their targets" if missed else ""))
-        return {'FINISHED'}
+        flexkin = import_flexkin(context)
+        body = bake.selected_tree(armature)
+        targets, names, looks = [], [], []
+        for k, item in enumerate(context.scene.flexkin_targets):
+            point = body.point_of_tail(item.bone)
+            if point is None:
+                raise bake.BakeError(f"target {k + 1}: bone '{item.bone}' is not among the "
+                                     "selected bones; select it or remove the target")
+            if item.target is None:
+                raise bake.BakeError(f"target {k + 1} (bone '{item.bone}') has no object; "
+                                     "choose the object its tail follows")
+            targets.append(point)
+            names.append(item.target.name)
+            looks.append(bool(item.look))
+        if not targets:
+            raise bake.BakeError("the tree has no target: add one (a bone and the object its "
+                                 "tail follows) in the flexkin panel")
+        data = bake.gather(context, armature, body, names)
+        points, missed = yield from bake.tree_steps(flexkin, data, body, targets, self.method,
+                                                    self.fix_root, looks)
+        keys = bake.pose_keys(armature, body, data, points)
+
+        def finish():
+            bake.write_keys(armature, body, data["frames"], keys)
+            self.report({'WARNING'} if missed else {'INFO'},
+                        f"flexkin: baked {len(body.bones)} bones over {len(data['frames'])} "
+                        f"frames ({self.method}) " + self._took()
+                        + (f"; {missed} frames did not reach their targets" if missed else ""))
+        return finish
 
 
 class FLEXKIN_PT_panel(bpy.types.Panel):

@@ -173,50 +173,57 @@ def gather_path(context, target_name):
     return {"frames": frames, "path": path}
 
 
-def run_chain(flexkin, points, path, method, substeps, window_manager=None, what="chain"):
+CHUNK = 16  # frames a piece of a bake's run, between which a bake from the interface may stop
+
+
+def chain_steps(flexkin, points, path, method, substeps, what="chain"):
     """flexkin.run of `points` (world space), the first driven along `path` (a point per frame
-    after the first), with the window manager's progress where given. Returns the frames'
-    points (world space); BakeError where flexkin refuses them."""
-    if window_manager is not None:
-        window_manager.progress_begin(0, len(path) + 1)
-    try:
-        return flexkin.run([list(p) for p in points], [list(p) for p in path], method=method,
-                           substeps=substeps,
-                           progress=(lambda done, total: window_manager.progress_update(done))
-                           if window_manager is not None else None).frames
-    except flexkin.InputError as error:
-        raise BakeError(f"flexkin refused the {what}: {error}") from error
-    finally:
-        if window_manager is not None:
-            window_manager.progress_end()
+    after the first), in pieces of CHUNK frames, each from where the last ended: a generator
+    that yields (frames done, frames) after each piece and returns every frame's points."""
+    frames = [[list(p) for p in points]]
+    total = len(path) + 1
+    for start in range(0, len(path), CHUNK):
+        try:
+            piece = flexkin.run(frames[-1], [list(p) for p in path[start:start + CHUNK]],
+                                method=method, substeps=substeps).frames
+        except flexkin.InputError as error:
+            raise BakeError(f"flexkin refused the {what}: {error}") from error
+        frames += [list(map(list, frame)) for frame in piece[1:]]
+        yield len(frames), total
+    return frames
 
 
-def chain_frames(flexkin, data, method, substeps, window_manager=None):
-    """The chain's frames (run_chain from its first-frame points along its path), every frame's
-    points in the armature's space."""
-    frames = run_chain(flexkin, data["points"], data["paths"][0][1:], method, substeps,
-                       window_manager)
+def in_armature(data, frames):
+    """Every frame's world points in the armature's space at that frame."""
     return [[data["world"][f].inverted() @ Vector(tuple(x)) for x in frame]
             for f, frame in enumerate(frames)]
 
 
-def run_flexkin_tree(flexkin, data, body, targets, method, fix_root, looks=None):
+def tree_steps(flexkin, data, body, targets, method, fix_root, looks=None):
     """flexkin.reach_tree of the body's points in the armature's space, the tail of each target
     bone driven along its target's path (in the armature's space at each frame), or with
-    looks[k] the bone turned to point at it, the root's head fixed or not. Returns the frames'
-    points in the armature's space and the report."""
-    points = [list(p) for p in data["local_points"]]
+    looks[k] the bone turned to point at it, the root's head fixed or not, in pieces of CHUNK
+    frames, each from where the last ended: a generator that yields (frames done, frames) and
+    returns the frames' points in the armature's space and the frames after the first that did
+    not reach their targets."""
+    frames = [list(map(list, data["local_points"]))]
     paths = [[list(data["world"][f].inverted() @ data["paths"][k][f])
               for k in range(len(targets))] for f in range(1, len(data["frames"]))]
-    try:
-        frames, report = flexkin.reach_tree(
-            points, body.parents, targets, paths, fixed=[0] if fix_root else [],
-            method="tractrix" if method == "overall" else method,
-            overall={"squared": 1.0} if method == "overall" else None,
-            looks=looks if looks is not None else [False] * len(targets))
-    except flexkin.InputError as error:
-        raise BakeError(f"flexkin refused the tree: {error}") from error
-    return [[Vector(tuple(x)) for x in frame] for frame in frames], report
+    missed = 0
+    for start in range(0, len(paths), CHUNK):
+        try:
+            piece, report = flexkin.reach_tree(
+                frames[-1], body.parents, targets, paths[start:start + CHUNK],
+                fixed=[0] if fix_root else [],
+                method="tractrix" if method == "overall" else method,
+                overall={"squared": 1.0} if method == "overall" else None,
+                looks=looks if looks is not None else [False] * len(targets))
+        except flexkin.InputError as error:
+            raise BakeError(f"flexkin refused the tree: {error}") from error
+        frames += [list(map(list, frame)) for frame in piece[1:]]
+        missed += int((~report["reached"]).sum())
+        yield len(frames), len(data["frames"])
+    return [[Vector(tuple(x)) for x in frame] for frame in frames], missed
 
 
 def _aligned(rotation, direction):
@@ -496,8 +503,8 @@ def rigid_poses(name, frames, poses):
 
 def hair_steps(flexkin, points, offsets, poses, method, substeps):
     """The strand engine (flexkin.StrandBatch) on the strands given at the first pose, their
-    roots pinned to the body, the body at each later pose, as a generator: it yields the number
-    of frames done after each frame, and returns the (F, P, 3) float32 points (StopIteration's
+    roots pinned to the body, the body at each later pose, as a generator: it yields (frames
+    done, frames) after each frame, and returns the (F, P, 3) float32 points (StopIteration's
     value), so that a caller may stop between frames (a cancelled bake) with nothing written."""
     import numpy as np
     strands = [points[offsets[i]:offsets[i + 1]] for i in range(len(offsets) - 1)]
@@ -509,25 +516,28 @@ def hair_steps(flexkin, points, offsets, poses, method, substeps):
         for f in range(1, len(poses)):
             batch.step(poses[f])
             out[f] = np.concatenate(batch.points())
-            yield f + 1
+            yield f + 1, len(poses)
     except flexkin.InputError as error:
         raise BakeError(f"flexkin refused the strands: {error}") from error
     return out
 
 
-def run_steps(steps, window_manager=None, total=0):
-    """A generator of steps (hair_steps) run to its end, with the window manager's progress."""
-    if window_manager is not None:
-        window_manager.progress_begin(0, total)
+def run_steps(steps, window_manager=None):
+    """A generator of (done, total) steps run to its end, with the window manager's progress;
+    returns its value."""
+    started = False
     try:
         while True:
-            done = next(steps)
+            done, total = next(steps)
             if window_manager is not None:
+                if not started:
+                    window_manager.progress_begin(0, total)
+                    started = True
                 window_manager.progress_update(done)
     except StopIteration as end:
         return end.value
     finally:
-        if window_manager is not None:
+        if started:
             window_manager.progress_end()
 
 

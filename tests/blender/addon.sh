@@ -17,7 +17,7 @@ rm -f "$out/flexkin_blender.zip"
 export BLENDER_USER_SCRIPTS="$out/scripts" BLENDER_USER_CONFIG="$out/config"
 log=$(blender -b --factory-startup --python "$source/tests/blender/bake_chain_check.py" -- \
   "$out/flexkin_blender.zip" "$module" "$source" "$out" 2>&1) || { echo "$log" >&2; echo "FAIL: bake_chain_check" >&2; exit 1; }
-echo "$log" | grep -E '^(blender |report: |timing: )'
+echo "$log" | grep -E '^(blender |report: |timing: |operators: )'
 if ! echo "$log" | grep -q '^ok$'; then
   echo "$log" >&2
   echo "FAIL: bake_chain_check did not finish" >&2

@@ -320,6 +320,16 @@ def case_tree(method, look=False):
 def tree_reports():
     arm = case_tree("tractrix")
     scene = bpy.context.scene
+    # The panel's target list: add (the active bone) and remove.
+    arm.data.bones.active = arm.data.bones["arm.L1"]
+    before = len(scene.flexkin_targets)
+    bpy.ops.flexkin.target_add()
+    if len(scene.flexkin_targets) != before + 1 or scene.flexkin_targets[-1].bone != "arm.L1":
+        fail("target_add did not add the active bone")
+    bpy.ops.flexkin.target_remove(index=len(scene.flexkin_targets) - 1)
+    if len(scene.flexkin_targets) != before:
+        fail("target_remove did not remove the target")
+    print("operators: target_add and target_remove keep the panel's list", flush=True)
     scene.flexkin_targets[0].bone = "nope"
     expect_report("tree target not selected", "bone 'nope' is not among the selected bones",
                   operator=bpy.ops.flexkin.bake_tree)
