@@ -651,6 +651,17 @@ def bad_inputs():
     sys.modules["flexkin"] = None  # import flexkin raises ImportError
     expect_report("module not found", "flexkin's Python module was not found")
     sys.modules["flexkin"] = saved
+    # Not on Python's path, but in the add-on's preferences: found there.
+    sys.modules.pop("flexkin")
+    for name in [m for m in sys.modules if m.startswith("flexkin.")]:
+        sys.modules.pop(name)
+    sys.path.remove(MODULE_DIR)
+    bpy.context.preferences.addons["flexkin_blender"].preferences.module_path = MODULE_DIR
+    if bake(method="tractrix", target="Driver") != {'FINISHED'}:
+        fail("the module in the preferences' folder: the bake did not finish")
+    if MODULE_DIR not in sys.path:
+        fail("the preferences' folder was not put on Python's path")
+    print("report: module found in the preferences' folder", flush=True)
     empty = bpy.data.objects["Driver"]
     bpy.context.view_layer.objects.active = empty
     expect_report("not an armature", "select an armature")
