@@ -89,11 +89,11 @@ format-check: deps
 install: build
 	@cmake --install $(BUILD) --prefix $(PREFIX)
 
-# The add-on for Blender (blender/flexkin_blender, docs/blender.md) as the zip that Blender's
+# The add-on for Blender (blender/addons/flexkin_blender, docs/blender.md) as the zip that Blender's
 # Preferences > Add-ons > Install... takes.
 blender-addon: build
 	@rm -f $(BUILD)/flexkin_blender.zip
-	@cd blender && /usr/bin/python3 -m zipfile -c $(abspath $(BUILD))/flexkin_blender.zip flexkin_blender
+	@cd blender/addons && /usr/bin/python3 -m zipfile -c $(abspath $(BUILD))/flexkin_blender.zip flexkin_blender
 	@echo "wrote $(BUILD)/flexkin_blender.zip"
 
 clean:

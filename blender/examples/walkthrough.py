@@ -17,7 +17,7 @@ from mathutils import Vector
 argv = sys.argv[sys.argv.index("--") + 1:]
 MODULE_DIR, OUT_DIR = argv[0], argv[1]
 sys.path.insert(0, MODULE_DIR)
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "addons"))
 import flexkin_blender  # noqa: E402
 
 flexkin_blender.register()

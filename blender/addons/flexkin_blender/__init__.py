@@ -2,8 +2,9 @@
 trees, computed by flexkin's Python module and baked into keyframes.
 
 Install: Edit > Preferences > Add-ons > Install... and choose the zip that `make blender-addon`
-writes (build/flexkin_blender.zip), or add the repository's blender/ folder to Blender's script
-paths; then enable "Animation: flexkin". The add-on imports flexkin's Python module (built for
+writes (build/flexkin_blender.zip), or by path: set Edit > Preferences > File Paths > Scripts to
+the repository's blender/ folder (it holds addons/flexkin_blender) and restart Blender; then
+enable "Animation: flexkin". The add-on imports flexkin's Python module (built for
 the Python that Debian's Blender runs, /usr/bin/python3): from Python's path, or from the folder
 set in the add-on's preferences.
 """
