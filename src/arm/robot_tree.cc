@@ -289,7 +289,6 @@ RobotTreeSolver::RobotTreeSolver(const RobotTree& robot, RobotTreeOptions option
   w.trial_jac.setZero(rows_, n);
   w.weighted.setZero(n, rows_);
   w.normal.setZero(rows_, rows_);
-  w.ldlt = Eigen::LDLT<Eigen::MatrixXd>(rows_);
   w.held.assign(n, 0);
 }
 
