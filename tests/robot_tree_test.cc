@@ -302,6 +302,14 @@ TEST(RobotTreeSolver, RefusesBadGoalsAndOptions) {
     EXPECT_EQ(e.field(), "goals[1]");
   }
   EXPECT_THROW(solver.Solve(robot.initial, Points::Zero(3, 3)), InputError);
+  Eigen::VectorXd nan_angle = robot.initial;
+  nan_angle[4] = std::nan("");
+  try {
+    solver.Solve(nan_angle, Points::Zero(2, 3));
+    FAIL() << "accepted a NaN angle";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "from[4]");
+  }
   RobotTreeOptions bad;
   bad.weights = {1.0, -1.0};
   try {

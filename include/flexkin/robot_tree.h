@@ -125,7 +125,7 @@ class RobotTreeSolver {
   // joints that would leave their limits put on them and held; a backtracking line search, and
   // Levenberg-Marquardt damping where full steps fail. Where the goals cannot be met, ends once
   // ten iterations gain less than 1e-4 of the squared misses, at the configuration found. Throws
-  // InputError for goals of the wrong shape or not finite.
+  // InputError for angles or goals of the wrong shape or not finite.
   RobotTreeSolve Solve(const Eigen::VectorXd& from, const Points& goals) const;
 
  private:

@@ -300,6 +300,12 @@ RobotTreeSolve RobotTreeSolver::Solve(const Eigen::VectorXd& from, const Points&
     throw InputError("from", "has " + std::to_string(from.size()) + " angles; expected " +
                                  std::to_string(n) + " (one per joint)");
   }
+  for (int j = 0; j < n; ++j) {
+    if (!std::isfinite(from[j])) {
+      throw InputError(Member("from", static_cast<size_t>(j)),
+                       FormatNumber(from[j]) + " is not valid; expected a finite angle (rad)");
+    }
+  }
   if (goals.rows() != k || goals.cols() != 3) {
     throw InputError("goals", "is " + std::to_string(goals.rows()) + " by " +
                                   std::to_string(goals.cols()) + "; expected " + std::to_string(k) +
