@@ -32,6 +32,7 @@
 #include "flexkin/robot_tree.h"
 #include "flexkin/urdf.h"
 #include "kdl_urdf_peer.h"
+#include "solve_counters.h"
 
 namespace flexkin {
 namespace {
@@ -56,14 +57,6 @@ const TreeScenario& Example() {
     return *s.tree;
   }();
   return scenario;
-}
-
-void SetCounters(benchmark::State& state, int64_t solves, int64_t failed, double worst) {
-  state.counters["worst_error"] = worst;
-  state.counters["failed"] = static_cast<double>(failed) / static_cast<double>(solves);
-  state.counters["us_per_solve"] = benchmark::Counter(
-      static_cast<double>(solves), benchmark::Counter::kIsRate | benchmark::Counter::kInvert,
-      benchmark::Counter::kIs1000);
 }
 
 void BM_Kdl(benchmark::State& state) {
@@ -126,7 +119,7 @@ void BM_Kdl(benchmark::State& state) {
     ++solves;
     state.ResumeTiming();
   }
-  SetCounters(state, solves, failed, worst);
+  SetSolveCounters(state, solves, failed, worst);
 }
 
 // Arg: 0 the two hands, 1 the hands and the camera watching the left hand.
@@ -168,7 +161,7 @@ void BM_Flexkin(benchmark::State& state) {
     ++solves;
     state.ResumeTiming();
   }
-  SetCounters(state, solves, failed, worst);
+  SetSolveCounters(state, solves, failed, worst);
   state.counters["iterations"] = static_cast<double>(iterations) / static_cast<double>(solves);
 }
 

@@ -32,6 +32,7 @@
 #include "flexkin/tree.h"
 #include "flexkin/tree_overall.h"
 #include "scenes/scenes.h"
+#include "solve_counters.h"
 
 namespace flexkin {
 namespace {
@@ -78,13 +79,6 @@ KDL::Tree MakeKdlTree(const Tree& t) {
 
 constexpr int kFrames = 120;
 
-void SetCounters(benchmark::State& state, int64_t solves, int64_t failed, double worst) {
-  state.counters["worst_error"] = worst;
-  state.counters["failed"] = static_cast<double>(failed) / static_cast<double>(solves);
-  state.counters["us_per_solve"] = benchmark::Counter(
-      static_cast<double>(solves), benchmark::Counter::kIsRate | benchmark::Counter::kInvert,
-      benchmark::Counter::kIs1000);
-}
 constexpr double kTolerance = 1e-10;
 
 // Args: shape (scenes::TreeKind).
@@ -154,7 +148,7 @@ void BM_Kdl(benchmark::State& state) {
     ++solves;
     state.ResumeTiming();
   }
-  SetCounters(state, solves, failed, worst);
+  SetSolveCounters(state, solves, failed, worst);
 }
 
 // Args: shape, 0 the natural passes (tractrix, centroid) or 1 the overall step.
@@ -183,7 +177,7 @@ void BM_Flexkin(benchmark::State& state) {
     ++solves;
     state.ResumeTiming();
   }
-  SetCounters(state, solves, failed, worst);
+  SetSolveCounters(state, solves, failed, worst);
 }
 
 BENCHMARK(BM_Kdl)->Arg(0)->Arg(1)->Arg(2)->ArgName("shape")->Unit(benchmark::kMicrosecond);

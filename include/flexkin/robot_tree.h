@@ -63,6 +63,7 @@ struct RobotTreeLayout {
   // Each joint's distance along the tree to the nearest tool below it (length; 0 where none).
   std::vector<double> tool_distance;
   double longest_link = 0.0;
+  double mean_link = 0.0;  // the links' mean length
 };
 RobotTreeLayout MakeRobotTreeLayout(const RobotTree& robot);
 
@@ -133,7 +134,6 @@ class RobotTreeSolver {
   RobotTreeOptions options_;
   RobotTreeLayout layout_;
   Eigen::VectorXd winv_;
-  double mean_link_ = 1.0;
   std::vector<std::vector<int>> above_;  // per tool: the joints above it
   std::vector<int> first_row_;           // per tool: its first row of the misses
   int rows_ = 0;

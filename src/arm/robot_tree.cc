@@ -160,6 +160,7 @@ RobotTreeLayout MakeRobotTreeLayout(const RobotTree& robot) {
     at.push_back(x);
     depth.push_back(depth[parent] + length);
     layout.longest_link = std::max(layout.longest_link, length);
+    layout.mean_link += length;  // the total, divided below
     return static_cast<int>(at.size()) - 1;
   };
   const int n = robot.joints();
@@ -176,6 +177,7 @@ RobotTreeLayout MakeRobotTreeLayout(const RobotTree& robot) {
                      "every joint and tool is on the base point; expected a robot of "
                      "positive length");
   }
+  layout.mean_link /= static_cast<double>(layout.parents.size() - 1);
   layout.tool_distance.assign(n, 0.0);
   std::vector<char> has(n, 0);
   for (size_t k = 0; k < robot.tools.size(); ++k) {
@@ -263,16 +265,10 @@ RobotTreeSolver::RobotTreeSolver(const RobotTree& robot, RobotTreeOptions option
   const size_t k = robot.tools.size();
   if (options_.looks.empty()) options_.looks.assign(k, 0);
   if (options_.weights.empty()) options_.weights.assign(k, 1.0);
-  // The mean link of the layout.
-  const Points zero = RobotTreePoints(robot, layout_, Eigen::VectorXd::Zero(n));
-  double total = 0.0;
-  for (size_t i = 1; i < layout_.parents.size(); ++i) {
-    total += (zero.row(i) - zero.row(layout_.parents[i])).norm();
-  }
-  mean_link_ = total / static_cast<double>(layout_.parents.size() - 1);
   winv_.resize(n);
   for (int j = 0; j < n; ++j) {
-    const double d = std::max(layout_.tool_distance[j], 0.5 * mean_link_) / mean_link_;
+    const double d =
+        std::max(layout_.tool_distance[j], 0.5 * layout_.mean_link) / layout_.mean_link;
     winv_[j] = 1.0 / (d * d);
   }
   above_.resize(k);
@@ -358,7 +354,7 @@ RobotTreeSolve RobotTreeSolver::Solve(const Eigen::VectorXd& from, const Points&
                                           : Eigen::Vector3d::Zero());
       m.angle = std::max(m.angle, angle);
       const Eigen::Vector3d u = g.unitOrthogonal(), v = g.cross(u);
-      const double scale = s * mean_link_;
+      const double scale = s * layout_.mean_link;
       (*err)[r0] = scale * u.dot(turn);
       (*err)[r0 + 1] = scale * v.dot(turn);
       for (int j : above_[i]) {

@@ -188,8 +188,7 @@ class TreeScenarioReader : public json_internal::JsonReader {
       s.targets = layout.tool_point;
       s.fixed = {0};
       s.robot = model;
-      RobotTreeSolver check(*model, RobotTreeOptionsOf(s));
-      (void)check;
+      ThrowIfAny(RobotTreeOptionsOf(s).Validate(*model));
     } catch (const InputError& e) {
       Problem p = e.problem();
       const std::string& f = p.field;
@@ -491,23 +490,12 @@ std::string TreeSummary(const TreeScenario& s) {
 
 namespace {
 
-// The largest relative change of the tree's link lengths from `start` to `points`.
-double TreeLinkLengthError(const Tree& start, const Points& points) {
-  double worst = 0.0;
-  for (size_t i = 0; i < start.parents.size(); ++i) {
-    const int u = start.parents[i];
-    if (u < 0) continue;
-    const double length = (start.points.row(i) - start.points.row(u)).norm();
-    worst = std::max(worst, std::abs((points.row(i) - points.row(u)).norm() - length) / length);
-  }
-  return worst;
-}
-
 // A robot tree: every frame's joints solved from the last frame's.
 TreeRunResult RunRobotTree(const TreeScenario& s,
                            const std::function<void(int64_t, int64_t)>& progress) {
   const RobotTree& robot = *s.robot;
   const RobotTreeSolver solver(robot, RobotTreeOptionsOf(s));
+  const TreeStepper links = MakeTreeStepper(Method::kTractrix, s.tree, 0);  // the start's lengths
   const int frames = s.frames();
   TreeRunResult r;
   Eigen::VectorXd q = robot.initial;
@@ -526,7 +514,7 @@ TreeRunResult RunRobotTree(const TreeScenario& s,
     r.reached.push_back(solve.converged);
     r.converged.push_back(1);
     r.finished.push_back(0);
-    r.max_length_error = std::max(r.max_length_error, TreeLinkLengthError(s.tree, r.frames.back()));
+    r.max_length_error = std::max(r.max_length_error, MaxTreeLengthError(links, r.frames.back()));
     if (progress) progress(f + 1, frames);
   }
   return r;
@@ -538,6 +526,7 @@ TreeRunResult RunTree(const TreeScenario& s,
                       const std::function<void(int64_t, int64_t)>& progress) {
   if (s.robot) return RunRobotTree(s, progress);
   TreeRunResult r;
+  const TreeStepper links = MakeTreeStepper(Method::kTractrix, s.tree, 0);  // the start's lengths
   const int frames = s.frames();
   const int dim = static_cast<int>(s.tree.points.cols());
   Points points = s.tree.points;
@@ -581,7 +570,7 @@ TreeRunResult RunTree(const TreeScenario& s,
     r.converged.push_back(converged);
     r.finished.push_back(finished);
     r.frames.push_back(points);
-    r.max_length_error = std::max(r.max_length_error, TreeLinkLengthError(s.tree, points));
+    r.max_length_error = std::max(r.max_length_error, MaxTreeLengthError(links, points));
     if (progress) progress(f + 1, frames);
   }
   return r;

@@ -12,9 +12,12 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <system_error>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "arm/internal.h"
@@ -191,6 +194,28 @@ urdf::ModelInterfaceSharedPtr Parse(const std::string& text) {
   return robot;
 }
 
+// A movable joint's axis in its own frame; InputError (`field` the joint) where it is zero.
+Eigen::Vector3d JointAxis(const urdf::Joint& joint, const std::string& field) {
+  const Eigen::Vector3d axis(joint.axis.x, joint.axis.y, joint.axis.z);
+  if (!(axis.norm() > 0.0) || !axis.allFinite()) {
+    throw InputError(field, "axis is zero; expected a direction");
+  }
+  return axis;
+}
+
+// A joint's limits as written, [lower, upper] (rad, or length for prismatic joints); none for a
+// continuous joint or one without <limit>. InputError where lower > upper.
+std::optional<std::pair<double, double>> JointRange(const urdf::Joint& joint,
+                                                    const std::string& field) {
+  if (joint.type == urdf::Joint::CONTINUOUS || !joint.limits) return std::nullopt;
+  const double lo = joint.limits->lower, hi = joint.limits->upper;
+  if (!(lo <= hi)) {
+    throw InputError(field, "limit lower " + FormatNumber(lo) + " > upper " + FormatNumber(hi) +
+                                "; expected lower <= upper");
+  }
+  return std::make_pair(lo, hi);
+}
+
 }  // namespace
 
 // The radius of a link's collision geometry: the largest radius of its cylinders and spheres (a
@@ -262,9 +287,7 @@ ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
                        "has an unknown type; expected revolute, continuous, prismatic "
                        "or fixed");
     }
-    const Eigen::Vector3d axis(joint->axis.x, joint->axis.y, joint->axis.z);
-    if (!(axis.norm() > 0.0) || !axis.allFinite())
-      throw InputError(field, "axis is zero; expected a direction");
+    const Eigen::Vector3d axis = JointAxis(*joint, field);
     origins.push_back(pose.translation());
     axes.push_back((pose.linear() * axis).normalized());
     names.push_back(joint->name);
@@ -272,13 +295,8 @@ ArmModel ArmFromUrdf(const std::string& text, const UrdfChain& chain) {
     types.push_back(prismatic ? JointType::kPrismatic : JointType::kRevolute);
     // Limits as written: continuous joints have none; revolute ones may span several turns.
     double lo = -kInf, hi = kInf, v = kInf;
-    if (joint->type != urdf::Joint::CONTINUOUS && joint->limits) {
-      lo = joint->limits->lower;
-      hi = joint->limits->upper;
-      if (!(lo <= hi)) {
-        throw InputError(field, "limit lower " + FormatNumber(lo) + " > upper " + FormatNumber(hi) +
-                                    "; expected lower <= upper");
-      }
+    if (const auto range = JointRange(*joint, field)) {
+      std::tie(lo, hi) = *range;
       any_limits = true;
     }
     // A velocity limit of 0 (or none) is taken as no limit, as URDF writers use it.
@@ -438,19 +456,9 @@ RobotTree RobotTreeFromUrdf(const std::string& text, const std::string& base_lin
                                       "ones); make it fixed or start the tree below it "
                                       "(base_link)");
         }
-        const Eigen::Vector3d axis(joint->axis.x, joint->axis.y, joint->axis.z);
-        if (!(axis.norm() > 0.0) || !axis.allFinite()) {
-          throw InputError(field, "axis is zero; expected a direction");
-        }
-        double lo = -kInf, hi = kInf;
-        if (joint->type == urdf::Joint::REVOLUTE && joint->limits) {
-          lo = joint->limits->lower;
-          hi = joint->limits->upper;
-          if (!(lo <= hi)) {
-            throw InputError(field, "limit lower " + FormatNumber(lo) + " > upper " +
-                                        FormatNumber(hi) + "; expected lower <= upper");
-          }
-        }
+        const Eigen::Vector3d axis = JointAxis(*joint, field);
+        const auto range = JointRange(*joint, field);
+        const double lo = range ? range->first : -kInf, hi = range ? range->second : kInf;
         origins.push_back(next.pose.translation());
         axes.push_back((next.pose.linear() * axis).normalized());
         lower.push_back(lo);

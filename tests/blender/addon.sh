@@ -7,10 +7,7 @@
 #   tests/blender/addon.sh SOURCE_DIR PYTHON_MODULE_DIR OUT_DIR
 set -euo pipefail
 source=$1 module=$2 out=$3
-if ! command -v blender > /dev/null; then
-  echo "FAIL: blender is not installed; run scripts/install-deps.sh" >&2
-  exit 1
-fi
+source "$(dirname "$0")/require_blender.sh"
 mkdir -p "$out"
 rm -f "$out/flexkin_blender.zip"
 (cd "$source/blender/addons" && /usr/bin/python3 -m zipfile -c "$out/flexkin_blender.zip" flexkin_blender)

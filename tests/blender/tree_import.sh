@@ -6,10 +6,7 @@
 #   tests/blender/tree_import.sh FLEXKIN_CLI SOURCE_DIR OUT_DIR
 set -euo pipefail
 cli=$1 source=$2 out=$3
-if ! command -v blender > /dev/null; then
-  echo "FAIL: blender is not installed; run scripts/install-deps.sh" >&2
-  exit 1
-fi
+source "$(dirname "$0")/require_blender.sh"
 mkdir -p "$out"
 for name in tree_torso tree_plant tree_robot_two_arms; do
   "$cli" run "$source/examples/$name.json" -o "$out/$name.npz" > /dev/null

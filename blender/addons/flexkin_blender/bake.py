@@ -154,23 +154,13 @@ def gather(context, armature, body, targets):
 
 def gather_path(context, target_name):
     """A rope's driving path: the target object's world position at every frame of the scene's
-    range (the run moves the rope's first point to the second frame's position, and so on).
-    Restores the current frame."""
-    scene = context.scene
-    frames = _frames(scene)
+    range (the run moves the rope's first point to the second frame's position, and so on)."""
     target = bpy.data.objects.get(target_name)
     if target is None:
         raise BakeError(f"target '{target_name}' is not an object of this file; choose the "
                         "object (an Empty) whose motion drives the rope's first point")
-    current = scene.frame_current
-    path = []
-    try:
-        for f in frames:
-            scene.frame_set(f)
-            path.append(target.matrix_world.translation.copy())
-    finally:
-        scene.frame_set(current)
-    return {"frames": frames, "path": path}
+    frames, poses = gather_poses(context, target)
+    return {"frames": frames, "path": [pose[:3, 3] for pose in poses]}
 
 
 CHUNK = 16  # frames a piece of a bake's run, between which a bake from the interface may stop
@@ -466,7 +456,8 @@ def hair_strands(hair):
 
 
 def gather_poses(context, obj):
-    """The object's world matrix (4 by 4, numpy) at every frame of the scene's range."""
+    """The scene's frame range and the object's world matrix (4 by 4, numpy) at every frame of it.
+    Restores the current frame."""
     import numpy as np
     scene = context.scene
     frames = _frames(scene)
