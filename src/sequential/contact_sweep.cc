@@ -6,7 +6,10 @@
 // their rule's tail of each link computed as metric_rules.cc computes it until a link meets a
 // collider, and from there on relative to where that link now lies.
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "flexkin/colliders.h"
@@ -16,6 +19,7 @@
 #include "sequential/rule_table.h"
 #include "sequential/sweep.h"
 #include "world/contact.h"
+#include "world/mesh_collider.h"
 
 namespace flexkin::internal {
 namespace {
@@ -48,16 +52,87 @@ const std::vector<Collider>& NearColliders(const double* head, double total, dou
   return near->size() == colliders.size() ? colliders : *near;
 }
 
+// The colliders of one sweep with, for each, a ball that holds it (its pose's translation and
+// BoundingRadius; a radius < 0 for a half-space, which no ball holds): a link whose distance to
+// that ball, bounded from below by its midpoint's less half its length, leaves the link clear and
+// cannot lower the least clearance measured so far is not measured against the collider (the
+// same steps and the same report, bit for bit: see KeepOutside).
+struct SweepSet {
+  const std::vector<Collider>* colliders = nullptr;
+  std::vector<Eigen::Vector4d> balls;       // centre x, y, z and radius
+  std::vector<char> spheres;                // whether the collider is a sphere (its ball is itself)
+  std::vector<Eigen::Isometry3d> to_local;  // a mesh's world-to-mesh transform (its pose inverted)
+};
+
+// Whether the link [a, b] is beyond mesh collider `c` (see BeyondBall) by the box that holds its
+// triangles (MeshSegmentLowerBound: tighter than the ball round a long or flat mesh), with a
+// margin of 1e-9 of the link and the mesh's size and place for the rounding.
+inline bool BeyondMeshBox(const Collider& c, const Eigen::Isometry3d& to_local,
+                          const Eigen::Vector3d& a, const Eigen::Vector3d& b, double length,
+                          double least) {
+  if (!(least < std::numeric_limits<double>::infinity())) return false;
+  const double floor = least > 0.0 ? least * length : 0.0;
+  const double bound =
+      c.scale * MeshSegmentLowerBound(*c.mesh, to_local * a / c.scale, to_local * b / c.scale) -
+      c.margin;
+  const double guard =
+      1e-9 * (length + c.scale * c.mesh->radius + c.pose.translation().norm() + a.norm());
+  return bound - guard > floor;
+}
+
+// Whether the link [a, b] of length `length`, measured against the collider of `ball`, can
+// neither enter it nor lower `least` (the least clearance so far, relative to the link): the
+// link's clearance is at least |m - centre| - length / 2 - radius (m its midpoint), and the pair
+// is skipped only where that bound is positive and no less than least x length, with a margin
+// of 1e-9 of the bound's terms for the rounding of this test and of the exact clearance.
+inline bool BeyondBall(const Eigen::Vector4d& ball, const Eigen::Vector3d& a,
+                       const Eigen::Vector3d& b, double length, double least) {
+  if (ball[3] < 0.0 || !(least < std::numeric_limits<double>::infinity())) return false;
+  const double floor = least > 0.0 ? least * length : 0.0;
+  const double reach = (0.5 * length + ball[3] + floor) * (1.0 + 1e-9);
+  const Eigen::Vector3d m = 0.5 * (a + b) - ball.head<3>();
+  return m.squaredNorm() > reach * reach;
+}
+
+// The same for a sphere (the ball is the sphere, margin included), with the segment's own
+// distance to its centre instead of the midpoint's bound: d^2 |ab|^2 = |ac|^2 |ab|^2 - (ac.ab)^2
+// where the nearest point is inside the segment, without a division or a root.
+inline bool BeyondSphere(const Eigen::Vector4d& ball, const Eigen::Vector3d& a,
+                         const Eigen::Vector3d& b, double length, double least) {
+  if (!(least < std::numeric_limits<double>::infinity())) return false;
+  const double floor = least > 0.0 ? least * length : 0.0;
+  const double reach = (ball[3] + floor) * (1.0 + 1e-9);
+  const Eigen::Vector3d ac = ball.head<3>() - a, ab = b - a;
+  const double along = ac.dot(ab), ab2 = ab.squaredNorm();
+  if (along <= 0.0) return ac.squaredNorm() > reach * reach;
+  if (along >= ab2) return (ball.head<3>() - b).squaredNorm() > reach * reach;
+  return ac.squaredNorm() * ab2 - along * along > reach * reach * ab2 * (1.0 + 1e-9);
+}
+
 // Link i (1-based) from its leading end `lead` (already placed) to the rule's position of its
 // trailing end `tail`: kept where the link stays outside every collider; else `tail` becomes the
 // clear position at the link's length from `lead` whose direction is nearest in angle to that from
 // `lead` to `toward` (world/contact.h). Counts the contact and the clearance in `stats`; returns
-// whether the link met a collider.
+// whether the link met a collider. A collider the link is beyond (BeyondBall) is not measured:
+// its clearance is then positive and no less than the least so far, so the smallest of the
+// others' decides the contact and the report as the smallest of all would.
 template <int Dim>
 bool KeepOutside(int i, const double* lead, const double* toward, double* tail, double length,
-                 double inv_length, const std::vector<Collider>& colliders, ContactStats* stats) {
-  const Eigen::Vector3d head = In3d<Dim>(lead);
-  double clearance = SegmentClearance(colliders, head, In3d<Dim>(tail));
+                 double inv_length, const SweepSet& set, ContactStats* stats) {
+  const std::vector<Collider>& colliders = *set.colliders;
+  const Eigen::Vector3d head = In3d<Dim>(lead), rule = In3d<Dim>(tail);
+  double clearance = std::numeric_limits<double>::infinity();
+  for (size_t k = 0; k < colliders.size(); ++k) {
+    const bool beyond = set.spheres[k]
+                            ? BeyondSphere(set.balls[k], head, rule, length, stats->least_clearance)
+                            : BeyondBall(set.balls[k], head, rule, length, stats->least_clearance);
+    if (beyond) continue;
+    if (colliders[k].shape == ColliderShape::kMesh &&
+        BeyondMeshBox(colliders[k], set.to_local[k], head, rule, length, stats->least_clearance)) {
+      continue;
+    }
+    clearance = std::min(clearance, SegmentClearance(colliders[k], head, rule));
+  }
   const bool contact = clearance < -kContactSlack * length;
   if (contact) {
     Eigen::Vector3d x;
@@ -75,21 +150,35 @@ bool KeepOutside(int i, const double* lead, const double* toward, double* tail, 
   return contact;
 }
 
-// The colliders a sweep from the new head `head` may meet (NearColliders over the chain's length).
+// The colliders a sweep from the new head `head` may meet (NearColliders over the chain's length),
+// with their balls.
 template <int Dim>
-const std::vector<Collider>& SweepColliders(const double* head, const double* lengths, int n,
-                                            const std::vector<Collider>& all,
-                                            const ContactStats& stats) {
+const SweepSet& SweepColliders(const double* head, const double* lengths, int n,
+                               const std::vector<Collider>& all, const ContactStats& stats) {
   double total = 0.0, longest = 0.0;
   for (int i = 0; i < n; ++i) total += lengths[i], longest = std::fmax(longest, lengths[i]);
   thread_local std::vector<Collider> near;
-  return NearColliders<Dim>(head, total * (1.0 + 1e-12), longest, all, stats, &near);
+  thread_local SweepSet set;
+  set.colliders = &NearColliders<Dim>(head, total * (1.0 + 1e-12), longest, all, stats, &near);
+  set.balls.resize(set.colliders->size());
+  set.spheres.resize(set.colliders->size());
+  for (size_t k = 0; k < set.colliders->size(); ++k) {
+    const Collider& c = (*set.colliders)[k];
+    set.spheres[k] = c.shape == ColliderShape::kSphere;
+    if (c.shape == ColliderShape::kMesh) {
+      if (set.to_local.size() < set.colliders->size()) set.to_local.resize(set.colliders->size());
+      set.to_local[k] = c.pose.inverse(Eigen::Isometry);
+    }
+    set.balls[k] << c.pose.translation(),
+        c.shape == ColliderShape::kHalfSpace ? -1.0 : BoundingRadius(c);
+  }
+  return set;
 }
 
 template <class Rule, int Dim>
 void ContactSweepOf(const double* head, const double* lengths, const double* inv_lengths, int n,
                     double* pts, const std::vector<Collider>& all, ContactStats* stats) {
-  const std::vector<Collider>& colliders = SweepColliders<Dim>(head, lengths, n, all, *stats);
+  const SweepSet& colliders = SweepColliders<Dim>(head, lengths, n, all, *stats);
   double lead_old[Dim], lead_new[Dim];
   for (int k = 0; k < Dim; ++k) {
     lead_old[k] = pts[k];
@@ -120,7 +209,7 @@ void MinRotationContactSweep(const double* head, const double* lengths, const do
     lead_old[k] = pts[k];
     pts[k] += shift[k];
   }
-  const std::vector<Collider>& colliders = SweepColliders<Dim>(pts, lengths, n, all, *stats);
+  const SweepSet& colliders = SweepColliders<Dim>(pts, lengths, n, all, *stats);
   bool shifted = true;  // no link of this sweep has met a collider yet
   for (int i = 1; i <= n; ++i) {
     double* tail = pts + i * Dim;
@@ -152,7 +241,7 @@ void MinJointAngleContactSweep(const double* head, const double* lengths, const 
                                ContactStats* stats) {
   using Vec = Eigen::Matrix<double, Dim, 1>;
   Eigen::Map<Eigen::Matrix<double, Dim, Eigen::Dynamic>> p(pts, Dim, n + 1);
-  const std::vector<Collider>& colliders = SweepColliders<Dim>(head, lengths, n, all, *stats);
+  const SweepSet& colliders = SweepColliders<Dim>(head, lengths, n, all, *stats);
   const Vec head_old = p.col(0), first_old = p.col(1);
   const Vec head_new = Eigen::Map<const Vec>(head);
   Vec first_new = first_old;

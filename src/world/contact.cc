@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "world/mesh_collider.h"
 
@@ -264,7 +265,7 @@ class TailSearch {
       // The head is outside: the crossings say it. Its depths are sampled (midpoints, the end)
       // where SegmentClearance samples others: a quarter of the slack keeps what this test lets
       // through within the slack as SegmentClearance measures it.
-      const Eigen::Isometry3d to_local = c.pose.inverse(Eigen::Isometry);
+      const Eigen::Isometry3d& to_local = ToLocal(static_cast<size_t>(&c - colliders_.data()));
       return MeshSegmentEnters(*c.mesh, to_local * head_ / c.scale,
                                to_local * Tail(theta, psi) / c.scale,
                                (c.margin - 0.25 * kContactSlack * length_) / c.scale);
@@ -273,6 +274,13 @@ class TailSearch {
     // Within the slack: clear, whatever the head's own depth allows (Allowed is never above it).
     if (clearance >= -kContactSlack * length_) return false;
     return clearance < Allowed(static_cast<size_t>(&c - colliders_.data()));
+  }
+
+  // Mesh k's world-to-mesh transform (its pose's inverse), computed when first needed.
+  const Eigen::Isometry3d& ToLocal(size_t k) const {
+    if (to_local_.empty()) to_local_.resize(colliders_.size());
+    if (!to_local_[k]) to_local_[k] = colliders_[k].pose.inverse(Eigen::Isometry);
+    return *to_local_[k];
   }
 
   // What a link may lie inside convex collider k: the slack, or, where the rounding of an earlier
@@ -349,6 +357,7 @@ class TailSearch {
   const Directions& dirs_;
   size_t rounds_ = colliders_.size();    // each convex collider is passed at most once
   mutable std::vector<double> allowed_;  // per collider: the least clearance a link may have
+  mutable std::vector<std::optional<Eigen::Isometry3d>> to_local_;  // per mesh: ToLocal
 };
 
 // The least exit angle near *psi (a sample no larger than its neighbours kStep away, whose exit

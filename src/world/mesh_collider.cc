@@ -370,6 +370,12 @@ double MeshSegmentClearance(const ColliderMeshData& m, const Vector3d& a, const 
   return least;
 }
 
+double MeshSegmentLowerBound(const ColliderMeshData& m, const Vector3d& a, const Vector3d& b) {
+  // Outside the root box by `gap`, every point of the segment is at least that far from every
+  // triangle (each lies within the box, to the padding) and so outside the solid.
+  return SegmentBoxBound(m.bvh->model.getBV(0).bv.obb, a, b) - m.bvh->pad;
+}
+
 namespace {
 
 // The triangles within `radius` of a head `a`, with what the test of a segment from `a` needs:
@@ -384,8 +390,10 @@ struct NearHead {
   struct Triangle {
     int face;
     std::array<Vector3d, 3> edge_planes;
-    double volume;  // (v0 - a) . ((v1 - a) x (v2 - a)); ~0: `a` in its plane, tested directly
-    double plane;   // face_normal . (v0 - a)
+    double volume;    // (v0 - a) . ((v1 - a) x (v2 - a)); ~0: `a` in its plane, tested directly
+    double plane;     // face_normal . (v0 - a)
+    double span;      // |edge_planes[1]|: the scale of `volume`
+    Vector3d normal;  // the face's (MeshBvh::face_normal), kept beside the rest for the loop
   };
   std::vector<Triangle> triangles;
 };
@@ -417,6 +425,8 @@ const NearHead& TrianglesNear(const ColliderMeshData& m, const Vector3d& a, doub
     for (int k = 0; k < 3; ++k) t.edge_planes[k] = v[k].cross(v[(k + 1) % 3]);
     t.volume = v[0].dot(t.edge_planes[1]);
     t.plane = h.face_normal[f].dot(v[0]);
+    t.span = t.edge_planes[1].norm();
+    t.normal = h.face_normal[f];
     near.triangles.push_back(t);
   }
   return near;
@@ -434,29 +444,37 @@ bool MeshSegmentEnters(const ColliderMeshData& m, const Vector3d& a, const Vecto
     const Vector3d ab = b - a;
     const double length = ab.norm();
     const NearHead& near = TrianglesNear(m, a, length * (1.0 + 1e-9) + 2.0 * m.bvh->pad);
-    std::vector<std::pair<double, int>> crossings;
+    thread_local std::vector<std::pair<double, int>> crossings;  // kept: no allocation a test
+    crossings.clear();
     for (const NearHead::Triangle& t : near.triangles) {
-      const double along = m.bvh->face_normal[t.face].dot(ab);
+      const double along = t.normal.dot(ab);
       if (std::fabs(t.plane) <= 1e-12 * length) {
         // The head on the triangle's plane (a contact step put it on the surface, to rounding,
         // either side): the segment crosses it at the head, if the head is on the triangle and
         // the segment leaves the plane.
         if (along == 0.0) continue;
-        const Vector3d n = m.bvh->face_normal[t.face];
+        const Vector3d n = t.normal;
         if (CrossingOf(a + n, a - n, Corner(m, t.face, 0), Corner(m, t.face, 1),
                        Corner(m, t.face, 2)) >= 0.0) {
           crossings.emplace_back(0.0, t.face);
         }
         continue;
       }
-      if (!(std::fabs(t.volume) > 1e-9 * length * t.edge_planes[1].norm())) {
+      if (!(std::fabs(t.volume) > 1e-9 * length * t.span)) {
         const double c =
             CrossingOf(a, b, Corner(m, t.face, 0), Corner(m, t.face, 1), Corner(m, t.face, 2));
         if (c >= 0.0) crossings.emplace_back(c, t.face);
         continue;
       }
-      // The plane is crossed within the segment: t.plane / along in [0, 1].
-      if (along == 0.0 || t.plane / along < 0.0 || t.plane / along > 1.0) continue;
+      // The plane is crossed within the segment: t.plane / along in [0, 1]. Told without the
+      // division (its latency held the loop): |t.plane| > 1e-12 length >= 1e-12 |along| above,
+      // so the quotient does not underflow and is negative exactly where the signs differ; and
+      // for positive doubles x / y rounds above 1 exactly where x > y (a quotient in
+      // (1, 1 + 2^-53] rounds to 1, and x > y makes it at least 1 + ulp(y) / y > 1 + 2^-53).
+      if (along == 0.0 || (t.plane > 0.0) != (along > 0.0) ||
+          std::fabs(t.plane) > std::fabs(along)) {
+        continue;
+      }
       // Exact signs, no tolerance: the plane through `a` and an edge is the same (negated
       // exactly) for the edge's two triangles, so a segment through an edge is counted by one of
       // them at least, and through a triangle near an edge by that triangle only.
@@ -491,7 +509,7 @@ bool MeshSegmentEnters(const ColliderMeshData& m, const Vector3d& a, const Vecto
         const auto deep = [&](const Vector3d& x) {
           const Vector3d from_head = x - a;
           for (const NearHead::Triangle& t : near.triangles) {
-            if (std::fabs(m.bvh->face_normal[t.face].dot(from_head) - t.plane) > depth) continue;
+            if (std::fabs(t.normal.dot(from_head) - t.plane) > depth) continue;
             const Vector3d v0 = Corner(m, t.face, 0), v1 = Corner(m, t.face, 1),
                            v2 = Corner(m, t.face, 2);
             if ((NearestOnTriangle(x, v0, v1, v2).point - x).norm() <= depth) return false;

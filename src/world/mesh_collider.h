@@ -25,6 +25,12 @@ SurfaceQuery MeshSurface(const ColliderMeshData& mesh, const Eigen::Vector3d& p)
 double MeshSegmentClearance(const ColliderMeshData& mesh, const Eigen::Vector3d& a,
                             const Eigen::Vector3d& b);
 
+// A lower bound of MeshSegmentClearance(mesh, a, b), cheap: the segment's distance to the box of
+// the mesh's hierarchy that holds every triangle (less the hierarchy's padding); at most 0 where
+// the segment meets that box (broad phases).
+double MeshSegmentLowerBound(const ColliderMeshData& mesh, const Eigen::Vector3d& a,
+                             const Eigen::Vector3d& b);
+
 // Whether the least signed distance of [a, b] is below `threshold` (the mesh's frame, unscaled),
 // for `a` outside the solid or on its surface (the contact step's head): the contact search's
 // test, which needs no distance, only the crossings (threshold <= 0) or the first triangle
