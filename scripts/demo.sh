@@ -76,8 +76,9 @@ echo "   two-armed URDF robot (15 revolute joints with limits) whose hands go ro
 echo "   its head camera watches the left hand (the joints solved in joint space, docs/trees.md)"
 for name in tree_two_arms tree_plant tree_torso tree_robot_two_arms; do
   "$flexkin" run "examples/$name.json" -o "out/$name.npz"
-  # The figure, the animation, the viewer and the glTF (a bone per link) of the tree result.
-  "$flexkin" render "out/$name.npz" -o out --formats svg,mp4,gif,html,glb --quiet
+  # The figure, the plots, the animation, the viewer and the glTF (a bone per link) of the tree
+  # result.
+  "$flexkin" render "out/$name.npz" -o out --formats svg,plots,mp4,gif,html,glb --quiet
 done
 # The passes and the residual of every frame beside a few frames (matplotlib).
 /usr/bin/python3 examples/python/tree_figure.py out/tree_two_arms.npz
@@ -121,4 +122,5 @@ echo "pictures: out/*.{svg,png,pdf}, out/*_{path_length,link_angles,length_error
 echo "  out/*.{mp4,gif}, out/*.html (open in a browser), out/*.glb (docs/rendering.md)"
 echo "Python examples' figures: out/python/*.png (docs/python-examples.md)"
 echo "trees: out/tree_*.npz (docs/trees.md, \"Results\"), their figures out/tree_*.{svg,png},"
+echo "  plots out/tree_*_{path_length,length_error,target_miss,joint_angles}.{svg,png},"
 echo "  animations out/tree_*.{mp4,gif}, viewers out/tree_*.html and glTF out/tree_*.glb (docs/trees.md, \"Pictures\")"

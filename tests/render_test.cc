@@ -27,6 +27,7 @@
 namespace flexkin {
 namespace {
 
+using render_test::Discs;
 using render_test::Exists;
 using render_test::ReadFile;
 using render_test::SmallScene;
@@ -319,14 +320,6 @@ TEST(SnapshotFigureTest, LinksWithARadiusAreDrawnAsTheirCapsules) {
 
 // The discs (filled paths with curves) of an SVG: where each starts. cairo starts a full circle
 // at angle 0, (x + r, y), so for discs of one radius these are their centres moved by (r, 0).
-std::vector<Eigen::Vector2d> Discs(const std::vector<SvgPath>& paths) {
-  std::vector<Eigen::Vector2d> starts;
-  for (const SvgPath& p : paths) {
-    if (!p.curved || p.style.find("fill:none") != std::string::npos) continue;
-    starts.emplace_back(p.vertices.front().first, p.vertices.front().second);
-  }
-  return starts;
-}
 
 TEST(PlotTest, PathLengthHasOneMarkerPerPointAtItsValue) {
   const ResultFile file = SmallScene(2);

@@ -121,4 +121,14 @@ inline std::vector<SvgPath> SvgPaths(const std::string& svg) {
   return paths;
 }
 
+// The start of each filled curved path of an SVG: cairo's discs (plot markers).
+inline std::vector<Eigen::Vector2d> Discs(const std::vector<SvgPath>& paths) {
+  std::vector<Eigen::Vector2d> starts;
+  for (const SvgPath& p : paths) {
+    if (!p.curved || p.style.find("fill:none") != std::string::npos) continue;
+    starts.emplace_back(p.vertices.front().first, p.vertices.front().second);
+  }
+  return starts;
+}
+
 }  // namespace flexkin::render_test

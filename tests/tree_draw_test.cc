@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -20,6 +21,7 @@
 #include "render/scene.h"
 #include "render/snapshot.h"
 #include "render_test_util.h"
+#include "test_util.h"
 
 namespace flexkin {
 namespace {
@@ -59,12 +61,16 @@ TreeResultFile TwoArms() {
   out.frames = run.frames;
   for (size_t f = 0; f < run.reached.size(); ++f) {
     out.reached.push_back(run.reached[f] && run.converged[f]);
+    Points goals(2, 2);
+    for (int k = 0; k < 2; ++k) goals.row(k) = paths[k].row(static_cast<Eigen::Index>(f));
+    out.goals.push_back(goals);
   }
   return out;
 }
 
 TEST(TreeDrawTest, EveryFormatOfTreesIsWritten) {
-  EXPECT_EQ(FormatNamesOf(DrawnKind::kTreeResult), "svg, png, pdf, mp4, gif, html, gltf, glb");
+  EXPECT_EQ(FormatNamesOf(DrawnKind::kTreeResult),
+            "svg, png, pdf, plots, mp4, gif, html, gltf, glb");
   TempDir dir;
   const TreeResultFile tree = TwoArms();
   DrawOptions options;
@@ -125,20 +131,140 @@ TEST(TreeDrawTest, EveryFormatOfTreesIsWritten) {
     EXPECT_EQ(e.field(), "viewer.trail_points[0]") << e.what();
   }
   options.viewer.trail_points = {};
-  // No plots: refused by name, before anything is written.
-  for (const char* format : {"plots"}) {
-    options.formats = ParseOutputFormats(format, "formats");
-    options.base = dir.Path("refused/arms");
-    try {
-      Draw(tree, options);
-      ADD_FAILURE() << format << " was drawn";
-    } catch (const InputError& e) {
-      EXPECT_EQ(e.field(), "formats");
-      EXPECT_NE(std::string(e.what()).find("is not available for tree results"), std::string::npos)
-          << e.what();
-    }
+  // A plot option out of range: refused by its name, before anything is written.
+  options.formats = ParseOutputFormats("plots", "formats");
+  options.base = dir.Path("refused/arms");
+  options.plot.width = 10;
+  try {
+    Draw(tree, options);
+    ADD_FAILURE() << "a plot 10 wide was drawn";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.field(), "plot.width") << e.what();
   }
   EXPECT_FALSE(std::filesystem::exists(dir.Path("refused")));
+}
+
+// ---- Plots of tree results ----
+
+TEST(TreePlotTest, PlotsOfATreeAreWrittenAsSvgAndPng) {
+  TempDir dir;
+  const TreeResultFile tree = TwoArms();
+  EXPECT_EQ(TreePlotKinds(tree),
+            (std::vector<PlotKind>{PlotKind::kPathLength, PlotKind::kLengthError,
+                                   PlotKind::kTargetMiss}));
+  DrawOptions options;
+  options.base = dir.Path("arms");
+  options.formats = ParseOutputFormats("plots", "formats");
+  const std::vector<std::string> written = Draw(tree, options);
+  std::vector<std::string> expected;
+  for (const char* plot : {"path_length", "length_error", "target_miss"}) {
+    for (const char* extension : {".svg", ".png"}) {
+      expected.push_back(dir.Path("arms_" + std::string(plot) + extension));
+    }
+  }
+  EXPECT_EQ(written, expected);
+  for (const std::string& path : written) EXPECT_GT(std::filesystem::file_size(path), 1000u);
+}
+
+TEST(TreePlotTest, PathLengthHasOneMarkerPerPointAtTheDistanceItTravelled) {
+  TempDir dir;
+  const TreeResultFile tree = TwoArms();
+  WriteTreePlot(tree, PlotKind::kPathLength, PlotOptions(), dir.Path("p.svg"));
+  const std::vector<Eigen::Vector2d> marks =
+      render_test::Discs(render_test::SvgPaths(test_util::ReadFile(dir.Path("p.svg"))));
+  ASSERT_EQ(marks.size(), tree.parents.size());
+  std::vector<double> travelled(tree.parents.size(), 0.0);
+  for (size_t v = 0; v < travelled.size(); ++v) {
+    for (size_t f = 1; f < tree.frames.size(); ++f) {
+      travelled[v] += (tree.frames[f].row(v) - tree.frames[f - 1].row(v)).norm();
+    }
+  }
+  EXPECT_EQ(travelled[0], 0.0);  // the fixed base
+  // Left to right by index, equally spaced; up in proportion to the distance.
+  const double dx = marks[1].x() - marks[0].x();
+  const double per_unit = (marks[4].y() - marks[0].y()) / travelled[4];
+  EXPECT_GT(dx, 0.0);
+  EXPECT_LT(per_unit, 0.0);
+  for (size_t v = 0; v < marks.size(); ++v) {
+    EXPECT_NEAR(marks[v].x() - marks[0].x(), dx * v, 0.02) << v;
+    EXPECT_NEAR(marks[v].y() - marks[0].y(), per_unit * travelled[v], 0.05) << v;
+  }
+}
+
+TEST(TreePlotTest, TargetMissDrawsOneLinePerTargetThroughItsMissesOnALogScale) {
+  TempDir dir;
+  TreeResultFile tree = TwoArms();
+  double longest = 0.0;
+  for (size_t v = 1; v < tree.parents.size(); ++v) {
+    longest =
+        std::max(longest, (tree.frames[0].row(v) - tree.frames[0].row(tree.parents[v])).norm());
+  }
+  // Known misses: every hand on its goal (drawn at the floor, 1e-17), but hand 1 (point 4) 1e-6
+  // of the longest link off it at frame 3 and hand 2 (point 7) 1e-3 off at frame 6.
+  for (size_t f = 1; f < tree.frames.size(); ++f) {
+    for (int k = 0; k < 2; ++k) tree.frames[f].row(tree.targets[k]) = tree.goals[f - 1].row(k);
+  }
+  tree.frames[3](4, 0) += 1e-6 * longest;
+  tree.frames[6](7, 1) -= 1e-3 * longest;
+  WriteTreePlot(tree, PlotKind::kTargetMiss, PlotOptions(), dir.Path("m.svg"));
+  // The two lines (open, of more than two vertices; cairo joins a line's collinear pieces, so
+  // each is the floor, its one peak and the floor again), the last target's drawn first.
+  std::vector<render_test::SvgPath> lines;
+  for (const render_test::SvgPath& p :
+       render_test::SvgPaths(test_util::ReadFile(dir.Path("m.svg")))) {
+    if (!p.closed && !p.curved && p.vertices.size() > 2) lines.push_back(p);
+  }
+  ASSERT_EQ(lines.size(), 2u);
+  struct Peak {
+    double x0 = 0, x = 0, y = 1e300, floor = -1e300;
+  };
+  std::vector<Peak> peaks(2);
+  for (int k = 0; k < 2; ++k) {
+    Peak& p = peaks[k];
+    p.x0 = lines[1 - k].vertices.front().first;
+    for (const auto& [x, y] : lines[1 - k].vertices) {
+      if (y < p.y) p.y = y, p.x = x;
+      p.floor = std::max(p.floor, y);
+    }
+  }
+  EXPECT_NEAR(peaks[0].floor, peaks[1].floor, 1e-6);
+  // Frame 3 and frame 6 from frame 1 (the first drawn): x 2 and 5 frames on.
+  EXPECT_NEAR((peaks[1].x - peaks[1].x0) / (peaks[0].x - peaks[0].x0), 2.5,
+              1e-3);  // SVG rounds to 1e-3 px
+  // 11 decades from the floor (1e-17) up to 1e-6, 3 more up to 1e-3.
+  const double decade = (peaks[0].floor - peaks[0].y) / 11.0;
+  EXPECT_GT(decade, 10.0);
+  EXPECT_NEAR(peaks[0].y - peaks[1].y, 3.0 * decade, 1e-3 * decade);
+}
+
+TEST(TreePlotTest, PlotsATreeHasNoDataForAreRefusedByName) {
+  TempDir dir;
+  TreeResultFile tree = TwoArms();
+  for (PlotKind kind : {PlotKind::kLinkAngles, PlotKind::kEnergy, PlotKind::kJointAngles}) {
+    test_util::ExpectInputError(
+        [&] { WriteTreePlot(tree, kind, PlotOptions(), dir.Path("x.svg")); }, "plot",
+        "path_length, length_error, target_miss");
+  }
+  tree.goals.clear();  // a file without goals: no misses to draw
+  test_util::ExpectInputError(
+      [&] { WriteTreePlot(tree, PlotKind::kTargetMiss, PlotOptions(), dir.Path("x.svg")); }, "plot",
+      "path_length, length_error");
+  tree.frames[3](2, 1) = std::nan("");
+  test_util::ExpectInputError(
+      [&] { WriteTreePlot(tree, PlotKind::kPathLength, PlotOptions(), dir.Path("x.svg")); },
+      "frames[3][2][1]", "");
+  EXPECT_FALSE(std::filesystem::exists(dir.Path("x.svg")));
+  // A chain result has no targets' misses.
+  ResultFile chain;
+  chain.dim = 2;
+  chain.result.lengths = Eigen::VectorXd::Ones(1);
+  Points p(2, 2);
+  p << 0, 0, 1, 0;
+  chain.result.frames.Add(0, p);
+  chain.result.metrics.path_length = Eigen::VectorXd::Zero(2);
+  test_util::ExpectInputError(
+      [&] { WritePlot(chain, PlotKind::kTargetMiss, PlotOptions(), dir.Path("c.svg")); }, "plot",
+      "tree results only");
 }
 
 // The final tree is drawn where its points are: the pixel at each point of the last frame (a

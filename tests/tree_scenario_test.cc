@@ -439,11 +439,19 @@ TEST_F(TreeResultFileTest, TheCommandLineRunsAndValidatesTrees) {
       EXPECT_TRUE(std::filesystem::exists(dir_ / "drawn" / "out.svg"));
       EXPECT_TRUE(std::filesystem::exists(dir_ / "drawn" / "out.glb"));
     }
-    CliProcess p(test_util::kCli, dir_.string(), {"render", "out.npz", "--formats", "plots"});
+    // Plots: a tree result's path length, link-length error and targets' misses.
+    CliProcess p(test_util::kCli, dir_.string(),
+                 {"render", "out.npz", "-o", "plotted", "--formats", "plots"});
     ASSERT_TRUE(p.Wait(60));
-    EXPECT_NE(p.exit_code(), 0);
-    EXPECT_NE(p.err().find("format \"plots\" is not available for tree results"), std::string::npos)
-        << p.err();
+    EXPECT_EQ(p.exit_code(), 0) << p.err();
+    for (const char* plot : {"path_length", "length_error", "target_miss"}) {
+      for (const char* extension : {".svg", ".png"}) {
+        EXPECT_TRUE(
+            std::filesystem::exists(dir_ / "plotted" / ("out_" + std::string(plot) + extension)))
+            << plot << extension;
+      }
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir_ / "plotted" / "out_joint_angles.svg"));  // no robot
     EXPECT_FALSE(IsTreeResultFile(scenario_));
   }
   {

@@ -46,7 +46,9 @@ struct Vocabulary<OutputFormat> {
       {OutputFormat::kSvg, "svg", "<stem>.svg"},
       {OutputFormat::kPng, "png", "<stem>.png"},
       {OutputFormat::kPdf, "pdf", "<stem>.pdf"},
-      {OutputFormat::kPlots, "plots", "<stem>_{path_length,link_angles,length_error}.{svg,png}"},
+      {OutputFormat::kPlots, "plots",
+       "<stem>_{path_length,link_angles,length_error}.{svg,png}; a tree's path_length, "
+       "length_error, target_miss, joint_angles"},
       {OutputFormat::kMp4, "mp4", "<stem>.mp4"},
       {OutputFormat::kGif, "gif", "<stem>.gif"},
       {OutputFormat::kHtml, "html", "<stem>.html"},
@@ -115,6 +117,9 @@ enum class PlotKind {
                  // against the leader step, log scale (FrameLengthErrors)
   kEnergy,       // "energy": a dynamic run's energy (dynamics.energy) at every frame against the
                  // time in seconds; dynamic chains only
+  kTargetMiss,   // "target_miss": a tree result's distance of each driven point from its goal
+                 // (relative to the longest link) against the frame, log scale; trees only
+  kJointAngles,  // "joint_angles": a robot tree's joint angles against the frame; robot trees only
 };
 template <>
 struct Vocabulary<PlotKind> {
@@ -124,6 +129,8 @@ struct Vocabulary<PlotKind> {
       {PlotKind::kLinkAngles, "link_angles", "each link's angle to the pull against the step"},
       {PlotKind::kLengthError, "length_error", "largest relative link-length error per frame"},
       {PlotKind::kEnergy, "energy", "a dynamic run's energy against the time"},
+      {PlotKind::kTargetMiss, "target_miss", "a tree's miss of each target against the frame"},
+      {PlotKind::kJointAngles, "joint_angles", "a robot tree's joint angles against the frame"},
   };
 };
 inline const char* PlotKindName(PlotKind kind) { return NameOf(kind); }
@@ -144,7 +151,8 @@ struct PlotOptions {
 };
 
 // Writes one plot of `file` to `path` (.svg, .png or .pdf). kLinkAngles needs link angles
-// (InputError "frames[f].link_angles" if a frame has none).
+// (InputError "frames[f].link_angles" if a frame has none); kTargetMiss and kJointAngles are
+// trees' (InputError "plot").
 void WritePlot(const ResultFile& file, PlotKind kind, const PlotOptions& options,
                const std::string& path);
 
@@ -211,6 +219,18 @@ void WriteTreeFigure(const TreeResultFile& tree, const FigureOptions& options,
 void WriteTreeAnimation(const TreeResultFile& tree, const AnimationOptions& options,
                         const std::string& path);
 
+// The plots of a tree result (docs/trees.md, "Plots"), against the frame: kPathLength (the
+// distance each point travelled, by its index: the targets' in red, the fixed points' grey),
+// kLengthError (each frame's largest relative link-length error against the first frame's
+// lengths), kTargetMiss (each position target's distance from its goal, relative to the longest
+// link; pointing goals are not drawn) and kJointAngles (a robot tree's). TreePlotKinds: the ones
+// `tree` has the data for (target_miss: goals and a position target; joint_angles: a robot
+// tree's angles). WriteTreePlot throws InputError for invalid options, a tree ValidateTreeResult
+// refuses, or a kind not among TreePlotKinds(tree) ("plot", naming those that are).
+std::vector<PlotKind> TreePlotKinds(const TreeResultFile& tree);
+void WriteTreePlot(const TreeResultFile& tree, PlotKind kind, const PlotOptions& options,
+                   const std::string& path);
+
 namespace internal {
 
 void WriteSnapshotFigure(const CheckedDrawing& drawing, const FigureOptions& options,
@@ -224,6 +244,8 @@ void WriteTreeFigure(const TreeResultFile& tree, const FigureOptions& options,
                      const std::string& path);
 void WriteTreeAnimation(const TreeResultFile& tree, const AnimationOptions& options,
                         const std::string& path);
+void WriteTreePlot(const TreeResultFile& tree, PlotKind kind, const PlotOptions& options,
+                   const std::string& path);
 
 }  // namespace internal
 

@@ -3,6 +3,7 @@ targets"). The targets are reachable by construction (points of another configur
 tree), so every frame must reach them; one target with nothing fixed moves as move_tree moves the
 tree driven at that point, bit for bit; a target out of reach reports its residual."""
 import pathlib
+import re
 
 import numpy as np
 import pytest
@@ -153,9 +154,12 @@ def test_a_tree_result_is_drawn_by_render(tmp_path):
     assert len(times) == len(result["frames"])
     # Joint 0 sits on the root, point 0 (the fixed base).
     np.testing.assert_allclose(positions[:, 0, :], result["frames"][:, 0, :], atol=1e-6)
-    with pytest.raises(flexkin.InputError) as error:
-        flexkin.render(tmp_path / "tree.npz", tmp_path / "drawn", "plots")
-    assert "is not available for tree results" in str(error.value)
+    # Plots of a tree: the points' path lengths, the length error, the hands' misses.
+    written = flexkin.render(tmp_path / "tree.npz", tmp_path / "drawn", "plots")
+    assert [pathlib.Path(p).name for p in written] == [
+        "tree_" + plot + extension
+        for plot in ("path_length", "length_error", "target_miss")
+        for extension in (".svg", ".png")]
 
 
 def test_a_pointing_goal_turns_its_link_onto_what_it_looks_at():
@@ -192,3 +196,11 @@ def test_a_robot_tree_runs_through_the_front_door(tmp_path):
     with np.load(tmp_path / "robot.npz") as archive:
         np.testing.assert_array_equal(archive["angles"], result["angles"])
         np.testing.assert_array_equal(archive["frames"], result["frames"])
+    # A robot tree's plots add its joint angles: one line a joint.
+    written = flexkin.render(tmp_path / "robot.npz", tmp_path / "drawn", "plots")
+    assert [pathlib.Path(p).name for p in written if p.endswith(".svg")] == [
+        "robot_path_length.svg", "robot_length_error.svg", "robot_target_miss.svg",
+        "robot_joint_angles.svg"]
+    svg = (tmp_path / "drawn" / "robot_joint_angles.svg").read_text()
+    paths = re.findall(r' d="([^"]*)"', svg)
+    assert sum(1 for d in paths if d.count(" L ") >= 50) == 15

@@ -47,6 +47,7 @@ void Plots(const Output& o) {
       continue;
     }
     if (kind == PlotKind::kEnergy && !o.drawing->result.result.dynamics.enabled) continue;
+    if (kind == PlotKind::kTargetMiss || kind == PlotKind::kJointAngles) continue;  // trees
     for (const char* extension : {".svg", ".png"}) {
       const std::string path = o.options.base + "_" + name + extension;
       o.Write(path, [&] { internal::WritePlot(*o.drawing, kind, o.options.plot, path); });
@@ -120,6 +121,16 @@ void TreeOutput(const Output& o, OutputFormat format) {
   });
 }
 
+// A tree result's plots: those it has the data for (TreePlotKinds), each as svg and png.
+void TreePlots(const Output& o, OutputFormat) {
+  for (const PlotKind kind : TreePlotKinds(*o.tree)) {
+    for (const char* extension : {".svg", ".png"}) {
+      const std::string path = o.options.base + "_" + PlotKindName(kind) + extension;
+      o.Write(path, [&] { internal::WriteTreePlot(*o.tree, kind, o.options.plot, path); });
+    }
+  }
+}
+
 // The one table: for each format, its writer for each kind (null: not drawn in for that kind).
 // Add a format with one line here and one in the vocabulary (flexkin/render.h).
 struct FormatWriters {
@@ -135,7 +146,7 @@ constexpr FormatWriters kWriters[] = {
     {OutputFormat::kSvg, Figure, Figure, StrandOutput, TreeOutput},
     {OutputFormat::kPng, Figure, Figure, StrandOutput, TreeOutput},
     {OutputFormat::kPdf, Figure, Figure, StrandOutput, TreeOutput},
-    {OutputFormat::kPlots, PlotsOf, nullptr, nullptr, nullptr},
+    {OutputFormat::kPlots, PlotsOf, nullptr, nullptr, TreePlots},
     {OutputFormat::kMp4, Animation, Animation, StrandOutput, TreeOutput},
     {OutputFormat::kGif, Animation, Animation, StrandOutput, TreeOutput},
     {OutputFormat::kHtml, ViewerOf, ViewerOf, StrandOutput, TreeOutput},
@@ -302,6 +313,7 @@ Problems ValidateDrawOptions(DrawnKind kind, const DrawOptions& options) {
     Prefixed(options.strands_viewer.Validate(), "strands_viewer.", &problems);
   } else if (kind == DrawnKind::kTreeResult) {
     Prefixed(options.figure.Validate(), "figure.", &problems);
+    Prefixed(options.plot.Validate(), "plot.", &problems);
     Prefixed(options.animation.Validate(), "animation.", &problems);
     Prefixed(options.viewer.Validate(), "viewer.", &problems);
     Prefixed(options.gltf.Validate(), "gltf.", &problems);

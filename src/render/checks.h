@@ -21,6 +21,9 @@ void CheckRange(const char* field, double value, double lo, double hi, bool inte
 std::string MainTitle(const ResultFile& file, const std::string& title);
 // "tractrix · 20 links · 2650 leader steps".
 std::string RunSummary(const ResultFile& file);
+// The same for a tree result: "tree · tractrix passes · 2D · 8 points · 2 targets · 1 fixed · 13
+// frames, all reached" (a robot tree's: its joints and the Gauss-Newton).
+std::string TreeResultSummary(const TreeResultFile& tree);
 
 // How a picture names and marks what it draws: a chain result's leading end and leader steps, or
 // a robot trajectory's end effector, targets and fixed base (RobotTrajectoryAsResult puts the end

@@ -10,59 +10,27 @@
 #include "render/axes.h"
 #include "render/canvas.h"
 #include "render/checks.h"
+#include "render/plot_parts.h"
 #include "render/snapshot.h"
 
 namespace flexkin {
 namespace {
 
 using render::Axes;
+using render::ColorBar;
+using render::DashedLevel;
+using render::kErrorFloor;
+using render::LogDecades;
+using render::Note;
+using render::PlotArea;
 using render::Rect;
-
-// Relative errors below this are drawn at it on the log axis (exact zeros included).
-constexpr double kErrorFloor = 1e-17;
-
-Rect PlotArea(const render::Canvas& canvas, double extra_right) {
-  const double ui = canvas.ui();
-  return {80 * ui, 66 * ui, canvas.width() - 80 * ui - 26 * ui - extra_right,
-          canvas.height() - 66 * ui - 60 * ui};
-}
-
-void StrokePolyline(cairo_t* cr, const Axes& axes, const std::vector<double>& x,
-                    const std::vector<double>& y, const render::Rgb& color, double width) {
-  for (size_t i = 0; i < x.size(); ++i) {
-    i == 0 ? cairo_move_to(cr, axes.X(x[i]), axes.Y(y[i]))
-           : cairo_line_to(cr, axes.X(x[i]), axes.Y(y[i]));
-  }
-  render::SetColor(cr, color);
-  cairo_set_line_width(cr, width);
-  cairo_stroke(cr);
-}
+using render::StrokePolyline;
 
 // x range of the recorded steps; a single step gets a unit-wide range around it.
 std::pair<double, double> StepRange(const RunResult& r) {
   const double a = static_cast<double>(r.frames.front().step);
   const double b = static_cast<double>(r.frames.back().step);
   return b > a ? std::make_pair(a, b) : std::make_pair(a - 0.5, a + 0.5);
-}
-
-// A dashed red line across the plot at value y (the caller has clipped to the axes).
-void DashedLevel(cairo_t* cr, const Axes& axes, double ui, double y) {
-  cairo_save(cr);
-  const double dash[] = {6 * ui, 4 * ui};
-  cairo_set_dash(cr, dash, 2, 0.0);
-  render::Line(cr, axes.plot().x, axes.Y(y), axes.plot().right(), axes.Y(y), render::kFinal,
-               1.3 * ui);
-  cairo_restore(cr);
-}
-
-// A note in red, its bottom right corner at (x, y).
-void Note(cairo_t* cr, double ui, double x, double y, const char* text) {
-  render::TextStyle note;
-  note.size = 11.5 * ui;
-  note.color = render::kFinal;
-  note.halign = render::Align::kEnd;
-  note.valign = render::Align::kEnd;
-  render::DrawText(cr, x, y, text, note);
 }
 
 void PathLengthPlot(render::Canvas* canvas, const ResultFile& file) {
@@ -137,38 +105,11 @@ void LinkAnglesPlot(render::Canvas* canvas, const ResultFile& file) {
   cairo_restore(cr);
 
   // The colour bar: link 1 (the leading link) at the bottom.
-  const Rect& plot = axes.plot();
-  const double bx = plot.right() + 22 * ui, bw = 14 * ui;
-  const int pieces = 64;
-  for (int k = 0; k < pieces; ++k) {
-    cairo_rectangle(cr, bx, plot.bottom() - plot.h * (k + 1) / pieces, bw, plot.h / pieces + 0.5);
-    render::SetColor(cr, render::Viridis((k + 0.5) / pieces));
-    cairo_fill(cr);
-  }
-  cairo_rectangle(cr, bx, plot.y, bw, plot.h);
-  render::SetColor(cr, render::kInk);
-  cairo_set_line_width(cr, 1.0 * ui);
-  cairo_stroke(cr);
-  render::TextStyle label;
-  label.size = 11.5 * ui;
-  label.color = render::kMuted;
   std::vector<double> ticks;
   for (Eigen::Index i : bold) ticks.push_back(static_cast<double>(i + 1));
   if (bold.empty()) ticks = render::NiceTicks(1.0, static_cast<double>(links), 6);
   if (ticks.empty() || links == 1) ticks = {1.0};
-  for (double t : ticks) {
-    if (t != std::floor(t)) continue;
-    const double py =
-        links == 1 ? plot.bottom() - plot.h / 2 : plot.bottom() - (t - 1.0) / (links - 1) * plot.h;
-    render::Line(cr, bx + bw, py, bx + bw + 4 * ui, py, render::kInk, 1.0 * ui);
-    render::DrawText(cr, bx + bw + 7 * ui, py, std::to_string(static_cast<long long>(t)), label);
-  }
-  render::TextStyle name;
-  name.size = 13 * ui;
-  name.halign = render::Align::kCenter;
-  name.valign = render::Align::kEnd;
-  name.angle = -M_PI / 2;
-  render::DrawText(cr, bx + bw + 34 * ui, plot.y + plot.h / 2, "link (1 = leading link)", name);
+  ColorBar(cr, axes, ui, static_cast<int>(links), ticks, "link (1 = leading link)");
 }
 
 void LengthErrorPlot(render::Canvas* canvas, const ResultFile& file) {
@@ -180,9 +121,7 @@ void LengthErrorPlot(render::Canvas* canvas, const ResultFile& file) {
       std::max({errors.maxCoeff(), r.metrics.max_relative_length_error, kErrorFloor});
   double low = high;
   for (double e : errors) low = std::min(low, std::max(e, kErrorFloor));
-  const double y0 = std::pow(10.0, std::floor(std::log10(low)));
-  double y1 = std::pow(10.0, std::ceil(std::log10(high) + 1e-9));
-  if (y1 <= y0 * 10.0) y1 = y0 * 100.0;
+  const auto [y0, y1] = LogDecades(low, high);
   const auto [x0, x1] = StepRange(r);
   Axes axes(PlotArea(*canvas, 0.0), x0, x1, y0, y1, true);
   axes.Draw(cr, ui, "leader step", "max relative link-length error");
@@ -266,9 +205,7 @@ void internal::WritePlot(const CheckedDrawing& drawing, PlotKind kind, const Plo
   const ResultFile& file = drawing.result;
   const ImageFormat format = ImageFormatFromPath(path);
   render::Canvas canvas(format, options.width, options.height);
-  static const char* kTitles[] = {"Path length of each point", "Angle of each link to the pull",
-                                  "Link-length error", "Energy"};
-  const std::string title = options.title.empty() ? kTitles[static_cast<int>(kind)] : options.title;
+  const std::string title = options.title.empty() ? render::PlotTitle(kind) : options.title;
   render::DrawTitle(canvas.cr(), canvas.ui(), canvas.width(), title,
                     render::MainTitle(file, "") + " \u00b7 " + render::RunSummary(file));
   switch (kind) {
@@ -284,8 +221,108 @@ void internal::WritePlot(const CheckedDrawing& drawing, PlotKind kind, const Plo
     case PlotKind::kEnergy:
       EnergyPlot(&canvas, file);
       break;
+    case PlotKind::kTargetMiss:
+    case PlotKind::kJointAngles:
+      throw InputError("plot", std::string("value \"") + PlotKindName(kind) +
+                                   "\" is not valid for a chain result: it is drawn for tree "
+                                   "results only (WriteTreePlot)");
   }
   render::SaveCanvas(&canvas, path);
 }
+
+namespace render {
+
+const char* PlotTitle(PlotKind kind) {
+  switch (kind) {
+    case PlotKind::kPathLength:
+      return "Path length of each point";
+    case PlotKind::kLinkAngles:
+      return "Angle of each link to the pull";
+    case PlotKind::kLengthError:
+      return "Link-length error";
+    case PlotKind::kEnergy:
+      return "Energy";
+    case PlotKind::kTargetMiss:
+      return "Distance of each target from its goal";
+    case PlotKind::kJointAngles:
+      return "Joint angles";
+  }
+  return "";
+}
+
+Rect PlotArea(const Canvas& canvas, double extra_right) {
+  const double ui = canvas.ui();
+  return {80 * ui, 66 * ui, canvas.width() - 80 * ui - 26 * ui - extra_right,
+          canvas.height() - 66 * ui - 60 * ui};
+}
+
+void StrokePolyline(cairo_t* cr, const Axes& axes, const std::vector<double>& x,
+                    const std::vector<double>& y, const Rgb& color, double width) {
+  for (size_t i = 0; i < x.size(); ++i) {
+    i == 0 ? cairo_move_to(cr, axes.X(x[i]), axes.Y(y[i]))
+           : cairo_line_to(cr, axes.X(x[i]), axes.Y(y[i]));
+  }
+  SetColor(cr, color);
+  cairo_set_line_width(cr, width);
+  cairo_stroke(cr);
+}
+
+void DashedLevel(cairo_t* cr, const Axes& axes, double ui, double y) {
+  cairo_save(cr);
+  const double dash[] = {6 * ui, 4 * ui};
+  cairo_set_dash(cr, dash, 2, 0.0);
+  Line(cr, axes.plot().x, axes.Y(y), axes.plot().right(), axes.Y(y), kFinal, 1.3 * ui);
+  cairo_restore(cr);
+}
+
+void Note(cairo_t* cr, double ui, double x, double y, const char* text) {
+  TextStyle note;
+  note.size = 11.5 * ui;
+  note.color = kFinal;
+  note.halign = Align::kEnd;
+  note.valign = Align::kEnd;
+  DrawText(cr, x, y, text, note);
+}
+
+std::pair<double, double> LogDecades(double low, double high) {
+  const double y0 = std::pow(10.0, std::floor(std::log10(low)));
+  double y1 = std::pow(10.0, std::ceil(std::log10(high) + 1e-9));
+  if (y1 <= y0 * 10.0) y1 = y0 * 100.0;
+  return {y0, y1};
+}
+
+void ColorBar(cairo_t* cr, const Axes& axes, double ui, int count, const std::vector<double>& ticks,
+              const std::string& name) {
+  const Rect& plot = axes.plot();
+  const double bx = plot.right() + 22 * ui, bw = 14 * ui;
+  const int pieces = 64;
+  for (int k = 0; k < pieces; ++k) {
+    cairo_rectangle(cr, bx, plot.bottom() - plot.h * (k + 1) / pieces, bw, plot.h / pieces + 0.5);
+    SetColor(cr, Viridis((k + 0.5) / pieces));
+    cairo_fill(cr);
+  }
+  cairo_rectangle(cr, bx, plot.y, bw, plot.h);
+  SetColor(cr, kInk);
+  cairo_set_line_width(cr, 1.0 * ui);
+  cairo_stroke(cr);
+  TextStyle label;
+  label.size = 11.5 * ui;
+  label.color = kMuted;
+  for (double t : ticks) {
+    if (t != std::floor(t)) continue;
+    const double py =
+        count == 1 ? plot.bottom() - plot.h / 2 : plot.bottom() - (t - 1.0) / (count - 1) * plot.h;
+    Line(cr, bx + bw, py, bx + bw + 4 * ui, py, kInk, 1.0 * ui);
+    DrawText(cr, bx + bw + 7 * ui, py, std::to_string(static_cast<long long>(t)), label);
+  }
+  TextStyle title;
+  title.size = 13 * ui;
+  title.halign = Align::kCenter;
+  title.valign = Align::kEnd;
+  title.angle = -M_PI / 2;
+  DrawText(cr, bx + bw + 34 * ui, plot.y + plot.h / 2, name, title);
+}
+
+}  // namespace render
 
 }  // namespace flexkin

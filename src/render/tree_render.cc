@@ -137,27 +137,6 @@ void DrawLookedAt(cairo_t* cr, const ChainScene& scene, const TreeResultFile& tr
   }
 }
 
-std::string TreeResultSummary(const TreeResultFile& tree) {
-  const bool passes = !(tree.targets.size() == 1 && tree.fixed.empty());
-  const std::string method =
-      tree.robot ? std::string("robot tree \u00b7 ") + std::to_string(tree.joints.size()) +
-                       " joints, joint-space Gauss-Newton"
-                 : std::string("tree \u00b7 ") + MethodName(tree.method) +
-                       (passes && tree.method != Method::kOverall ? " passes" : "");
-  std::string s = method + " \u00b7 " + std::to_string(tree.dim) + "D \u00b7 " +
-                  std::to_string(tree.parents.size()) + " points \u00b7 " +
-                  std::to_string(tree.targets.size()) +
-                  (tree.targets.size() == 1 ? " target" : " targets");
-  if (!tree.fixed.empty()) s += " \u00b7 " + std::to_string(tree.fixed.size()) + " fixed";
-  const int missed =
-      static_cast<int>(std::count(tree.reached.begin(), tree.reached.end(), char(0)));
-  s += " \u00b7 " + std::to_string(tree.frames.size()) + " frames";
-  if (tree.frames.size() > 1) {
-    s += missed == 0 ? ", all reached" : ", " + std::to_string(missed) + " not reached";
-  }
-  return s;
-}
-
 void DrawTreeJoints(cairo_t* cr, const ChainScene& scene, const TreeResultFile& tree,
                     const Points& points, double ui) {
   if (points.rows() <= 41) {
@@ -341,6 +320,27 @@ void DrawTreeAnimation(const TreeResultFile& tree, const AnimationOptions& optio
 }
 
 }  // namespace
+
+std::string TreeResultSummary(const TreeResultFile& tree) {
+  const bool passes = !(tree.targets.size() == 1 && tree.fixed.empty());
+  const std::string method =
+      tree.robot ? std::string("robot tree \u00b7 ") + std::to_string(tree.joints.size()) +
+                       " joints, joint-space Gauss-Newton"
+                 : std::string("tree \u00b7 ") + MethodName(tree.method) +
+                       (passes && tree.method != Method::kOverall ? " passes" : "");
+  std::string s = method + " \u00b7 " + std::to_string(tree.dim) + "D \u00b7 " +
+                  std::to_string(tree.parents.size()) + " points \u00b7 " +
+                  std::to_string(tree.targets.size()) +
+                  (tree.targets.size() == 1 ? " target" : " targets");
+  if (!tree.fixed.empty()) s += " \u00b7 " + std::to_string(tree.fixed.size()) + " fixed";
+  const int missed =
+      static_cast<int>(std::count(tree.reached.begin(), tree.reached.end(), char(0)));
+  s += " \u00b7 " + std::to_string(tree.frames.size()) + " frames";
+  if (tree.frames.size() > 1) {
+    s += missed == 0 ? ", all reached" : ", " + std::to_string(missed) + " not reached";
+  }
+  return s;
+}
 }  // namespace render
 
 void WriteTreeFigure(const TreeResultFile& tree, const FigureOptions& options,
