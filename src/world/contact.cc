@@ -256,7 +256,10 @@ class TailSearch {
     for (const Collider& c : colliders) {
       if (c.shape == ColliderShape::kMesh) rounds_ = std::numeric_limits<size_t>::max() - 1;
     }
-    allowed_.assign(colliders.size(), std::numeric_limits<double>::quiet_NaN());
+    // The thread's buffer (ContactTail does not call itself): no allocation a contact step.
+    thread_local std::vector<double> allowed;
+    allowed.assign(colliders.size(), std::numeric_limits<double>::quiet_NaN());
+    allowed_ = &allowed;
   }
 
   Vector3d Tail(double theta, double psi) const { return head_ + length_ * dirs_.At(theta, psi); }
@@ -288,7 +291,7 @@ class TailSearch {
   // directions leading out of the collider are not held against the link. Computed when first
   // needed (a collider the link does not reach never needs it).
   double Allowed(size_t k) const {
-    double& allowed = allowed_[k];
+    double& allowed = (*allowed_)[k];
     if (std::isnan(allowed)) {
       const Collider& c = colliders_[k];
       allowed = -kContactSlack * length_;
@@ -355,8 +358,8 @@ class TailSearch {
   const double length_;
   const std::vector<Collider>& colliders_;
   const Directions& dirs_;
-  size_t rounds_ = colliders_.size();    // each convex collider is passed at most once
-  mutable std::vector<double> allowed_;  // per collider: the least clearance a link may have
+  size_t rounds_ = colliders_.size();       // each convex collider is passed at most once
+  std::vector<double>* allowed_ = nullptr;  // per collider: the least clearance a link may have
   mutable std::vector<std::optional<Eigen::Isometry3d>> to_local_;  // per mesh: ToLocal
 };
 
