@@ -468,6 +468,15 @@ OverallReport ContactSolver::Solve(Points* x_io) {
   Point p, trial;
   p.x = *x_io;
   Evaluate(&p, true);
+  // A contact the start has left (off its surface by more than 1e-6 of its link) starts without
+  // the multiplier the last sub-step left it (a link's contact passed to its end point, say):
+  // held as an equality it would pull its point back onto the surface, and the links beside it
+  // inside (at a box's corner the iteration then stalled there).
+  for (Contact& c : p.near) {
+    if (c.multiplier > 0.0 && c.value > 1e-6 * lengths_[c.index - 1]) {
+      Multiplier(c) = c.multiplier = 0.0;
+    }
+  }
   StartingMultipliers(p);
   Eigen::VectorXd residual, solution;
   std::vector<int> working;
