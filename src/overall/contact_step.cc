@@ -144,6 +144,40 @@ class ContactSolver {
   Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu_;
 };
 
+// A link on a sharp box's edge (its nearest point within 1e-9 of the box's size of two faces'
+// planes, not of a third): the signed distance between the link's line and the edge's is smooth
+// there, and its gradient is their common perpendicular, d x u for the link's direction d and
+// the edge's u, turned outward. Where the link crosses the edge that is the normal, whatever face
+// the point measures nearest; kept only inside the edge's cone of outward normals (else a face
+// is nearer, and `*normal` stands).
+void BoxEdgeNormal(const Collider& c, const Vector3d& a, const Vector3d& b, double s,
+                   Vector3d* normal) {
+  if (c.margin > 0.0) return;  // rounded edges: the distance is smooth already
+  const Eigen::Isometry3d to_local = c.pose.inverse(Eigen::Isometry);
+  const Vector3d la = to_local * a, lb = to_local * b, p = la + s * (lb - la);
+  const double tol = 1e-9 * c.extents.norm();
+  int on[3], count = 0, free_axis = -1;
+  for (int k = 0; k < 3; ++k) {
+    on[k] = std::fabs(std::fabs(p[k]) - c.extents[k]) <= tol ? (p[k] > 0.0 ? 1 : -1) : 0;
+    if (on[k] != 0)
+      ++count;
+    else
+      free_axis = k;
+  }
+  if (count != 2) return;
+  const Vector3d d = (lb - la).normalized(), u = Vector3d::Unit(free_axis);
+  Vector3d n = d.cross(u);
+  if (!(n.norm() > 1e-6)) return;  // the link along the edge: no single perpendicular
+  n.normalize();
+  Vector3d outward = Vector3d::Zero();
+  for (int k = 0; k < 3; ++k) outward[k] = on[k];
+  if (n.dot(outward) < 0.0) n = -n;
+  for (int k = 0; k < 3; ++k) {
+    if (on[k] != 0 && n[k] * on[k] < 0.0) return;  // outside the edge's cone: a face is nearer
+  }
+  *normal = c.pose.linear() * n;
+}
+
 Contact ContactSolver::Measure(const Contact& contact, const Points& x) const {
   Contact out = contact;
   const Collider& c = colliders_[contact.collider];
@@ -172,6 +206,7 @@ Contact ContactSolver::Measure(const Contact& contact, const Points& x) const {
     if (edged && near.clearance < hair) {
       const Vector3d shift = (hair - near.clearance) * near.normal;
       out.normal = NearestOnSegment(c, a + shift, b + shift).normal;
+      if (c.shape == ColliderShape::kBox) BoxEdgeNormal(c, a, b, near.s, &out.normal);
     }
     if (dim_ == 2 && near.s > 0.0 && near.s < 1.0) {
       // Where the interior is nearest, the normal is across the link (exactly so on a smooth
