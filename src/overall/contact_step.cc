@@ -37,6 +37,7 @@
 #include "overall/objective.h"
 #include "overall/step.h"
 #include "world/contact.h"
+#include "world/mesh_collider.h"
 
 namespace flexkin::internal {
 namespace {
@@ -178,6 +179,24 @@ void BoxEdgeNormal(const Collider& c, const Vector3d& a, const Vector3d& b, doub
   *normal = c.pose.linear() * n;
 }
 
+// The same on a mesh's convex edge (MeshNearestConvexEdge): the common perpendicular of the
+// link's line and the edge's, turned outward, where it lies between the two faces' normals.
+void MeshEdgeNormal(const Collider& c, const Vector3d& a, const Vector3d& b, double s,
+                    Vector3d* normal) {
+  if (c.margin > 0.0 || !(s > 0.0 && s < 1.0)) return;
+  const Eigen::Isometry3d to_local = c.pose.inverse(Eigen::Isometry);
+  const Vector3d la = to_local * a / c.scale, lb = to_local * b / c.scale;
+  Vector3d from, to, n1, n2;
+  if (!MeshNearestConvexEdge(*c.mesh, la + s * (lb - la), &from, &to, &n1, &n2)) return;
+  Vector3d n = (lb - la).normalized().cross((to - from).normalized());
+  if (!(n.norm() > 1e-6)) return;  // the link along the edge
+  n.normalize();
+  if (n.dot(n1 + n2) < 0.0) n = -n;
+  const Vector3d across = n1.cross(n2);
+  if (n.cross(n2).dot(across) < 0.0 || n1.cross(n).dot(across) < 0.0) return;
+  *normal = c.pose.linear() * n;
+}
+
 Contact ContactSolver::Measure(const Contact& contact, const Points& x) const {
   Contact out = contact;
   const Collider& c = colliders_[contact.collider];
@@ -207,6 +226,7 @@ Contact ContactSolver::Measure(const Contact& contact, const Points& x) const {
       const Vector3d shift = (hair - near.clearance) * near.normal;
       out.normal = NearestOnSegment(c, a + shift, b + shift).normal;
       if (c.shape == ColliderShape::kBox) BoxEdgeNormal(c, a, b, near.s, &out.normal);
+      if (c.shape == ColliderShape::kMesh) MeshEdgeNormal(c, a, b, near.s, &out.normal);
     }
     if (dim_ == 2 && near.s > 0.0 && near.s < 1.0) {
       // Where the interior is nearest, the normal is across the link (exactly so on a smooth

@@ -370,6 +370,21 @@ double MeshSegmentClearance(const ColliderMeshData& m, const Vector3d& a, const 
   return least;
 }
 
+bool MeshNearestConvexEdge(const ColliderMeshData& m, const Vector3d& p, Vector3d* from,
+                           Vector3d* to, Vector3d* n1, Vector3d* n2) {
+  const Nearest n = NearestToPoint(m, p);
+  if (n.face < 0 || n.feature < 3) return false;
+  const int k = n.feature - 3;
+  *from = Corner(m, n.face, k);
+  *to = Corner(m, n.face, (k + 1) % 3);
+  *n1 = m.bvh->face_normal[n.face];
+  *n2 = m.bvh->edge_normal[m.bvh->face_edges[n.face][k]] - *n1;
+  // The face runs counter-clockwise seen from outside: n1 x u points into it, and the other face
+  // turns away from it at a convex edge.
+  const Vector3d u = (*to - *from).normalized();
+  return n2->dot(n1->cross(u)) < -1e-9;
+}
+
 double MeshSegmentLowerBound(const ColliderMeshData& m, const Vector3d& a, const Vector3d& b) {
   // Outside the root box by `gap`, every point of the segment is at least that far from every
   // triangle (each lies within the box, to the padding) and so outside the solid.

@@ -25,6 +25,13 @@ SurfaceQuery MeshSurface(const ColliderMeshData& mesh, const Eigen::Vector3d& p)
 double MeshSegmentClearance(const ColliderMeshData& mesh, const Eigen::Vector3d& a,
                             const Eigen::Vector3d& b);
 
+// Where the mesh's feature nearest p (its frame, unscaled) is a convex edge: its ends (`from` to
+// `to`, in the order of the face on one side) and the outward normals of its two faces; false
+// for a face, a vertex, or a flat or reflex edge.
+bool MeshNearestConvexEdge(const ColliderMeshData& mesh, const Eigen::Vector3d& p,
+                           Eigen::Vector3d* from, Eigen::Vector3d* to, Eigen::Vector3d* n1,
+                           Eigen::Vector3d* n2);
+
 // A lower bound of MeshSegmentClearance(mesh, a, b), cheap: the segment's distance to the box of
 // the mesh's hierarchy that holds every triangle (less the hierarchy's padding); at most 0 where
 // the segment meets that box (broad phases).
