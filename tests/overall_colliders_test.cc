@@ -243,6 +243,15 @@ TEST(OverallCollidersTest, EveryShapeKeepsEveryLinkOutsideWhereTheFreeRunCutsThr
         EXPECT_GE(LeastBrute(result, c), -1e-12);
       }
       if (smooth) EXPECT_EQ(result.overall.failures, 0) << result.overall.first_failure;
+      // Edges (docs/colliders.md): a link over an edge takes the common perpendicular as its
+      // normal, and a contact the start has left drops its multiplier. Measured 166 of 167 in 2D
+      // on the box and its mesh, 146, 114 and 100 of 169 in 3D on the box, its mesh and the L
+      // (158, 158, 113, 99 and 87 before); held with a margin for other builds' rounding.
+      const long long converged = result.overall.solves - result.overall.failures;
+      if (name == "box" || name == "box mesh") {
+        EXPECT_GE(converged, dim == 2 ? 162 : (name == "box" ? 140 : 108));
+      }
+      if (name == "L-shaped mesh" && dim == 3) EXPECT_GE(converged, 95);
       std::printf(
           "%s %dD: %lld of %lld sub-steps converged, %lld link steps in contact, least "
           "clearance %.3g, length error %.3g (%.2f s)\n",
