@@ -145,56 +145,47 @@ class ContactSolver {
   Eigen::SparseLU<Eigen::SparseMatrix<double>, Eigen::COLAMDOrdering<int>> lu_;
 };
 
-// A link on a sharp box's edge (its nearest point within 1e-9 of the box's size of two faces'
-// planes, not of a third): the signed distance between the link's line and the edge's is smooth
-// there, and its gradient is their common perpendicular, d x u for the link's direction d and
-// the edge's u, turned outward. Where the link crosses the edge that is the normal, whatever face
-// the point measures nearest; kept only inside the edge's cone of outward normals (else a face
-// is nearer, and `*normal` stands).
-void BoxEdgeNormal(const Collider& c, const Vector3d& a, const Vector3d& b, double s,
-                   Vector3d* normal) {
-  if (c.margin > 0.0) return;  // rounded edges: the distance is smooth already
+// A link over a convex edge of a sharp box or a mesh: the signed distance between the link's
+// line and the edge's is smooth there, and its gradient is their common perpendicular, d x u for
+// the link's direction d and the edge's u, turned outward. Where the link crosses the edge that
+// is the normal, whatever face the point measures nearest (their normals turn by up to a right
+// angle across it). Into `*normal` (world), where the link's nearest point (parameter s) lies on
+// such an edge and the perpendicular lies between its two faces' normals (else a face is nearer);
+// returns whether it did. The edge: for a box, the point within 1e-9 of its size of two faces'
+// planes and not of a third; for a mesh, MeshNearestConvexEdge.
+bool EdgeNormal(const Collider& c, const Vector3d& a, const Vector3d& b, double s,
+                Vector3d* normal) {
+  if (c.margin > 0.0 || !(s > 0.0 && s < 1.0)) return false;  // rounded edges are smooth already
+  if (c.shape != ColliderShape::kBox && c.shape != ColliderShape::kMesh) return false;
   const Eigen::Isometry3d to_local = c.pose.inverse(Eigen::Isometry);
-  const Vector3d la = to_local * a, lb = to_local * b, p = la + s * (lb - la);
-  const double tol = 1e-9 * c.extents.norm();
-  int on[3], count = 0, free_axis = -1;
-  for (int k = 0; k < 3; ++k) {
-    on[k] = std::fabs(std::fabs(p[k]) - c.extents[k]) <= tol ? (p[k] > 0.0 ? 1 : -1) : 0;
-    if (on[k] != 0)
-      ++count;
-    else
-      free_axis = k;
+  const double scale = c.shape == ColliderShape::kMesh ? c.scale : 1.0;
+  const Vector3d la = to_local * a / scale, lb = to_local * b / scale, p = la + s * (lb - la);
+  Vector3d u, n1 = Vector3d::Zero(), n2 = Vector3d::Zero();
+  if (c.shape == ColliderShape::kBox) {
+    const double tol = 1e-9 * c.extents.norm();
+    int count = 0, free_axis = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (std::fabs(std::fabs(p[k]) - c.extents[k]) > tol) {
+        free_axis = k;
+        continue;
+      }
+      (count++ == 0 ? n1 : n2)[k] = p[k] > 0.0 ? 1.0 : -1.0;
+    }
+    if (count != 2) return false;
+    u = Vector3d::Unit(free_axis);
+  } else {
+    Vector3d from, to;
+    if (!MeshNearestConvexEdge(*c.mesh, p, &from, &to, &n1, &n2)) return false;
+    u = (to - from).normalized();
   }
-  if (count != 2) return;
-  const Vector3d d = (lb - la).normalized(), u = Vector3d::Unit(free_axis);
-  Vector3d n = d.cross(u);
-  if (!(n.norm() > 1e-6)) return;  // the link along the edge: no single perpendicular
-  n.normalize();
-  Vector3d outward = Vector3d::Zero();
-  for (int k = 0; k < 3; ++k) outward[k] = on[k];
-  if (n.dot(outward) < 0.0) n = -n;
-  for (int k = 0; k < 3; ++k) {
-    if (on[k] != 0 && n[k] * on[k] < 0.0) return;  // outside the edge's cone: a face is nearer
-  }
-  *normal = c.pose.linear() * n;
-}
-
-// The same on a mesh's convex edge (MeshNearestConvexEdge): the common perpendicular of the
-// link's line and the edge's, turned outward, where it lies between the two faces' normals.
-void MeshEdgeNormal(const Collider& c, const Vector3d& a, const Vector3d& b, double s,
-                    Vector3d* normal) {
-  if (c.margin > 0.0 || !(s > 0.0 && s < 1.0)) return;
-  const Eigen::Isometry3d to_local = c.pose.inverse(Eigen::Isometry);
-  const Vector3d la = to_local * a / c.scale, lb = to_local * b / c.scale;
-  Vector3d from, to, n1, n2;
-  if (!MeshNearestConvexEdge(*c.mesh, la + s * (lb - la), &from, &to, &n1, &n2)) return;
-  Vector3d n = (lb - la).normalized().cross((to - from).normalized());
-  if (!(n.norm() > 1e-6)) return;  // the link along the edge
+  Vector3d n = (lb - la).normalized().cross(u);
+  if (!(n.norm() > 1e-6)) return false;  // the link along the edge: no single perpendicular
   n.normalize();
   if (n.dot(n1 + n2) < 0.0) n = -n;
   const Vector3d across = n1.cross(n2);
-  if (n.cross(n2).dot(across) < 0.0 || n1.cross(n).dot(across) < 0.0) return;
+  if (n.cross(n2).dot(across) < 0.0 || n1.cross(n).dot(across) < 0.0) return false;
   *normal = c.pose.linear() * n;
+  return true;
 }
 
 Contact ContactSolver::Measure(const Contact& contact, const Points& x) const {
@@ -222,11 +213,9 @@ Contact ContactSolver::Measure(const Contact& contact, const Points& x) const {
     out.value = near.clearance;
     out.s = near.s;
     out.normal = near.normal;
-    if (edged && near.clearance < hair) {
+    if (edged && near.clearance < hair && !EdgeNormal(c, a, b, near.s, &out.normal)) {
       const Vector3d shift = (hair - near.clearance) * near.normal;
       out.normal = NearestOnSegment(c, a + shift, b + shift).normal;
-      if (c.shape == ColliderShape::kBox) BoxEdgeNormal(c, a, b, near.s, &out.normal);
-      if (c.shape == ColliderShape::kMesh) MeshEdgeNormal(c, a, b, near.s, &out.normal);
     }
     if (dim_ == 2 && near.s > 0.0 && near.s < 1.0) {
       // Where the interior is nearest, the normal is across the link (exactly so on a smooth

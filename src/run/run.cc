@@ -79,18 +79,13 @@ void CheckOutsideColliders(const Chain& chain, const Points& leader_steps,
       }
     }
     if (colliders[c].motion) continue;
-    // A move that stays farther from the collider's bounding ball than its own length cannot
-    // enter it: measured exactly only where it comes nearer (the same verdicts, at a few
-    // operations a move over a long path).
-    const double ball = colliders[c].shape == ColliderShape::kHalfSpace
-                            ? -1.0
-                            : internal::BoundingRadius(colliders[c]);
-    const Eigen::Vector3d centre = colliders[c].pose.translation();
     Eigen::Vector3d from = at(chain.points.row(0));
     for (Eigen::Index s = 0; s < leader_steps.rows(); ++s) {
       const Eigen::Vector3d to = at(leader_steps.row(s));
-      const double reach = ((to - from).norm() + ball) * (1.0 + 1e-9);
-      if (ball >= 0.0 && (from - centre).squaredNorm() > reach * reach) {
+      // A move shorter than its start's distance from the collider (a lower bound of it) cannot
+      // enter it: measured exactly only where it comes nearer (the same verdicts, at a few
+      // operations a move over a long path).
+      if (internal::DistanceLowerBound(colliders[c], from) > (to - from).norm()) {
         from = to;
         continue;
       }
