@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -14,6 +16,7 @@
 #include "flexkin/run.h"
 #include "flexkin/strands.h"
 #include "strands/strand_engine.h"
+#include "world/contact.h"
 
 namespace flexkin {
 namespace {
@@ -296,6 +299,156 @@ TEST(StrandCollidersTest, TheLanesContactStepIsTheScalarOne) {
       EXPECT_EQ(lanes.contacts().contact_link_steps, scalar.contacts().contact_link_steps)
           << engine;
       EXPECT_GE(lanes.contacts().least_clearance, -1e-13) << engine;
+    }
+  }
+}
+
+// The SIMD engines' check of a sphere after the sweep (StrandSphereCheckFn), which takes the exact
+// clearance only of links that can change its answers, against the check it replaced: every
+// link's clearance from the same engine's StrandBoundsFn, then CheckLanes' loop (near: within a
+// link's length; entering: below -kContactSlack of it; the least clearance over the length).
+// Blocks of links lying on the sphere, a rounding inside and outside it, within and beyond the
+// slack, deep inside, near and far; a sphere of 1e-4 among links of 0.1 (the squared distance's
+// cancellation); carried-over answers of other colliders. The same bits for every lane.
+TEST(StrandCollidersTest, TheLanesSphereCheckIsEveryLinksMeasure) {
+  constexpr int L = internal::kStrandLanes;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> normal;
+  int checked = 0, entered = 0, near_lanes = 0;
+  for (const char* engine : {"avx2", "avx512"}) {
+    const internal::StrandSphereCheckFn check = internal::StrandSphereCheckOf(engine);
+    const internal::StrandBoundsFn measure = internal::StrandBoundsOf(engine);
+    if (check == nullptr || measure == nullptr) continue;
+    for (int dim : {2, 3}) {
+      for (int trial = 0; trial < 200; ++trial) {
+        const int n = 4 + trial % 13, head = trial % 3 == 0 ? 1 : 0;
+        internal::ColliderBound bound;
+        bound.exact = true;
+        bound.radius = trial % 5 == 4 ? 1e-4 : 0.5 + unit(rng);
+        for (int k = 0; k < dim; ++k) bound.center[k] = normal(rng);
+        // The engine's arrays are 64-byte aligned.
+        std::vector<double> store((n + 1) * dim * L + 2 * n * L + 24);
+        double* base = store.data();
+        while (reinterpret_cast<uintptr_t>(base) % 64 != 0) ++base;
+        double* points = base;
+        double* lengths = points + (n + 1) * dim * L;
+        double* inv = lengths + n * L;
+        for (int lane = 0; lane < L; ++lane) {
+          Eigen::Vector3d p = Eigen::Vector3d::Zero(), c = Eigen::Vector3d::Zero();
+          for (int k = 0; k < dim; ++k) c[k] = bound.center[k];
+          for (int i = 0; i <= n; ++i) {
+            Eigen::Vector3d d = Eigen::Vector3d::Zero();
+            for (int k = 0; k < dim; ++k) d[k] = normal(rng);
+            d.normalize();
+            if (i == 0) {
+              p = c + (bound.radius + 0.3 * unit(rng)) * d;
+            } else {
+              p += (0.05 + 0.15 * unit(rng)) * d;
+            }
+            // Onto the surface, a rounding or the slack inside or outside it, or deep inside.
+            const double pick = unit(rng);
+            const double scale = pick < 0.2    ? 1.0
+                                 : pick < 0.3  ? 1.0 - 1e-15
+                                 : pick < 0.4  ? 1.0 + 1e-14
+                                 : pick < 0.5  ? 1.0 - 2e-13
+                                 : pick < 0.55 ? 0.5
+                                               : 0.0;
+            if (scale > 0.0) p = c + scale * bound.radius * (p - c).normalized();
+            for (int k = 0; k < dim; ++k) points[(i * dim + k) * L + lane] = p[k];
+          }
+          for (int i = 1; i <= n; ++i) {
+            double l2 = 0.0;
+            for (int k = 0; k < dim; ++k) {
+              const double e =
+                  points[(i * dim + k) * L + lane] - points[((i - 1) * dim + k) * L + lane];
+              l2 += e * e;
+            }
+            lengths[(i - 1) * L + lane] = std::sqrt(l2);
+            inv[(i - 1) * L + lane] = 1.0 / std::sqrt(l2);
+          }
+        }
+        // What other colliders left: nothing, or a clearance and an entering link.
+        std::vector<double> least(L), want_least(L);
+        std::vector<int> first(L), want_first(L);
+        for (int lane = 0; lane < L; ++lane) {
+          least[lane] = lane % 4 == 1 ? 0.2 * unit(rng) : std::numeric_limits<double>::infinity();
+          first[lane] = lane % 5 == 2 ? 1 + static_cast<int>(unit(rng) * n) : n + 1;
+        }
+        want_least = least;
+        want_first = first;
+        std::vector<double> clear((n - head) * L);
+        measure(dim, n, head, points, &bound, 1, clear.data());
+        std::vector<uint8_t> want_near(L, 0), near(L, 7);
+        for (int i = head + 1; i <= n; ++i) {
+          for (int lane = 0; lane < L; ++lane) {
+            const double c = clear[(i - head - 1) * L + lane];
+            const double len = lengths[(i - 1) * L + lane];
+            if (!(c < len)) continue;
+            want_near[lane] = 1;
+            if (c < -internal::kContactSlack * len)
+              want_first[lane] = std::min(want_first[lane], i);
+            want_least[lane] = std::min(want_least[lane], c * inv[(i - 1) * L + lane]);
+          }
+        }
+        check(dim, n, head, points, lengths, inv, bound, internal::kContactSlack, least.data(),
+              first.data(), near.data());
+        for (int lane = 0; lane < L; ++lane) {
+          ASSERT_EQ(near[lane], want_near[lane]) << engine << " " << dim << "D, trial " << trial;
+          ASSERT_EQ(first[lane], want_first[lane]) << engine << " " << dim << "D, trial " << trial;
+          // Bit for bit (infinity where no link came near).
+          ASSERT_EQ(std::memcmp(&least[lane], &want_least[lane], sizeof(double)), 0)
+              << engine << " " << dim << "D, trial " << trial << ", lane " << lane << ": "
+              << least[lane] << " against " << want_least[lane];
+          near_lanes += want_near[lane];
+          entered += want_first[lane] <= n;
+          ++checked;
+        }
+      }
+    }
+  }
+  if (checked == 0) GTEST_SKIP() << "no SIMD engine here";
+  // The blocks exercise every answer.
+  EXPECT_GT(near_lanes, checked / 2);
+  EXPECT_GT(entered, checked / 10);
+  EXPECT_LT(entered, checked);
+}
+
+// A strand's motion is its own, whichever strands share its block (docs/strands.md, "Layout":
+// blocks are made of strands rooted near each other, so a batch of other strands makes other
+// blocks): every third strand of a batch, stepped as a batch of its own, moves as in the whole
+// batch, with contacts against the scalp and a neck capsule, on 1 and 2 threads: bit for bit on
+// the scalar engine; on the SIMD engines within their documented rounding (a register takes the
+// exp's reduction and the rule's pushing branch for all its lanes when one needs it, so a lane's
+// last bits depend on its mates), here 1e-12 after 25 frames.
+TEST(StrandCollidersTest, AStrandMovesAsInAnyOtherBlock) {
+  const std::vector<Points> strands = LyingStrands(75, 3, 10, 5);
+  std::vector<Points> thirds;
+  for (size_t s = 0; s < strands.size(); s += 3) thirds.push_back(strands[s]);
+  StrandOptions options;
+  options.body_colliders = {Sphere(Vector3d::Zero(), 1.0),
+                            CapsuleBetween(Vector3d(0, 0, -0.8), Vector3d(0, 0, -2.0), 0.35)};
+  for (const char* engine : {"scalar", "avx2", "avx512"}) {
+    for (int threads : {1, 2}) {
+      options.threads = threads;
+      StrandBatch all(strands, options), some(thirds, options);
+      if (!internal::SetStrandEngine(&all, engine)) continue;
+      ASSERT_TRUE(internal::SetStrandEngine(&some, engine));
+      for (int f = 1; f <= 25; ++f) {
+        StepStrands(&all, TurningPose(f, 3));
+        StepStrands(&some, TurningPose(f, 3));
+      }
+      EXPECT_GT(some.contacts().contact_link_steps, 100) << engine;
+      double worst = 0.0;
+      for (int s = 0; s < some.size(); ++s) {
+        if (std::string(engine) == "scalar") {
+          ASSERT_TRUE(some.strand(s) == all.strand(3 * s))
+              << engine << ", " << threads << " threads, strand " << 3 * s;
+        }
+        worst = std::max(worst, (some.strand(s) - all.strand(3 * s)).cwiseAbs().maxCoeff());
+      }
+      EXPECT_LT(worst, 1e-12) << engine << ", " << threads << " threads";
+      std::printf("%s, %d threads: largest difference %.1e\n", engine, threads, worst);
     }
   }
 }

@@ -63,10 +63,25 @@ struct StrandSphere {
 // lowered to the first link of lane j that the closed form could not step (a head inside the
 // sphere, a degenerate direction, a result the rounding left inside): that link and those after it
 // hold meaningless values, for the caller to step again.
+// `saved` receives the points head .. n as they were before the sweep (the block's layout from
+// point `head` on), for the caller to step a lane again from there.
 using StrandSphereSweepFn = void (*)(Method method, int dim, int n, int head, const double* heads,
                                      const double* lengths, const double* inv_lengths,
                                      double* points, const StrandSphere& sphere, uint8_t* contact,
-                                     int* fallback);
+                                     int* fallback, double* saved);
+
+// The exact check of one sphere (a ColliderBound with `exact`) after a sweep, for every free link
+// (head + 1 .. n) of every lane, as CheckLanes makes it from StrandBoundsFn's clearances, bit for
+// bit: where link i of lane j comes nearer the sphere than its length, near[j] is set to 1,
+// least[j] lowered to the link's clearance over its length, and first_enter[j] lowered to i where
+// the clearance is below -slack times the length. A link whose squared distance (without a
+// division or a root) shows it further from the sphere, by a margin above the rounding, than the
+// least relative clearance this sphere has given the lane so far (or than its length, before any)
+// can change none of them and is not measured exactly.
+using StrandSphereCheckFn = void (*)(int dim, int n, int head, const double* points,
+                                     const double* lengths, const double* inv_lengths,
+                                     const ColliderBound& bound, double slack, double* least,
+                                     int* first_enter, uint8_t* near);
 
 // Dynamic strands (flexkin/strands.h `dynamics`): one sub-step of one block, in stages.
 // Stage 1: the pinned points 0 .. head are at the sub-step's end in x (their start in x_old), the
@@ -125,10 +140,18 @@ void StrandBoundsAvx512(int dim, int n, int head, const double* points, const Co
                         int num_bounds, double* clearances);
 void StrandSphereSweepAvx2(Method method, int dim, int n, int head, const double* heads,
                            const double* lengths, const double* inv_lengths, double* points,
-                           const StrandSphere& sphere, uint8_t* contact, int* fallback);
+                           const StrandSphere& sphere, uint8_t* contact, int* fallback,
+                           double* saved);
 void StrandSphereSweepAvx512(Method method, int dim, int n, int head, const double* heads,
                              const double* lengths, const double* inv_lengths, double* points,
-                             const StrandSphere& sphere, uint8_t* contact, int* fallback);
+                             const StrandSphere& sphere, uint8_t* contact, int* fallback,
+                             double* saved);
+void StrandSphereCheckAvx2(int dim, int n, int head, const double* points, const double* lengths,
+                           const double* inv_lengths, const ColliderBound& bound, double slack,
+                           double* least, int* first_enter, uint8_t* near);
+void StrandSphereCheckAvx512(int dim, int n, int head, const double* points, const double* lengths,
+                             const double* inv_lengths, const ColliderBound& bound, double slack,
+                             double* least, int* first_enter, uint8_t* near);
 #endif
 
 }  // namespace flexkin::internal
@@ -139,5 +162,10 @@ namespace internal {
 // For tests and benchmarks: steps `batch` with the named engine ("scalar", "avx2", "avx512")
 // from now on. Returns false (and changes nothing) where this CPU has no such engine.
 bool SetStrandEngine(StrandBatch* batch, const char* name);
+// For tests: the named SIMD engine's sphere check (StrandSphereCheckFn), or null where this CPU or
+// build has no such engine (the scalar engine has none: it measures a sphere as any bound).
+StrandSphereCheckFn StrandSphereCheckOf(const char* name);
+// For tests: the named engine's StrandBoundsFn (null where this CPU or build has no such engine).
+StrandBoundsFn StrandBoundsOf(const char* name);
 }  // namespace internal
 }  // namespace flexkin

@@ -202,7 +202,15 @@ struct ContactScratch {
   std::vector<uint64_t> near;            // per lane: the colliders a link came near (bits)
   std::vector<Collider> near_colliders;  // one lane's near colliders
   ContactStats stats;
-  std::string error;  // the first contact step that found no room
+  // The contact step that found no room of the lowest-numbered strand this thread stepped (the
+  // same whatever the threads and the blocks' order).
+  std::string error;
+  int error_strand = std::numeric_limits<int>::max();
+  void NoteError(int strand, std::string text) {
+    if (strand >= error_strand) return;
+    error_strand = strand;
+    error = std::move(text);
+  }
 };
 
 // Per thread: what the dynamic sub-steps need, made once (the overall projection's solver state
@@ -230,12 +238,19 @@ struct StrandBatchImpl {
   std::vector<Block> blocks;
   AlignedDoubles points, lengths, inv_lengths, body;
   std::vector<AlignedDoubles> scratch;  // per thread: the heads of the sub-steps and the target
-  std::vector<int> first_block;         // thread t steps blocks [first_block[t], first_block[t+1])
+  // Threads take runs of job_blocks blocks in turn (Job): an eighth of a thread's share, at least
+  // 16: short enough that a patch of contacts is shared out, long enough that each thread streams
+  // through memory as with one run per thread.
+  int job_blocks = 16;
+  std::atomic<int> next_job{0};  // the next run a thread takes
   StrandSweepsFn sweeps = StrandSweepsScalar;
   // The SIMD engines' sweep with the contact step against one sphere in the lanes (null: the
   // scalar engine, whose lanes take the contact sweep link by link).
   StrandSphereSweepFn sphere_sweep = nullptr;
   StrandBoundsFn measure_bounds = StrandBoundsScalar;
+  // The SIMD engines' check of a sphere after the sweep (null: the scalar engine, which measures
+  // it as any bound).
+  StrandSphereCheckFn check_sphere = nullptr;
   const char* engine = "scalar";
   std::unique_ptr<WorkerPool> pool;
 
@@ -296,25 +311,41 @@ struct StrandBatchImpl {
   // room (InputError "colliders").
   void GatherContacts() {
     std::string error;
+    int error_strand = std::numeric_limits<int>::max();
     for (ContactScratch& cs : contact) {
       contacts.contact_link_steps += cs.stats.contact_link_steps;
       contacts.least_clearance = std::min(contacts.least_clearance, cs.stats.least_clearance);
       cs.stats = ContactStats();
-      if (error.empty()) error = cs.error;
+      if (cs.error_strand < error_strand) {
+        error_strand = cs.error_strand;
+        error = cs.error;
+      }
       cs.error.clear();
+      cs.error_strand = std::numeric_limits<int>::max();
     }
     if (!error.empty()) throw InputError("colliders", error);
   }
+  // Each thread takes the next run of job_blocks blocks not yet taken: blocks hold strands rooted
+  // near each other (docs/strands.md, "Layout"), so their work comes in patches (the contacts),
+  // which one fixed run of blocks per thread would split unevenly. Each block is stepped by one
+  // thread from start to end, and what is summed over blocks is summed in block order, so the
+  // results are the same whichever thread takes which block.
   static void Job(void* self, int t) {
     auto* impl = static_cast<StrandBatchImpl*>(self);
-    for (int b = impl->first_block[t]; b < impl->first_block[t + 1]; ++b) {
-      if (impl->dynamic) {
-        impl->StepBlockDynamic(b, t);
-      } else if (impl->has_colliders) {
-        impl->StepBlockWithColliders(b, impl->scratch[t].data(), &impl->contact[t]);
-      } else {
-        impl->StepBlock(b, impl->scratch[t].data());
-      }
+    const int count = static_cast<int>(impl->blocks.size());
+    const int run = impl->job_blocks;
+    for (int first = run * impl->next_job.fetch_add(1, std::memory_order_relaxed); first < count;
+         first = run * impl->next_job.fetch_add(1, std::memory_order_relaxed)) {
+      for (int b = first; b < std::min(first + run, count); ++b) StepBlockOf(impl, b, t);
+    }
+  }
+  static void StepBlockOf(StrandBatchImpl* impl, int b, int t) {
+    if (impl->dynamic) {
+      impl->StepBlockDynamic(b, t);
+    } else if (impl->has_colliders) {
+      impl->StepBlockWithColliders(b, impl->scratch[t].data(), &impl->contact[t]);
+    } else {
+      impl->StepBlock(b, impl->scratch[t].data());
     }
   }
 };
@@ -433,8 +464,8 @@ void LinkBoundsOf(int n, int head, const double* points, const ColliderBound* bo
   }
 }
 
-void CheckLanes(StrandBoundsFn measure, int dim, int n, int head, double reach, const double* pts,
-                const double* lengths, const double* inv_lengths,
+void CheckLanes(StrandBoundsFn measure, StrandSphereCheckFn check_sphere, int dim, int n, int head,
+                double reach, const double* pts, const double* lengths, const double* inv_lengths,
                 const std::vector<Collider>& colliders, const std::vector<ColliderBound>& bounds,
                 ContactScratch* cs) {
   // A collider whose bound is further than the block's reach from every lane's leading end is
@@ -461,6 +492,15 @@ void CheckLanes(StrandBoundsFn measure, int dim, int n, int head, double reach, 
       near = !(clear > reach);
     }
     if (!near) continue;
+    if (check_sphere != nullptr && bound.exact && !bound.half_space) {
+      // A sphere: checked in the lanes, its exact clearance only where it can matter.
+      uint8_t near_lanes[L];
+      check_sphere(dim, n, head, pts, lengths, inv_lengths, bound, kContactSlack, cs->least.data(),
+                   cs->first_enter.data(), near_lanes);
+      const uint64_t bit = c < 64 ? uint64_t{1} << c : ~uint64_t{0};
+      for (int lane = 0; lane < L; ++lane) cs->near[lane] |= near_lanes[lane] ? bit : uint64_t{0};
+      continue;
+    }
     cs->active.push_back(bound);
     cs->active_index.push_back(static_cast<int>(c));
   }
@@ -570,21 +610,22 @@ void StrandBatchImpl::StepBlockWithColliders(int b, double* scratch_heads, Conta
         }
       }
     }
-    std::copy(pts + free_begin, pts + free_begin + free_size, cs->saved.data());
     const bool in_lanes = sphere_sweep != nullptr && lone_sphere[s - 1];
     if (in_lanes) {
+      // The sweep keeps the points it moves in `saved` itself.
       std::fill(cs->fallback.begin(), cs->fallback.end(), n + 1);
       sphere_sweep(options.method, dim, n, head, heads, block_lengths, block_inv, pts,
-                   spheres[s - 1], cs->contact_flags.data(), cs->fallback.data());
+                   spheres[s - 1], cs->contact_flags.data(), cs->fallback.data(), cs->saved.data());
     } else {
+      std::copy(pts + free_begin, pts + free_begin + free_size, cs->saved.data());
       sweeps(options.method, dim, n, head, 1, heads, block_lengths, block_inv, pts);
     }
     std::fill(cs->least.begin(), cs->least.end(), std::numeric_limits<double>::infinity());
     std::fill(cs->first_enter.begin(), cs->first_enter.end(), n + 1);
     std::fill(cs->near.begin(), cs->near.end(), 0);
     const std::vector<Collider>& all = placed[s - 1];
-    CheckLanes(measure_bounds, dim, n, head, block.reach, pts, block_lengths, block_inv, all,
-               bounds[s - 1], cs);
+    CheckLanes(measure_bounds, check_sphere, dim, n, head, block.reach, pts, block_lengths,
+               block_inv, all, bounds[s - 1], cs);
     for (int lane = 0; lane < L; ++lane) {
       int first = cs->first_enter[lane];
       if (in_lanes) {
@@ -636,10 +677,8 @@ void StrandBatchImpl::StepBlockWithColliders(int b, double* scratch_heads, Conta
               cs->chain[i * dim + k] = cs->saved[((from - head + i) * dim + k) * L + lane];
             }
           }
-          if (cs->error.empty()) {
-            cs->error =
-                "strands[" + std::to_string(block.source[lane]) + "]: " + e.problem().Text();
-          }
+          cs->NoteError(block.source[lane], "strands[" + std::to_string(block.source[lane]) +
+                                                "]: " + e.problem().Text());
           break;
         }
         // Against the near colliders only: kept if no link entered another one, else again
@@ -1006,11 +1045,12 @@ void StrandBatchImpl::ContactLane(const Block& block, int lane, int first, int s
         // A point a collider placed takes no DFTL velocity correction (its correction is the
         // contact's, not the link's): its prediction is made its place.
         for (int k = 0; k < dim; ++k) p[(i * dim + k) * L + lane] = x[k];
-      } else if (cs->error.empty()) {
-        cs->error = "strands[" + std::to_string(block.source[lane]) + "]: link " +
-                    std::to_string(i) +
-                    " finds no direction clear of the colliders (its leading end is wedged "
-                    "between them)";
+      } else {
+        cs->NoteError(block.source[lane],
+                      "strands[" + std::to_string(block.source[lane]) + "]: link " +
+                          std::to_string(i) +
+                          " finds no direction clear of the colliders (its leading end is "
+                          "wedged between them)");
       }
     }
     cs->stats.least_clearance = std::min(cs->stats.least_clearance, clearance / length);
@@ -1151,8 +1191,8 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
         std::fill(cs->least.begin(), cs->least.end(), std::numeric_limits<double>::infinity());
         std::fill(cs->first_enter.begin(), cs->first_enter.end(), n + 1);
         std::fill(cs->near.begin(), cs->near.end(), 0);
-        CheckLanes(measure_bounds, dim, n, head, block.reach, pts, q.lengths, q.inv_lengths,
-                   placed[s - 1], bounds[s - 1], cs);
+        CheckLanes(measure_bounds, check_sphere, dim, n, head, block.reach, pts, q.lengths,
+                   q.inv_lengths, placed[s - 1], bounds[s - 1], cs);
       };
       check();
       if (in_lanes && solved) {
@@ -1283,6 +1323,38 @@ void CheckStart(const std::vector<Points>& strands, const StrandOptions& options
                        " of the link's length); a strand must start outside every collider");
 }
 
+// Per strand, its root's place along a Z-order (Morton) curve through the roots' bounding box:
+// strands whose roots lie near each other have near keys, and sorted by them they share blocks.
+// Contacts with the body come in patches (the side of the head the hair is laid against), so
+// grouped strands take the lanes' contact step in fewer blocks; each lane's results are its own
+// (no lane's arithmetic depends on another's), so the order changes no result, only the time.
+std::vector<uint64_t> RootOrder(const std::vector<Points>& strands, int dim) {
+  const size_t count = strands.size();
+  std::vector<uint64_t> key(count, 0);
+  if (count == 0) return key;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (const Points& p : strands) {
+    for (int k = 0; k < dim; ++k) {
+      lo[k] = std::min(lo[k], p(0, k));
+      hi[k] = std::max(hi[k], p(0, k));
+    }
+  }
+  const int bits = dim == 2 ? 31 : 21;  // per coordinate, into 62 or 63 bits
+  const double cells = static_cast<double>((uint64_t{1} << bits) - 1);
+  for (size_t s = 0; s < count; ++s) {
+    uint64_t code = 0;
+    for (int k = 0; k < dim; ++k) {
+      const double span = hi[k] - lo[k];
+      const double t = span > 0.0 ? (strands[s](0, k) - lo[k]) / span : 0.0;
+      const uint64_t cell = static_cast<uint64_t>(std::clamp(t, 0.0, 1.0) * cells);
+      for (int b = 0; b < bits; ++b) code |= ((cell >> b) & 1u) << (b * dim + k);
+    }
+    key[s] = code;
+  }
+  return key;
+}
+
 }  // namespace
 
 StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions& options,
@@ -1323,11 +1395,15 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
   }
   m.links.resize(count);
   for (int i = 0; i < count; ++i) m.links[i] = static_cast<int>(strands[i].rows()) - 1;
-  // Strands of one link count side by side, in the order given.
+  // Strands of one link count side by side, neighbours by their roots in one block (RootOrder).
+  const std::vector<uint64_t> near_key = RootOrder(strands, dim);
   std::vector<int> order(count);
   for (int i = 0; i < count; ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(),
-                   [&](int a, int b) { return m.links[a] < m.links[b]; });
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    if (m.links[a] != m.links[b]) return m.links[a] < m.links[b];
+    if (near_key[a] != near_key[b]) return near_key[a] < near_key[b];
+    return a < b;
+  });
   m.block_of.resize(count);
   m.lane_of.resize(count);
   size_t num_points = 0, num_lengths = 0, num_body = 0;
@@ -1385,29 +1461,22 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
     m.sweeps = internal::StrandSweepsAvx512;
     m.sphere_sweep = internal::StrandSphereSweepAvx512;
     m.measure_bounds = internal::StrandBoundsAvx512;
+    m.check_sphere = internal::StrandSphereCheckAvx512;
     m.engine = "avx512";
   } else if (internal::AllowedSimd().avx2_fma) {
     m.sweeps = internal::StrandSweepsAvx2;
     m.sphere_sweep = internal::StrandSphereSweepAvx2;
     m.measure_bounds = internal::StrandBoundsAvx2;
+    m.check_sphere = internal::StrandSphereCheckAvx2;
     m.engine = "avx2";
   }
 #endif
-  // Threads: contiguous runs of blocks of about equal work (links times sub-steps).
+  // Threads: each takes the next block not yet taken (Job).
   int threads = options.threads == 0
                     ? std::max(1, static_cast<int>(std::thread::hardware_concurrency()))
                     : options.threads;
   threads = std::max(1, std::min(threads, static_cast<int>(m.blocks.size())));
-  double total = 0.0;
-  for (const auto& block : m.blocks) total += block.n + 1;
-  m.first_block.assign(threads + 1, static_cast<int>(m.blocks.size()));
-  m.first_block[0] = 0;
-  double done = 0.0;
-  int t = 1;
-  for (int b = 0; b < static_cast<int>(m.blocks.size()) && t < threads; ++b) {
-    done += m.blocks[b].n + 1;
-    if (done >= total * t / threads) m.first_block[t++] = b + 1;
-  }
+  m.job_blocks = std::max(16, static_cast<int>(m.blocks.size()) / (8 * threads));
   for (int i = 0; i < threads; ++i) {
     m.scratch.emplace_back(static_cast<size_t>(options.substeps + 1) * std::max(dim, 1) * L);
   }
@@ -1597,6 +1666,7 @@ void StepStrands(StrandBatch* batch, const BodyPose& pose, double time) {
   m.frame_time = time;
   if (m.has_colliders) m.PlaceColliders(&pose);
   if (m.dynamic) m.BeginDynamicFrame(&pose);
+  m.next_job.store(0, std::memory_order_relaxed);
   m.pool->Run(internal::StrandBatchImpl::Job, &m);
   m.pose = nullptr;
   m.last_pose = pose;
@@ -1624,6 +1694,7 @@ void StepStrands(StrandBatch* batch, const Eigen::Ref<const Points>& roots) {
   m.roots_stride = roots.outerStride();
   m.pose = nullptr;
   if (m.dynamic) m.BeginDynamicFrame(nullptr);
+  m.next_job.store(0, std::memory_order_relaxed);
   m.pool->Run(internal::StrandBatchImpl::Job, &m);
   m.roots = nullptr;
   if (m.dynamic) m.EndDynamicFrame();
@@ -1634,11 +1705,31 @@ void StepStrands(StrandBatch* batch, const Eigen::Ref<const Points>& roots) {
 
 namespace flexkin::internal {
 
+StrandSphereCheckFn StrandSphereCheckOf(const char* name) {
+  const std::string engine = name;
+#if FLEXKIN_HAVE_WAVEFRONT
+  if (engine == "avx2" && CpuSimd().avx2_fma) return StrandSphereCheckAvx2;
+  if (engine == "avx512" && CpuSimd().avx512) return StrandSphereCheckAvx512;
+#endif
+  return nullptr;
+}
+
+StrandBoundsFn StrandBoundsOf(const char* name) {
+  const std::string engine = name;
+  if (engine == "scalar") return StrandBoundsScalar;
+#if FLEXKIN_HAVE_WAVEFRONT
+  if (engine == "avx2" && CpuSimd().avx2_fma) return StrandBoundsAvx2;
+  if (engine == "avx512" && CpuSimd().avx512) return StrandBoundsAvx512;
+#endif
+  return nullptr;
+}
+
 bool SetStrandEngine(StrandBatch* batch, const char* name) {
   const std::string engine = name;
   StrandSweepsFn fn = nullptr;
   StrandSphereSweepFn sphere = nullptr;
   StrandBoundsFn bounds = StrandBoundsScalar;
+  StrandSphereCheckFn check = nullptr;
   StrandDynamicFn dynamic = StrandDynamicScalar;
   if (engine == "scalar") fn = StrandSweepsScalar;
 #if FLEXKIN_HAVE_WAVEFRONT
@@ -1646,12 +1737,14 @@ bool SetStrandEngine(StrandBatch* batch, const char* name) {
     fn = StrandSweepsAvx2;
     sphere = StrandSphereSweepAvx2;
     bounds = StrandBoundsAvx2;
+    check = StrandSphereCheckAvx2;
     dynamic = StrandDynamicAvx2;
   }
   if (engine == "avx512" && CpuSimd().avx512) {
     fn = StrandSweepsAvx512;
     sphere = StrandSphereSweepAvx512;
     bounds = StrandBoundsAvx512;
+    check = StrandSphereCheckAvx512;
     dynamic = StrandDynamicAvx512;
   }
 #endif
@@ -1660,6 +1753,7 @@ bool SetStrandEngine(StrandBatch* batch, const char* name) {
   batch->impl().sweeps = fn;
   batch->impl().sphere_sweep = sphere;
   batch->impl().measure_bounds = bounds;
+  batch->impl().check_sphere = check;
   batch->impl().engine = engine == "scalar" ? "scalar" : engine == "avx2" ? "avx2" : "avx512";
   return true;
 }

@@ -7,6 +7,7 @@
 // their (independent) rule evaluations overlap. The per-link formula is the wavefront engine's:
 // the rules of sequential/link_rules.h with the vector exp of sequential/wavefront.h, and the
 // scalar reference form for the rare flagged lanes.
+#include <limits>
 #include <xsimd/xsimd.hpp>
 
 #include "sequential/link_rules.h"
@@ -21,12 +22,14 @@ namespace flexkin::internal {
 #define FLEXKIN_STRAND_ENTRY StrandSweepsAvx2
 #define FLEXKIN_SPHERE_ENTRY StrandSphereSweepAvx2
 #define FLEXKIN_BOUNDS_ENTRY StrandBoundsAvx2
+#define FLEXKIN_CHECK_ENTRY StrandSphereCheckAvx2
 #define FLEXKIN_DYNAMIC_ENTRY StrandDynamicAvx2
 using Arch = xsimd::fma3<xsimd::avx2>;
 #elif FLEXKIN_ISA == 3
 #define FLEXKIN_STRAND_ENTRY StrandSweepsAvx512
 #define FLEXKIN_SPHERE_ENTRY StrandSphereSweepAvx512
 #define FLEXKIN_BOUNDS_ENTRY StrandBoundsAvx512
+#define FLEXKIN_CHECK_ENTRY StrandSphereCheckAvx512
 #define FLEXKIN_DYNAMIC_ENTRY StrandDynamicAvx512
 using Arch = xsimd::avx512f;
 #else
@@ -221,7 +224,7 @@ void SphereContact(const B* h, const B* old, const B& length, const B& inv_lengt
 template <class Rule, int Dim>
 void BlockSphereSweep(int n, int head, const double* heads, const double* lengths,
                       const double* inv_lengths, double* points, const StrandSphere& sphere,
-                      uint8_t* contact, int* fallback) {
+                      uint8_t* contact, int* fallback, double* saved) {
   using B = xsimd::batch<double, Arch>;
   constexpr int W = B::size;
   constexpr int U = kStrandLanes / W;
@@ -234,6 +237,7 @@ void BlockSphereSweep(int n, int head, const double* heads, const double* length
   for (int u = 0; u < U; ++u) {
     for (int k = 0; k < Dim; ++k) {
       lead_old[u][k] = B::load_aligned(lead + k * L + u * W);
+      lead_old[u][k].store_unaligned(saved + k * L + u * W);
       lead_new[u][k] = B::load_aligned(heads + k * L + u * W);
       lead_new[u][k].store_aligned(lead + k * L + u * W);
     }
@@ -243,9 +247,13 @@ void BlockSphereSweep(int n, int head, const double* heads, const double* length
     const double* len_ptr = lengths + (i - 1) * L;
     const double* inv_ptr = inv_lengths + (i - 1) * L;
     uint8_t* flags = contact + i * L;
+    double* saved_ptr = saved + (i - head) * Dim * L;
     for (int u = 0; u < U; ++u) {
       B old[Dim], tail[Dim];
-      for (int k = 0; k < Dim; ++k) old[k] = tail[k] = B::load_aligned(tail_ptr + k * L + u * W);
+      for (int k = 0; k < Dim; ++k) {
+        old[k] = tail[k] = B::load_aligned(tail_ptr + k * L + u * W);
+        old[k].store_unaligned(saved_ptr + k * L + u * W);
+      }
       const B length = B::load_aligned(len_ptr + u * W);
       RuleStep<Rule, B, Dim>(lead_old[u], lead_new[u], old, len_ptr + u * W, inv_ptr + u * W, tail);
       // The sphere: lanes whose rule step enters it take the contact step.
@@ -313,7 +321,76 @@ void LinkBounds(int n, int head, const double* points, const ColliderBound* boun
   }
 }
 
+template <int Dim>
+void SphereCheck(int n, int head, const double* points, const double* lengths,
+                 const double* inv_lengths, const ColliderBound& bound, double slack_value,
+                 double* least, int* first_enter, uint8_t* near) {
+  using B = xsimd::batch<double, Arch>;
+  constexpr int W = B::size;
+  constexpr int L = kStrandLanes;
+  B c[Dim];
+  for (int k = 0; k < Dim; ++k) c[k] = B(bound.center[k]);
+  const B r(bound.radius), slack(slack_value);
+  for (int u = 0; u < L; u += W) {
+    alignas(64) double first_in[W], near_out[W];
+    for (int j = 0; j < W; ++j) first_in[j] = first_enter[u + j];
+    B lst = B::load_unaligned(least + u), first = B::load_aligned(first_in);
+    B own(std::numeric_limits<double>::infinity());  // this sphere's least so far
+    auto is_near_any = B(0.0) != B(0.0);
+    for (int i = head + 1; i <= n; ++i) {
+      const double* a = points + (i - 1) * Dim * L + u;
+      const double* b = points + i * Dim * L + u;
+      B pa[Dim], ab[Dim];
+      B dot(0.0), ab2(0.0), e2(0.0), f2(0.0);
+      for (int k = 0; k < Dim; ++k) {
+        pa[k] = B::load_aligned(a + k * L);
+        ab[k] = B::load_aligned(b + k * L) - pa[k];
+        const B e = c[k] - pa[k];
+        const B f = e - ab[k];
+        dot += ab[k] * e;
+        ab2 += ab[k] * ab[k];
+        e2 += e * e;
+        f2 += f * f;
+      }
+      const B len = B::load_aligned(lengths + (i - 1) * L + u);
+      // The squared distance times |ab|^2, as SphereEnters, against the least this sphere can
+      // still lower (its own least, or the length before any), widened past the rounding of both
+      // (the cancellation e2 ab2 - dot^2 loses up to a few ulps of e2 ab2).
+      const B scaled = xsimd::select(dot <= B(0.0), e2 * ab2,
+                                     xsimd::select(dot >= ab2, f2 * ab2, e2 * ab2 - dot * dot));
+      const B reach = r + len * xsimd::min(own, B(1.0));
+      const auto skip =
+          (reach > B(0.0)) & (scaled > reach * reach * ab2 * B(1.0 + 1e-9) + B(1e-12) * e2 * ab2);
+      if (xsimd::all(skip)) continue;
+      const B clear = SphereClearance<B, Dim>(pa, ab, c, r);
+      const B rel = clear * B::load_aligned(inv_lengths + (i - 1) * L + u);
+      const auto is_near = clear < len;
+      is_near_any = is_near_any | is_near;
+      first = xsimd::select(is_near & (clear < -slack * len) & (B(static_cast<double>(i)) < first),
+                            B(static_cast<double>(i)), first);
+      lst = xsimd::select(is_near & (rel < lst), rel, lst);
+      own = xsimd::select(is_near & (rel < own), rel, own);
+    }
+    lst.store_unaligned(least + u);
+    first.store_aligned(first_in);
+    xsimd::select(is_near_any, B(1.0), B(0.0)).store_aligned(near_out);
+    for (int j = 0; j < W; ++j) {
+      first_enter[u + j] = static_cast<int>(first_in[j]);
+      near[u + j] = near_out[j] != 0.0;
+    }
+  }
+}
+
 }  // namespace
+
+void FLEXKIN_CHECK_ENTRY(int dim, int n, int head, const double* points, const double* lengths,
+                         const double* inv_lengths, const ColliderBound& bound, double slack,
+                         double* least, int* first_enter, uint8_t* near) {
+  dim == 2 ? SphereCheck<2>(n, head, points, lengths, inv_lengths, bound, slack, least, first_enter,
+                            near)
+           : SphereCheck<3>(n, head, points, lengths, inv_lengths, bound, slack, least, first_enter,
+                            near);
+}
 
 void FLEXKIN_BOUNDS_ENTRY(int dim, int n, int head, const double* points,
                           const ColliderBound* bounds, int num_bounds, double* clearances) {
@@ -323,13 +400,14 @@ void FLEXKIN_BOUNDS_ENTRY(int dim, int n, int head, const double* points,
 
 void FLEXKIN_SPHERE_ENTRY(Method method, int dim, int n, int head, const double* heads,
                           const double* lengths, const double* inv_lengths, double* points,
-                          const StrandSphere& sphere, uint8_t* contact, int* fallback) {
+                          const StrandSphere& sphere, uint8_t* contact, int* fallback,
+                          double* saved) {
   DispatchRule<kStrandEngine>(method, [&](auto rule) {
     using Rule = decltype(rule);
     dim == 2 ? BlockSphereSweep<typename Rule::template Step<2, BatchExp>, 2>(
-                   n, head, heads, lengths, inv_lengths, points, sphere, contact, fallback)
+                   n, head, heads, lengths, inv_lengths, points, sphere, contact, fallback, saved)
              : BlockSphereSweep<typename Rule::template Step<3, BatchExp>, 3>(
-                   n, head, heads, lengths, inv_lengths, points, sphere, contact, fallback);
+                   n, head, heads, lengths, inv_lengths, points, sphere, contact, fallback, saved);
   });
 }
 
