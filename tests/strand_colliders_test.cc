@@ -309,17 +309,19 @@ TEST(StrandCollidersTest, TheLanesContactStepIsTheScalarOne) {
 // link's length; entering: below -kContactSlack of it; the least clearance over the length).
 // Blocks of links lying on the sphere, a rounding inside and outside it, within and beyond the
 // slack, deep inside, near and far; a sphere of 1e-4 among links of 0.1 (the squared distance's
-// cancellation); carried-over answers of other colliders. The same bits for every lane.
+// cancellation); carried-over answers of other colliders. The same bits for every lane; and the
+// same bits from the sphere sweep's own check, made link by link as the sweep leaves each.
 TEST(StrandCollidersTest, TheLanesSphereCheckIsEveryLinksMeasure) {
   constexpr int L = internal::kStrandLanes;
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::normal_distribution<double> normal;
-  int checked = 0, entered = 0, near_lanes = 0;
+  int checked = 0, entered = 0, near_lanes = 0, swept_contacts = 0;
   for (const char* engine : {"avx2", "avx512"}) {
-    const internal::StrandSphereCheckFn check = internal::StrandSphereCheckOf(engine);
-    const internal::StrandBoundsFn measure = internal::StrandBoundsOf(engine);
-    if (check == nullptr || measure == nullptr) continue;
+    internal::StrandEngineEntries entries;
+    if (!internal::StrandEngineOf(engine, &entries)) continue;
+    const internal::StrandSphereCheckFn check = entries.check_sphere;
+    const internal::StrandBoundsFn measure = entries.bounds;
     for (int dim : {2, 3}) {
       for (int trial = 0; trial < 200; ++trial) {
         const int n = 4 + trial % 13, head = trial % 3 == 0 ? 1 : 0;
@@ -328,12 +330,13 @@ TEST(StrandCollidersTest, TheLanesSphereCheckIsEveryLinksMeasure) {
         bound.radius = trial % 5 == 4 ? 1e-4 : 0.5 + unit(rng);
         for (int k = 0; k < dim; ++k) bound.center[k] = normal(rng);
         // The engine's arrays are 64-byte aligned.
-        std::vector<double> store((n + 1) * dim * L + 2 * n * L + 24);
+        std::vector<double> store((n + 1) * dim * L + 2 * n * L + dim * L + 24);
         double* base = store.data();
         while (reinterpret_cast<uintptr_t>(base) % 64 != 0) ++base;
         double* points = base;
         double* lengths = points + (n + 1) * dim * L;
         double* inv = lengths + n * L;
+        double* heads = inv + n * L;
         for (int lane = 0; lane < L; ++lane) {
           Eigen::Vector3d p = Eigen::Vector3d::Zero(), c = Eigen::Vector3d::Zero();
           for (int k = 0; k < dim; ++k) c[k] = bound.center[k];
@@ -404,6 +407,37 @@ TEST(StrandCollidersTest, TheLanesSphereCheckIsEveryLinksMeasure) {
           entered += want_first[lane] <= n;
           ++checked;
         }
+        // The sphere sweep's own check, made as it leaves each link: the check's answers on
+        // the swept points, bit for bit (the leading ends moved a tenth of a link, so that
+        // links follow, some onto the sphere by the contact step).
+        const internal::StrandSphereSweepFn sweep = entries.sphere_sweep;
+        for (int lane = 0; lane < L; ++lane) {
+          for (int k = 0; k < dim; ++k) {
+            heads[k * L + lane] = points[(head * dim + k) * L + lane] + 0.01 * normal(rng);
+          }
+        }
+        internal::StrandSphere sphere;
+        for (int k = 0; k < 3; ++k) sphere.center[k] = bound.center[k];
+        sphere.radius = bound.radius;
+        sphere.slack = internal::kContactSlack;
+        std::vector<uint8_t> contact((n + 1) * L, 0);
+        std::vector<int> fallback(L, n + 1);
+        std::vector<double> saved((n + 1) * dim * L);
+        internal::StrandSphereFound found;
+        sweep(Method::kTractrix, dim, n, head, heads, lengths, inv, points, sphere, contact.data(),
+              fallback.data(), saved.data(), &found);
+        std::vector<double> after(L, std::numeric_limits<double>::infinity());
+        std::vector<int> after_first(L, n + 1);
+        std::vector<uint8_t> after_near(L, 0);
+        check(dim, n, head, points, lengths, inv, bound, internal::kContactSlack, after.data(),
+              after_first.data(), after_near.data());
+        for (int lane = 0; lane < L; ++lane) {
+          ASSERT_EQ(found.near[lane], after_near[lane]) << engine << " trial " << trial;
+          ASSERT_EQ(found.first_enter[lane], after_first[lane]) << engine << " trial " << trial;
+          ASSERT_EQ(std::memcmp(&found.least[lane], &after[lane], sizeof(double)), 0)
+              << engine << " trial " << trial << ", lane " << lane;
+          swept_contacts += contact[(n * L) + lane] + contact[((head + 1) * L) + lane];
+        }
       }
     }
   }
@@ -412,6 +446,7 @@ TEST(StrandCollidersTest, TheLanesSphereCheckIsEveryLinksMeasure) {
   EXPECT_GT(near_lanes, checked / 2);
   EXPECT_GT(entered, checked / 10);
   EXPECT_LT(entered, checked);
+  EXPECT_GT(swept_contacts, 0);
 }
 
 // A strand's motion is its own, whichever strands share its block (docs/strands.md, "Layout":

@@ -64,11 +64,18 @@ struct StrandSphere {
 // sphere, a degenerate direction, a result the rounding left inside): that link and those after it
 // hold meaningless values, for the caller to step again.
 // `saved` receives the points head .. n as they were before the sweep (the block's layout from
-// point `head` on), for the caller to step a lane again from there.
+// point `head` on), for the caller to step a lane again from there. `found` receives the check of
+// the sphere after the sweep (StrandSphereCheckFn's answers, from least infinity, first_enter
+// n + 1 and near 0), made link by link as the sweep leaves each link: the same bits.
+struct StrandSphereFound {
+  double least[kStrandLanes];
+  int first_enter[kStrandLanes];
+  uint8_t near[kStrandLanes];
+};
 using StrandSphereSweepFn = void (*)(Method method, int dim, int n, int head, const double* heads,
                                      const double* lengths, const double* inv_lengths,
                                      double* points, const StrandSphere& sphere, uint8_t* contact,
-                                     int* fallback, double* saved);
+                                     int* fallback, double* saved, StrandSphereFound* found);
 
 // The exact check of one sphere (a ColliderBound with `exact`) after a sweep, for every free link
 // (head + 1 .. n) of every lane, as CheckLanes makes it from StrandBoundsFn's clearances, bit for
@@ -141,11 +148,11 @@ void StrandBoundsAvx512(int dim, int n, int head, const double* points, const Co
 void StrandSphereSweepAvx2(Method method, int dim, int n, int head, const double* heads,
                            const double* lengths, const double* inv_lengths, double* points,
                            const StrandSphere& sphere, uint8_t* contact, int* fallback,
-                           double* saved);
+                           double* saved, StrandSphereFound* found);
 void StrandSphereSweepAvx512(Method method, int dim, int n, int head, const double* heads,
                              const double* lengths, const double* inv_lengths, double* points,
                              const StrandSphere& sphere, uint8_t* contact, int* fallback,
-                             double* saved);
+                             double* saved, StrandSphereFound* found);
 void StrandSphereCheckAvx2(int dim, int n, int head, const double* points, const double* lengths,
                            const double* inv_lengths, const ColliderBound& bound, double slack,
                            double* least, int* first_enter, uint8_t* near);
@@ -162,10 +169,16 @@ namespace internal {
 // For tests and benchmarks: steps `batch` with the named engine ("scalar", "avx2", "avx512")
 // from now on. Returns false (and changes nothing) where this CPU has no such engine.
 bool SetStrandEngine(StrandBatch* batch, const char* name);
-// For tests: the named SIMD engine's sphere check (StrandSphereCheckFn), or null where this CPU or
-// build has no such engine (the scalar engine has none: it measures a sphere as any bound).
-StrandSphereCheckFn StrandSphereCheckOf(const char* name);
-// For tests: the named engine's StrandBoundsFn (null where this CPU or build has no such engine).
-StrandBoundsFn StrandBoundsOf(const char* name);
+// For tests: the named engine's entry points (the scalar engine has no sphere sweep or sphere
+// check: it measures a sphere as any bound). Returns false where this CPU or build has no such
+// engine.
+struct StrandEngineEntries {
+  StrandSweepsFn sweeps = nullptr;
+  StrandSphereSweepFn sphere_sweep = nullptr;
+  StrandBoundsFn bounds = StrandBoundsScalar;
+  StrandSphereCheckFn check_sphere = nullptr;
+  StrandDynamicFn dynamic = StrandDynamicScalar;
+};
+bool StrandEngineOf(const char* name, StrandEngineEntries* out);
 }  // namespace internal
 }  // namespace flexkin

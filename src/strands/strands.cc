@@ -199,6 +199,7 @@ struct ContactScratch {
   std::vector<ColliderBound> active;     // the bounds some lane of a block can come near
   std::vector<int> active_index;         // their colliders' indices
   std::vector<uint8_t> contact_flags;    // per link and lane: the lanes' contact step taken
+  StrandSphereFound found;               // the sphere sweep's own check
   std::vector<uint64_t> near;            // per lane: the colliders a link came near (bits)
   std::vector<Collider> near_colliders;  // one lane's near colliders
   ContactStats stats;
@@ -270,6 +271,7 @@ struct StrandBatchImpl {
   // the lanes' own contact step.
   std::vector<char> lone_sphere;
   std::vector<StrandSphere> spheres;
+  std::vector<int> sphere_index;  // its index among the colliders
   BodyPose last_pose;
   // The last frame's time and the one being stepped (keyframed world colliders).
   double last_time = 0.0, frame_time = 0.0;
@@ -464,7 +466,8 @@ void LinkBoundsOf(int n, int head, const double* points, const ColliderBound* bo
   }
 }
 
-void CheckLanes(StrandBoundsFn measure, StrandSphereCheckFn check_sphere, int dim, int n, int head,
+void CheckLanes(StrandBoundsFn measure, StrandSphereCheckFn check_sphere,
+                const StrandSphereFound* found, int found_collider, int dim, int n, int head,
                 double reach, const double* pts, const double* lengths, const double* inv_lengths,
                 const std::vector<Collider>& colliders, const std::vector<ColliderBound>& bounds,
                 ContactScratch* cs) {
@@ -476,6 +479,16 @@ void CheckLanes(StrandBoundsFn measure, StrandSphereCheckFn check_sphere, int di
   const double* h = pts + static_cast<size_t>(head) * dim * L;
   for (size_t c = 0; c < bounds.size(); ++c) {
     const ColliderBound& bound = bounds[c];
+    if (found != nullptr && static_cast<int>(c) == found_collider) {
+      // The sweep's own check of its sphere (the same answers as check_sphere's).
+      const uint64_t bit = c < 64 ? uint64_t{1} << c : ~uint64_t{0};
+      for (int lane = 0; lane < L; ++lane) {
+        cs->near[lane] |= found->near[lane] ? bit : uint64_t{0};
+        cs->first_enter[lane] = std::min(cs->first_enter[lane], found->first_enter[lane]);
+        cs->least[lane] = std::min(cs->least[lane], found->least[lane]);
+      }
+      continue;
+    }
     bool near = false;
     for (int lane = 0; lane < L && !near; ++lane) {
       double clear = 0.0;
@@ -615,7 +628,8 @@ void StrandBatchImpl::StepBlockWithColliders(int b, double* scratch_heads, Conta
       // The sweep keeps the points it moves in `saved` itself.
       std::fill(cs->fallback.begin(), cs->fallback.end(), n + 1);
       sphere_sweep(options.method, dim, n, head, heads, block_lengths, block_inv, pts,
-                   spheres[s - 1], cs->contact_flags.data(), cs->fallback.data(), cs->saved.data());
+                   spheres[s - 1], cs->contact_flags.data(), cs->fallback.data(), cs->saved.data(),
+                   &cs->found);
     } else {
       std::copy(pts + free_begin, pts + free_begin + free_size, cs->saved.data());
       sweeps(options.method, dim, n, head, 1, heads, block_lengths, block_inv, pts);
@@ -624,7 +638,8 @@ void StrandBatchImpl::StepBlockWithColliders(int b, double* scratch_heads, Conta
     std::fill(cs->first_enter.begin(), cs->first_enter.end(), n + 1);
     std::fill(cs->near.begin(), cs->near.end(), 0);
     const std::vector<Collider>& all = placed[s - 1];
-    CheckLanes(measure_bounds, check_sphere, dim, n, head, block.reach, pts, block_lengths,
+    CheckLanes(measure_bounds, check_sphere, in_lanes ? &cs->found : nullptr,
+               in_lanes ? sphere_index[s - 1] : -1, dim, n, head, block.reach, pts, block_lengths,
                block_inv, all, bounds[s - 1], cs);
     for (int lane = 0; lane < L; ++lane) {
       int first = cs->first_enter[lane];
@@ -928,6 +943,7 @@ void StrandBatchImpl::PlaceColliders(const BodyPose* frame_pose) {
       if (out[j].shape != ColliderShape::kSphere) continue;
       ++count;
       StrandSphere& sphere = spheres[s - 1];
+      sphere_index[s - 1] = static_cast<int>(j);
       for (int k = 0; k < 3; ++k) sphere.center[k] = out[j].pose.translation()[k];
       sphere.radius = out[j].radius + out[j].margin;
       sphere.slack = kContactSlack;
@@ -1191,8 +1207,8 @@ void StrandBatchImpl::StepBlockDynamic(int b, int thread) {
         std::fill(cs->least.begin(), cs->least.end(), std::numeric_limits<double>::infinity());
         std::fill(cs->first_enter.begin(), cs->first_enter.end(), n + 1);
         std::fill(cs->near.begin(), cs->near.end(), 0);
-        CheckLanes(measure_bounds, check_sphere, dim, n, head, block.reach, pts, q.lengths,
-                   q.inv_lengths, placed[s - 1], bounds[s - 1], cs);
+        CheckLanes(measure_bounds, check_sphere, nullptr, -1, dim, n, head, block.reach, pts,
+                   q.lengths, q.inv_lengths, placed[s - 1], bounds[s - 1], cs);
       };
       check();
       if (in_lanes && solved) {
@@ -1551,6 +1567,7 @@ StrandBatch::StrandBatch(const std::vector<Points>& strands, const StrandOptions
     m.bounds.assign(S, std::vector<internal::ColliderBound>(num));
     m.lone_sphere.assign(S, 0);
     m.spheres.assign(S, internal::StrandSphere());
+    m.sphere_index.assign(S, -1);
     if (!options.body_colliders.empty() && S > 1) m.substep_poses.resize(S);
     m.PlaceColliders(&rest);
     CheckStart(strands, options, rest, time);
@@ -1705,55 +1722,34 @@ void StepStrands(StrandBatch* batch, const Eigen::Ref<const Points>& roots) {
 
 namespace flexkin::internal {
 
-StrandSphereCheckFn StrandSphereCheckOf(const char* name) {
+bool StrandEngineOf(const char* name, StrandEngineEntries* out) {
   const std::string engine = name;
+  StrandEngineEntries e;
+  if (engine == "scalar") e.sweeps = StrandSweepsScalar;
 #if FLEXKIN_HAVE_WAVEFRONT
-  if (engine == "avx2" && CpuSimd().avx2_fma) return StrandSphereCheckAvx2;
-  if (engine == "avx512" && CpuSimd().avx512) return StrandSphereCheckAvx512;
+  if (engine == "avx2" && CpuSimd().avx2_fma) {
+    e = {StrandSweepsAvx2, StrandSphereSweepAvx2, StrandBoundsAvx2, StrandSphereCheckAvx2,
+         StrandDynamicAvx2};
+  }
+  if (engine == "avx512" && CpuSimd().avx512) {
+    e = {StrandSweepsAvx512, StrandSphereSweepAvx512, StrandBoundsAvx512, StrandSphereCheckAvx512,
+         StrandDynamicAvx512};
+  }
 #endif
-  return nullptr;
-}
-
-StrandBoundsFn StrandBoundsOf(const char* name) {
-  const std::string engine = name;
-  if (engine == "scalar") return StrandBoundsScalar;
-#if FLEXKIN_HAVE_WAVEFRONT
-  if (engine == "avx2" && CpuSimd().avx2_fma) return StrandBoundsAvx2;
-  if (engine == "avx512" && CpuSimd().avx512) return StrandBoundsAvx512;
-#endif
-  return nullptr;
+  if (e.sweeps == nullptr) return false;
+  *out = e;
+  return true;
 }
 
 bool SetStrandEngine(StrandBatch* batch, const char* name) {
+  StrandEngineEntries e;
+  if (!StrandEngineOf(name, &e)) return false;
   const std::string engine = name;
-  StrandSweepsFn fn = nullptr;
-  StrandSphereSweepFn sphere = nullptr;
-  StrandBoundsFn bounds = StrandBoundsScalar;
-  StrandSphereCheckFn check = nullptr;
-  StrandDynamicFn dynamic = StrandDynamicScalar;
-  if (engine == "scalar") fn = StrandSweepsScalar;
-#if FLEXKIN_HAVE_WAVEFRONT
-  if (engine == "avx2" && CpuSimd().avx2_fma) {
-    fn = StrandSweepsAvx2;
-    sphere = StrandSphereSweepAvx2;
-    bounds = StrandBoundsAvx2;
-    check = StrandSphereCheckAvx2;
-    dynamic = StrandDynamicAvx2;
-  }
-  if (engine == "avx512" && CpuSimd().avx512) {
-    fn = StrandSweepsAvx512;
-    sphere = StrandSphereSweepAvx512;
-    bounds = StrandBoundsAvx512;
-    check = StrandSphereCheckAvx512;
-    dynamic = StrandDynamicAvx512;
-  }
-#endif
-  if (fn == nullptr) return false;
-  batch->impl().dynamic_step = dynamic;
-  batch->impl().sweeps = fn;
-  batch->impl().sphere_sweep = sphere;
-  batch->impl().measure_bounds = bounds;
-  batch->impl().check_sphere = check;
+  batch->impl().dynamic_step = e.dynamic;
+  batch->impl().sweeps = e.sweeps;
+  batch->impl().sphere_sweep = e.sphere_sweep;
+  batch->impl().measure_bounds = e.bounds;
+  batch->impl().check_sphere = e.check_sphere;
   batch->impl().engine = engine == "scalar" ? "scalar" : engine == "avx2" ? "avx2" : "avx512";
   return true;
 }

@@ -221,10 +221,74 @@ void SphereContact(const B* h, const B* old, const B& length, const B& inv_lengt
   *bad = no;
 }
 
+// The check of one sphere after a sweep (StrandSphereCheckFn) for the W lanes of a register, link
+// by link: what it has found so far, and the next link.
+template <class B, int Dim>
+struct SphereCheckLanes {
+  using Bool = typename B::batch_bool_type;
+  B c[Dim], r, slack;
+  B least, first;                                      // as the caller's arrays
+  B own = B(std::numeric_limits<double>::infinity());  // this sphere's least so far
+  Bool near = B(0.0) != B(0.0);
+
+  // From the answers so far (other colliders'), at `least` and `first_enter`.
+  void Init(const double* center, double radius, double slack_value, const double* least_in,
+            const int* first_enter) {
+    for (int k = 0; k < Dim; ++k) c[k] = B(center[k]);
+    r = B(radius);
+    slack = B(slack_value);
+    alignas(64) double first_in[B::size];
+    for (int j = 0; j < B::size; ++j) first_in[j] = first_enter[j];
+    least = B::load_unaligned(least_in);
+    first = B::load_aligned(first_in);
+  }
+  // Link i, from pa along ab; its length and inverse at len and inv.
+  __attribute__((always_inline)) void Link(int i, const B* pa, const B* ab, const double* len_ptr,
+                                           const double* inv_ptr) {
+    B dot(0.0), ab2(0.0), e2(0.0), f2(0.0);
+    for (int k = 0; k < Dim; ++k) {
+      const B e = c[k] - pa[k];
+      const B f = e - ab[k];
+      dot += ab[k] * e;
+      ab2 += ab[k] * ab[k];
+      e2 += e * e;
+      f2 += f * f;
+    }
+    const B len = B::load_aligned(len_ptr);
+    // The squared distance times |ab|^2, as SphereEnters, against the least this sphere can
+    // still lower (its own least, or the length before any), widened past the rounding of both
+    // (the cancellation e2 ab2 - dot^2 loses up to a few ulps of e2 ab2).
+    const B scaled = xsimd::select(dot <= B(0.0), e2 * ab2,
+                                   xsimd::select(dot >= ab2, f2 * ab2, e2 * ab2 - dot * dot));
+    const B reach = r + len * xsimd::min(own, B(1.0));
+    const auto skip =
+        (reach > B(0.0)) & (scaled > reach * reach * ab2 * B(1.0 + 1e-9) + B(1e-12) * e2 * ab2);
+    if (xsimd::all(skip)) return;
+    const B clear = SphereClearance<B, Dim>(pa, ab, c, r);
+    const B rel = clear * B::load_aligned(inv_ptr);
+    const auto is_near = clear < len;
+    near = near | is_near;
+    first = xsimd::select(is_near & (clear < -slack * len) & (B(static_cast<double>(i)) < first),
+                          B(static_cast<double>(i)), first);
+    least = xsimd::select(is_near & (rel < least), rel, least);
+    own = xsimd::select(is_near & (rel < own), rel, own);
+  }
+  void Store(double* least_out, int* first_enter, uint8_t* near_out) const {
+    alignas(64) double first_out[B::size], near_lanes[B::size];
+    least.store_unaligned(least_out);
+    first.store_aligned(first_out);
+    xsimd::select(near, B(1.0), B(0.0)).store_aligned(near_lanes);
+    for (int j = 0; j < B::size; ++j) {
+      first_enter[j] = static_cast<int>(first_out[j]);
+      near_out[j] = near_lanes[j] != 0.0;
+    }
+  }
+};
+
 template <class Rule, int Dim>
 void BlockSphereSweep(int n, int head, const double* heads, const double* lengths,
                       const double* inv_lengths, double* points, const StrandSphere& sphere,
-                      uint8_t* contact, int* fallback, double* saved) {
+                      uint8_t* contact, int* fallback, double* saved, StrandSphereFound* found) {
   using B = xsimd::batch<double, Arch>;
   constexpr int W = B::size;
   constexpr int U = kStrandLanes / W;
@@ -232,6 +296,16 @@ void BlockSphereSweep(int n, int head, const double* heads, const double* length
   B c[Dim];
   for (int k = 0; k < Dim; ++k) c[k] = B(sphere.center[k]);
   const B r(sphere.radius), slack(sphere.slack);
+  // The check after the sweep, link by link as the sweep leaves each.
+  for (int j = 0; j < L; ++j) {
+    found->least[j] = std::numeric_limits<double>::infinity();
+    found->first_enter[j] = n + 1;
+  }
+  SphereCheckLanes<B, Dim> checks[U];
+  for (int u = 0; u < U; ++u) {
+    checks[u].Init(sphere.center, sphere.radius, sphere.slack, found->least + u * W,
+                   found->first_enter + u * W);
+  }
   B lead_old[U][Dim], lead_new[U][Dim];
   double* lead = points + head * Dim * L;
   for (int u = 0; u < U; ++u) {
@@ -248,38 +322,51 @@ void BlockSphereSweep(int n, int head, const double* heads, const double* length
     const double* inv_ptr = inv_lengths + (i - 1) * L;
     uint8_t* flags = contact + i * L;
     double* saved_ptr = saved + (i - head) * Dim * L;
+    // The rule steps of the registers first, side by side (independent: their latencies overlap),
+    // then the sphere's test and contact step of each.
+    B old[U][Dim], tail[U][Dim];
     for (int u = 0; u < U; ++u) {
-      B old[Dim], tail[Dim];
       for (int k = 0; k < Dim; ++k) {
-        old[k] = tail[k] = B::load_aligned(tail_ptr + k * L + u * W);
-        old[k].store_unaligned(saved_ptr + k * L + u * W);
+        old[u][k] = tail[u][k] = B::load_aligned(tail_ptr + k * L + u * W);
+        old[u][k].store_unaligned(saved_ptr + k * L + u * W);
       }
+      RuleStep<Rule, B, Dim>(lead_old[u], lead_new[u], old[u], len_ptr + u * W, inv_ptr + u * W,
+                             tail[u]);
+    }
+    for (int u = 0; u < U; ++u) {
       const B length = B::load_aligned(len_ptr + u * W);
-      RuleStep<Rule, B, Dim>(lead_old[u], lead_new[u], old, len_ptr + u * W, inv_ptr + u * W, tail);
       // The sphere: lanes whose rule step enters it take the contact step.
       B step[Dim];
-      for (int k = 0; k < Dim; ++k) step[k] = tail[k] - lead_new[u][k];
+      for (int k = 0; k < Dim; ++k) step[k] = tail[u][k] - lead_new[u][k];
       const auto enter = SphereEnters<B, Dim>(lead_new[u], step, c, r - slack * length);
       alignas(64) double entered[W], failed[W];
       xsimd::select(enter, B(1.0), B(0.0)).store_aligned(entered);
       if (xsimd::any(enter)) {
         B moved[Dim];
         typename B::batch_bool_type bad;
-        SphereContact<B, Dim>(lead_new[u], old, length, B::load_aligned(inv_ptr + u * W), c, r,
+        SphereContact<B, Dim>(lead_new[u], old[u], length, B::load_aligned(inv_ptr + u * W), c, r,
                               slack, moved, &bad);
-        for (int k = 0; k < Dim; ++k) tail[k] = xsimd::select(enter, moved[k], tail[k]);
+        for (int k = 0; k < Dim; ++k) tail[u][k] = xsimd::select(enter, moved[k], tail[u][k]);
         xsimd::select(enter & bad, B(1.0), B(0.0)).store_aligned(failed);
         for (int j = 0; j < W; ++j) {
           if (failed[j] != 0.0 && fallback[u * W + j] > i) fallback[u * W + j] = i;
         }
       }
       for (int j = 0; j < W; ++j) flags[u * W + j] = entered[j] != 0.0;
+      B ab[Dim];
       for (int k = 0; k < Dim; ++k) {
-        tail[k].store_aligned(tail_ptr + k * L + u * W);
-        lead_old[u][k] = old[k];
-        lead_new[u][k] = tail[k];
+        tail[u][k].store_aligned(tail_ptr + k * L + u * W);
+        ab[k] = tail[u][k] - lead_new[u][k];
+      }
+      checks[u].Link(i, lead_new[u], ab, len_ptr + u * W, inv_ptr + u * W);
+      for (int k = 0; k < Dim; ++k) {
+        lead_old[u][k] = old[u][k];
+        lead_new[u][k] = tail[u][k];
       }
     }
+  }
+  for (int u = 0; u < U; ++u) {
+    checks[u].Store(found->least + u * W, found->first_enter + u * W, found->near + u * W);
   }
 }
 
@@ -323,61 +410,25 @@ void LinkBounds(int n, int head, const double* points, const ColliderBound* boun
 
 template <int Dim>
 void SphereCheck(int n, int head, const double* points, const double* lengths,
-                 const double* inv_lengths, const ColliderBound& bound, double slack_value,
-                 double* least, int* first_enter, uint8_t* near) {
+                 const double* inv_lengths, const ColliderBound& bound, double slack, double* least,
+                 int* first_enter, uint8_t* near) {
   using B = xsimd::batch<double, Arch>;
   constexpr int W = B::size;
   constexpr int L = kStrandLanes;
-  B c[Dim];
-  for (int k = 0; k < Dim; ++k) c[k] = B(bound.center[k]);
-  const B r(bound.radius), slack(slack_value);
   for (int u = 0; u < L; u += W) {
-    alignas(64) double first_in[W], near_out[W];
-    for (int j = 0; j < W; ++j) first_in[j] = first_enter[u + j];
-    B lst = B::load_unaligned(least + u), first = B::load_aligned(first_in);
-    B own(std::numeric_limits<double>::infinity());  // this sphere's least so far
-    auto is_near_any = B(0.0) != B(0.0);
+    SphereCheckLanes<B, Dim> check;
+    check.Init(bound.center, bound.radius, slack, least + u, first_enter + u);
     for (int i = head + 1; i <= n; ++i) {
       const double* a = points + (i - 1) * Dim * L + u;
       const double* b = points + i * Dim * L + u;
       B pa[Dim], ab[Dim];
-      B dot(0.0), ab2(0.0), e2(0.0), f2(0.0);
       for (int k = 0; k < Dim; ++k) {
         pa[k] = B::load_aligned(a + k * L);
         ab[k] = B::load_aligned(b + k * L) - pa[k];
-        const B e = c[k] - pa[k];
-        const B f = e - ab[k];
-        dot += ab[k] * e;
-        ab2 += ab[k] * ab[k];
-        e2 += e * e;
-        f2 += f * f;
       }
-      const B len = B::load_aligned(lengths + (i - 1) * L + u);
-      // The squared distance times |ab|^2, as SphereEnters, against the least this sphere can
-      // still lower (its own least, or the length before any), widened past the rounding of both
-      // (the cancellation e2 ab2 - dot^2 loses up to a few ulps of e2 ab2).
-      const B scaled = xsimd::select(dot <= B(0.0), e2 * ab2,
-                                     xsimd::select(dot >= ab2, f2 * ab2, e2 * ab2 - dot * dot));
-      const B reach = r + len * xsimd::min(own, B(1.0));
-      const auto skip =
-          (reach > B(0.0)) & (scaled > reach * reach * ab2 * B(1.0 + 1e-9) + B(1e-12) * e2 * ab2);
-      if (xsimd::all(skip)) continue;
-      const B clear = SphereClearance<B, Dim>(pa, ab, c, r);
-      const B rel = clear * B::load_aligned(inv_lengths + (i - 1) * L + u);
-      const auto is_near = clear < len;
-      is_near_any = is_near_any | is_near;
-      first = xsimd::select(is_near & (clear < -slack * len) & (B(static_cast<double>(i)) < first),
-                            B(static_cast<double>(i)), first);
-      lst = xsimd::select(is_near & (rel < lst), rel, lst);
-      own = xsimd::select(is_near & (rel < own), rel, own);
+      check.Link(i, pa, ab, lengths + (i - 1) * L + u, inv_lengths + (i - 1) * L + u);
     }
-    lst.store_unaligned(least + u);
-    first.store_aligned(first_in);
-    xsimd::select(is_near_any, B(1.0), B(0.0)).store_aligned(near_out);
-    for (int j = 0; j < W; ++j) {
-      first_enter[u + j] = static_cast<int>(first_in[j]);
-      near[u + j] = near_out[j] != 0.0;
-    }
+    check.Store(least + u, first_enter + u, near + u);
   }
 }
 
@@ -401,13 +452,15 @@ void FLEXKIN_BOUNDS_ENTRY(int dim, int n, int head, const double* points,
 void FLEXKIN_SPHERE_ENTRY(Method method, int dim, int n, int head, const double* heads,
                           const double* lengths, const double* inv_lengths, double* points,
                           const StrandSphere& sphere, uint8_t* contact, int* fallback,
-                          double* saved) {
+                          double* saved, StrandSphereFound* found) {
   DispatchRule<kStrandEngine>(method, [&](auto rule) {
     using Rule = decltype(rule);
-    dim == 2 ? BlockSphereSweep<typename Rule::template Step<2, BatchExp>, 2>(
-                   n, head, heads, lengths, inv_lengths, points, sphere, contact, fallback, saved)
-             : BlockSphereSweep<typename Rule::template Step<3, BatchExp>, 3>(
-                   n, head, heads, lengths, inv_lengths, points, sphere, contact, fallback, saved);
+    dim == 2
+        ? BlockSphereSweep<typename Rule::template Step<2, BatchExp>, 2>(
+              n, head, heads, lengths, inv_lengths, points, sphere, contact, fallback, saved, found)
+        : BlockSphereSweep<typename Rule::template Step<3, BatchExp>, 3>(
+              n, head, heads, lengths, inv_lengths, points, sphere, contact, fallback, saved,
+              found);
   });
 }
 
