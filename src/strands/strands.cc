@@ -466,6 +466,10 @@ void LinkBoundsOf(int n, int head, const double* points, const ColliderBound* bo
   }
 }
 
+// Collider c's bit in a lane's set of near colliders (the 64th and later share all bits: a lane
+// near one of them is taken as near every collider).
+inline uint64_t ColliderBit(size_t c) { return c < 64 ? uint64_t{1} << c : ~uint64_t{0}; }
+
 void CheckLanes(StrandBoundsFn measure, StrandSphereCheckFn check_sphere,
                 const StrandSphereFound* found, int found_collider, int dim, int n, int head,
                 double reach, const double* pts, const double* lengths, const double* inv_lengths,
@@ -481,7 +485,7 @@ void CheckLanes(StrandBoundsFn measure, StrandSphereCheckFn check_sphere,
     const ColliderBound& bound = bounds[c];
     if (found != nullptr && static_cast<int>(c) == found_collider) {
       // The sweep's own check of its sphere (the same answers as check_sphere's).
-      const uint64_t bit = c < 64 ? uint64_t{1} << c : ~uint64_t{0};
+      const uint64_t bit = ColliderBit(c);
       for (int lane = 0; lane < L; ++lane) {
         cs->near[lane] |= found->near[lane] ? bit : uint64_t{0};
         cs->first_enter[lane] = std::min(cs->first_enter[lane], found->first_enter[lane]);
@@ -510,7 +514,7 @@ void CheckLanes(StrandBoundsFn measure, StrandSphereCheckFn check_sphere,
       uint8_t near_lanes[L];
       check_sphere(dim, n, head, pts, lengths, inv_lengths, bound, kContactSlack, cs->least.data(),
                    cs->first_enter.data(), near_lanes);
-      const uint64_t bit = c < 64 ? uint64_t{1} << c : ~uint64_t{0};
+      const uint64_t bit = ColliderBit(c);
       for (int lane = 0; lane < L; ++lane) cs->near[lane] |= near_lanes[lane] ? bit : uint64_t{0};
       continue;
     }
@@ -530,7 +534,7 @@ void CheckLanes(StrandBoundsFn measure, StrandSphereCheckFn check_sphere,
     for (int j = 0; j < nb; ++j, clear += L) {
       const ColliderBound& bound = cs->active[j];
       const int c = cs->active_index[j];
-      const uint64_t bit = c < 64 ? uint64_t{1} << c : ~uint64_t{0};
+      const uint64_t bit = ColliderBit(c);
       if (bound.exact || bound.half_space) {
         // The bound's clearance is the collider's: the same as below with no exact measure, in a
         // loop without branches (the compiler's vector code).
@@ -568,7 +572,7 @@ bool EntersOther(int dim, int m, const double* points, const double* lengths,
                  const std::vector<Collider>& colliders, const std::vector<ColliderBound>& bounds,
                  uint64_t skip) {
   for (size_t c = 0; c < colliders.size(); ++c) {
-    if (skip & (c < 64 ? uint64_t{1} << c : ~uint64_t{0})) continue;
+    if (skip & ColliderBit(c)) continue;
     const ColliderBound& bound = bounds[c];
     for (int i = 1; i <= m; ++i) {
       const double* a = points + (i - 1) * dim;
@@ -668,7 +672,7 @@ void StrandBatchImpl::StepBlockWithColliders(int b, double* scratch_heads, Conta
       }
       cs->near_colliders.clear();
       for (size_t c = 0; c < all.size(); ++c) {
-        if (cs->near[lane] & (c < 64 ? uint64_t{1} << c : ~uint64_t{0})) {
+        if (cs->near[lane] & ColliderBit(c)) {
           cs->near_colliders.push_back(all[c]);
         }
       }
@@ -1342,8 +1346,9 @@ void CheckStart(const std::vector<Points>& strands, const StrandOptions& options
 // Per strand, its root's place along a Z-order (Morton) curve through the roots' bounding box:
 // strands whose roots lie near each other have near keys, and sorted by them they share blocks.
 // Contacts with the body come in patches (the side of the head the hair is laid against), so
-// grouped strands take the lanes' contact step in fewer blocks; each lane's results are its own
-// (no lane's arithmetic depends on another's), so the order changes no result, only the time.
+// grouped strands take the lanes' contact step in fewer blocks. On the scalar engine the order
+// changes no result; on the SIMD engines a strand's last bits depend on its register's other
+// lanes (docs/strands.md, "Layout").
 std::vector<uint64_t> RootOrder(const std::vector<Points>& strands, int dim) {
   const size_t count = strands.size();
   std::vector<uint64_t> key(count, 0);
