@@ -436,6 +436,10 @@ TEST(StrandCollidersTest, TheLanesSphereCheckIsEveryLinksMeasure) {
           ASSERT_EQ(found.first_enter[lane], after_first[lane]) << engine << " trial " << trial;
           ASSERT_EQ(std::memcmp(&found.least[lane], &after[lane], sizeof(double)), 0)
               << engine << " trial " << trial << ", lane " << lane;
+          // Its count of contact steps is the lane's flags'.
+          int flagged = 0;
+          for (int i = head + 1; i <= n; ++i) flagged += contact[i * L + lane];
+          ASSERT_EQ(found.contacts[lane], flagged) << engine << " trial " << trial;
           swept_contacts += contact[(n * L) + lane] + contact[((head + 1) * L) + lane];
         }
       }

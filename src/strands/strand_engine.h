@@ -66,11 +66,13 @@ struct StrandSphere {
 // `saved` receives the points head .. n as they were before the sweep (the block's layout from
 // point `head` on), for the caller to step a lane again from there. `found` receives the check of
 // the sphere after the sweep (StrandSphereCheckFn's answers, from least infinity, first_enter
-// n + 1 and near 0), made link by link as the sweep leaves each link: the same bits.
+// n + 1 and near 0), made link by link as the sweep leaves each link: the same bits; and, per
+// lane, how many links took the contact step (the count of its `contact` flags).
 struct StrandSphereFound {
   double least[kStrandLanes];
   int first_enter[kStrandLanes];
   uint8_t near[kStrandLanes];
+  int contacts[kStrandLanes];
 };
 using StrandSphereSweepFn = void (*)(Method method, int dim, int n, int head, const double* heads,
                                      const double* lengths, const double* inv_lengths,

@@ -650,8 +650,12 @@ void StrandBatchImpl::StepBlockWithColliders(int b, double* scratch_heads, Conta
       if (in_lanes) {
         // The lanes' own contact steps stand up to the first link stepped again.
         first = std::min(first, cs->fallback[lane]);
-        for (int i = head + 1; i < first && i <= n; ++i) {
-          cs->stats.contact_link_steps += cs->contact_flags[i * L + lane];
+        if (first > n) {
+          cs->stats.contact_link_steps += cs->found.contacts[lane];
+        } else {
+          for (int i = head + 1; i < first; ++i) {
+            cs->stats.contact_link_steps += cs->contact_flags[i * L + lane];
+          }
         }
       }
       if (first > n) {

@@ -123,14 +123,16 @@ __attribute__((always_inline)) inline B SphereClearance(const B* h, const B* ab,
   return xsimd::sqrt(d2) - r;
 }
 
-// Whether the segment [h, h + ab] comes nearer `c` than `inner` (the sphere's radius less the
-// slack: the lanes where its clearance is below -slack), NaN lanes included: the segment's least
-// squared distance times |ab|^2 against inner^2 |ab|^2, with no division and no root.
+// The segment [h, h + ab] against a sphere's centre `c`, without a division or a root: its
+// least squared distance to the centre times |ab|^2 (`scaled`, the nearest point at t = dot / ab2
+// clamped to the segment), and what it is made from.
+template <class B>
+struct SegmentMeasure {
+  B ab2, e2, scaled;
+};
 template <class B, int Dim>
-__attribute__((always_inline)) inline typename B::batch_bool_type SphereEnters(const B* h,
-                                                                               const B* ab,
-                                                                               const B* c,
-                                                                               const B& inner) {
+__attribute__((always_inline)) inline SegmentMeasure<B> MeasureSegment(const B* h, const B* ab,
+                                                                       const B* c) {
   B dot(0.0), ab2(0.0), e2(0.0), f2(0.0);
   for (int k = 0; k < Dim; ++k) {
     const B e = c[k] - h[k];  // the centre from the segment's start
@@ -140,10 +142,25 @@ __attribute__((always_inline)) inline typename B::batch_bool_type SphereEnters(c
     e2 += e * e;
     f2 += f * f;
   }
-  // The nearest point at t = dot / ab2, clamped to the segment.
   const B scaled = xsimd::select(dot <= B(0.0), e2 * ab2,
                                  xsimd::select(dot >= ab2, f2 * ab2, e2 * ab2 - dot * dot));
-  return (inner > B(0.0)) & !(scaled >= inner * inner * ab2);
+  return {ab2, e2, scaled};
+}
+
+// Whether the measured segment comes nearer the centre than `inner` (the sphere's radius less the
+// slack: the lanes where its clearance is below -slack), NaN lanes included: its least squared
+// distance times |ab|^2 against inner^2 |ab|^2.
+template <class B>
+__attribute__((always_inline)) inline typename B::batch_bool_type SphereEnters(
+    const SegmentMeasure<B>& m, const B& inner) {
+  return (inner > B(0.0)) & !(m.scaled >= inner * inner * m.ab2);
+}
+template <class B, int Dim>
+__attribute__((always_inline)) inline typename B::batch_bool_type SphereEnters(const B* h,
+                                                                               const B* ab,
+                                                                               const B* c,
+                                                                               const B& inner) {
+  return SphereEnters<B>(MeasureSegment<B, Dim>(h, ab, c), inner);
 }
 
 // The contact step of lanes `enter` of one link against the sphere (strand_engine.h): the new
@@ -242,27 +259,17 @@ struct SphereCheckLanes {
     least = B::load_unaligned(least_in);
     first = B::load_aligned(first_in);
   }
-  // Link i, from pa along ab; its length and inverse at len and inv.
-  __attribute__((always_inline)) void Link(int i, const B* pa, const B* ab, const double* len_ptr,
+  // Link i, from pa along ab (measured in m); its length and inverse at len and inv.
+  __attribute__((always_inline)) void Link(int i, const B* pa, const B* ab,
+                                           const SegmentMeasure<B>& m, const double* len_ptr,
                                            const double* inv_ptr) {
-    B dot(0.0), ab2(0.0), e2(0.0), f2(0.0);
-    for (int k = 0; k < Dim; ++k) {
-      const B e = c[k] - pa[k];
-      const B f = e - ab[k];
-      dot += ab[k] * e;
-      ab2 += ab[k] * ab[k];
-      e2 += e * e;
-      f2 += f * f;
-    }
     const B len = B::load_aligned(len_ptr);
     // The squared distance times |ab|^2, as SphereEnters, against the least this sphere can
     // still lower (its own least, or the length before any), widened past the rounding of both
     // (the cancellation e2 ab2 - dot^2 loses up to a few ulps of e2 ab2).
-    const B scaled = xsimd::select(dot <= B(0.0), e2 * ab2,
-                                   xsimd::select(dot >= ab2, f2 * ab2, e2 * ab2 - dot * dot));
     const B reach = r + len * xsimd::min(own, B(1.0));
-    const auto skip =
-        (reach > B(0.0)) & (scaled > reach * reach * ab2 * B(1.0 + 1e-9) + B(1e-12) * e2 * ab2);
+    const auto skip = (reach > B(0.0)) &
+                      (m.scaled > reach * reach * m.ab2 * B(1.0 + 1e-9) + B(1e-12) * m.e2 * m.ab2);
     if (xsimd::all(skip)) return;
     const B clear = SphereClearance<B, Dim>(pa, ab, c, r);
     const B rel = clear * B::load_aligned(inv_ptr);
@@ -306,6 +313,8 @@ void BlockSphereSweep(int n, int head, const double* heads, const double* length
     checks[u].Init(sphere.center, sphere.radius, sphere.slack, found->least + u * W,
                    found->first_enter + u * W);
   }
+  B contacts[U];  // per lane, the links that took the contact step
+  for (int u = 0; u < U; ++u) contacts[u] = B(0.0);
   B lead_old[U][Dim], lead_new[U][Dim];
   double* lead = points + head * Dim * L;
   for (int u = 0; u < U; ++u) {
@@ -333,32 +342,47 @@ void BlockSphereSweep(int n, int head, const double* heads, const double* length
       RuleStep<Rule, B, Dim>(lead_old[u], lead_new[u], old[u], len_ptr + u * W, inv_ptr + u * W,
                              tail[u]);
     }
+    // The sphere: lanes whose rule step enters it take the contact step. The registers' tests
+    // first, then their contact steps one after another (independent: their latencies overlap),
+    // then the check of each link as it stands.
+    SegmentMeasure<B> m[U];
+    typename B::batch_bool_type enter[U];
+    bool any_enter[U];
     for (int u = 0; u < U; ++u) {
       const B length = B::load_aligned(len_ptr + u * W);
-      // The sphere: lanes whose rule step enters it take the contact step.
       B step[Dim];
       for (int k = 0; k < Dim; ++k) step[k] = tail[u][k] - lead_new[u][k];
-      const auto enter = SphereEnters<B, Dim>(lead_new[u], step, c, r - slack * length);
-      alignas(64) double entered[W], failed[W];
-      xsimd::select(enter, B(1.0), B(0.0)).store_aligned(entered);
-      if (xsimd::any(enter)) {
-        B moved[Dim];
-        typename B::batch_bool_type bad;
-        SphereContact<B, Dim>(lead_new[u], old[u], length, B::load_aligned(inv_ptr + u * W), c, r,
-                              slack, moved, &bad);
-        for (int k = 0; k < Dim; ++k) tail[u][k] = xsimd::select(enter, moved[k], tail[u][k]);
-        xsimd::select(enter & bad, B(1.0), B(0.0)).store_aligned(failed);
-        for (int j = 0; j < W; ++j) {
-          if (failed[j] != 0.0 && fallback[u * W + j] > i) fallback[u * W + j] = i;
-        }
-      }
+      m[u] = MeasureSegment<B, Dim>(lead_new[u], step, c);
+      enter[u] = SphereEnters<B>(m[u], r - slack * length);
+      any_enter[u] = xsimd::any(enter[u]);
+      contacts[u] += xsimd::select(enter[u], B(1.0), B(0.0));
+      alignas(64) double entered[W];
+      xsimd::select(enter[u], B(1.0), B(0.0)).store_aligned(entered);
       for (int j = 0; j < W; ++j) flags[u * W + j] = entered[j] != 0.0;
+    }
+    for (int u = 0; u < U; ++u) {
+      if (!any_enter[u]) continue;
+      B moved[Dim];
+      typename B::batch_bool_type bad;
+      SphereContact<B, Dim>(lead_new[u], old[u], B::load_aligned(len_ptr + u * W),
+                            B::load_aligned(inv_ptr + u * W), c, r, slack, moved, &bad);
+      for (int k = 0; k < Dim; ++k) tail[u][k] = xsimd::select(enter[u], moved[k], tail[u][k]);
+      alignas(64) double failed[W];
+      xsimd::select(enter[u] & bad, B(1.0), B(0.0)).store_aligned(failed);
+      for (int j = 0; j < W; ++j) {
+        if (failed[j] != 0.0 && fallback[u * W + j] > i) fallback[u * W + j] = i;
+      }
+    }
+    for (int u = 0; u < U; ++u) {
+      // The check takes the link as it stands: the rule step's, measured above, unless a lane
+      // took the contact step.
       B ab[Dim];
       for (int k = 0; k < Dim; ++k) {
         tail[u][k].store_aligned(tail_ptr + k * L + u * W);
         ab[k] = tail[u][k] - lead_new[u][k];
       }
-      checks[u].Link(i, lead_new[u], ab, len_ptr + u * W, inv_ptr + u * W);
+      if (any_enter[u]) m[u] = MeasureSegment<B, Dim>(lead_new[u], ab, c);
+      checks[u].Link(i, lead_new[u], ab, m[u], len_ptr + u * W, inv_ptr + u * W);
       for (int k = 0; k < Dim; ++k) {
         lead_old[u][k] = old[u][k];
         lead_new[u][k] = tail[u][k];
@@ -367,6 +391,9 @@ void BlockSphereSweep(int n, int head, const double* heads, const double* length
   }
   for (int u = 0; u < U; ++u) {
     checks[u].Store(found->least + u * W, found->first_enter + u * W, found->near + u * W);
+    alignas(64) double counted[W];
+    contacts[u].store_aligned(counted);
+    for (int j = 0; j < W; ++j) found->contacts[u * W + j] = static_cast<int>(counted[j]);
   }
 }
 
@@ -426,7 +453,8 @@ void SphereCheck(int n, int head, const double* points, const double* lengths,
         pa[k] = B::load_aligned(a + k * L);
         ab[k] = B::load_aligned(b + k * L) - pa[k];
       }
-      check.Link(i, pa, ab, lengths + (i - 1) * L + u, inv_lengths + (i - 1) * L + u);
+      const SegmentMeasure<B> m = MeasureSegment<B, Dim>(pa, ab, check.c);
+      check.Link(i, pa, ab, m, lengths + (i - 1) * L + u, inv_lengths + (i - 1) * L + u);
     }
     check.Store(least + u, first_enter + u, near + u);
   }
