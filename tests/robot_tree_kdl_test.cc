@@ -4,6 +4,7 @@
 // Not under the sanitizers (tests/CMakeLists.txt: KDL's Eigen allocator).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <string>
 #include <vector>
@@ -18,15 +19,13 @@ namespace {
 
 using test_util::SourceFileText;
 
-TEST(RobotTreeKdl, ForwardKinematicsMatchesKdlsTree) {
-  const std::string text = SourceFileText("examples/robot_two_arms.urdf");
-  // Tools with offsets and axes off the links' own: a point and a direction of each frame.
-  const std::vector<UrdfTool> tools = {{"l_tool", {0.02, 0.03, -0.01}, {0, 1, 0}},
-                                       {"r_hand", {0.0, -0.05, 0.02}, {1, 1, 0}},
-                                       {"camera", {0, 0, 0}, {1, 0, 0}}};
+// Every joint's origin (the child link's frame: for a prismatic joint, where it has slid to),
+// every tool's point and looking axis, at 100 random configurations within the limits; the
+// largest joint origin difference.
+double CompareWithKdl(const std::string& text, const std::vector<UrdfTool>& tools) {
   const RobotTree robot = RobotTreeFromUrdf(text, "", tools);
   const peers::KdlUrdfTree kdl = peers::KdlTreeFromUrdf(text);
-  ASSERT_EQ(kdl.num_joints(), robot.joints());
+  EXPECT_EQ(kdl.num_joints(), robot.joints());
   const RobotTreeLayout layout = MakeRobotTreeLayout(robot);
   std::mt19937 rng(1);
   double worst = 0.0;
@@ -39,7 +38,8 @@ TEST(RobotTreeKdl, ForwardKinematicsMatchesKdlsTree) {
     const Points points = RobotTreePoints(robot, layout, q);
     for (int j = 0; j < robot.joints(); ++j) {
       const std::string link = peers::KdlTreeChildLink(kdl, robot.joint_names[j]);
-      ASSERT_FALSE(link.empty()) << robot.joint_names[j];
+      EXPECT_FALSE(link.empty()) << robot.joint_names[j];
+      if (link.empty()) return worst;
       const peers::KdlLinkPose pose = peers::KdlTreeLinkPose(kdl, kq, link);
       const double d = (points.row(layout.joint_point[j]).transpose() - pose.origin).norm();
       worst = std::max(worst, d);
@@ -56,6 +56,27 @@ TEST(RobotTreeKdl, ForwardKinematicsMatchesKdlsTree) {
       EXPECT_EQ(points.row(layout.tool_point[k]), at.row(k));
     }
   }
+  return worst;
+}
+
+// Tools with offsets and axes off the links' own: a point and a direction of each frame.
+const std::vector<UrdfTool> kTools = {{"l_tool", {0.02, 0.03, -0.01}, {0, 1, 0}},
+                                      {"r_hand", {0.0, -0.05, 0.02}, {1, 1, 0}},
+                                      {"camera", {0, 0, 0}, {1, 0, 0}}};
+
+TEST(RobotTreeKdl, ForwardKinematicsMatchesKdlsTree) {
+  const double worst = CompareWithKdl(SourceFileText("examples/robot_two_arms.urdf"), kTools);
+  RecordProperty("largest_joint_origin_difference", std::to_string(worst));
+}
+
+// Prismatic joints (test_util::SlidingTwoArms: a lift, a telescoping arm, a rising neck): KDL
+// slides them by its own joint type (TransAxis).
+TEST(RobotTreeKdl, SlidingJointsMatchKdlsTree) {
+  const std::string text = test_util::SlidingTwoArms();
+  ASSERT_FALSE(text.empty());
+  const std::vector<char> sliding = RobotTreeFromUrdf(text, "", kTools).prismatic;
+  ASSERT_EQ(std::count(sliding.begin(), sliding.end(), char(1)), 3);
+  const double worst = CompareWithKdl(text, kTools);
   RecordProperty("largest_joint_origin_difference", std::to_string(worst));
 }
 

@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <random>
 #include <string>
 #include <system_error>
@@ -34,6 +36,19 @@ RobotTree TwoArmRobot(bool camera = false) {
   std::vector<UrdfTool> tools = {{"l_tool"}, {"r_tool"}};
   if (camera) tools.push_back({"camera"});
   return RobotTreeFromUrdf(TwoArms(), "", tools);
+}
+
+// The two arms with three sliding joints (test_util::SlidingTwoArms): a lift under the torso,
+// a telescoping left upper arm and a neck that rises from its pan joint's point.
+RobotTree LiftRobot(bool camera = false) {
+  std::vector<UrdfTool> tools = {{"l_tool"}, {"r_tool"}};
+  if (camera) tools.push_back({"camera"});
+  return RobotTreeFromUrdf(test_util::SlidingTwoArms(), "", tools);
+}
+
+int JointIndex(const RobotTree& robot, const std::string& name) {
+  return static_cast<int>(std::find(robot.joint_names.begin(), robot.joint_names.end(), name) -
+                          robot.joint_names.begin());
 }
 
 // Random angles within the limits, `spread` rad about 0 at most.
@@ -93,12 +108,12 @@ TEST(RobotTreeUrdf, RefusesWhatItCannotDriveNamingIt) {
             std::string::npos);
   // The base link itself moves with no joint.
   EXPECT_NE(message(TwoArms(), "", {{"base_link"}}).find("below no revolute"), std::string::npos);
-  std::string prismatic = TwoArms();
+  std::string floating = TwoArms();
   const std::string revolute = "\"l_elbow\" type=\"revolute\"";
-  const size_t at = prismatic.find(revolute);
+  const size_t at = floating.find(revolute);
   ASSERT_NE(at, std::string::npos);
-  prismatic.replace(at, revolute.size(), "\"l_elbow\" type=\"prismatic\"");
-  EXPECT_EQ(message(prismatic, "", {{"l_tool"}}).rfind("joint \"l_elbow\" | has type prismatic", 0),
+  floating.replace(at, revolute.size(), "\"l_elbow\" type=\"floating\"");
+  EXPECT_EQ(message(floating, "", {{"l_tool"}}).rfind("joint \"l_elbow\" | has type floating", 0),
             0u);
   EXPECT_EQ(message("<robot", "", {{"l_tool"}}).rfind("urdf |", 0), 0u);
 }
@@ -122,6 +137,69 @@ TEST(RobotTreeLayout, MergesJointsOnOnePointAndKeepsEveryLinkLength) {
   }
 }
 
+TEST(RobotTreeUrdf, ReadsPrismaticJointsAsSlidingOnes) {
+  const RobotTree robot = LiftRobot(true);
+  ASSERT_EQ(robot.joints(), 15);
+  ASSERT_EQ(robot.prismatic.size(), 15u);
+  const std::vector<std::string> sliding = {"waist", "l_upper_arm_twist", "neck_tilt"};
+  for (int j = 0; j < robot.joints(); ++j) {
+    const bool slides =
+        std::find(sliding.begin(), sliding.end(), robot.joint_names[j]) != sliding.end();
+    EXPECT_EQ(robot.prismatic[j], slides ? 1 : 0) << robot.joint_names[j];
+  }
+  // Limits in the length unit, as written.
+  EXPECT_EQ(robot.joint_min[JointIndex(robot, "waist")], -0.1);
+  EXPECT_EQ(robot.joint_max[JointIndex(robot, "waist")], 0.3);
+  EXPECT_EQ(robot.joint_max[JointIndex(robot, "neck_tilt")], 0.1);
+  // The neck's sliding joint starts on the pan joint's point and still has a point of its own.
+  const RobotTreeLayout layout = MakeRobotTreeLayout(robot);
+  const int tilt = JointIndex(robot, "neck_tilt"), pan = JointIndex(robot, "neck_pan");
+  EXPECT_EQ(layout.parents[layout.joint_point[tilt]], layout.joint_point[pan]);
+  ASSERT_EQ(layout.sliding.size(), layout.parents.size());
+  int count = 0;
+  for (size_t i = 0; i < layout.sliding.size(); ++i) count += layout.sliding[i];
+  EXPECT_EQ(count, 3);
+  for (const std::string& name : sliding) {
+    EXPECT_EQ(layout.sliding[layout.joint_point[JointIndex(robot, name)]], 1) << name;
+  }
+}
+
+// Every link keeps its length as the joints turn and slide, but the link into a sliding joint's
+// point, whose length is its offset along the axis plus the displacement (from the URDF: the lift
+// 0.5 above the base along z, the upper arm's 0.15 along its own axis y, the neck's 0).
+TEST(RobotTreeLayout, OnlyTheLinksIntoSlidingJointsChangeLength) {
+  const RobotTree robot = LiftRobot(true);
+  const RobotTreeLayout layout = MakeRobotTreeLayout(robot);
+  const Points start = RobotTreePoints(robot, layout, Eigen::VectorXd::Zero(robot.joints()));
+  std::map<int, std::pair<int, double>> sliding;  // point: its joint and the offset
+  sliding[layout.joint_point[JointIndex(robot, "waist")]] = {JointIndex(robot, "waist"), 0.5};
+  sliding[layout.joint_point[JointIndex(robot, "l_upper_arm_twist")]] = {
+      JointIndex(robot, "l_upper_arm_twist"), 0.15};
+  sliding[layout.joint_point[JointIndex(robot, "neck_tilt")]] = {JointIndex(robot, "neck_tilt"),
+                                                                 0.0};
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double worst = 0.0;
+  for (int trial = 0; trial < 50; ++trial) {
+    Eigen::VectorXd q(robot.joints());
+    for (int j = 0; j < robot.joints(); ++j) {
+      q[j] = robot.joint_min[j] + u(rng) * (robot.joint_max[j] - robot.joint_min[j]);
+    }
+    const Points p = RobotTreePoints(robot, layout, q);
+    for (size_t i = 1; i < layout.parents.size(); ++i) {
+      const int up = layout.parents[i];
+      const double length = (p.row(i) - p.row(up)).norm();
+      const auto at = sliding.find(static_cast<int>(i));
+      const double expected = at == sliding.end()
+                                  ? (start.row(i) - start.row(up)).norm()
+                                  : std::abs(at->second.second + q[at->second.first]);
+      worst = std::max(worst, std::abs(length - expected));
+      EXPECT_NEAR(length, expected, 1e-15 * 8) << "link " << i << ", trial " << trial;
+    }
+  }
+  RecordProperty("worst_length_difference", std::to_string(worst));
+}
+
 // The position misses of the tools at q (largest).
 double Miss(const RobotTree& robot, const Eigen::VectorXd& q, const Points& goals) {
   Points tools, axes;
@@ -129,20 +207,22 @@ double Miss(const RobotTree& robot, const Eigen::VectorXd& q, const Points& goal
   return (tools - goals).rowwise().norm().maxCoeff();
 }
 
-TEST(RobotTreeSolver, ReachesReachableGoalsToTheToleranceWithinTheLimits) {
-  const RobotTree robot = TwoArmRobot();
+// 40 trials: from random joint values (`spread` about 0) to goals the robot reaches, its tools at
+// other values not far away (`step`), each reached to the tolerance within the limits. The
+// joints' motion summed over the trials.
+Eigen::VectorXd ReachNearbyGoals(const RobotTree& robot, uint32_t seed, double spread,
+                                 double step) {
   const RobotTreeSolver solver(robot);
-  std::mt19937 rng(3);
-  int reached = 0;
+  std::mt19937 rng(seed);
+  Eigen::VectorXd moved = Eigen::VectorXd::Zero(robot.joints());
   for (int trial = 0; trial < 40; ++trial) {
-    const Eigen::VectorXd from = RandomAngles(robot, &rng, 1.0);
-    // Goals the robot reaches: its tools at other angles not far away.
-    const Eigen::VectorXd there =
-        (from + RandomAngles(robot, &rng, 0.3)).cwiseMax(robot.joint_min).cwiseMin(robot.joint_max);
+    const Eigen::VectorXd from = RandomAngles(robot, &rng, spread);
+    const Eigen::VectorXd there = (from + RandomAngles(robot, &rng, step))
+                                      .cwiseMax(robot.joint_min)
+                                      .cwiseMin(robot.joint_max);
     Points goals, axes;
     RobotTreeTools(robot, there, &goals, &axes);
     const RobotTreeSolve s = solver.Solve(from, goals);
-    reached += s.converged;
     EXPECT_TRUE(s.converged) << "trial " << trial << ": miss " << s.residual;
     EXPECT_LE(Miss(robot, s.angles, goals), 1e-10 * solver.layout().longest_link);
     EXPECT_EQ(s.residual, Miss(robot, s.angles, goals));
@@ -150,8 +230,13 @@ TEST(RobotTreeSolver, ReachesReachableGoalsToTheToleranceWithinTheLimits) {
       EXPECT_GE(s.angles[j], robot.joint_min[j]);
       EXPECT_LE(s.angles[j], robot.joint_max[j]);
     }
+    moved += (s.angles - from).cwiseAbs();
   }
-  EXPECT_EQ(reached, 40);
+  return moved;
+}
+
+TEST(RobotTreeSolver, ReachesReachableGoalsToTheToleranceWithinTheLimits) {
+  ReachNearbyGoals(TwoArmRobot(), 3, 1.0, 0.3);
 }
 
 TEST(RobotTreeSolver, JointsWithNoToolBelowThemDoNotMove) {
@@ -172,15 +257,16 @@ TEST(RobotTreeSolver, JointsWithNoToolBelowThemDoNotMove) {
   }
 }
 
-// A small move is, to first order, the smallest joint motion in the weighted norm that takes the
-// tools there: dq = W^-1 J' (J W^-1 J')^-1 dx, with J by central differences of the tools' points
-// (not the solver's analytic Jacobian).
-TEST(RobotTreeSolver, ASmallMoveIsTheLeastWeightedJointMotion) {
-  const RobotTree robot = TwoArmRobot();
-  const RobotTreeSolver solver(robot);
+// A small move of the two hands from `from` (1e-6), solved: the joints' motion, and what it is to
+// first order, the smallest joint motion in the weighted norm that takes the tools there: dq =
+// W^-1 J' (J W^-1 J')^-1 dx, with J by central differences of the tools' points (not the solver's
+// analytic Jacobian).
+struct SmallMove {
+  Eigen::VectorXd dq, expected;
+};
+SmallMove SolveSmallMove(const RobotTree& robot, const RobotTreeSolver& solver,
+                         const Eigen::VectorXd& from) {
   const int n = robot.joints();
-  std::mt19937 rng(11);
-  const Eigen::VectorXd from = RandomAngles(robot, &rng, 0.7);
   Points at, axes;
   RobotTreeTools(robot, from, &at, &axes);
   Eigen::MatrixXd jac(6, n);
@@ -203,16 +289,48 @@ TEST(RobotTreeSolver, ASmallMoveIsTheLeastWeightedJointMotion) {
   goals.row(1) += dx.tail<3>().transpose();
   const Eigen::VectorXd winv = solver.inverse_weights();
   const Eigen::MatrixXd weighted = winv.asDiagonal() * jac.transpose();
-  const Eigen::VectorXd expected = weighted * (jac * weighted).ldlt().solve(dx);
+  SmallMove out;
+  out.expected = weighted * (jac * weighted).ldlt().solve(dx);
   const RobotTreeSolve s = solver.Solve(from, goals);
-  ASSERT_TRUE(s.converged);
-  const Eigen::VectorXd dq = s.angles - from;
+  EXPECT_TRUE(s.converged);
+  out.dq = s.angles - from;
+  return out;
+}
+
+TEST(RobotTreeSolver, ASmallMoveIsTheLeastWeightedJointMotion) {
+  const RobotTree robot = TwoArmRobot();
+  const RobotTreeSolver solver(robot);
+  std::mt19937 rng(11);
+  const SmallMove move = SolveSmallMove(robot, solver, RandomAngles(robot, &rng, 0.7));
   // Second-order terms: |dq|^2 ~ 1e-11 against |dq| ~ 1e-5.
-  EXPECT_LT((dq - expected).norm(), 1e-4 * expected.norm());
+  EXPECT_LT((move.dq - move.expected).norm(), 1e-4 * move.expected.norm());
   // The weights favour the joints near the hands: the wrists move more than the waist.
-  EXPECT_GT(winv[std::find(robot.joint_names.begin(), robot.joint_names.end(), "l_wrist_pitch") -
-                 robot.joint_names.begin()],
-            winv[0]);
+  const Eigen::VectorXd& winv = solver.inverse_weights();
+  EXPECT_GT(winv[JointIndex(robot, "l_wrist_pitch")], winv[0]);
+}
+
+// The sliding joints take part: goals reached to the tolerance within the limits (the
+// displacements included), and the lift and the telescoping arm move.
+TEST(RobotTreeSolver, ReachesGoalsWithSlidingJoints) {
+  const RobotTree robot = LiftRobot();
+  const Eigen::VectorXd moved = ReachNearbyGoals(robot, 23, 0.8, 0.2);
+  EXPECT_GT(moved[JointIndex(robot, "waist")], 1e-3);
+  EXPECT_GT(moved[JointIndex(robot, "l_upper_arm_twist")], 1e-3);
+}
+
+// As ASmallMoveIsTheLeastWeightedJointMotion, with sliding joints: a sliding joint's inverse
+// weight the mean link squared.
+TEST(RobotTreeSolver, ASmallMoveWithSlidingJointsIsTheLeastWeightedJointMotion) {
+  const RobotTree robot = LiftRobot();
+  const RobotTreeSolver solver(robot);
+  const double mean = solver.layout().mean_link;
+  for (int j = 0; j < robot.joints(); ++j) {
+    if (robot.prismatic[j]) EXPECT_EQ(solver.inverse_weights()[j], mean * mean);
+  }
+  std::mt19937 rng(29);
+  const SmallMove move = SolveSmallMove(robot, solver, RandomAngles(robot, &rng, 0.05));
+  EXPECT_LT((move.dq - move.expected).norm(), 1e-4 * move.expected.norm());
+  EXPECT_GT(std::abs(move.expected[JointIndex(robot, "waist")]), 1e-3 * move.expected.norm());
 }
 
 TEST(RobotTreeSolver, HoldsJointsOnTheirLimits) {
@@ -271,13 +389,31 @@ TEST(RobotTreeSolver, EndsNearTheGoalsItCannotReachAndSaysSo) {
   }
 }
 
-TEST(RobotTreeSolver, TurnsALookingToolToItsGoalPoint) {
-  const RobotTree robot = TwoArmRobot(true);
+// The camera turned to look at the left hand, also with the neck's tilt made a rise (a sliding
+// joint below the pan: its column of the looking goal's Jacobian turns nothing and moves the
+// camera along z).
+class LookingTool : public ::testing::TestWithParam<bool> {};
+INSTANTIATE_TEST_SUITE_P(RobotTreeSolver, LookingTool, ::testing::Values(false, true),
+                         [](const auto& info) { return info.param ? "sliding" : "turning"; });
+TEST_P(LookingTool, TurnsToItsGoalPoint) {
+  const RobotTree robot = GetParam() ? LiftRobot(true) : TwoArmRobot(true);
   RobotTreeOptions options;
   options.looks = {0, 0, 1};
   const RobotTreeSolver solver(robot, options);
   Points goals(3, 3);
   goals << 0.3, 0.4, 1.2, 0.35, -0.35, 0.95, 0.3, 0.4, 1.2;  // the camera watches the left hand
+  if (GetParam()) {
+    // Where the hands and the camera are at other joint values (the rise up 0.06), the camera
+    // looking at a point ahead of it there: reachable by the sliding robot.
+    Eigen::VectorXd there = robot.initial;
+    there[JointIndex(robot, "neck_tilt")] = 0.06;
+    there[JointIndex(robot, "neck_pan")] = 0.3;
+    there[JointIndex(robot, "l_elbow")] = -0.5;
+    Points tools, axes;
+    RobotTreeTools(robot, there, &tools, &axes);
+    goals.topRows(2) = tools.topRows(2);
+    goals.row(2) = tools.row(2) + 0.7 * axes.row(2);
+  }
   const RobotTreeSolve s = solver.Solve(robot.initial, goals);
   ASSERT_TRUE(s.converged) << s.residual << " " << s.angle_residual;
   Points tools, axes;
@@ -288,6 +424,31 @@ TEST(RobotTreeSolver, TurnsALookingToolToItsGoalPoint) {
   EXPECT_LE(s.angle_residual, 1e-10);
   EXPECT_LE((tools.topRows(2) - goals.topRows(2)).rowwise().norm().maxCoeff(),
             1e-10 * solver.layout().longest_link);
+}
+
+// Gauss-Newton with the exact Jacobian converges quadratically: a small look away (the camera's
+// goal point where a rise of 1e-3 more of the sliding neck puts it) is met in at most 3
+// iterations, which a wrong column for the sliding joint (tried: one scaled by 0.3) does not do.
+TEST(RobotTreeSolver, ASmallLookWithASlidingJointConvergesQuadratically) {
+  const RobotTree robot = LiftRobot(true);
+  RobotTreeOptions options;
+  options.looks = {0, 0, 1};
+  const RobotTreeSolver solver(robot, options);
+  const int rise = JointIndex(robot, "neck_tilt");
+  Eigen::VectorXd from = robot.initial;
+  from[rise] = 0.03;
+  from[JointIndex(robot, "neck_pan")] = 0.2;
+  Eigen::VectorXd there = from;
+  there[rise] += 1e-3;
+  Points tools, axes, moved, moved_axes;
+  RobotTreeTools(robot, from, &tools, &axes);
+  RobotTreeTools(robot, there, &moved, &moved_axes);
+  Points goals = tools;
+  goals.row(2) = moved.row(2) + 0.7 * moved_axes.row(2);
+  const RobotTreeSolve s = solver.Solve(from, goals);
+  ASSERT_TRUE(s.converged) << s.angle_residual;
+  EXPECT_LE(s.iterations, 3);
+  EXPECT_GT(std::abs(s.angles[rise] - from[rise]), 1e-4);
 }
 
 TEST(RobotTreeSolver, RefusesBadGoalsAndOptions) {
@@ -367,6 +528,78 @@ TEST(RobotTreeScenario, RunsTheExampleThroughTheFrontDoor) {
     EXPECT_EQ(back.parents, s.tree->tree.parents);
     std::filesystem::remove(path);
   }
+}
+
+// A robot tree with sliding joints through the front door: a scenario whose two hands follow
+// where a smooth motion of every joint (the lift and the telescoping arm included) takes them, so
+// that every frame is reachable. Every frame reached, the rigid links' lengths kept, the sliding
+// links' lengths the lift's and the telescope's, and the result written and read back with its
+// sliding links and joints (the neck's link of length 0 at the start accepted).
+TEST(RobotTreeScenario, RunsSlidingJointsThroughTheFrontDoor) {
+  const std::string dir = ::testing::TempDir() + "/sliding_robot";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream urdf(dir + "/lift.urdf");
+    urdf << test_util::SlidingTwoArms();
+  }
+  const RobotTree robot = LiftRobot();
+  const int frames = 40;
+  std::string paths[2];
+  for (int f = 1; f <= frames; ++f) {
+    const double t = static_cast<double>(f) / frames;
+    Eigen::VectorXd q(robot.joints());
+    for (int j = 0; j < robot.joints(); ++j) {
+      const double amplitude = robot.prismatic[j] ? 0.08 : 0.4;
+      q[j] = std::clamp(amplitude * std::sin(M_PI * t * (1 + j % 3)), robot.joint_min[j],
+                        robot.joint_max[j]);
+    }
+    Points tools, axes;
+    RobotTreeTools(robot, q, &tools, &axes);
+    for (int k = 0; k < 2; ++k) {
+      paths[k] += std::string(f > 1 ? ", " : "") + "[" + std::to_string(tools(k, 0)) + ", " +
+                  std::to_string(tools(k, 1)) + ", " + std::to_string(tools(k, 2)) + "]";
+    }
+  }
+  {
+    std::ofstream scenario(dir + "/lift.json");
+    scenario << R"({"format": "flexkin-tree", "name": "lift", "robot": {"urdf": "lift.urdf"},
+                   "targets": [{"link": "l_tool", "path": [)"
+             << paths[0] << R"(]}, {"link": "r_tool", "path": [)" << paths[1] << "]}]}";
+  }
+  ScenarioReadOptions read;
+  read.robot = UrdfRobotScenarioOptions();
+  const AnyScenario s = ReadScenarioFile(dir + "/lift.json", read);
+  ASSERT_TRUE(s.valid()) << s.problems.front().Text();
+  ASSERT_TRUE(s.tree.has_value() && s.tree->robot);
+  const TreeRunResult r = RunTree(*s.tree);
+  ASSERT_EQ(r.frames.size(), static_cast<size_t>(frames + 1));
+  EXPECT_EQ(r.failures(), 0) << r.BriefReport();
+  EXPECT_LT(r.max_length_error, 1e-14);
+  const RobotTreeLayout layout = MakeRobotTreeLayout(*s.tree->robot);
+  const int waist = JointIndex(robot, "waist"), twist = JointIndex(robot, "l_upper_arm_twist");
+  double lift = 0.0;
+  for (size_t f = 0; f < r.frames.size(); ++f) {
+    for (const auto& [joint, offset] : {std::pair<int, double>{waist, 0.5}, {twist, 0.15}}) {
+      const int i = layout.joint_point[joint];
+      const double length = (r.frames[f].row(i) - r.frames[f].row(layout.parents[i])).norm();
+      EXPECT_NEAR(length, offset + r.angles[f][joint], 1e-15 * 4) << "frame " << f;
+    }
+    lift = std::max(lift, std::abs(r.angles[f][waist]));
+  }
+  EXPECT_GT(lift, 0.01);  // the lift took part
+  for (const char* name : {"lift.npz", "lift_result.json"}) {
+    const std::string path = dir + "/" + name;
+    WriteTreeResult(path, *s.tree, r);
+    const TreeResultFile back = ReadTreeResultFile(path);
+    std::vector<int> sliding;
+    for (size_t i = 0; i < layout.sliding.size(); ++i) {
+      if (layout.sliding[i]) sliding.push_back(static_cast<int>(i));
+    }
+    EXPECT_EQ(back.sliding, sliding);
+    EXPECT_EQ(back.prismatic, robot.prismatic);
+    EXPECT_EQ(back.frames.back(), r.frames.back());
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(RobotTreeScenario, NamesEveryProblemByItsJsonPointer) {

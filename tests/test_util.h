@@ -136,6 +136,36 @@ inline std::string SourceFileText(const std::string& file) {
   text << in.rdbuf();
   return text.str();
 }
+
+// examples/robot_two_arms.urdf with three of its joints made prismatic (sliding along their
+// axes): the waist a lift along z (limits -0.1 to 0.3), the left upper arm's twist a telescope
+// along the arm (y, -0.1 to 0.1), and the neck's tilt a rise along z from the pan joint's own
+// point (origin moved to 0 0 0, limits 0 to 0.1). "" where a joint is not as expected.
+inline std::string SlidingTwoArms() {
+  std::string text = SourceFileText("examples/robot_two_arms.urdf");
+  const auto edit = [&](const std::string& joint, const std::vector<std::string>& from,
+                        const std::vector<std::string>& to) {
+    const size_t begin = text.find("<joint name=\"" + joint + "\" type=\"revolute\">");
+    const size_t end = text.find("</joint>", begin);
+    if (begin == std::string::npos || end == std::string::npos) return false;
+    std::string block = text.substr(begin, end - begin);
+    block.replace(block.find("revolute"), 8, "prismatic");
+    for (size_t i = 0; i < from.size(); ++i) {
+      const size_t at = block.find(from[i]);
+      if (at == std::string::npos) return false;
+      block.replace(at, from[i].size(), to[i]);
+    }
+    text.replace(begin, end - begin, block);
+    return true;
+  };
+  const bool ok =
+      edit("waist", {"lower=\"-1.6\" upper=\"1.6\""}, {"lower=\"-0.1\" upper=\"0.3\""}) &&
+      edit("l_upper_arm_twist", {"lower=\"-2.5\" upper=\"2.5\""},
+           {"lower=\"-0.1\" upper=\"0.1\""}) &&
+      edit("neck_tilt", {"xyz=\"0 0 0.08\"", "xyz=\"0 1 0\"", "lower=\"-0.8\" upper=\"0.8\""},
+           {"xyz=\"0 0 0\"", "xyz=\"0 0 1\"", "lower=\"0\" upper=\"0.1\""});
+  return ok ? text : std::string();
+}
 #endif
 
 }  // namespace flexkin::test_util

@@ -146,6 +146,49 @@ TEST(TreeDrawTest, EveryFormatOfTreesIsWritten) {
 
 // ---- Plots of tree results ----
 
+// A link that slides (a robot tree's prismatic joint): of length 0 in the first frame and longer
+// in each after it. Declared as sliding, the result is valid, drawn and plotted; glTF export,
+// whose bones keep their lengths, is refused by name and writes nothing.
+TEST(TreeDrawTest, SlidingLinksAreDrawnAndPlottedButNotExportedToGltf) {
+  TempDir dir;
+  TreeResultFile tree;
+  tree.name = "lift";
+  tree.dim = 2;
+  tree.parents = {-1, 0, 1, 2};
+  tree.targets = {3};
+  tree.fixed = {0};
+  for (int f = 0; f <= 5; ++f) {
+    Points p(4, 2);
+    const double a = 0.2 * f, slide = 0.1 * f;
+    p << 0, 0, 0, 1, slide * std::cos(a), 1 + slide * std::sin(a), slide * std::cos(a) + 0.5,
+        1 + slide * std::sin(a);
+    tree.frames.push_back(p);
+    if (f > 0) tree.reached.push_back(1);
+  }
+  tree.sliding = {2};
+  EXPECT_TRUE(ValidateTreeResult(tree).empty()) << ValidateTreeResult(tree).front().Text();
+  TreeResultFile undeclared = tree;
+  undeclared.sliding.clear();
+  const Problems problems = ValidateTreeResult(undeclared);
+  ASSERT_FALSE(problems.empty());
+  EXPECT_EQ(problems.front().field, "frames[0][2]");
+  DrawOptions options;
+  options.base = dir.Path("lift");
+  options.formats = ParseOutputFormats("svg,png,plots", "formats");
+  const std::vector<std::string> written = Draw(tree, options);
+  EXPECT_EQ(written.size(), 6u);  // the figure and two plots, each as SVG and PNG
+  for (const std::string& path : written) EXPECT_GT(std::filesystem::file_size(path), 1000u);
+  const std::string gltf = dir.Path("lift.glb");
+  try {
+    WriteTreeGltf(tree, GltfOptions(), gltf);
+    ADD_FAILURE() << "a sliding link exported";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.problem().field, "sliding");
+    EXPECT_NE(e.problem().message.find("prismatic"), std::string::npos) << e.problem().message;
+  }
+  EXPECT_FALSE(std::filesystem::exists(gltf));
+}
+
 TEST(TreePlotTest, PlotsOfATreeAreWrittenAsSvgAndPng) {
   TempDir dir;
   const TreeResultFile tree = TwoArms();

@@ -32,9 +32,13 @@ struct RobotTree {
   std::vector<int> joint_parents;  // the joint above each (-1: on the base); parent < joint
   Eigen::Matrix<double, Eigen::Dynamic, 3> origins;  // a point of each joint's axis
   Eigen::Matrix<double, Eigen::Dynamic, 3> axes;     // unit
-  Eigen::VectorXd joint_min, joint_max;              // rad; -inf and inf: unlimited
-  Eigen::VectorXd initial;                           // the start, within the limits
-  Eigen::Vector3d base = Eigen::Vector3d::Zero();    // the base link's origin
+  Eigen::VectorXd joint_min, joint_max;  // rad (length for sliding joints); -inf, inf: unlimited
+  Eigen::VectorXd initial;               // the start, within the limits
+  // Per joint: 1 where it slides along its axis (a prismatic joint: its value is a displacement
+  // in the length unit, and the origin moves with the joint), 0 where it turns about it. Empty:
+  // every joint turns.
+  std::vector<char> prismatic;
+  Eigen::Vector3d base = Eigen::Vector3d::Zero();  // the base link's origin
   // The tools, one per target: a point of a link, and the axis of its frame that looks.
   struct Tool {
     std::string link;                                     // the link's name
@@ -53,11 +57,14 @@ struct RobotTree {
 };
 
 // The robot as a tree of points (flexkin/tree.h): point 0 the base, then a point per joint
-// origin that is not on its parent's point, then a point per tool not on its joint's point.
-// The distances between points joined by a link are fixed by the robot's rigid links, so the
-// tree's links keep their lengths as the joints turn.
+// origin that is not on its parent's point (a sliding joint's always has its own), then a point
+// per tool not on its joint's point. The distances between points joined by a link are fixed by
+// the robot's rigid links, so the tree's links keep their lengths as the joints turn; only the
+// link into a sliding joint's origin (which moves with the joint) changes its length as that
+// joint slides, and may be of length 0.
 struct RobotTreeLayout {
   std::vector<int> parents;      // of the points (parents[0] = -1)
+  std::vector<char> sliding;     // per point: 1 where the link into it changes length
   std::vector<int> joint_point;  // the point of each joint's origin
   std::vector<int> tool_point;   // the point of each tool
   // Each joint's distance along the tree to the nearest tool below it (length; 0 where none).
@@ -117,7 +124,8 @@ class RobotTreeSolver {
   RobotTreeSolver& operator=(const RobotTreeSolver&) = delete;
   const RobotTreeLayout& layout() const { return layout_; }
   // The inverse weights of the joint-motion norm: joint j's 1 / (d_j / mean link)^2, d_j its
-  // distance to the nearest tool below it (at least half a mean link).
+  // distance to the nearest tool below it (at least half a mean link); a sliding joint's (its
+  // motion moves the tools as far as it slides) the mean link squared.
   const Eigen::VectorXd& inverse_weights() const { return winv_; }
 
   // From `from` (within the limits) toward `goals` (a row per tool: the target point, or the
@@ -125,7 +133,9 @@ class RobotTreeSolver {
   // the weighted misses to first order (a looking goal's miss is its angle times the mean link),
   // joints that would leave their limits put on them and held; a backtracking line search, and
   // Levenberg-Marquardt damping where full steps fail. Where the goals cannot be met, ends once
-  // ten iterations gain less than 1e-4 of the squared misses, at the configuration found. Throws
+  // ten iterations gain less than 1e-4 of the squared misses, at the configuration found. A
+  // step turns no joint by more than half a radian and slides none by more than half a mean
+  // link (a longer one is scaled down whole). Throws
   // InputError for angles or goals of the wrong shape or not finite.
   RobotTreeSolve Solve(const Eigen::VectorXd& from, const Points& goals) const;
 

@@ -28,7 +28,10 @@ struct Tree {
 // exactly one root (-1), every other parent a point of the tree other than itself, no cycle, and
 // no point on its parent (a link of length 0). Throws InputError naming `field` ("tree.parents[4]",
 // "tree.points[7]"; "parents[4]" where `field` is empty) with the value and what would be valid.
-void ValidateTree(const Tree& tree, const char* field = "tree");
+// `sliding` (per point, or null): 1 where the link into the point slides (a robot tree's prismatic
+// joint, flexkin/robot_tree.h), which may be of length 0.
+void ValidateTree(const Tree& tree, const char* field = "tree",
+                  const std::vector<char>* sliding = nullptr);
 
 // The path of `chain` as a tree (point i hangs from point i - 1).
 Tree TreeOfChain(const Chain& chain);

@@ -38,6 +38,9 @@ struct TreeScenario {
   // "targets"[k]), `fixed` the base; its joints are solved by RobotTreeSolver with
   // reach.tolerance and reach.max_passes (iterations a frame). Null: a tree of points.
   std::shared_ptr<const RobotTree> robot;
+  // Per point of a robot tree: 1 where the link into it slides (a prismatic joint,
+  // RobotTreeLayout::sliding); empty for a tree of points.
+  std::vector<char> sliding;
 
   // One driven point and nothing fixed: moved by MoveTreePoint (any rule of trees); otherwise
   // by the passes (tractrix, ftl) or, with method "overall", by StepTreeOverall.
@@ -101,6 +104,12 @@ struct TreeResultFile {
   bool robot = false;                   // a robot tree's result ("method": "newton")
   std::vector<std::string> joints;      // a robot tree's joint names
   std::vector<Eigen::VectorXd> angles;  // a robot tree's joint angles, every frame (or none)
+  // The points whose link into them slides (a robot tree's prismatic joints: its length changes,
+  // and may be 0); empty in files without "sliding".
+  std::vector<int> sliding;
+  // Per joint of a robot tree: 1 where it slides (its "angles" are displacements, in the length
+  // unit); empty in files without "prismatic" (every joint turns).
+  std::vector<char> prismatic;
 };
 
 // Reads a tree result (.npz or .json, told apart by content) and checks it: the format, the

@@ -384,6 +384,15 @@ py::dict RunTreeToDict(const AnyScenario& any, ProgressCallback progress, const 
     }
     out["angles"] = angles;
     out["joints"] = robot.joint_names;
+    // Sliding joints (prismatic): per joint, and the points whose link into them slides.
+    std::vector<bool> prismatic(static_cast<size_t>(n), false);
+    for (size_t j = 0; j < robot.prismatic.size(); ++j) prismatic[j] = robot.prismatic[j] != 0;
+    out["prismatic"] = prismatic;
+    std::vector<int> sliding;
+    for (size_t i = 0; i < any.tree->sliding.size(); ++i) {
+      if (any.tree->sliding[i]) sliding.push_back(static_cast<int>(i));
+    }
+    out["sliding"] = sliding;
   }
   return out;
 }

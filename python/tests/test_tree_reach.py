@@ -189,6 +189,7 @@ def test_a_robot_tree_runs_through_the_front_door(tmp_path):
     assert result["frames"].shape == (181, 17, 3)
     assert result["angles"].shape == (181, 15)
     assert result["joints"][0] == "waist"
+    assert not any(result["prismatic"]) and result["sliding"] == []  # every joint turns
     assert result["reached"].all()
     assert result["max_length_error"] < 1e-14
     # No flips: the joints move little between frames.

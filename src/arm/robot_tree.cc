@@ -19,8 +19,14 @@ std::string Member(const char* name, size_t i) {
   return std::string(name) + "[" + std::to_string(i) + "]";
 }
 
+bool Slides(const RobotTree& robot, int j) {
+  return !robot.prismatic.empty() && robot.prismatic[j];
+}
+
 // The joints' frames at `q`: joint j moves the points of its subtree by x -> rot[j] x + shift[j]
-// (x at the zero pose), and its origin and axis are at origin[j] and axis[j] in the world.
+// (x at the zero pose), and its origin and axis are at origin[j] and axis[j] in the world. A
+// turning joint's origin is on its axis, where its subtree turns about; a sliding joint's moves
+// with it (origin[j] = rot[j] o0 + shift[j] for both).
 struct RobotFrames {
   std::vector<Eigen::Matrix3d> rot;
   std::vector<Eigen::Vector3d> shift, origin, axis;
@@ -35,6 +41,13 @@ struct RobotFrames {
       const int p = robot.joint_parents[j];
       const Eigen::Vector3d o0 = robot.origins.row(j).transpose();
       const Eigen::Vector3d a0 = robot.axes.row(j).transpose();
+      if (Slides(robot, j)) {
+        axis[j] = p < 0 ? a0 : Eigen::Vector3d(rot[p] * a0);
+        rot[j] = p < 0 ? Eigen::Matrix3d::Identity() : rot[p];
+        shift[j] = (p < 0 ? Eigen::Vector3d::Zero() : shift[p]) + q[j] * axis[j];
+        origin[j] = rot[j] * o0 + shift[j];
+        continue;
+      }
       if (p < 0) {
         origin[j] = o0;
         axis[j] = a0;
@@ -101,6 +114,7 @@ Problems RobotTree::Validate() const {
   size("joint_min", static_cast<size_t>(joint_min.size()));
   size("joint_max", static_cast<size_t>(joint_max.size()));
   size("initial", static_cast<size_t>(initial.size()));
+  if (!prismatic.empty()) size("prismatic", prismatic.size());
   if (!out.empty()) return out;
   if (!base.allFinite()) out.push_back(Problem("base", "is not finite; expected a point"));
   for (size_t j = 0; j < n; ++j) {
@@ -118,13 +132,15 @@ Problems RobotTree::Validate() const {
                                      "a unit vector (the joint's axis)"));
     }
     if (std::isnan(joint_min[j]) || std::isnan(joint_max[j]) || !(joint_min[j] <= joint_max[j])) {
-      out.push_back(Problem::Invalid(
-          Member("joint_min", j), FormatNumber(joint_min[j]),
-          "a lower limit <= the upper limit " + FormatNumber(joint_max[j]) + " (rad)"));
+      out.push_back(Problem::Invalid(Member("joint_min", j), FormatNumber(joint_min[j]),
+                                     "a lower limit <= the upper limit " +
+                                         FormatNumber(joint_max[j]) +
+                                         (Slides(*this, j) ? " (length)" : " (rad)")));
     } else if (!std::isfinite(initial[j]) || initial[j] < joint_min[j] ||
                initial[j] > joint_max[j]) {
       out.push_back(Problem::Invalid(Member("initial", j), FormatNumber(initial[j]),
-                                     "an angle within [" + FormatNumber(joint_min[j]) + ", " +
+                                     std::string(Slides(*this, j) ? "a displacement" : "an angle") +
+                                         " within [" + FormatNumber(joint_min[j]) + ", " +
                                          FormatNumber(joint_max[j]) + "]"));
     }
   }
@@ -153,10 +169,12 @@ RobotTreeLayout MakeRobotTreeLayout(const RobotTree& robot) {
   std::vector<Eigen::Vector3d> at{robot.base};
   std::vector<double> depth{0.0};  // the length along the tree from the base
   layout.parents = {-1};
-  auto place = [&](int parent, const Eigen::Vector3d& x) {
+  layout.sliding = {0};
+  auto place = [&](int parent, const Eigen::Vector3d& x, bool slides = false) {
     const double length = (x - at[parent]).norm();
-    if (!(length > eps)) return parent;
+    if (!(length > eps) && !slides) return parent;
     layout.parents.push_back(parent);
+    layout.sliding.push_back(slides ? 1 : 0);
     at.push_back(x);
     depth.push_back(depth[parent] + length);
     layout.longest_link = std::max(layout.longest_link, length);
@@ -166,8 +184,8 @@ RobotTreeLayout MakeRobotTreeLayout(const RobotTree& robot) {
   const int n = robot.joints();
   for (int j = 0; j < n; ++j) {
     const int p = robot.joint_parents[j];
-    layout.joint_point.push_back(
-        place(p < 0 ? 0 : layout.joint_point[p], robot.origins.row(j).transpose()));
+    layout.joint_point.push_back(place(p < 0 ? 0 : layout.joint_point[p],
+                                       robot.origins.row(j).transpose(), Slides(robot, j)));
   }
   for (const RobotTree::Tool& t : robot.tools) {
     layout.tool_point.push_back(place(layout.joint_point[t.joint], t.point));
@@ -269,7 +287,7 @@ RobotTreeSolver::RobotTreeSolver(const RobotTree& robot, RobotTreeOptions option
   for (int j = 0; j < n; ++j) {
     const double d =
         std::max(layout_.tool_distance[j], 0.5 * layout_.mean_link) / layout_.mean_link;
-    winv_[j] = 1.0 / (d * d);
+    winv_[j] = Slides(robot, j) ? layout_.mean_link * layout_.mean_link : 1.0 / (d * d);
   }
   above_.resize(k);
   for (size_t i = 0; i < k; ++i) {
@@ -334,7 +352,9 @@ RobotTreeSolve RobotTreeSolver::Solve(const Eigen::VectorXd& from, const Points&
         m.position = std::max(m.position, miss.norm());
         err->segment<3>(r0) = s * miss;
         for (int j : above_[i]) {
-          jac->block<3, 1>(r0, j) = s * frames->axis[j].cross(x - frames->origin[j]);
+          jac->block<3, 1>(r0, j) =
+              Slides(robot, j) ? Eigen::Vector3d(s * frames->axis[j])
+                               : Eigen::Vector3d(s * frames->axis[j].cross(x - frames->origin[j]));
         }
         continue;
       }
@@ -360,8 +380,11 @@ RobotTreeSolve RobotTreeSolver::Solve(const Eigen::VectorXd& from, const Points&
       for (int j : above_[i]) {
         const Eigen::Vector3d a = frames->axis[j];
         // The tool's axis turns at a per unit of q_j; the direction to the goal turns at
-        // -(g x xdot) / r as the tool point moves at xdot.
-        const Eigen::Vector3d c = a + g.cross(a.cross(x - frames->origin[j])) / r;
+        // -(g x xdot) / r as the tool point moves at xdot. A sliding joint turns nothing and
+        // moves the tool point at a.
+        const Eigen::Vector3d c =
+            Slides(robot, j) ? Eigen::Vector3d(g.cross(a) / r)
+                             : Eigen::Vector3d(a + g.cross(a.cross(x - frames->origin[j])) / r);
         (*jac)(r0, j) = scale * u.dot(c);
         (*jac)(r0 + 1, j) = scale * v.dot(c);
       }
@@ -413,8 +436,13 @@ RobotTreeSolve RobotTreeSolver::Solve(const Eigen::VectorXd& from, const Points&
       }
       if (!more) break;
     }
-    // At most half a radian a joint per iteration: far goals are approached in several.
-    const double largest = w.dq.cwiseAbs().maxCoeff();
+    // At most half a radian a joint (half a mean link a sliding joint) per iteration: far goals
+    // are approached in several.
+    double largest = 0.0;
+    for (int j = 0; j < n; ++j) {
+      largest = std::max(
+          largest, Slides(robot, j) ? std::abs(w.dq[j]) / layout_.mean_link : std::abs(w.dq[j]));
+    }
     if (largest > 0.5) w.dq *= 0.5 / largest;
     bool accepted = false;
     RobotMisses trial_misses;

@@ -193,6 +193,18 @@ void WriteTreeGltf(const TreeResultFile& tree, const GltfOptions& options,
 
 void internal::WriteTreeGltf(const TreeResultFile& tree, const GltfOptions& options,
                              const std::string& path) {
+  if (!tree.sliding.empty()) {
+    // The skin's bones keep the first frame's lengths; a sliding link's does not.
+    throw InputError(Problem("sliding",
+                             "the tree has " + std::to_string(tree.sliding.size()) +
+                                 " sliding links (a robot tree's prismatic joints, point " +
+                                 std::to_string(tree.sliding.front()) +
+                                 " the first), whose lengths change; glTF export takes trees "
+                                 "whose links keep their lengths (its bones do); draw it, "
+                                 "animate it or view it instead",
+                             std::to_string(tree.sliding.size()) + " sliding links",
+                             "a tree without sliding links"));
+  }
   const bool binary = gltf::IsBinaryPath(path);
   const gltf::TreeSkeleton skeleton = gltf::MakeTreeSkeleton(tree.parents);
   CheckTreeGltfLimits(tree, skeleton, options);

@@ -30,7 +30,8 @@ class TreeResultReader : public json_internal::JsonReader {
     if (!ExpectObject(root, "", "an object (a tree result, docs/trees.md)")) return;
     std::vector<std::string> keys = {"format",           "name",     "method", "dim",
                                      "parents",          "targets",  "looks",  "fixed",
-                                     "max_length_error", "failures", "joints"};
+                                     "max_length_error", "failures", "joints", "sliding",
+                                     "prismatic"};
     if (json_form) {
       for (const char* k : {"frames", "goals", "angles", "passes", "residual", "reached",
                             "converged", "finished"}) {
@@ -78,6 +79,10 @@ class TreeResultReader : public json_internal::JsonReader {
     out->targets = Indices(root, "targets", 0, std::max(last, 0), false);
     out->fixed = Indices(root, "fixed", 0, std::max(last, 0), false);
     if (Find(root, "looks") != nullptr) Flags(root, "looks", out->targets.size(), &out->looks);
+    out->sliding = Indices(root, "sliding", 1, std::max(last, 1), false);
+    if (Find(root, "prismatic") != nullptr) {
+      Flags(root, "prismatic", out->joints.size(), &out->prismatic);
+    }
   }
 
   // The JSON form's frames, each (n+1) by dim, and "reached" and "converged" (F - 1 booleans).
@@ -324,6 +329,11 @@ Problems CheckTreeResult(const TreeResultFile& out, Naming naming) {
                                    " entries; expected one per target (" +
                                    std::to_string(out.targets.size()) + ") or none")};
     }
+    if (!out.prismatic.empty() && out.prismatic.size() != out.joints.size()) {
+      return {Problem("prismatic", "has " + std::to_string(out.prismatic.size()) +
+                                       " entries; expected one per joint (" +
+                                       std::to_string(out.joints.size()) + ") or none")};
+    }
     if (!out.goals.empty() && out.goals.size() + 1 != out.frames.size()) {
       return {Problem("goals", "has " + std::to_string(out.goals.size()) +
                                    " frames; expected one per frame after the first (" +
@@ -359,8 +369,19 @@ Problems CheckTreeResult(const TreeResultFile& out, Naming naming) {
       }
     }
   }
+  std::vector<char> sliding(static_cast<size_t>(rows), 0);
+  for (size_t k = 0; k < out.sliding.size(); ++k) {
+    if (out.sliding[k] < 1 || out.sliding[k] >= rows) {
+      return {Problem::Invalid(member ? "sliding[" + std::to_string(k) + "]"
+                               : npz  ? "tree.json/sliding/" + std::to_string(k)
+                                      : "/sliding/" + std::to_string(k),
+                               std::to_string(out.sliding[k]),
+                               "a point from 1 to " + std::to_string(rows - 1))};
+    }
+    sliding[out.sliding[k]] = 1;
+  }
   try {
-    ValidateTree(Tree{out.frames.front(), out.parents}, "");
+    ValidateTree(Tree{out.frames.front(), out.parents}, "", &sliding);
   } catch (const InputError& e) {
     Problem p = e.problem();
     // "parents[4]" -> the parents' entry; "points[7]" -> point 7 of the first frame.

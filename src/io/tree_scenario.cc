@@ -185,6 +185,10 @@ class TreeScenarioReader : public json_internal::JsonReader {
       const RobotTreeLayout layout = MakeRobotTreeLayout(*model);
       s.tree.points = RobotTreePoints(*model, layout, model->initial);
       s.tree.parents = layout.parents;
+      if (std::find(layout.sliding.begin(), layout.sliding.end(), char(1)) !=
+          layout.sliding.end()) {
+        s.sliding = layout.sliding;
+      }
       s.targets = layout.tool_point;
       s.fixed = {0};
       s.robot = model;
@@ -413,6 +417,16 @@ nlohmann::ordered_json TreeResultHeader(const TreeScenario& s, const TreeRunResu
   j["name"] = s.name;
   j["method"] = s.robot ? "newton" : NameOf(s.method);
   if (s.robot) j["joints"] = s.robot->joint_names;
+  std::vector<int> sliding;
+  for (size_t i = 0; i < s.sliding.size(); ++i) {
+    if (s.sliding[i]) sliding.push_back(static_cast<int>(i));
+  }
+  if (!sliding.empty()) {
+    j["sliding"] = sliding;
+    std::vector<bool> prismatic;
+    for (const char c : s.robot->prismatic) prismatic.push_back(c != 0);
+    j["prismatic"] = prismatic;
+  }
   j["dim"] = s.tree.points.cols();
   j["parents"] = s.tree.parents;
   j["targets"] = s.targets;
@@ -495,12 +509,20 @@ TreeRunResult RunRobotTree(const TreeScenario& s,
                            const std::function<void(int64_t, int64_t)>& progress) {
   const RobotTree& robot = *s.robot;
   const RobotTreeSolver solver(robot, RobotTreeOptionsOf(s));
-  const TreeStepper links = MakeTreeStepper(Method::kTractrix, s.tree, 0);  // the start's lengths
+  const std::vector<int>& parents = solver.layout().parents;
+  const std::vector<char>& sliding = solver.layout().sliding;
   const int frames = s.frames();
   TreeRunResult r;
   Eigen::VectorXd q = robot.initial;
   r.frames.push_back(RobotTreePoints(robot, solver.layout(), q));
   r.angles.push_back(q);
+  // The links' lengths at the start, against which each frame's are measured (a sliding joint's
+  // link is not: its length is the joint's).
+  const Points& start = r.frames.front();
+  std::vector<double> lengths(parents.size(), 0.0);
+  for (size_t i = 1; i < parents.size(); ++i) {
+    lengths[i] = (start.row(i) - start.row(parents[i])).norm();
+  }
   Points goals(s.targets.size(), 3);
   const double longest = solver.layout().longest_link;
   for (int f = 0; f < frames; ++f) {
@@ -514,7 +536,12 @@ TreeRunResult RunRobotTree(const TreeScenario& s,
     r.reached.push_back(solve.converged);
     r.converged.push_back(1);
     r.finished.push_back(0);
-    r.max_length_error = std::max(r.max_length_error, MaxTreeLengthError(links, r.frames.back()));
+    const Points& p = r.frames.back();
+    for (size_t i = 1; i < parents.size(); ++i) {
+      if (sliding[i]) continue;
+      const double length = (p.row(i) - p.row(parents[i])).norm();
+      r.max_length_error = std::max(r.max_length_error, std::abs(length - lengths[i]) / lengths[i]);
+    }
     if (progress) progress(f + 1, frames);
   }
   return r;

@@ -28,7 +28,7 @@ std::pair<double, double> FrameRange(size_t count) {
 }
 
 // The points with a parent (each the trailing end of its link) and, at frame 0, their links'
-// lengths.
+// lengths; links that slide (a robot tree's prismatic joints) are not among them.
 struct TreeLinks {
   std::vector<int> ends;
   std::vector<double> lengths;
@@ -40,6 +40,7 @@ TreeLinks LinksOf(const TreeResultFile& tree) {
   for (size_t v = 0; v < tree.parents.size(); ++v) {
     if (tree.parents[v] < 0) continue;
     const int i = static_cast<int>(v);
+    if (std::find(tree.sliding.begin(), tree.sliding.end(), i) != tree.sliding.end()) continue;
     links.ends.push_back(i);
     links.lengths.push_back((first.row(i) - first.row(tree.parents[v])).norm());
     links.longest = std::max(links.longest, links.lengths.back());
@@ -169,25 +170,36 @@ void TargetMissPlot(Canvas* canvas, const TreeResultFile& tree) {
   Note(cr, ui, axes.plot().right() - 6 * ui, axes.Y(1e-10) - 5 * ui, buf);
 }
 
+// The turning joints' angles; sliding joints (their values are lengths) are left out.
 void JointAnglesPlot(Canvas* canvas, const TreeResultFile& tree) {
   const size_t frames = tree.angles.size();
   const Eigen::Index joints = tree.angles.front().size();
+  const auto slides = [&](Eigen::Index j) {
+    return static_cast<size_t>(j) < tree.prismatic.size() && tree.prismatic[j] != 0;
+  };
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (const Eigen::VectorXd& a : tree.angles) {
-    lo = std::min(lo, a.minCoeff() * 180.0 / M_PI);
-    hi = std::max(hi, a.maxCoeff() * 180.0 / M_PI);
+    for (Eigen::Index j = 0; j < joints; ++j) {
+      if (slides(j)) continue;
+      lo = std::min(lo, a[j] * 180.0 / M_PI);
+      hi = std::max(hi, a[j] * 180.0 / M_PI);
+    }
   }
+  if (!(lo <= hi)) lo = hi = 0.0;  // every joint slides
   const double pad = std::max(0.06 * (hi - lo), 1.0);
   cairo_t* cr = canvas->cr();
   const double ui = canvas->ui();
   const auto [x0, x1] = FrameRange(frames);
   Axes axes(PlotArea(*canvas, 86 * ui), x0, x1, lo - pad, hi + pad);
-  axes.Draw(cr, ui, "frame", "joint angle (degrees)");
+  axes.Draw(cr, ui, "frame",
+            tree.prismatic.empty() ? "joint angle (degrees)"
+                                   : "joint angle (degrees; sliding joints not drawn)");
   std::vector<double> x(frames), y(frames);
   for (size_t f = 0; f < frames; ++f) x[f] = static_cast<double>(f);
   cairo_save(cr);
   axes.Clip(cr);
   for (Eigen::Index j = joints - 1; j >= 0; --j) {
+    if (slides(j)) continue;
     for (size_t f = 0; f < frames; ++f) y[f] = tree.angles[f][j] * 180.0 / M_PI;
     const Rgb color = Viridis(joints == 1 ? 0.0 : static_cast<double>(j) / (joints - 1));
     if (frames == 1) {

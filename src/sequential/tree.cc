@@ -62,7 +62,7 @@ void TreeSweeps(const TreeStepper& t, const double* heads, int substeps, double*
 
 }  // namespace
 
-void ValidateTree(const Tree& tree, const char* field) {
+void ValidateTree(const Tree& tree, const char* field, const std::vector<char>* sliding) {
   const std::string f = field;
   const std::string points_field = f.empty() ? "points" : f + ".points";
   const std::string parents_field = f.empty() ? "parents" : f + ".parents";
@@ -139,7 +139,9 @@ void ValidateTree(const Tree& tree, const char* field) {
   for (int i = 0; i < count; ++i) {
     if (i == root) continue;
     const double length = (points.row(i) - points.row(parents[i])).norm();
-    if (!(length > 0.0) || !std::isfinite(length)) {
+    const bool slides =
+        sliding != nullptr && static_cast<size_t>(i) < sliding->size() && (*sliding)[i] != 0;
+    if (slides ? !std::isfinite(length) : !(length > 0.0) || !std::isfinite(length)) {
       throw InputError(At(f, "points", i), "lies at distance " + FormatNumber(length) +
                                                " from its parent point " +
                                                std::to_string(parents[i]) +

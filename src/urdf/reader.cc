@@ -445,15 +445,14 @@ RobotTree RobotTreeFromUrdf(const std::string& text, const std::string& base_lin
       const std::string field = "joint " + Quote(joint->name);
       LinkAt next{at.pose * Transform(joint->parent_to_joint_origin_transform), at.joint};
       if (joint->type != urdf::Joint::FIXED) {
-        if (joint->type != urdf::Joint::REVOLUTE && joint->type != urdf::Joint::CONTINUOUS) {
-          const char* type = joint->type == urdf::Joint::PRISMATIC  ? "prismatic"
-                             : joint->type == urdf::Joint::FLOATING ? "floating"
-                             : joint->type == urdf::Joint::PLANAR   ? "planar"
-                                                                    : "unknown";
+        if (joint->type != urdf::Joint::REVOLUTE && joint->type != urdf::Joint::CONTINUOUS &&
+            joint->type != urdf::Joint::PRISMATIC) {
+          const char* type = joint->type == urdf::Joint::FLOATING ? "floating"
+                             : joint->type == urdf::Joint::PLANAR ? "planar"
+                                                                  : "unknown";
           throw InputError(field, std::string("has type ") + type +
-                                      "; robot trees take revolute, continuous and fixed joints "
-                                      "(a serial arm, scenario kind \"robot\", takes prismatic "
-                                      "ones); make it fixed or start the tree below it "
+                                      "; robot trees take revolute, continuous, prismatic and "
+                                      "fixed joints; make it fixed or start the tree below it "
                                       "(base_link)");
         }
         const Eigen::Vector3d axis = JointAxis(*joint, field);
@@ -465,6 +464,7 @@ RobotTree RobotTreeFromUrdf(const std::string& text, const std::string& base_lin
         upper.push_back(hi);
         tree.joint_names.push_back(joint->name);
         tree.joint_parents.push_back(at.joint);
+        tree.prismatic.push_back(joint->type == urdf::Joint::PRISMATIC ? 1 : 0);
         next.joint = static_cast<int>(tree.joint_parents.size()) - 1;
       }
       stack.push_back({child, next});
@@ -472,9 +472,10 @@ RobotTree RobotTreeFromUrdf(const std::string& text, const std::string& base_lin
   }
   const int n = static_cast<int>(origins.size());
   if (n == 0) {
-    throw InputError("base_link", "link " + Quote(base->name) +
-                                      " has no revolute or continuous joint below it; expected "
-                                      "the link a robot tree is bolted to");
+    throw InputError("base_link",
+                     "link " + Quote(base->name) +
+                         " has no revolute, continuous or prismatic joint below it; expected "
+                         "the link a robot tree is bolted to");
   }
   tree.origins.resize(n, 3);
   tree.axes.resize(n, 3);
@@ -500,9 +501,10 @@ RobotTree RobotTreeFromUrdf(const std::string& text, const std::string& base_lin
                                             "; expected a link below the base");
     }
     if (at->second.joint < 0) {
-      throw InputError(field + ".link", "link " + Quote(want.link) +
-                                            " is below no revolute or continuous joint; expected "
-                                            "a link that the joints move");
+      throw InputError(field + ".link",
+                       "link " + Quote(want.link) +
+                           " is below no revolute, continuous or prismatic joint; expected "
+                           "a link that the joints move");
     }
     if (!want.offset.allFinite()) {
       throw InputError(field + ".offset", "is not finite; expected a point of the link's frame");
