@@ -18,6 +18,7 @@
 
 #include "flexkin/chain.h"
 #include "flexkin/error.h"
+#include "flexkin/tree_scenario.h"
 
 namespace flexkin::test_util {
 
@@ -127,6 +128,28 @@ class TempDirTest : public ::testing::Test {
   }
   std::string dir_;
 };
+
+// A tree result whose link into point 2 slides (a robot tree's prismatic joint), 2D, 6 frames:
+// a base, a post of 1 on it, the sliding link turning 0.2 rad and growing 0.1 a frame from
+// length 0, and a link of 0.5 along x at its end (point 3, the target).
+inline TreeResultFile SlidingTreeResult() {
+  TreeResultFile tree;
+  tree.name = "lift";
+  tree.dim = 2;
+  tree.parents = {-1, 0, 1, 2};
+  tree.targets = {3};
+  tree.fixed = {0};
+  for (int f = 0; f <= 5; ++f) {
+    Points p(4, 2);
+    const double a = 0.2 * f, slide = 0.1 * f;
+    p << 0, 0, 0, 1, slide * std::cos(a), 1 + slide * std::sin(a), slide * std::cos(a) + 0.5,
+        1 + slide * std::sin(a);
+    tree.frames.push_back(p);
+    if (f > 0) tree.reached.push_back(1);
+  }
+  tree.sliding = {2};
+  return tree;
+}
 
 #ifdef FLEXKIN_SOURCE_DIR
 // The text of a file of the source tree ("examples/robot_two_arms.urdf"); "" if it cannot be read.

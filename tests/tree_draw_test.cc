@@ -151,21 +151,7 @@ TEST(TreeDrawTest, EveryFormatOfTreesIsWritten) {
 // whose bones keep their lengths, is refused by name and writes nothing.
 TEST(TreeDrawTest, SlidingLinksAreDrawnAndPlottedButNotExportedToGltf) {
   TempDir dir;
-  TreeResultFile tree;
-  tree.name = "lift";
-  tree.dim = 2;
-  tree.parents = {-1, 0, 1, 2};
-  tree.targets = {3};
-  tree.fixed = {0};
-  for (int f = 0; f <= 5; ++f) {
-    Points p(4, 2);
-    const double a = 0.2 * f, slide = 0.1 * f;
-    p << 0, 0, 0, 1, slide * std::cos(a), 1 + slide * std::sin(a), slide * std::cos(a) + 0.5,
-        1 + slide * std::sin(a);
-    tree.frames.push_back(p);
-    if (f > 0) tree.reached.push_back(1);
-  }
-  tree.sliding = {2};
+  const TreeResultFile tree = test_util::SlidingTreeResult();
   EXPECT_TRUE(ValidateTreeResult(tree).empty()) << ValidateTreeResult(tree).front().Text();
   TreeResultFile undeclared = tree;
   undeclared.sliding.clear();

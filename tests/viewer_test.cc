@@ -238,6 +238,18 @@ TEST_F(ViewerTest, PageCarriesTheLinkRadiiWhenTheResultHasThem) {
   }
 }
 
+// A tree whose link into point 2 slides (a robot tree's prismatic joint, of length 0 in the first
+// frame): the page is written, and its length errors leave that link out.
+TEST_F(ViewerTest, ASlidingLinkIsNotALengthError) {
+  const TreeResultFile tree = test_util::SlidingTreeResult();
+  WriteTreeViewerHtml(tree, ViewerOptions(), Path("lift.html"));
+  const nlohmann::json data = EmbeddedData(test_util::ReadFile(Path("lift.html")));
+  ASSERT_EQ(data["frame_length_error"].size(), 6u);
+  // The other links' lengths to their rounding (the slide added and taken away).
+  for (const auto& e : data["frame_length_error"]) EXPECT_LE(e.get<double>(), 4e-16);
+  EXPECT_LE(data["metrics"]["max_relative_length_error"].get<double>(), 4e-16);
+}
+
 TEST_F(ViewerTest, OptionsAreValidatedNamingTheField) {
   EXPECT_TRUE(ViewerOptions().Validate().empty());
   const ResultFile file = MakeResult(3, 4, 5, 0.1, "");

@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -74,10 +75,13 @@ void AppendExactArray(const Eigen::VectorXd& v, std::string* out) {
 // Largest |(|x_b - x_a| - L_k)| / L_k of one frame over its links k (from point a[k] to b[k]:
 // a chain's from k to k + 1, a tree's from a point's parent to it), from the unrounded
 // coordinates.
+// The largest relative link-length error of a frame, links that slide (a robot tree's prismatic
+// joints: `sliding`, per link, if given) left out.
 double FrameLengthError(const Points& p, const Eigen::VectorXd& lengths, const std::vector<int>& a,
-                        const std::vector<int>& b) {
+                        const std::vector<int>& b, const std::vector<char>& sliding = {}) {
   double worst = 0.0;
   for (size_t k = 0; k < a.size(); ++k) {
+    if (k < sliding.size() && sliding[k]) continue;
     const double d = (p.row(b[k]) - p.row(a[k])).norm();
     worst = std::max(worst, std::abs(d - lengths[k]) / lengths[k]);
   }
@@ -190,6 +194,15 @@ ResultFile TreeAsViewerResult(const TreeResultFile& tree) {
   r.lengths.resize(static_cast<Eigen::Index>(ends.size()));
   for (size_t k = 0; k < ends.size(); ++k) {
     r.lengths[k] = (first.row(ends[k]) - first.row(tree.parents[ends[k]])).norm();
+    if (std::count(tree.sliding.begin(), tree.sliding.end(), ends[k]) > 0) {
+      // A sliding link (a robot tree's prismatic joint) is not checked against a length: it is
+      // given its longest over the frames (the smallest positive double if it never opens).
+      for (const Points& p : tree.frames) {
+        r.lengths[k] =
+            std::max(r.lengths[k], (p.row(ends[k]) - p.row(tree.parents[ends[k]])).norm());
+      }
+      r.lengths[k] = std::max(r.lengths[k], std::numeric_limits<double>::min());
+    }
   }
   const size_t frames = tree.frames.size();
   r.num_steps = static_cast<int64_t>(frames) - 1;
@@ -200,6 +213,7 @@ ResultFile TreeAsViewerResult(const TreeResultFile& tree) {
   for (size_t f = 0; f < frames; ++f) {
     r.frames.Add(static_cast<int64_t>(f), tree.frames[f]);
     for (size_t k = 0; k < ends.size(); ++k) {
+      if (std::count(tree.sliding.begin(), tree.sliding.end(), ends[k]) > 0) continue;
       const double d =
           (tree.frames[f].row(ends[k]) - tree.frames[f].row(tree.parents[ends[k]])).norm();
       m.max_relative_length_error =
@@ -249,9 +263,13 @@ std::string ViewerDataJson(const ResultFile& file, const ViewerOptions& options,
   }
   // Link k from point a[k] to point b[k].
   std::vector<int> link_a, link_b;
+  std::vector<char> sliding;  // per link: it slides (a robot tree's prismatic joint)
   if (tree != nullptr) {
     link_b = TreeLinkPoints(*tree);
-    for (const int c : link_b) link_a.push_back(tree->parents[c]);
+    for (const int c : link_b) {
+      link_a.push_back(tree->parents[c]);
+      sliding.push_back(std::count(tree->sliding.begin(), tree->sliding.end(), c) > 0 ? 1 : 0);
+    }
     AppendKey("tree", &out);
     out.push_back('{');
     AppendKey("parents", &out);
@@ -315,7 +333,7 @@ std::string ViewerDataJson(const ResultFile& file, const ViewerOptions& options,
   out.push_back('[');
   for (size_t f = 0; f < num_frames; ++f) {
     if (f > 0) out.push_back(',');
-    AppendNumber(FrameLengthError(r.frames[f].points, r.lengths, link_a, link_b), 3, &out);
+    AppendNumber(FrameLengthError(r.frames[f].points, r.lengths, link_a, link_b, sliding), 3, &out);
   }
   out.push_back(']');
   // Frame after frame, point after point (leading end first), coordinate after coordinate.
