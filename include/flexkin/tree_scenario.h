@@ -38,9 +38,9 @@ struct TreeScenario {
   // "targets"[k]), `fixed` the base; its joints are solved by RobotTreeSolver with
   // reach.tolerance and reach.max_passes (iterations a frame). Null: a tree of points.
   std::shared_ptr<const RobotTree> robot;
-  // Per point of a robot tree: 1 where the link into it slides (a prismatic joint,
+  // A robot tree's points whose link into them slides (its prismatic joints,
   // RobotTreeLayout::sliding); empty for a tree of points.
-  std::vector<char> sliding;
+  std::vector<int> sliding;
 
   // One driven point and nothing fixed: moved by MoveTreePoint (any rule of trees); otherwise
   // by the passes (tractrix, ftl) or, with method "overall", by StepTreeOverall.

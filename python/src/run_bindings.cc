@@ -388,11 +388,7 @@ py::dict RunTreeToDict(const AnyScenario& any, ProgressCallback progress, const 
     std::vector<bool> prismatic(static_cast<size_t>(n), false);
     for (size_t j = 0; j < robot.prismatic.size(); ++j) prismatic[j] = robot.prismatic[j] != 0;
     out["prismatic"] = prismatic;
-    std::vector<int> sliding;
-    for (size_t i = 0; i < any.tree->sliding.size(); ++i) {
-      if (any.tree->sliding[i]) sliding.push_back(static_cast<int>(i));
-    }
-    out["sliding"] = sliding;
+    out["sliding"] = any.tree->sliding;
   }
   return out;
 }

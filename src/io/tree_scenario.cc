@@ -185,9 +185,8 @@ class TreeScenarioReader : public json_internal::JsonReader {
       const RobotTreeLayout layout = MakeRobotTreeLayout(*model);
       s.tree.points = RobotTreePoints(*model, layout, model->initial);
       s.tree.parents = layout.parents;
-      if (std::find(layout.sliding.begin(), layout.sliding.end(), char(1)) !=
-          layout.sliding.end()) {
-        s.sliding = layout.sliding;
+      for (size_t i = 0; i < layout.sliding.size(); ++i) {
+        if (layout.sliding[i]) s.sliding.push_back(static_cast<int>(i));
       }
       s.targets = layout.tool_point;
       s.fixed = {0};
@@ -417,12 +416,8 @@ nlohmann::ordered_json TreeResultHeader(const TreeScenario& s, const TreeRunResu
   j["name"] = s.name;
   j["method"] = s.robot ? "newton" : NameOf(s.method);
   if (s.robot) j["joints"] = s.robot->joint_names;
-  std::vector<int> sliding;
-  for (size_t i = 0; i < s.sliding.size(); ++i) {
-    if (s.sliding[i]) sliding.push_back(static_cast<int>(i));
-  }
-  if (!sliding.empty()) {
-    j["sliding"] = sliding;
+  if (!s.sliding.empty()) {
+    j["sliding"] = s.sliding;
     std::vector<bool> prismatic;
     for (const char c : s.robot->prismatic) prismatic.push_back(c != 0);
     j["prismatic"] = prismatic;

@@ -141,7 +141,7 @@ void ValidateTree(const Tree& tree, const char* field, const std::vector<char>* 
     const double length = (points.row(i) - points.row(parents[i])).norm();
     const bool slides =
         sliding != nullptr && static_cast<size_t>(i) < sliding->size() && (*sliding)[i] != 0;
-    if (slides ? !std::isfinite(length) : !(length > 0.0) || !std::isfinite(length)) {
+    if (!std::isfinite(length) || (!slides && !(length > 0.0))) {
       throw InputError(At(f, "points", i), "lies at distance " + FormatNumber(length) +
                                                " from its parent point " +
                                                std::to_string(parents[i]) +

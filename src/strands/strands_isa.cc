@@ -355,9 +355,10 @@ void BlockSphereSweep(int n, int head, const double* heads, const double* length
       m[u] = MeasureSegment<B, Dim>(lead_new[u], step, c);
       enter[u] = SphereEnters<B>(m[u], r - slack * length);
       any_enter[u] = xsimd::any(enter[u]);
-      contacts[u] += xsimd::select(enter[u], B(1.0), B(0.0));
+      const B entered_lanes = xsimd::select(enter[u], B(1.0), B(0.0));
+      contacts[u] += entered_lanes;
       alignas(64) double entered[W];
-      xsimd::select(enter[u], B(1.0), B(0.0)).store_aligned(entered);
+      entered_lanes.store_aligned(entered);
       for (int j = 0; j < W; ++j) flags[u * W + j] = entered[j] != 0.0;
     }
     for (int u = 0; u < U; ++u) {

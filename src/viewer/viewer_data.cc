@@ -74,9 +74,8 @@ void AppendExactArray(const Eigen::VectorXd& v, std::string* out) {
 
 // Largest |(|x_b - x_a| - L_k)| / L_k of one frame over its links k (from point a[k] to b[k]:
 // a chain's from k to k + 1, a tree's from a point's parent to it), from the unrounded
-// coordinates.
-// The largest relative link-length error of a frame, links that slide (a robot tree's prismatic
-// joints: `sliding`, per link, if given) left out.
+// coordinates. Links that slide (`sliding`, per link, if given: a robot tree's prismatic joints)
+// are left out.
 double FrameLengthError(const Points& p, const Eigen::VectorXd& lengths, const std::vector<int>& a,
                         const std::vector<int>& b, const std::vector<char>& sliding = {}) {
   double worst = 0.0;
@@ -183,6 +182,14 @@ std::vector<int> TreeLinkPoints(const TreeResultFile& tree) {
   return points;
 }
 
+std::vector<char> TreeSlidingLinks(const TreeResultFile& tree) {
+  std::vector<char> slides(tree.parents.size(), 0);
+  for (const int i : tree.sliding) slides[i] = 1;
+  std::vector<char> links;
+  for (const int i : TreeLinkPoints(tree)) links.push_back(slides[i]);
+  return links;
+}
+
 ResultFile TreeAsViewerResult(const TreeResultFile& tree) {
   ResultFile file;
   file.dim = tree.dim;
@@ -190,13 +197,14 @@ ResultFile TreeAsViewerResult(const TreeResultFile& tree) {
   RunResult& r = file.result;
   r.method = tree.method;
   const std::vector<int> ends = TreeLinkPoints(tree);
+  const std::vector<char> sliding = TreeSlidingLinks(tree);
+  std::vector<int> starts;
+  for (const int i : ends) starts.push_back(tree.parents[i]);
   const Points& first = tree.frames.front();
   r.lengths.resize(static_cast<Eigen::Index>(ends.size()));
   for (size_t k = 0; k < ends.size(); ++k) {
     r.lengths[k] = (first.row(ends[k]) - first.row(tree.parents[ends[k]])).norm();
-    if (std::count(tree.sliding.begin(), tree.sliding.end(), ends[k]) > 0) {
-      // A sliding link (a robot tree's prismatic joint) is not checked against a length: it is
-      // given its longest over the frames (the smallest positive double if it never opens).
+    if (sliding[k]) {
       for (const Points& p : tree.frames) {
         r.lengths[k] =
             std::max(r.lengths[k], (p.row(ends[k]) - p.row(tree.parents[ends[k]])).norm());
@@ -212,13 +220,9 @@ ResultFile TreeAsViewerResult(const TreeResultFile& tree) {
   m.l2_weighted_per_step = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(frames - 1));
   for (size_t f = 0; f < frames; ++f) {
     r.frames.Add(static_cast<int64_t>(f), tree.frames[f]);
-    for (size_t k = 0; k < ends.size(); ++k) {
-      if (std::count(tree.sliding.begin(), tree.sliding.end(), ends[k]) > 0) continue;
-      const double d =
-          (tree.frames[f].row(ends[k]) - tree.frames[f].row(tree.parents[ends[k]])).norm();
-      m.max_relative_length_error =
-          std::max(m.max_relative_length_error, std::abs(d - r.lengths[k]) / r.lengths[k]);
-    }
+    m.max_relative_length_error =
+        std::max(m.max_relative_length_error,
+                 FrameLengthError(tree.frames[f], r.lengths, starts, ends, sliding));
     if (f == 0) continue;
     const Eigen::VectorXd moved = (tree.frames[f] - tree.frames[f - 1]).rowwise().norm();
     m.path_length += moved;
@@ -266,10 +270,8 @@ std::string ViewerDataJson(const ResultFile& file, const ViewerOptions& options,
   std::vector<char> sliding;  // per link: it slides (a robot tree's prismatic joint)
   if (tree != nullptr) {
     link_b = TreeLinkPoints(*tree);
-    for (const int c : link_b) {
-      link_a.push_back(tree->parents[c]);
-      sliding.push_back(std::count(tree->sliding.begin(), tree->sliding.end(), c) > 0 ? 1 : 0);
-    }
+    sliding = TreeSlidingLinks(*tree);
+    for (const int c : link_b) link_a.push_back(tree->parents[c]);
     AppendKey("tree", &out);
     out.push_back('{');
     AppendKey("parents", &out);

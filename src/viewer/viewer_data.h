@@ -36,10 +36,16 @@ std::string ViewerDataJson(const ResultFile& result, const ViewerOptions& option
 // k-th of them.
 std::vector<int> TreeLinkPoints(const TreeResultFile& tree);
 
+// Per link k of TreeLinkPoints: 1 where it slides (the tree's `sliding`: a robot tree's prismatic
+// joint), else 0.
+std::vector<char> TreeSlidingLinks(const TreeResultFile& tree);
+
 // A checked tree result (ValidateTreeResult) as the result the viewer page shows: frame f at step
-// f; link k's length that of the link ending at TreeLinkPoints(tree)[k] in the first frame; the
-// metrics of the tree's motion from frame to frame (each point's path length, L2 per frame: the
-// sum of the points' distances, L2 total, the largest relative link-length error).
+// f; link k's length that of the link ending at TreeLinkPoints(tree)[k] in the first frame (a
+// sliding link's, which is not checked against it, its longest over the frames, or the smallest
+// positive double if it never opens); the metrics of the tree's motion from frame to frame (each
+// point's path length, L2 per frame: the sum of the points' distances, L2 total, the largest
+// relative link-length error of the links that do not slide).
 ResultFile TreeAsViewerResult(const TreeResultFile& tree);
 
 }  // namespace flexkin::viewer_internal
