@@ -11,6 +11,19 @@ namespace {
 using Ipopt::Index;
 using Ipopt::Number;
 
+// The objective's terms other than the L2 term.
+double SmoothObjective(const OverallContactProblem& problem, const Eigen::MatrixXd& x) {
+  double f = 0.0;
+  const Eigen::Index n = problem.lengths.size();
+  for (Eigen::Index j = 1; j <= n; ++j) {
+    f += problem.squared * (x.row(j) - problem.old_points.row(j)).squaredNorm();
+    const Eigen::RowVectorXd d =
+        (x.row(j) - x.row(j - 1)) - (problem.old_points.row(j) - problem.old_points.row(j - 1));
+    f += problem.rotation * d.squaredNorm() / problem.lengths[j - 1];
+  }
+  return f;
+}
+
 // Unknowns: points 1..n, dim coordinates each. Constraints: n lengths |D_i|^2 (= L_i^2), then
 // for link i and sphere k the distance |p - c| (>= r), p the point of the segment nearest to c
 // at s = clamp((c - a).(b - a) / |b - a|^2, 0, 1); its gradient by the envelope theorem:
@@ -24,11 +37,17 @@ class OverallContactNlp : public Ipopt::TNLP {
         n_(static_cast<int>(problem.lengths.size())),
         dim_(static_cast<int>(problem.old_points.cols())) {}
 
+  // The epigraph's unknowns t_j (after the points' n dim) and rows (after the links' and the
+  // spheres'), with an L2 term.
+  bool Cones() const { return p_.l2 > 0.0; }
+  Index PointRows() const { return n_ + n_ * static_cast<Index>(p_.spheres.size()); }
+
   bool get_nlp_info(Index& n, Index& m, Index& nnz_jac_g, Index& nnz_h_lag,
                     IndexStyleEnum& index_style) override {
-    n = n_ * dim_;
-    m = n_ + n_ * static_cast<Index>(p_.spheres.size());
-    nnz_jac_g = m * 2 * dim_;  // every constraint: both ends of its link (link 1: entries 0)
+    n = n_ * dim_ + (Cones() ? n_ : 0);
+    m = PointRows() + (Cones() ? n_ : 0);
+    // Every link or sphere row: both ends of its link (link 1: entries 0); a cone: x_j and t_j.
+    nnz_jac_g = PointRows() * 2 * dim_ + (Cones() ? n_ * (dim_ + 1) : 0);
     nnz_h_lag = 0;
     index_style = C_STYLE;
     return true;
@@ -36,27 +55,36 @@ class OverallContactNlp : public Ipopt::TNLP {
   bool get_bounds_info(Index n, Number* x_l, Number* x_u, Index m, Number* g_l,
                        Number* g_u) override {
     for (Index i = 0; i < n; ++i) x_l[i] = -1e19, x_u[i] = 1e19;
+    for (Index i = n_ * dim_; i < n; ++i) x_l[i] = 0.0;  // t_j >= 0
     for (int i = 0; i < n_; ++i) g_l[i] = g_u[i] = p_.lengths[i] * p_.lengths[i];
-    for (Index r = n_; r < m; ++r) {
+    for (Index r = n_; r < PointRows(); ++r) {
       g_l[r] = p_.spheres[(r - n_) % p_.spheres.size()].radius;
       g_u[r] = 1e19;
     }
+    for (Index r = PointRows(); r < m; ++r) g_l[r] = 0.0, g_u[r] = 1e19;
     return true;
   }
   bool get_starting_point(Index, bool, Number* x, bool, Number*, Number*, Index, bool,
                           Number*) override {
     for (int j = 1; j <= n_; ++j) {
       for (int q = 0; q < dim_; ++q) x[(j - 1) * dim_ + q] = start_(j, q);
+      // t_j strictly inside its cone, by 1e-2 of the link.
+      if (Cones()) {
+        x[n_ * dim_ + j - 1] =
+            (start_.row(j) - p_.old_points.row(j)).norm() + 1e-2 * p_.lengths[j - 1];
+      }
     }
     return true;
   }
   bool eval_f(Index, const Number* x, bool, Number& f) override {
-    f = OverallContactObjective(p_, Points(x));
+    f = SmoothObjective(p_, Points(x));
+    for (int j = 0; Cones() && j < n_; ++j) f += p_.l2 * x[n_ * dim_ + j];
     return true;
   }
   bool eval_grad_f(Index, const Number* x, bool, Number* g) override {
     const Eigen::MatrixXd pts = Points(x);
     std::fill(g, g + n_ * dim_, 0.0);
+    for (int j = 0; Cones() && j < n_; ++j) g[n_ * dim_ + j] = p_.l2;
     for (int j = 1; j <= n_; ++j) {
       for (int q = 0; q < dim_; ++q) {
         g[(j - 1) * dim_ + q] += 2.0 * p_.squared * (pts(j, q) - p_.old_points(j, q));
@@ -82,17 +110,31 @@ class OverallContactNlp : public Ipopt::TNLP {
         g[n_ + (i - 1) * p_.spheres.size() + k] = Away(pts, i, p_.spheres[k].center, &s).norm();
       }
     }
+    for (int j = 1; Cones() && j <= n_; ++j) {
+      const double t = x[n_ * dim_ + j - 1];
+      g[PointRows() + j - 1] = t * t - (pts.row(j) - p_.old_points.row(j)).squaredNorm();
+    }
     return true;
   }
-  bool eval_jac_g(Index, const Number* x, bool, Index m, Index, Index* rows, Index* cols,
+  bool eval_jac_g(Index, const Number* x, bool, Index, Index, Index* rows, Index* cols,
                   Number* values) override {
     // Row r's entries: point i-1's coordinates (link 1: the head, not an unknown: given the
     // column of point 1 and the value 0), then point i's.
     const auto link_of = [&](Index r) {
       return r < n_ ? static_cast<int>(r) + 1 : static_cast<int>((r - n_) / p_.spheres.size()) + 1;
     };
+    const Index cones = PointRows() * 2 * dim_;  // the cones' first entry
     if (values == nullptr) {
-      for (Index r = 0; r < m; ++r) {
+      for (int j = 1; Cones() && j <= n_; ++j) {
+        const Index at = cones + (j - 1) * (dim_ + 1);
+        for (int q = 0; q < dim_; ++q) {
+          rows[at + q] = PointRows() + j - 1;
+          cols[at + q] = (j - 1) * dim_ + q;
+        }
+        rows[at + dim_] = PointRows() + j - 1;
+        cols[at + dim_] = n_ * dim_ + j - 1;
+      }
+      for (Index r = 0; r < PointRows(); ++r) {
         const int i = link_of(r);
         for (int q = 0; q < dim_; ++q) {
           rows[r * 2 * dim_ + q] = r;
@@ -104,7 +146,12 @@ class OverallContactNlp : public Ipopt::TNLP {
       return true;
     }
     const Eigen::MatrixXd pts = Points(x);
-    for (Index r = 0; r < m; ++r) {
+    for (int j = 1; Cones() && j <= n_; ++j) {
+      const Index at = cones + (j - 1) * (dim_ + 1);
+      for (int q = 0; q < dim_; ++q) values[at + q] = -2.0 * (pts(j, q) - p_.old_points(j, q));
+      values[at + dim_] = 2.0 * x[n_ * dim_ + j - 1];
+    }
+    for (Index r = 0; r < PointRows(); ++r) {
       const int i = link_of(r);
       Eigen::VectorXd ga(dim_), gb(dim_);
       if (r < n_) {
@@ -167,13 +214,9 @@ class OverallContactNlp : public Ipopt::TNLP {
 }  // namespace
 
 double OverallContactObjective(const OverallContactProblem& problem, const Eigen::MatrixXd& x) {
-  double f = 0.0;
-  const Eigen::Index n = problem.lengths.size();
-  for (Eigen::Index j = 1; j <= n; ++j) {
-    f += problem.squared * (x.row(j) - problem.old_points.row(j)).squaredNorm();
-    const Eigen::RowVectorXd d =
-        (x.row(j) - x.row(j - 1)) - (problem.old_points.row(j) - problem.old_points.row(j - 1));
-    f += problem.rotation * d.squaredNorm() / problem.lengths[j - 1];
+  double f = SmoothObjective(problem, x);
+  for (Eigen::Index j = 1; j <= problem.lengths.size(); ++j) {
+    f += problem.l2 * (x.row(j) - problem.old_points.row(j)).norm();
   }
   return f;
 }

@@ -348,11 +348,6 @@ TEST(ContactTest, BadInputIsRefusedByField) {
   options.colliders = {Sphere(Vector3d(5.0, 0.0, 0.0), -1.0)};
   refused(options, "colliders[0].radius");
   options.colliders = {Sphere(Vector3d(5.0, 0.0, 0.0), 1.0)};
-  options.method = Method::kOverall;
-  options.overall.weights.l2 = 1.0;  // the overall method takes colliders with a smooth metric
-  refused(options, "overall.weights.l2");
-  options.overall.weights.l2 = 0.0;
-  options.method = Method::kTractrix;
   options.tolerance = 1e-6;
   refused(options, "accuracy control does not account for colliders");
 }

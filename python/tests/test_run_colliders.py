@@ -1,7 +1,7 @@
 """Colliders through flexkin.run and RunOptions (docs/colliders.md): the scenario's form of each
 collider as a list of dicts, read by the scenario reader itself, so a run from Python is the
 scenario file's run bit for bit; keyframed colliders ("motion", times in leader steps) included;
-mistakes named by JSON pointer."""
+the overall method's L2 metric among them; mistakes named by JSON pointer."""
 import json
 
 import numpy as np
@@ -60,3 +60,31 @@ def test_bad_colliders_are_named_by_json_pointer():
     with pytest.raises(flexkin.InputError, match=r"points\[1\].*inside"):
         flexkin.run(p, [[0.0, 1.0]], colliders=[{"shape": "sphere", "center": [0, -1],
                                                   "radius": 0.5}])
+
+
+def test_the_overall_l2_metric_slides_round_the_post_through_the_front_door():
+    # The paper's L2 metric with colliders (docs/colliders.md, "The L2 metric"): the rope of
+    # rope_round_post.json, every link outside the post in every frame, the lengths kept.
+    scenario, colliders = scenario_and_colliders("rope_round_post.json")
+    steps = scenario.leader_steps[:60]
+    free = flexkin.run(scenario.chain, steps, method="overall",
+                       overall=flexkin.ObjectiveWeights(l2=1))
+    result = flexkin.run(scenario.chain, steps, method="overall",
+                         overall=flexkin.ObjectiveWeights(l2=1), colliders=colliders)
+    assert result.overall.failures == 0
+    assert result.contacts.contact_link_steps > 0
+    assert result.contacts.least_clearance >= -1e-12
+    center, radius = np.array([-0.35, 1.65]), 0.3
+    s = np.linspace(0.0, 1.0, 51)[None, None, :, None]
+    a, b = result.frames[:, :-1, None, :], result.frames[:, 1:, None, :]
+    assert np.linalg.norm(a + s * (b - a) - center, axis=-1).min() >= radius - 1e-12
+    a, b = free.frames[:, :-1, None, :], free.frames[:, 1:, None, :]
+    assert np.linalg.norm(a + s * (b - a) - center, axis=-1).min() < radius - 0.05
+    lengths = np.linalg.norm(np.diff(result.frames, axis=1), axis=2)
+    assert np.abs(lengths - 0.05).max() < 1e-13
+    # A moving collider is refused by name for it.
+    moving = [dict(colliders[0], motion={"keyframes": [{"time": 0, "translation": [0, 0]},
+                                                       {"time": 5, "translation": [0.1, 0]}]})]
+    with pytest.raises(flexkin.InputError, match=r"overall.weights.l2"):
+        flexkin.run(scenario.chain, steps, method="overall",
+                    overall=flexkin.ObjectiveWeights(l2=1), colliders=moving)

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "overall/retract.h"
 
@@ -103,8 +104,8 @@ bool SolveWithMoving(const Eigen::VectorXd& lengths, const Points& old_points,
   return true;
 }
 
-// The pull on the first still point k+1 at `x`: its smooth terms' gradient plus link k+1's
-// multiplier times the link's direction, into buffers->force.
+}  // namespace
+
 void PullOnFirstStillPoint(const Eigen::VectorXd& lengths, const Points& old_points,
                            const OverallOptions& options, int k, double multiplier, const Points& x,
                            ActiveSetBuffers* buffers) {
@@ -122,10 +123,55 @@ void PullOnFirstStillPoint(const Eigen::VectorXd& lengths, const Points& old_poi
   buffers->force = gradient.tail(dim) + multiplier * buffers->link;
 }
 
+double HeldDistance(const Eigen::Vector3d& v, const Eigen::Vector3d& e, const Eigen::Vector3d& n,
+                    double a, double b) {
+  const auto distance = [&](double t, double mu) { return (v - t * e - mu * n).norm(); };
+  // The convex quadratic in (t, mu) over the box t in [a, b], mu >= 0: its least lies inside or
+  // on a side, where it is the side's own least (the corners among them).
+  double best = distance(std::clamp(v.dot(e), a, b), 0.0);
+  if (n.squaredNorm() == 0.0) return best;
+  for (const double t : {a, b})
+    best = std::fmin(best, distance(t, std::fmax(0.0, (v - t * e).dot(n))));
+  const double c = e.dot(n), det = 1.0 - c * c;
+  if (e.squaredNorm() > 0.0 && det > 1e-12) {
+    const double t = (v.dot(e) - c * v.dot(n)) / det;
+    const double mu = (v.dot(n) - c * v.dot(e)) / det;
+    if (t >= a && t <= b && mu >= 0.0) best = std::fmin(best, distance(t, mu));
+  }
+  return best;
+}
+
+namespace {
+
+// The largest tension (sign +1) or the least (sign -1) of link j that a still point j of weight
+// w in contact (outward normal n) holds, the next link's (direction e1) in [a, b]: the end of
+// the interval of lambda with HeldDistance(lambda e, e1, n, a, b) <= w, which holds 0. By
+// doubling, then bisection to the last bit; a tension it holds beyond 1e15 w (a pull straight
+// into the surface) is that bound.
+double HeldEnd(const Eigen::Vector3d& e, const Eigen::Vector3d& e1, const Eigen::Vector3d& n,
+               double w, double a, double b, double sign) {
+  const auto holds = [&](double lambda) {
+    return HeldDistance(sign * lambda * e, e1, n, a, b) <= w;
+  };
+  double low = 0.0, high = std::fmax(w, std::numeric_limits<double>::min());
+  while (holds(high)) {
+    low = high;
+    high *= 2.0;
+    if (high > 1e15 * w) return sign * low;
+  }
+  for (int i = 0; i < 200 && low < high; ++i) {
+    const double mid = 0.5 * (low + high);
+    if (mid <= low || mid >= high) break;
+    (holds(mid) ? low : high) = mid;
+  }
+  return sign * low;
+}
+
 }  // namespace
 
 void MakeTailFriction(const ObjectiveWeights& weights, const Eigen::VectorXd& lengths,
-                      const Points& old_points, ActiveSetBuffers* buffers) {
+                      const Points& old_points, ActiveSetBuffers* buffers,
+                      const std::vector<Eigen::Vector3d>* normals) {
   const int n = static_cast<int>(lengths.size());
   const int dim = static_cast<int>(old_points.cols());
   TailFriction& f = buffers->friction;
@@ -146,7 +192,20 @@ void MakeTailFriction(const ObjectiveWeights& weights, const Eigen::VectorXd& le
     }
     f.w[i] = L2Weight(weights, lengths, i);
   }
+  const auto unit = [&](int i) {  // link i's direction as a 3-vector
+    Eigen::Vector3d out = Eigen::Vector3d::Zero();
+    for (int k = 0; k < dim; ++k) out[k] = f.e(i - 1, k);
+    return out;
+  };
   for (int j = n; j >= 2; --j) {
+    if (normals != nullptr && (*normals)[j].squaredNorm() > 0.0) {
+      // A still point on a collider's surface: the collider pushes it along the normal too.
+      const Eigen::Vector3d e = unit(j), e1 = j < n ? unit(j + 1) : Eigen::Vector3d::Zero();
+      const double a = j < n ? f.lo[j + 1] : 0.0, b = j < n ? f.hi[j + 1] : 0.0;
+      f.hi[j] = HeldEnd(e, e1, (*normals)[j], f.w[j], a, b, 1.0);
+      f.lo[j] = HeldEnd(e, e1, (*normals)[j], f.w[j], a, b, -1.0);
+      continue;
+    }
     if (j == n) {
       f.lo[j] = -f.w[n];
       f.hi[j] = f.w[n];

@@ -4,6 +4,7 @@
 // hold the pull of the chain.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <vector>
 
 #include "flexkin/overall.h"
@@ -39,8 +40,24 @@ struct ActiveSetBuffers {
 };
 
 // Fills `*friction` (see TailFriction) for the old configuration, using `buffers`' vectors.
+// `normals` (n + 1 entries, if set; colliders, overall/contact_step.cc): the outward normal of
+// the collider a still point j lies on, zero where it touches none; such a point also holds
+// what the collider can push back along it, mu n with mu >= 0 (the interval found by bisection).
 void MakeTailFriction(const ObjectiveWeights& weights, const Eigen::VectorXd& lengths,
-                      const Points& old_points, ActiveSetBuffers* buffers);
+                      const Points& old_points, ActiveSetBuffers* buffers,
+                      const std::vector<Eigen::Vector3d>* normals = nullptr);
+
+// The pull on the first still point k+1 at `x`: its smooth terms' gradient plus link k+1's
+// multiplier times the link's direction, into buffers->force.
+void PullOnFirstStillPoint(const Eigen::VectorXd& lengths, const Points& old_points,
+                           const OverallOptions& options, int k, double multiplier, const Points& x,
+                           ActiveSetBuffers* buffers);
+
+// min over t in [a, b] and mu >= 0 of |v - t e - mu n| (e and n unit or zero): how far a pull v
+// on a still point is from what it holds, the next link (direction e) pulling with t and a
+// collider pushing along its normal n (zero: none).
+double HeldDistance(const Eigen::Vector3d& v, const Eigen::Vector3d& e, const Eigen::Vector3d& n,
+                    double a, double b);
 
 // One (sub-)step of a metric with an L2 term: Newton's method on points 1..k, the others held
 // still, with k (`*moving`, carried from the last sub-step) raised while the still points cannot

@@ -58,10 +58,15 @@ struct Contact {
 class ContactSolver {
  public:
   // `point_weights` (n + 1 entries, [0] unused; their largest about 1), if set: the metric is
-  // sum_j w_j |x_j - old_j|^2 (options' squared weight 1, the others 0).
+  // sum_j w_j |x_j - old_j|^2 (options' squared weight 1, the others 0). `moving` (k, 1..n; -1:
+  // n): only points 1..k are unknowns, the points after k held where they are (the L2 metric's
+  // still tail, which the caller places at the old points); the constraints are those of links
+  // 1..k+1 and of the contacts of points 1..k and links 1..k+1. `smoothing` > 0: the L2 term
+  // smoothed (objective.h's Evaluate).
   ContactSolver(const Eigen::VectorXd& lengths, const Points& old_points,
                 const OverallOptions& options, const std::vector<Collider>& colliders,
-                OverallContactState* state, const Eigen::VectorXd* point_weights = nullptr)
+                OverallContactState* state, const Eigen::VectorXd* point_weights = nullptr,
+                int moving = -1, double smoothing = 0.0)
       : lengths_(lengths),
         old_(old_points),
         options_(options),
@@ -70,18 +75,25 @@ class ContactSolver {
         n_(static_cast<int>(lengths.size())),
         dim_(static_cast<int>(old_points.cols())),
         m_(static_cast<int>(colliders.size())),
-        unknowns_(n_ * dim_),
+        k_(moving < 0 ? n_ : moving),
+        links_(std::min(k_ + 1, n_)),
+        unknowns_(k_ * dim_),
+        last_(k_ < n_ ? std::min(n_, k_ + 2) : -1),
         shortest_(lengths.minCoeff()),
-        weight_sum_(WeightSum(options.weights, lengths)) {
+        weight_sum_(WeightSum(options.weights, lengths)),
+        smoothing_(smoothing) {
     sink_.dim = dim_;
     sink_.offset.assign(n_ + 1, -1);
-    for (int j = 1; j <= n_; ++j) sink_.offset[j] = (j - 1) * dim_;
+    for (int j = 1; j <= k_; ++j) sink_.offset[j] = (j - 1) * dim_;
     if (point_weights != nullptr) sink_.point_weights = point_weights->data();
   }
 
   // Solves the sub-problem with the head at row 0 of `*x`, from `*x` (outside every collider,
   // lengths kept). On success `*x` is the solution; else it is left as it was.
   OverallReport Solve(Points* x);
+  // After Solve: the force the solution's contacts put on the still point j (k < j): minus the
+  // multiplier times s times the normal of an active contact of link j, into `*force` (dim).
+  void AddContactForceOnStill(int j, Eigen::VectorXd* force) const;
 
  private:
   // The state of the iteration at one configuration.
@@ -128,7 +140,7 @@ class ContactSolver {
   bool SolveQp(const Point& p, std::vector<int>* working, Eigen::VectorXd* solution);
   double Merit(const Point& p, double penalty) const {
     double sum = 0.0;
-    for (int i = 0; i < n_; ++i) sum += std::fabs(p.c[i]);
+    for (int i = 0; i < links_; ++i) sum += std::fabs(p.c[i]);
     return p.objective + penalty * (sum + p.penetration);
   }
 
@@ -137,8 +149,9 @@ class ContactSolver {
   const OverallOptions& options_;
   const std::vector<Collider>& colliders_;
   OverallContactState& state_;
-  const int n_, dim_, m_, unknowns_;
-  const double shortest_, weight_sum_;
+  const int n_, dim_, m_, k_, links_, unknowns_, last_;
+  const double shortest_, weight_sum_, smoothing_;
+  std::vector<Contact> final_;  // the contacts of Solve's last iterate
   Sink sink_;
   std::vector<Eigen::Triplet<double>> triplets_;  // the Lagrangian's Hessian at the iterate
   Eigen::SparseMatrix<double> kkt_;
@@ -241,13 +254,22 @@ void ContactSolver::AddGradient(const Contact& contact, double scale, Eigen::Vec
     for (int q = 0; q < dim_; ++q) (*out)[row + q] += scale * (1.0 - contact.s) * contact.normal[q];
   }
   const int row = sink_.offset[i];
+  if (row < 0) return;  // the still point after the last moving one
   for (int q = 0; q < dim_; ++q) (*out)[row + q] += scale * contact.s * contact.normal[q];
+}
+
+void ContactSolver::AddContactForceOnStill(int j, Eigen::VectorXd* force) const {
+  for (const Contact& c : final_) {
+    if (c.link && c.index == j && c.multiplier > 0.0) {
+      for (int q = 0; q < dim_; ++q) (*force)[q] -= c.multiplier * c.s * c.normal[q];
+    }
+  }
 }
 
 double ContactSolver::Linearized(const Contact& contact, const Eigen::VectorXd& step) const {
   double value = contact.value;
   const auto add = [&](int j, double w) {
-    if (j < 1) return;
+    if (j < 1 || sink_.offset[j] < 0) return;
     for (int q = 0; q < dim_; ++q) value += w * contact.normal[q] * step[sink_.offset[j] + q];
   };
   if (contact.link) {
@@ -268,6 +290,7 @@ void ContactSolver::AddCurvature(const Contact& contact, const Points& x, double
   Points probe = x;
   Eigen::VectorXd plus = Eigen::VectorXd::Zero(unknowns_), minus = plus;
   for (int j = first; j <= last; ++j) {
+    if (sink_.offset[j] < 0) continue;
     for (int q = 0; q < dim_; ++q) {
       const int col = sink_.offset[j] + q;
       plus.setZero();
@@ -278,6 +301,7 @@ void ContactSolver::AddCurvature(const Contact& contact, const Points& x, double
       AddGradient(Measure(contact, probe), 1.0, &minus);
       probe(j, q) = x(j, q);
       for (int r = first; r <= last; ++r) {
+        if (sink_.offset[r] < 0) continue;
         for (int p = 0; p < dim_; ++p) {
           const int row = sink_.offset[r] + p;
           const double d = (plus[row] - minus[row]) / (2.0 * h);
@@ -302,7 +326,9 @@ void ContactSolver::FindContacts(const Points& x, bool keep, std::vector<Contact
   for (int k = 0; k < m_; ++k) {
     const Collider& c = colliders_[k];
     depth[0] = QuerySurface(c, At(x, 0)).distance;
-    for (int j = 1; j <= n_; ++j) {
+    // (The still point after the last moving one is measured for the links beside it; it is no
+    // unknown, and no contact of its own.)
+    for (int j = 1; j <= links_; ++j) {
       Contact p;
       p.index = j;
       p.collider = k;
@@ -311,11 +337,11 @@ void ContactSolver::FindContacts(const Points& x, bool keep, std::vector<Contact
       *least = std::fmin(*least, p.value / lengths_[j - 1]);
       *penetration += std::fmax(0.0, -p.value);
       p.multiplier = Multiplier(p);
-      if (p.value < reach || p.multiplier > 0.0) near->push_back(p);
+      if (j <= k_ && (p.value < reach || p.multiplier > 0.0)) near->push_back(p);
     }
     // Links whose interior comes nearer than both ends (a link nearest at an end is covered by
     // that point's constraint).
-    for (int i = 1; i <= n_; ++i) {
+    for (int i = 1; i <= links_; ++i) {
       Contact l;
       l.link = true;
       l.index = i;
@@ -353,10 +379,11 @@ void ContactSolver::Evaluate(Point* p, bool hessian) {
   sink_.band = nullptr;
   sink_.form = nullptr;
   if (hessian) triplets_.clear();
-  p->objective = internal::Evaluate(options_.weights, lengths_, old_, p->x, sink_);
-  p->c.resize(n_);
+  p->objective =
+      internal::Evaluate(options_.weights, lengths_, old_, p->x, sink_, last_, smoothing_);
+  p->c.resize(links_);
   p->violation = 0.0;
-  for (int i = 1; i <= n_; ++i) {
+  for (int i = 1; i <= links_; ++i) {
     const double sq = (p->x.row(i) - p->x.row(i - 1)).squaredNorm();
     const double l = lengths_[i - 1];
     p->c[i - 1] = (sq - l * l) / (2.0 * l);
@@ -371,11 +398,11 @@ void ContactSolver::Evaluate(Point* p, bool hessian) {
 double ContactSolver::Stationarity(const Point& p, Eigen::VectorXd* residual) const {
   *residual = p.gradient;
   const Eigen::VectorXd& lambda = state_.lambda;
-  for (int i = 1; i <= n_; ++i) {
+  for (int i = 1; i <= links_; ++i) {
     const double f = lambda[i - 1] / lengths_[i - 1];
     for (int q = 0; q < dim_; ++q) {
       const double d = f * (p.x(i, q) - p.x(i - 1, q));
-      (*residual)[sink_.offset[i] + q] += d;
+      if (i <= k_) (*residual)[sink_.offset[i] + q] += d;
       if (i >= 2) (*residual)[sink_.offset[i - 1] + q] -= d;
     }
   }
@@ -387,7 +414,14 @@ double ContactSolver::Stationarity(const Point& p, Eigen::VectorXd* residual) co
   }
   const double r = residual->cwiseAbs().maxCoeff();
   const double extent = std::fmax(p.x.cwiseAbs().maxCoeff(), lengths_.maxCoeff());
-  const double kappa = weight_sum_ + (2.0 * lambda.cwiseAbs().maxCoeff() + mu_max) / shortest_;
+  double kappa = weight_sum_ + (2.0 * lambda.cwiseAbs().maxCoeff() + mu_max) / shortest_;
+  if (options_.weights.l2 > 0.0 || options_.weights.l2_weighted > 0.0) {
+    // The L2 term's curvature at a point moved by r is its weight over sqrt(r^2 + mu^2).
+    for (int j = 1; j <= k_; ++j) {
+      const double moved = std::hypot((p.x.row(j) - old_.row(j)).norm(), smoothing_);
+      if (moved > 0.0) kappa = std::fmax(kappa, L2Weight(options_.weights, lengths_, j) / moved);
+    }
+  }
   if (r <= 64.0 * std::numeric_limits<double>::epsilon() * extent * kappa) return 0.0;
   return r / std::fmax(p.gradient.cwiseAbs().maxCoeff(), std::numeric_limits<double>::min());
 }
@@ -399,14 +433,14 @@ void ContactSolver::StartingMultipliers(const Point& p) {
     if (c.multiplier != 0.0) AddGradient(c, -c.multiplier, &force);
   }
   std::vector<Eigen::Triplet<double>> entries;
-  for (int i = 1; i <= n_; ++i) {
+  for (int i = 1; i <= links_; ++i) {
     for (int q = 0; q < dim_; ++q) {
       const double d = (p.x(i, q) - p.x(i - 1, q)) / lengths_[i - 1];
-      entries.emplace_back(i - 1, sink_.offset[i] + q, d);
+      if (i <= k_) entries.emplace_back(i - 1, sink_.offset[i] + q, d);
       if (i >= 2) entries.emplace_back(i - 1, sink_.offset[i - 1] + q, -d);
     }
   }
-  Eigen::SparseMatrix<double> jacobian(n_, unknowns_);
+  Eigen::SparseMatrix<double> jacobian(links_, unknowns_);
   jacobian.setFromTriplets(entries.begin(), entries.end());
   const Eigen::SparseMatrix<double> normal = jacobian * jacobian.transpose();
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(normal);
@@ -414,22 +448,24 @@ void ContactSolver::StartingMultipliers(const Point& p) {
   if (ldlt.info() == Eigen::Success && lambda.allFinite()) {
     state_.lambda = lambda;
   } else {
-    state_.lambda.setZero(n_);
+    state_.lambda.setZero(links_);
   }
 }
 
 bool ContactSolver::SolveModel(const Point& p, const std::vector<int>& working,
                                Eigen::VectorXd* solution) {
   const int na = static_cast<int>(working.size());
-  const int size = unknowns_ + n_ + na;
+  const int size = unknowns_ + links_ + na;
   std::vector<Eigen::Triplet<double>> entries = triplets_;
   // Jacobian rows of c_i: D_i / L_i on x_i, -D_i / L_i on x_{i-1}.
-  for (int i = 1; i <= n_; ++i) {
+  for (int i = 1; i <= links_; ++i) {
     const int row = unknowns_ + i - 1;
     for (int q = 0; q < dim_; ++q) {
       const double d = (p.x(i, q) - p.x(i - 1, q)) / lengths_[i - 1];
-      entries.emplace_back(row, sink_.offset[i] + q, d);
-      entries.emplace_back(sink_.offset[i] + q, row, d);
+      if (i <= k_) {
+        entries.emplace_back(row, sink_.offset[i] + q, d);
+        entries.emplace_back(sink_.offset[i] + q, row, d);
+      }
       if (i >= 2) {
         entries.emplace_back(row, sink_.offset[i - 1] + q, -d);
         entries.emplace_back(sink_.offset[i - 1] + q, row, -d);
@@ -441,7 +477,7 @@ bool ContactSolver::SolveModel(const Point& p, const std::vector<int>& working,
   for (int a = 0; a < na; ++a) {
     column.setZero();
     AddGradient(p.near[working[a]], -1.0, &column);
-    const int row = unknowns_ + n_ + a;
+    const int row = unknowns_ + links_ + a;
     for (int r = 0; r < unknowns_; ++r) {
       if (column[r] == 0.0) continue;
       entries.emplace_back(row, r, column[r]);
@@ -450,8 +486,8 @@ bool ContactSolver::SolveModel(const Point& p, const std::vector<int>& working,
   }
   Eigen::VectorXd rhs(size);
   rhs.head(unknowns_) = -p.gradient;
-  rhs.segment(unknowns_, n_) = -p.c;
-  for (int a = 0; a < na; ++a) rhs[unknowns_ + n_ + a] = p.near[working[a]].value;
+  rhs.segment(unknowns_, links_) = -p.c;
+  for (int a = 0; a < na; ++a) rhs[unknowns_ + links_ + a] = p.near[working[a]].value;
   const size_t base = entries.size();
   for (const double regularization : {0.0, 1e-12, 1e-9}) {
     entries.resize(base);
@@ -480,7 +516,7 @@ bool ContactSolver::SolveQp(const Point& p, std::vector<int>* working, Eigen::Ve
     int leave = -1;
     double most = 0.0;
     for (size_t a = 0; a < working->size(); ++a) {
-      const double mu = (*solution)[unknowns_ + n_ + static_cast<int>(a)];
+      const double mu = (*solution)[unknowns_ + links_ + static_cast<int>(a)];
       if (mu < most) most = mu, leave = static_cast<int>(a);
     }
     if (leave >= 0) {
@@ -507,7 +543,7 @@ bool ContactSolver::SolveQp(const Point& p, std::vector<int>* working, Eigen::Ve
 
 OverallReport ContactSolver::Solve(Points* x_io) {
   OverallReport report;
-  if (state_.lambda.size() != n_) state_.lambda = Eigen::VectorXd::Zero(n_);
+  if (state_.lambda.size() != links_) state_.lambda = Eigen::VectorXd::Zero(links_);
   const int max_iterations = std::max(options_.max_iterations, 1);
   Point p, trial;
   p.x = *x_io;
@@ -564,16 +600,18 @@ OverallReport ContactSolver::Solve(Points* x_io) {
       return report;
     }
     // The model: the Lagrangian's Hessian with the contacts' curvature.
-    for (int i = 1; i <= n_; ++i) {
+    for (int i = 1; i <= links_; ++i) {
       const double w = state_.lambda[i - 1] / lengths_[i - 1];
       for (int q = 0; q < dim_; ++q) {
-        const int b = sink_.offset[i] + q;
-        triplets_.emplace_back(b, b, w);
+        const int b = i <= k_ ? sink_.offset[i] + q : -1;
+        if (b >= 0) triplets_.emplace_back(b, b, w);
         if (i >= 2) {
           const int a = sink_.offset[i - 1] + q;
           triplets_.emplace_back(a, a, w);
-          triplets_.emplace_back(a, b, -w);
-          triplets_.emplace_back(b, a, -w);
+          if (b >= 0) {
+            triplets_.emplace_back(a, b, -w);
+            triplets_.emplace_back(b, a, -w);
+          }
         }
       }
     }
@@ -585,60 +623,85 @@ OverallReport ContactSolver::Solve(Points* x_io) {
         working.push_back(static_cast<int>(a));
       }
     }
-    if (!SolveQp(p, &working, &solution)) {
-      report.status = OverallStatus::kFailed;
-      return report;
-    }
-    const Eigen::VectorXd step = solution.head(unknowns_);
-    // The step's length: at most half the shortest link for any point; then backtracking on
-    // the l1 merit function (penalty above every multiplier), a full step also taken where it
-    // halves the infeasibility.
-    double longest = 0.0;
-    for (int j = 1; j <= n_; ++j)
-      longest = std::fmax(longest, step.segment(sink_.offset[j], dim_).norm());
-    double alpha = std::fmin(1.0, 0.5 * shortest_ / std::fmax(longest, 1e-300));
-    double penalty = 0.0;
-    for (int i = 0; i < n_; ++i) penalty = std::fmax(penalty, std::fabs(solution[unknowns_ + i]));
-    for (size_t a = 0; a < working.size(); ++a) {
-      penalty = std::fmax(penalty, std::fabs(solution[unknowns_ + n_ + static_cast<int>(a)]));
-    }
-    penalty = 2.0 * penalty + 1e-3 * weight_sum_ * shortest_;
-    const double merit = Merit(p, penalty);
-    double infeasibility = p.penetration;
-    for (int i = 0; i < n_; ++i) infeasibility += std::fabs(p.c[i]);
-    const double slope = p.gradient.dot(step) - penalty * infeasibility;
-    for (int tries = 0;; ++tries) {
-      trial.x = p.x;
-      for (int j = 1; j <= n_; ++j) {
-        for (int q = 0; q < dim_; ++q) trial.x(j, q) += alpha * step[sink_.offset[j] + q];
+    // Where the model is not convex along the step (the L2 term's radial curvature is 0, and a
+    // link's in compression is negative), its step may lead nowhere the merit falls: then the
+    // Hessian is damped, d I with d from 1e-4 of the metric's scale up by 100 at a time, and the
+    // model solved again (the iteration's fixed points, the KKT conditions, are the same).
+    const std::vector<int> start_working = working;
+    const size_t hessian_size = triplets_.size();
+    double alpha = 1.0, damping = 0.0;
+    Eigen::VectorXd step;
+    for (;;) {
+      working = start_working;
+      triplets_.resize(hessian_size);
+      for (int r = 0; damping > 0.0 && r < unknowns_; ++r) triplets_.emplace_back(r, r, damping);
+      if (!SolveQp(p, &working, &solution)) {
+        report.status = OverallStatus::kFailed;
+        return report;
       }
-      // (The multipliers the trial's contacts carry are not used: measured again below.)
-      Evaluate(&trial, false);
-      double trial_infeasibility = trial.penetration;
-      for (int i = 0; i < n_; ++i) trial_infeasibility += std::fabs(trial.c[i]);
-      // (A full step that changes the merit only at its rounding is taken: near the solution
-      // the step's own gain is below it.)
-      const double trial_merit = Merit(trial, penalty);
-      if (trial_merit <= merit + 1e-4 * alpha * std::fmin(slope, 0.0) ||
-          (tries == 0 && trial_merit <= merit + 1e-13 * std::fabs(merit)) ||
-          (tries == 0 && trial_infeasibility <= 0.5 * infeasibility) || tries >= 30) {
-        break;
+      step = solution.head(unknowns_);
+      // The step's length: at most half the shortest link for any point; then backtracking on
+      // the l1 merit function (penalty above every multiplier), a full step also taken where it
+      // halves the infeasibility.
+      double longest = 0.0;
+      for (int j = 1; j <= k_; ++j)
+        longest = std::fmax(longest, step.segment(sink_.offset[j], dim_).norm());
+      alpha = std::fmin(1.0, 0.5 * shortest_ / std::fmax(longest, 1e-300));
+      double penalty = 0.0;
+      for (int i = 0; i < links_; ++i) {
+        penalty = std::fmax(penalty, std::fabs(solution[unknowns_ + i]));
       }
-      alpha *= 0.5;
+      for (size_t a = 0; a < working.size(); ++a) {
+        penalty = std::fmax(penalty, std::fabs(solution[unknowns_ + links_ + static_cast<int>(a)]));
+      }
+      penalty = 2.0 * penalty + 1e-3 * weight_sum_ * shortest_;
+      const double merit = Merit(p, penalty);
+      double infeasibility = p.penetration;
+      for (int i = 0; i < links_; ++i) infeasibility += std::fabs(p.c[i]);
+      const double slope = p.gradient.dot(step) - penalty * infeasibility;
+      bool found = false;
+      for (int tries = 0; tries <= 30; ++tries) {
+        trial.x = p.x;
+        for (int j = 1; j <= k_; ++j) {
+          for (int q = 0; q < dim_; ++q) trial.x(j, q) += alpha * step[sink_.offset[j] + q];
+        }
+        // (The multipliers the trial's contacts carry are not used: measured again below.)
+        Evaluate(&trial, false);
+        double trial_infeasibility = trial.penetration;
+        for (int i = 0; i < links_; ++i) trial_infeasibility += std::fabs(trial.c[i]);
+        // (A full step that changes the merit only at its rounding is taken: near the solution
+        // the step's own gain is below it.)
+        const double trial_merit = Merit(trial, penalty);
+        // A full step of at most 1e-6 of the shortest link is taken where the merit rises by
+        // no more than 1e-10 of itself: the constraints' curvature can make the merit rise
+        // along the Newton step near the solution, and the multipliers move with it.
+        if (trial_merit <= merit + 1e-4 * alpha * std::fmin(slope, 0.0) ||
+            (tries == 0 && trial_merit <= merit + 1e-13 * std::fabs(merit)) ||
+            (tries == 0 && trial_infeasibility <= 0.5 * infeasibility) ||
+            (tries == 0 && longest <= 1e-6 * shortest_ &&
+             trial_merit <= merit + 1e-10 * std::fabs(merit))) {
+          found = true;
+          break;
+        }
+        if (tries < 30) alpha *= 0.5;
+      }
+      if (found || damping > 1e6 * weight_sum_) break;
+      damping = damping == 0.0 ? 1e-4 * weight_sum_ : 100.0 * damping;
     }
     // The multipliers: lambda and the working contacts' move by alpha toward the model's; every
     // other contact's is 0.
-    state_.lambda += alpha * (solution.segment(unknowns_, n_) - state_.lambda);
+    state_.lambda += alpha * (solution.segment(unknowns_, links_) - state_.lambda);
     for (const Contact& c : p.near) Multiplier(c) = 0.0;
     for (size_t a = 0; a < working.size(); ++a) {
       const Contact& c = p.near[working[a]];
-      Multiplier(c) =
-          c.multiplier + alpha * (solution[unknowns_ + n_ + static_cast<int>(a)] - c.multiplier);
+      Multiplier(c) = c.multiplier +
+                      alpha * (solution[unknowns_ + links_ + static_cast<int>(a)] - c.multiplier);
     }
     p.x = trial.x;
     Evaluate(&p, true);
   }
   *x_io = p.x;
+  final_ = p.near;
   return report;
 }
 
@@ -659,6 +722,13 @@ bool Clear(const Points& x, const Eigen::VectorXd& lengths, const std::vector<Co
   return *least >= -kContactSlack;
 }
 
+// The points 1..n of `x` that are not where they were in `old`, up to the last that moved.
+int CountMoving(const Points& old, const Points& x) {
+  int k = static_cast<int>(old.rows()) - 1;
+  while (k > 0 && x.row(k) == old.row(k)) --k;
+  return k;
+}
+
 // The state's contact multipliers sized for n links and `colliders` (kept where they are).
 void SizeMultipliers(int n, size_t colliders, OverallContactState* state) {
   const size_t pairs = static_cast<size_t>(n + 1) * colliders;
@@ -671,6 +741,126 @@ void SizeMultipliers(int n, size_t colliders, OverallContactState* state) {
 void ClearMultipliers(OverallContactState* state) {
   std::fill(state->point_multipliers.begin(), state->point_multipliers.end(), 0.0);
   std::fill(state->link_multipliers.begin(), state->link_multipliers.end(), 0.0);
+}
+
+// The outward normal of the collider each old point j = 1..n lies on (within 1e-9 of its link;
+// the nearest where several), zero where it touches none, into `*normals` (n + 1 entries).
+void RestingNormals(const Points& old, const Eigen::VectorXd& lengths,
+                    const std::vector<Collider>& colliders, std::vector<Vector3d>* normals) {
+  const int n = static_cast<int>(lengths.size());
+  const int dim = static_cast<int>(old.cols());
+  normals->assign(n + 1, Vector3d::Zero());
+  for (int j = 1; j <= n; ++j) {
+    const Vector3d p(old(j, 0), old(j, 1), dim == 3 ? old(j, 2) : 0.0);
+    double nearest = 1e-9 * lengths[j - 1];
+    for (const Collider& c : colliders) {
+      const SurfaceQuery q = QuerySurface(c, p);
+      if (q.distance <= nearest) {
+        nearest = q.distance;
+        (*normals)[j] = q.normal;
+        if (dim == 2) (*normals)[j][2] = 0.0;
+      }
+    }
+    if ((*normals)[j].squaredNorm() > 0.0) (*normals)[j].normalize();
+  }
+}
+
+// One sub-step under a metric with an L2 term (docs/colliders.md, "The L2 metric"), colliders
+// static: the active set of overall/active_set.cc, points 1..k moving and the points after k
+// still while they hold the pull of the chain (their friction, and the collider a still point
+// lies on pushing back), each solve a ContactSolver with the tail held. The start: the solution
+// of the problem with the L2 term smoothed (mu = 1e-2, 1e-4, 1e-6 of the shortest link) over
+// every point, from `guess` (the sub-problem's solution without colliders), or where that does
+// not converge from `*x` (the sub-step's sequential contact step); its tail still from the last
+// point that moved by more than 1e-5 of its link. A moving point that comes back to rest (within
+// 1e-12 of its link) ends the moving set there; a first still point whose tail cannot hold its
+// pull moves (solved smoothed, then exactly), unless it came to rest when it was free to.
+// `*x` becomes the solution where it converged.
+OverallReport SolveL2Contact(const Eigen::VectorXd& lengths, const Points& old,
+                             const OverallOptions& options, const std::vector<Collider>& colliders,
+                             const Points& guess, OverallContactState* state, Points* x) {
+  const int n = static_cast<int>(lengths.size());
+  const int dim = static_cast<int>(old.cols());
+  const double shortest = lengths.minCoeff();
+  const TailFriction& friction = state->active_set.friction;
+  constexpr double kSmoothing[] = {1e-2, 1e-4, 1e-6};
+  OverallReport report;
+  int iterations = 0;
+  Points& current = state->current;
+  Points& trial = state->trial;
+  current = guess;
+  for (const double mu : kSmoothing) {
+    ContactSolver smoothed(lengths, old, options, colliders, state, nullptr, n, mu * shortest);
+    report = smoothed.Solve(&current);
+    iterations += report.iterations;
+    if (!report.converged() && mu == kSmoothing[0]) {
+      current = *x;
+      report = smoothed.Solve(&current);
+      iterations += report.iterations;
+    }
+  }
+  int k = n;
+  while (k > 1 && (current.row(k) - old.row(k)).norm() <= 1e-5 * lengths[k - 1]) --k;
+  std::vector<char> rested(n + 1, 0);
+  bool released = false;
+  for (int round = 0;; ++round) {
+    if (round > 2 * n + 8) {  // the active set cycles
+      report.status = OverallStatus::kStalled;
+      break;
+    }
+    trial = current;
+    trial.bottomRows(n - k) = old.bottomRows(n - k);
+    if (released) {
+      for (const double mu : kSmoothing) {
+        ContactSolver smoothed(lengths, old, options, colliders, state, nullptr, k, mu * shortest);
+        iterations += smoothed.Solve(&trial).iterations;
+      }
+      released = false;
+    }
+    ContactSolver exact(lengths, old, options, colliders, state, nullptr, k, 0.0);
+    report = exact.Solve(&trial);
+    iterations += report.iterations;
+    if (!report.converged()) {
+      if (k == n) break;
+      ++k;
+      released = true;
+      continue;
+    }
+    current = trial;
+    int rest = 0;
+    for (int j = 2; j <= k && rest == 0; ++j) {
+      if (!rested[j] && (trial.row(j) - old.row(j)).norm() <= 1e-12 * lengths[j - 1]) rest = j;
+    }
+    if (rest > 0) {
+      rested[rest] = 1;
+      k = rest - 1;
+      continue;
+    }
+    if (k == n) break;
+    // The pull on the first still point, its link's contacts' push included, against what the
+    // tail after it and the collider it lies on hold.
+    PullOnFirstStillPoint(lengths, old, options, k, state->lambda[k], trial, &state->active_set);
+    Eigen::VectorXd& force = state->active_set.force;
+    exact.AddContactForceOnStill(k + 1, &force);
+    Vector3d v = Vector3d::Zero(), e = Vector3d::Zero();
+    for (int q = 0; q < dim; ++q) v[q] = force[q];
+    double a = 0.0, b = 0.0;
+    if (k + 1 < n) {
+      for (int q = 0; q < dim; ++q) e[q] = friction.e(k + 1, q);  // link k+2
+      a = friction.lo[k + 2];
+      b = friction.hi[k + 2];
+    }
+    if (HeldDistance(v, e, state->normals[k + 1], a, b) <= friction.w[k + 1] * (1.0 + 1e-9)) break;
+    // A point that came back to rest when it was free to move: the solve itself found it still
+    // (the tail's friction counts no support from a collider along a still link's interior).
+    if (rested[k + 1]) break;
+    ++k;
+    released = true;
+  }
+  report.iterations = iterations;
+  report.moving_points = k;
+  if (report.converged()) *x = current;
+  return report;
 }
 
 }  // namespace
@@ -708,6 +898,11 @@ void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& h
   const bool has_mesh = std::any_of(colliders.begin(), colliders.end(), [](const Collider& c) {
     return c.shape == ColliderShape::kMesh;
   });
+  const bool l2 = options.weights.l2 > 0.0 || options.weights.l2_weighted > 0.0;
+  if (l2) {
+    RestingNormals(old, lengths, colliders, &state->normals);
+    MakeTailFriction(options.weights, lengths, old, &state->active_set, &state->normals);
+  }
   Eigen::VectorXd target(dim);
   ContactStats sweep_stats;
   for (int s = 1; s <= sub_steps; ++s) {
@@ -716,12 +911,24 @@ void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& h
     ContactSweep(Method::kTractrix, dim, target.data(), lengths.data(), inv_lengths.data(), n,
                  state->start.data(), colliders, &sweep_stats);
     *points = state->start;
-    ContactSolver solver(lengths, old, options, colliders, state);
-    OverallReport sub = solver.Solve(points);
+    OverallReport sub;
+    if (l2) {
+      // The sub-problem without colliders, from the old configuration: a start near the
+      // solution where the contacts change it little.
+      state->guess = old;
+      OverallReport free_report;
+      OverallStepUnchecked(lengths, target, options, &state->guess, workspace, &free_report);
+      sub = SolveL2Contact(lengths, old, options, colliders, state->guess, state, points);
+    } else {
+      ContactSolver solver(lengths, old, options, colliders, state);
+      sub = solver.Solve(points);
+    }
     iterations += sub.iterations;
     // The solver measures a link against a mesh at its nearest local minimum (NearestOnSegment):
     // a converged solution is kept only where every link is clear by the exact clearances.
-    if (sub.converged() && has_mesh && !Clear(*points, lengths, colliders, &least, &touching)) {
+    // (With an L2 term the solves do not measure the still tail: checked here too.)
+    if (sub.converged() && (has_mesh || l2) &&
+        !Clear(*points, lengths, colliders, &least, &touching)) {
       sub.status = OverallStatus::kFailed;
     }
     if (!sub.converged()) {
@@ -739,7 +946,7 @@ void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& h
   stats->least_clearance = std::fmin(stats->least_clearance, least);
   stats->contact_link_steps += touching;
   result.iterations = iterations;
-  result.moving_points = n;
+  result.moving_points = l2 ? CountMoving(old, *points) : n;
   result.start = "continuation in " + std::to_string(sub_steps) +
                  " head sub-steps with colliders, each from the sequential contact step";
   if (fallbacks > 0) {

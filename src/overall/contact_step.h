@@ -11,6 +11,7 @@
 
 #include "flexkin/colliders.h"
 #include "flexkin/overall.h"
+#include "overall/active_set.h"
 #include "sequential/sweep.h"
 
 namespace flexkin::internal {
@@ -23,6 +24,11 @@ struct OverallContactState {
   Eigen::VectorXd lambda;                 // n: the length constraints' multipliers
   Points start;                           // a sub-step's sequential contact step
   Points free;                            // the step without colliders
+  // With an L2 term: the still tail's friction (and its buffers), the normal of the collider
+  // each old point lies on, and the active set's iterates.
+  ActiveSetBuffers active_set;
+  std::vector<Eigen::Vector3d> normals;
+  Points current, trial, guess;
 };
 
 // One overall step of the chain (`lengths`, `*points`) with the head moving to `head`, for

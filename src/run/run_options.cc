@@ -49,18 +49,21 @@ Problems RunOptions::Validate() const {
     const Problems collider = CheckCollider(colliders[i], "colliders[" + std::to_string(i) + "]");
     problems.insert(problems.end(), collider.begin(), collider.end());
   }
-  if (!colliders.empty() && method == Method::kOverall) {
-    // The overall step with colliders (overall/contact_step.h) needs a smooth metric.
+  const bool moving =
+      std::any_of(colliders.begin(), colliders.end(), [](const Collider& c) { return c.motion; });
+  if (moving && method == Method::kOverall) {
+    // With static colliders the L2 metric's still points are a tail (overall/contact_step.cc);
+    // a collider that moves into the chain can leave them anywhere along it.
     for (const char* term : {"l2", "l2_weighted"}) {
       const double weight =
           std::string(term) == "l2" ? overall.weights.l2 : overall.weights.l2_weighted;
       if (weight > 0.0) {
         problems.emplace_back(std::string("overall.weights.") + term,
-                              "the overall method with colliders takes the smooth metrics "
-                              "(squared, squared_weighted, rotation, joint_angle); the L2 metric's "
-                              "still points and the contacts are not solved together yet: set it "
-                              "to 0, or use \"tractrix\"",
-                              FormatNumber(weight), "0 with colliders");
+                              "the overall method takes the L2 metric with colliders that do not "
+                              "move; with a moving collider (\"motion\") its still points may lie "
+                              "anywhere along the chain, which is not solved yet: set it to 0 (a "
+                              "smooth metric), or use \"tractrix\"",
+                              FormatNumber(weight), "0 with moving colliders");
       }
     }
   }
