@@ -3,7 +3,10 @@
 // (closed form) or the same capsule as a mesh of 10,000 triangles (FCL's hierarchy, the contact
 // search marching past a non-convex shape), and, for scale, the same run without the post. Time
 // per run of 200 leader steps, 2 sub-steps each; counters: the contact link steps and the least
-// clearance (relative to a link) of the run.
+// clearance (relative to a link) of the run. Beside them the other convex shapes of the post's
+// size, whose contact steps are searches over the link's directions with the clearance of each
+// found by golden-section search along the link: an ellipsoid (semi-axes 0.1, 0.1, 0.6), a
+// cylinder (radius 0.1, half length 0.6) and a box (half extents 0.1, 0.1, 0.6).
 // Run: build/bench/mesh_colliders_benchmark --benchmark_repetitions=5
 //        --benchmark_report_aggregates_only=true
 
@@ -64,7 +67,8 @@ std::shared_ptr<const ColliderMeshData> CapsuleMesh(int around, int half) {
   return MakeColliderMesh(std::move(v), std::move(t), "", "post", &problems);
 }
 
-// 0: no post; 1: the capsule; 2: the capsule as a 10,000-triangle mesh.
+// 0: no post; 1: the capsule; 2: the capsule as a 10,000-triangle mesh; 3: an ellipsoid; 4: a
+// cylinder; 5: a box.
 void BM_ChainRoundAPost(benchmark::State& state) {
   LineDef line;
   line.start = Vector3d::Zero();
@@ -89,6 +93,16 @@ void BM_ChainRoundAPost(benchmark::State& state) {
     post.shape = ColliderShape::kMesh;
     post.mesh = CapsuleMesh(100, 25);
     state.counters["triangles"] = static_cast<double>(post.mesh->triangles.rows());
+  } else if (state.range(0) == 3) {
+    post.shape = ColliderShape::kEllipsoid;
+    post.extents = Vector3d(kRadius, kRadius, kHalfLength + kRadius);
+  } else if (state.range(0) == 4) {
+    post.shape = ColliderShape::kCylinder;
+    post.radius = kRadius;
+    post.half_length = kHalfLength + kRadius;
+  } else if (state.range(0) == 5) {
+    post.shape = ColliderShape::kBox;
+    post.extents = Vector3d(kRadius, kRadius, kHalfLength + kRadius);
   }
   if (state.range(0) > 0) options.colliders = {post};
   RunResult result;
@@ -98,9 +112,10 @@ void BM_ChainRoundAPost(benchmark::State& state) {
   }
   state.counters["contact_link_steps"] = static_cast<double>(result.contacts.contact_link_steps);
   state.counters["least_clearance"] = result.contacts.least_clearance;
-  state.SetLabel(state.range(0) == 0 ? "no post" : state.range(0) == 1 ? "capsule" : "mesh");
+  constexpr const char* kLabels[] = {"no post", "capsule", "mesh", "ellipsoid", "cylinder", "box"};
+  state.SetLabel(kLabels[state.range(0)]);
 }
-BENCHMARK(BM_ChainRoundAPost)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ChainRoundAPost)->DenseRange(0, 5)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace flexkin

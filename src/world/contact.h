@@ -21,6 +21,18 @@ constexpr double kContactSlack = 1e-13;
 double SegmentClearance(const Collider& collider, const Eigen::Vector3d& a,
                         const Eigen::Vector3d& b);
 
+// QuerySurface(collider, x), the same bits, with `to_local` = the collider's pose inverted
+// (pose.inverse(Eigen::Isometry)) computed once by the caller: for searches that query one
+// collider many times.
+SurfaceQuery QuerySurface(const Collider& collider, const Eigen::Isometry3d& to_local,
+                          const Eigen::Vector3d& x);
+
+// QuerySurface(collider, x).distance, the same bits, with `to_local` = the collider's pose
+// inverted (pose.inverse(Eigen::Isometry)) computed once by the caller, and without the nearest
+// point and normal carried back to the world: for searches that query one collider many times.
+double SurfaceDistance(const Collider& collider, const Eigen::Isometry3d& to_local,
+                       const Eigen::Vector3d& x);
+
 // The radius of a ball about the collider's origin (its pose's translation) that holds it, its
 // margin included (0 for a half-space, which no ball holds).
 double BoundingRadius(const Collider& collider);
@@ -28,6 +40,12 @@ double BoundingRadius(const Collider& collider);
 // A lower bound of QuerySurface(collider, x).distance, cheap: exact for a sphere and a
 // half-space, else the distance to the ball of BoundingRadius (broad phases).
 double DistanceLowerBound(const Collider& collider, const Eigen::Vector3d& x);
+
+// Whether SegmentClearance(collider, a, b) < threshold, for an ellipsoid, a cylinder or a box:
+// the same answer, from the same golden-section search, stopped where its answer is known (a
+// value below the threshold, or a lower bound of the convex function above it).
+bool SegmentClearanceBelow(const Collider& collider, const Eigen::Vector3d& a,
+                           const Eigen::Vector3d& b, double threshold);
 
 // The smallest clearance of [a, b] over `colliders` (+inf for none).
 double SegmentClearance(const std::vector<Collider>& colliders, const Eigen::Vector3d& a,
