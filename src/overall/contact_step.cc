@@ -907,6 +907,7 @@ void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& h
   ContactStats sweep_stats;
   for (int s = 1; s <= sub_steps; ++s) {
     for (int k = 0; k < dim; ++k) target[k] = SubstepHead(from[k], head[k], s, sub_steps);
+    state->previous_solution = *points;
     state->start = *points;
     ContactSweep(Method::kTractrix, dim, target.data(), lengths.data(), inv_lengths.data(), n,
                  state->start.data(), colliders, &sweep_stats);
@@ -922,6 +923,19 @@ void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& h
     } else {
       ContactSolver solver(lengths, old, options, colliders, state);
       sub = solver.Solve(points);
+      if (!sub.converged()) {
+        // The sequential contact step can start far from the solution (in 3D a link swung
+        // round a box's edge moves the chain behind it; the first model steps of half a link
+        // then leave the lengths by a fifth of a link, and the iteration wanders inside): the
+        // solve is tried again from the last sub-step's solution with only the head moved.
+        iterations += sub.iterations;
+        Points retry = state->previous_solution;
+        retry.row(0) = target.transpose();
+        ClearMultipliers(state);
+        ContactSolver again(lengths, old, options, colliders, state);
+        sub = again.Solve(&retry);
+        if (sub.converged()) *points = retry;
+      }
     }
     iterations += sub.iterations;
     // The solver measures a link against a mesh at its nearest local minimum (NearestOnSegment):

@@ -23,6 +23,7 @@ struct OverallContactState {
   std::vector<double> link_multipliers;   // (n + 1) by colliders: link i against collider k
   Eigen::VectorXd lambda;                 // n: the length constraints' multipliers
   Points start;                           // a sub-step's sequential contact step
+  Points previous_solution;               // the last sub-step's solution (retry start)
   Points free;                            // the step without colliders
   // With an L2 term: the still tail's friction (and its buffers), the normal of the collider
   // each old point lies on, and the active set's iterates.
