@@ -16,7 +16,9 @@ if (!toolsDir || !outDir || pages.length === 0) {
   process.exit(2);
 }
 const chromiumPath = process.env.FLEXKIN_CHROMIUM || '/usr/bin/chromium';
-const minFps = Number(process.env.FLEXKIN_MIN_FPS || 20);
+// The page must keep drawing while it plays. This floor is far below what any machine draws (59
+// fps here); the frame rate itself is a measurement (bench/viewer_fps.sh), not a test's pass mark.
+const minFps = Number(process.env.FLEXKIN_MIN_FPS || 5);
 if (!existsSync(chromiumPath)) {
   console.error(`Chromium not found at ${chromiumPath}; run scripts/install-deps.sh`);
   process.exit(3);
@@ -329,7 +331,7 @@ async function checkPage(browser, file) {
               `in ${seconds.toFixed(2)} s, ${(perf.ticks / seconds).toFixed(1)} animation ` +
               `callbacks/s, mean draw ${(perf.drawMs / perf.draws).toFixed(2)} ms, max ` +
               `${perf.maxDrawMs.toFixed(2)} ms)`);
-  check(fps >= minFps, `${name}: frame rate ${fps.toFixed(1)} >= ${minFps} fps`);
+  check(fps >= minFps, `${name}: keeps drawing while playing (${fps.toFixed(1)} >= ${minFps} fps)`);
 
   check(requests.length === 0, `${name}: no network requests (${requests.join(', ')})`);
   check(errors.length === 0, `${name}: no console or page errors ${errors.join('; ')}`);
