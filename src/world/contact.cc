@@ -69,30 +69,77 @@ double SegmentSegmentDistance(const Vector3d& p, const Vector3d& q, const Vector
 }
 
 // The minimum of the signed distance along [a, b] by golden-section search (the function is
-// convex), with the ends (the collider's margin included).
-double ConvexMinimumAlong(const Collider& c, const Vector3d& a, const Vector3d& b) {
+// convex), with the ends (the collider's margin included): the least of the values evaluated.
+//
+// Given a finite `threshold`, it answers only whether that minimum lies below it, from the same
+// evaluations in the same order, stopping as soon as they tell: it returns a value below the
+// threshold if the minimum is, else one above it. The result is the least of the values evaluated
+// (the golden-section pair always holds the least interior value so far, and the ends are in the
+// minimum), so one below the threshold answers yes. The function is convex, so on the bracket
+// [lo, hi] with its inner pair x1 < x2 it lies above the chord of (x1, x2) extended beyond them,
+// and between them above the larger of the chords (lo, x1) and (x2, hi) extended: the least of
+// these bounds the minimum from below, and a bound above the threshold, by a margin of 1e-12 of
+// the values' scale (the queries' rounding, which the golden-section ratios amplify at most
+// threefold), answers no. Near the threshold it runs to the end as the full search.
+double ConvexMinimumAlong(const Collider& c, const Vector3d& a, const Vector3d& b,
+                          double threshold = -std::numeric_limits<double>::infinity()) {
   const Eigen::Isometry3d to_local = c.pose.inverse(Eigen::Isometry);
   const auto f = [&](double t) { return SurfaceDistance(c, to_local, a + t * (b - a)); };
+  const bool stop_early = std::isfinite(threshold);
+  const double f0 = f(0.0), f_end = f(1.0);
+  if (f0 < threshold) return f0;
+  if (f_end < threshold) return f_end;
+  const double scale = (b - a).norm() + std::fabs(f0) + std::fabs(f_end) + std::fabs(threshold);
+  const double margin = 1e-12 * scale;
   constexpr double kInvPhi = 0.6180339887498949;
-  double lo = 0.0, hi = 1.0;
+  double lo = 0.0, hi = 1.0, f_lo = f0, f_hi = f_end;
   double x1 = hi - kInvPhi * (hi - lo), x2 = lo + kInvPhi * (hi - lo);
-  double f1 = f(x1), f2 = f(x2);
+  double f1 = f(x1);
+  if (f1 < threshold) return f1;
+  double f2 = f(x2);
+  if (f2 < threshold) return f2;
+  // A lower bound of the minimum on [lo, hi] from the four values there.
+  const auto lower_bound = [&]() {
+    // The chord of (x1, x2), extended to lo and to hi.
+    const double s12 = (f2 - f1) / (x2 - x1);
+    double bound = std::min({f1, f2, f1 + s12 * (lo - x1), f2 + s12 * (hi - x2)});
+    // Between x1 and x2: above max(left, right), the chords of (lo, x1) and (x2, hi) extended;
+    // the least of that maximum on [x1, x2] is at an end or where they cross.
+    const double left_slope = (f1 - f_lo) / (x1 - lo), right_slope = (f_hi - f2) / (hi - x2);
+    const auto left = [&](double t) { return f1 + left_slope * (t - x1); };
+    const auto right = [&](double t) { return f2 + right_slope * (t - x2); };
+    double inner = std::min(std::max(left(x1), right(x1)), std::max(left(x2), right(x2)));
+    if (right_slope > left_slope) {
+      const double cross =
+          (f1 - f2 + right_slope * x2 - left_slope * x1) / (right_slope - left_slope);
+      if (cross > x1 && cross < x2) inner = std::min(inner, left(cross));
+    }
+    return std::min(bound, inner);
+  };
   for (int i = 0; i < 90 && hi - lo > 1e-15; ++i) {
+    if (stop_early) {
+      const double bound = lower_bound();
+      if (std::isfinite(bound) && bound > threshold + margin) return bound;
+    }
     if (f1 <= f2) {
       hi = x2;
+      f_hi = f2;
       x2 = x1;
       f2 = f1;
       x1 = hi - kInvPhi * (hi - lo);
       f1 = f(x1);
+      if (f1 < threshold) return f1;
     } else {
       lo = x1;
+      f_lo = f1;
       x1 = x2;
       f1 = f2;
       x2 = lo + kInvPhi * (hi - lo);
       f2 = f(x2);
+      if (f2 < threshold) return f2;
     }
   }
-  return std::min({f1, f2, f(0.0), f(1.0)});
+  return std::min({f1, f2, f0, f_end});
 }
 
 }  // namespace
@@ -128,70 +175,16 @@ double SegmentClearance(const Collider& c, const Vector3d& a, const Vector3d& b)
   return 0.0;
 }
 
-// ConvexMinimumAlong (SegmentClearance of a convex shape) below `threshold`: the same answer,
-// from the same evaluations in the same order, decided as soon as the evaluations tell. The result
-// is the least of the values evaluated (the golden-section pair always holds the least interior
-// value so far, and the ends are in the minimum), so one below the threshold answers yes. The
-// function is convex, so on the bracket [lo, hi] with its inner pair x1 < x2 it lies above the
-// chord of (x1, x2) extended beyond them, and between them above the larger of the chords (lo, x1)
-// and (x2, hi) extended: the least of these bounds the minimum from below, and a bound above the
-// threshold, by a margin of 1e-12 of the values' scale (the queries' rounding, which the
-// golden-section ratios amplify at most threefold), answers no. Near the threshold it runs to the
-// end as ConvexMinimumAlong.
 bool SegmentClearanceBelow(const Collider& c, const Vector3d& a, const Vector3d& b,
                            double threshold) {
-  const Eigen::Isometry3d to_local = c.pose.inverse(Eigen::Isometry);
-  const auto f = [&](double t) { return SurfaceDistance(c, to_local, a + t * (b - a)); };
-  const double f0 = f(0.0), f_end = f(1.0);
-  if (f0 < threshold || f_end < threshold) return true;
-  const double scale = (b - a).norm() + std::fabs(f0) + std::fabs(f_end) + std::fabs(threshold);
-  const double margin = 1e-12 * scale;
-  constexpr double kInvPhi = 0.6180339887498949;
-  double lo = 0.0, hi = 1.0, f_lo = f0, f_hi = f_end;
-  double x1 = hi - kInvPhi * (hi - lo), x2 = lo + kInvPhi * (hi - lo);
-  double f1 = f(x1);
-  if (f1 < threshold) return true;
-  double f2 = f(x2);
-  if (f2 < threshold) return true;
-  const auto bounded_above = [&]() {
-    // The chord of (x1, x2), extended to lo and to hi.
-    const double s12 = (f2 - f1) / (x2 - x1);
-    double bound = std::min({f1, f2, f1 + s12 * (lo - x1), f2 + s12 * (hi - x2)});
-    // Between x1 and x2: above max(left, right), the chords of (lo, x1) and (x2, hi) extended;
-    // the least of that maximum on [x1, x2] is at an end or where they cross.
-    const double left_slope = (f1 - f_lo) / (x1 - lo), right_slope = (f_hi - f2) / (hi - x2);
-    const auto left = [&](double t) { return f1 + left_slope * (t - x1); };
-    const auto right = [&](double t) { return f2 + right_slope * (t - x2); };
-    double inner = std::min(std::max(left(x1), right(x1)), std::max(left(x2), right(x2)));
-    if (right_slope > left_slope) {
-      const double cross =
-          (f1 - f2 + right_slope * x2 - left_slope * x1) / (right_slope - left_slope);
-      if (cross > x1 && cross < x2) inner = std::min(inner, left(cross));
-    }
-    bound = std::min(bound, inner);
-    return std::isfinite(bound) && bound > threshold + margin;
-  };
-  for (int i = 0; i < 90 && hi - lo > 1e-15; ++i) {
-    if (bounded_above()) return false;
-    if (f1 <= f2) {
-      hi = x2;
-      f_hi = f2;
-      x2 = x1;
-      f2 = f1;
-      x1 = hi - kInvPhi * (hi - lo);
-      f1 = f(x1);
-      if (f1 < threshold) return true;
-    } else {
-      lo = x1;
-      f_lo = f1;
-      x1 = x2;
-      f1 = f2;
-      x2 = lo + kInvPhi * (hi - lo);
-      f2 = f(x2);
-      if (f2 < threshold) return true;
-    }
+  switch (c.shape) {
+    case ColliderShape::kEllipsoid:
+    case ColliderShape::kCylinder:
+    case ColliderShape::kBox:
+      return ConvexMinimumAlong(c, a, b, threshold) < threshold;
+    default:
+      return SegmentClearance(c, a, b) < threshold;
   }
-  return std::min({f1, f2, f0, f_end}) < threshold;
 }
 
 double SegmentClearance(const std::vector<Collider>& colliders, const Vector3d& a,
@@ -343,17 +336,11 @@ class TailSearch {
                                to_local * Tail(theta, psi) / c.scale,
                                (c.margin - 0.25 * kContactSlack * length_) / c.scale);
     }
-    if (c.shape == ColliderShape::kEllipsoid || c.shape == ColliderShape::kCylinder ||
-        c.shape == ColliderShape::kBox) {
-      // SegmentClearance's golden-section search, stopped where its answer is known: the
-      // answer below as the full search's (Allowed is never above the slack's threshold).
-      return SegmentClearanceBelow(c, head_, Tail(theta, psi),
-                                   Allowed(static_cast<size_t>(&c - colliders_.data())));
-    }
-    const double clearance = SegmentClearance(c, head_, Tail(theta, psi));
-    // Within the slack: clear, whatever the head's own depth allows (Allowed is never above it).
-    if (clearance >= -kContactSlack * length_) return false;
-    return clearance < Allowed(static_cast<size_t>(&c - colliders_.data()));
+    // SegmentClearance's answer, from a golden-section search stopped where it is known for the
+    // shapes that take one. Allowed is never above the slack's threshold, so a link within the
+    // slack is clear whatever the head's own depth allows.
+    return SegmentClearanceBelow(c, head_, Tail(theta, psi),
+                                 Allowed(static_cast<size_t>(&c - colliders_.data())));
   }
 
   // Mesh k's world-to-mesh transform (its pose's inverse), computed when first needed.

@@ -41,7 +41,7 @@ double BoundingRadius(const Collider& collider);
 // half-space, else the distance to the ball of BoundingRadius (broad phases).
 double DistanceLowerBound(const Collider& collider, const Eigen::Vector3d& x);
 
-// Whether SegmentClearance(collider, a, b) < threshold, for an ellipsoid, a cylinder or a box:
+// Whether SegmentClearance(collider, a, b) < threshold; for an ellipsoid, a cylinder or a box
 // the same answer, from the same golden-section search, stopped where its answer is known (a
 // value below the threshold, or a lower bound of the convex function above it).
 bool SegmentClearanceBelow(const Collider& collider, const Eigen::Vector3d& a,
