@@ -253,15 +253,18 @@ TEST(OverallCollidersTest, EveryShapeKeepsEveryLinkOutsideWhereTheFreeRunCutsThr
       }
       if (smooth) EXPECT_EQ(result.overall.failures, 0) << result.overall.first_failure;
       // Edges (docs/colliders.md): a link over an edge takes the common perpendicular as its
-      // normal, a contact the start has left drops its multiplier, and a step the merit refuses
-      // is taken again on the damped model. Measured 167 of 167 in 2D on the box and both
-      // meshes, 157, 120 and 98 of 169 in 3D on the box, its mesh and the L (before the damping
-      // 166 of 167, and 146, 114 and 100); held with a margin for other builds' rounding.
+      // normal, a contact the start has left drops its multiplier, a step the merit refuses
+      // is taken again on the damped model, a sub-step that does not converge is solved again
+      // from the last one's solution, and a step that leaves the lengths takes its second-order
+      // correction. Measured 167 of 167 in 2D on the box and both meshes, 168, 135 and 125 of
+      // 169 in 3D on the box, its mesh and the L (157, 120 and 98 before the retry and the
+      // correction; 146, 114 and 100 before the damping); held with a margin for other builds'
+      // rounding.
       const long long converged = result.overall.solves - result.overall.failures;
       if (name == "box" || name == "box mesh") {
-        EXPECT_GE(converged, dim == 2 ? 162 : (name == "box" ? 140 : 108));
+        EXPECT_GE(converged, dim == 2 ? 162 : (name == "box" ? 160 : 125));
       }
-      if (name == "L-shaped mesh" && dim == 3) EXPECT_GE(converged, 95);
+      if (name == "L-shaped mesh" && dim == 3) EXPECT_GE(converged, 115);
       std::printf(
           "%s %dD: %lld of %lld sub-steps converged, %lld link steps in contact, least "
           "clearance %.3g, length error %.3g (%.2f s)\n",

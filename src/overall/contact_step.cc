@@ -138,6 +138,13 @@ class ContactSolver {
   // The model's solution with its active contacts chosen by a primal active set (a contact whose
   // multiplier pulls inward leaves; the one the step would enter most joins).
   bool SolveQp(const Point& p, std::vector<int>* working, Eigen::VectorXd* solution);
+  // The second-order correction of a trial point (Nocedal and Wright, section 18.3): the step
+  // p^ that the last model's matrix gives for the constraints' values at the trial (lengths and
+  // working contacts), which the constraints' curvature left off them; `trial` + p^ into
+  // `*corrected`, evaluated. False where the model gives none or it moves a point by more than
+  // half the shortest link.
+  bool Correct(const Point& p, const std::vector<int>& working, const Point& trial,
+               Point* corrected);
   double Merit(const Point& p, double penalty) const {
     double sum = 0.0;
     for (int i = 0; i < links_; ++i) sum += std::fabs(p.c[i]);
@@ -541,11 +548,31 @@ bool ContactSolver::SolveQp(const Point& p, std::vector<int>* working, Eigen::Ve
   }
 }
 
+bool ContactSolver::Correct(const Point& p, const std::vector<int>& working, const Point& trial,
+                            Point* corrected) {
+  const int na = static_cast<int>(working.size());
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(unknowns_ + links_ + na);
+  rhs.segment(unknowns_, links_) = -trial.c;
+  for (int a = 0; a < na; ++a) {
+    rhs[unknowns_ + links_ + a] = Measure(p.near[working[a]], trial.x).value;
+  }
+  const Eigen::VectorXd correction = lu_.solve(rhs);
+  if (lu_.info() != Eigen::Success || !correction.allFinite()) return false;
+  corrected->x = trial.x;
+  for (int j = 1; j <= k_; ++j) {
+    const auto move = correction.segment(sink_.offset[j], dim_);
+    if (move.norm() > 0.5 * shortest_) return false;
+    for (int q = 0; q < dim_; ++q) corrected->x(j, q) += move[q];
+  }
+  Evaluate(corrected, false);
+  return true;
+}
+
 OverallReport ContactSolver::Solve(Points* x_io) {
   OverallReport report;
   if (state_.lambda.size() != links_) state_.lambda = Eigen::VectorXd::Zero(links_);
   const int max_iterations = std::max(options_.max_iterations, 1);
-  Point p, trial;
+  Point p, trial, corrected;
   p.x = *x_io;
   Evaluate(&p, true);
   // A contact the start has left (off its surface by more than 1e-6 of its link) starts without
@@ -675,11 +702,25 @@ OverallReport ContactSolver::Solve(Points* x_io) {
         // A full step of at most 1e-6 of the shortest link is taken where the merit rises by
         // no more than 1e-10 of itself: the constraints' curvature can make the merit rise
         // along the Newton step near the solution, and the multipliers move with it.
-        if (trial_merit <= merit + 1e-4 * alpha * std::fmin(slope, 0.0) ||
-            (tries == 0 && trial_merit <= merit + 1e-13 * std::fabs(merit)) ||
-            (tries == 0 && trial_infeasibility <= 0.5 * infeasibility) ||
-            (tries == 0 && longest <= 1e-6 * shortest_ &&
-             trial_merit <= merit + 1e-10 * std::fabs(merit))) {
+        const double sufficient = merit + 1e-4 * alpha * std::fmin(slope, 0.0);
+        const bool accepted = trial_merit <= sufficient ||
+                              (tries == 0 && trial_merit <= merit + 1e-13 * std::fabs(merit)) ||
+                              (tries == 0 && trial_infeasibility <= 0.5 * infeasibility) ||
+                              (tries == 0 && longest <= 1e-6 * shortest_ &&
+                               trial_merit <= merit + 1e-10 * std::fabs(merit));
+        // Where the full step leaves the lengths more than the iterate does, its second-order
+        // correction is tried: taken where it meets the sufficient decrease and the step did not,
+        // or it leaves the lengths less than the step does (the l1 penalty, small while the
+        // multipliers are, can accept a step a fifth of a link off them, from which the
+        // iteration does not find its way back).
+        if (tries == 0 && trial.violation > std::fmax(p.violation, 1e-12) &&
+            Correct(p, working, trial, &corrected) && Merit(corrected, penalty) <= sufficient &&
+            (!accepted || corrected.violation < trial.violation)) {
+          std::swap(trial, corrected);
+          found = true;
+          break;
+        }
+        if (accepted) {
           found = true;
           break;
         }
@@ -907,10 +948,10 @@ void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& h
   ContactStats sweep_stats;
   for (int s = 1; s <= sub_steps; ++s) {
     for (int k = 0; k < dim; ++k) target[k] = SubstepHead(from[k], head[k], s, sub_steps);
-    state->previous_solution = *points;
     state->start = *points;
     ContactSweep(Method::kTractrix, dim, target.data(), lengths.data(), inv_lengths.data(), n,
                  state->start.data(), colliders, &sweep_stats);
+    state->previous_solution.swap(*points);  // kept for a retry, without a copy
     *points = state->start;
     OverallReport sub;
     if (l2) {
