@@ -73,8 +73,9 @@ echo "== trees (docs/trees.md): two arms on a spine whose hands go round circles
 echo "   (the passes between the targets), a plant whose trunk sways (its canopy following), and a"
 echo "   torso reaching with both hands while its head follows a ball (a pointing goal), and a"
 echo "   two-armed URDF robot (15 revolute joints with limits) whose hands go round two circles while"
-echo "   its head camera watches the left hand (the joints solved in joint space, docs/trees.md)"
-for name in tree_two_arms tree_plant tree_torso tree_robot_two_arms; do
+echo "   its head camera watches the left hand (the joints solved in joint space, docs/trees.md),"
+echo "   and the same robot with a lift, a telescoping arm and a rising neck (prismatic joints)"
+for name in tree_two_arms tree_plant tree_torso tree_robot_two_arms tree_robot_lift; do
   "$flexkin" run "examples/$name.json" -o "out/$name.npz"
   # The figure, the plots, the animation, the viewer and the glTF (a bone per link) of the tree
   # result.

@@ -778,6 +778,99 @@ TEST(GltfTree, CapsulesLieOnTheLinksAndTheBindPoseIsTheFirstFrame) {
   }
 }
 
+// A tree whose links slide (a robot tree's prismatic joints): point 2's link, closed in the first
+// frame, opens along a turning direction and has a child; the leaf 4's telescopes from 0.3 to 0.7.
+TreeResultFile SlidingTree3d() {
+  TreeResultFile tree;
+  tree.name = "telescopes";
+  tree.dim = 3;
+  tree.parents = {-1, 0, 1, 2, 1};
+  tree.fixed = {0};
+  for (int f = 0; f <= 8; ++f) {
+    const double a = 0.15 * f, slide = 0.05 * f;
+    Points p(5, 3);
+    p.row(0) << 0, 0, 0;
+    p.row(1) << 0, 0, 1;
+    p.row(2) = p.row(1) + slide * Eigen::RowVector3d(std::cos(a), std::sin(a), 0.2);
+    p.row(3) = p.row(2) + 0.4 * Eigen::RowVector3d(std::cos(2 * a), 0.0, std::sin(2 * a));
+    p.row(4) = p.row(1) + (0.3 + 0.05 * f) * Eigen::RowVector3d(0.0, -std::cos(a), std::sin(a));
+    tree.frames.push_back(p);
+    if (f > 0) tree.reached.push_back(1);
+  }
+  tree.sliding = {2, 4};
+  return tree;
+}
+
+// Sliding links are exported: every joint on its point in every frame (a joint "slide_2" on the
+// sliding point that is not a leaf, as a tip on the leaf 4), and each sliding link's capsule as
+// long as its longest, its far end's joint bound there (its inverse bind matrix), so that the
+// capsule stretches with the link; the rigid links' capsules and joints in the first frame's
+// pose, as without sliding links.
+TEST(GltfTree, SlidingLinksStretchTheirCapsules) {
+  TempDir dir;
+  const TreeResultFile tree = SlidingTree3d();
+  ASSERT_TRUE(ValidateTreeResult(tree).empty()) << ValidateTreeResult(tree).front().Text();
+  GltfOptions options;
+  options.up_axis = GltfUpAxis::kY;  // the scene's coordinates are flexkin's
+  options.tube_radius = 0.04;
+  const std::string path = dir / "telescopes.glb";
+  WriteTreeGltf(tree, options, path);
+  ExpectValidGltf({path});
+  const GltfJointMotion motion = ReadGltfJointPositions(path);
+  // point_0, link_1, link_2, link_4, link_3 (breadth first), tip_4, tip_3, slide_2.
+  ASSERT_EQ(motion.joint_points, (std::vector<int>{0, 0, 1, 1, 2, 4, 3, 2}));
+  ASSERT_EQ(motion.positions.size(), tree.frames.size());
+  double worst = 0.0;
+  for (size_t f = 0; f < tree.frames.size(); ++f) {
+    for (size_t j = 0; j < motion.joint_points.size(); ++j) {
+      worst = std::max(
+          worst, (motion.positions[f].row(j) - tree.frames[f].row(motion.joint_points[j])).norm());
+    }
+  }
+  EXPECT_LE(worst, 1e-6);
+  // The bind pose: the joints of the rigid links and the root on the first frame's points; the
+  // end joints of the sliding links (slide_2, tip_4) at the far end of a capsule as long as the
+  // link's longest, along the link's first direction (point 2's: the direction it opens in).
+  const gltf::SkinnedMeshRestPose rest = gltf::ReadSkinnedMeshRestPose(path);
+  ASSERT_EQ(rest.inverse_bind_matrices.size(), motion.joint_points.size());
+  const Points& first = tree.frames.front();
+  const auto direction = [&](int c, size_t f) -> Eigen::Vector3d {
+    return (tree.frames[f].row(c) - tree.frames[f].row(tree.parents[c])).transpose().normalized();
+  };
+  const auto longest = [&](int c) {
+    double most = 0.0;
+    for (const Points& p : tree.frames)
+      most = std::max(most, (p.row(c) - p.row(tree.parents[c])).norm());
+    return most;
+  };
+  const Eigen::Vector3d far2 = first.row(1).transpose() + longest(2) * direction(2, 1);
+  const Eigen::Vector3d far4 = first.row(1).transpose() + longest(4) * direction(4, 0);
+  for (size_t j = 0; j < motion.joint_points.size(); ++j) {
+    const Eigen::Vector3d origin = rest.inverse_bind_matrices[j].inverse().topRightCorner<3, 1>();
+    const Eigen::Vector3d expected =
+        j == 7   ? far2
+        : j == 5 ? far4
+                 : Eigen::Vector3d(first.row(motion.joint_points[j]).transpose());
+    EXPECT_LT((origin - expected).norm(), 1e-5) << j;
+  }
+  // Every vertex on its capsule, of radius 0.04: the rigid links' in the first frame, the sliding
+  // links' from their first point to the far ends above. The capsules come in the links' joints'
+  // order (link_1, link_2, link_4, link_3), each with as many vertices.
+  const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> axes = {
+      {first.row(0).transpose(), first.row(1).transpose()},
+      {first.row(1).transpose(), far2},
+      {first.row(1).transpose(), far4},
+      {first.row(2).transpose(), first.row(3).transpose()}};
+  ASSERT_EQ(rest.positions.size() % axes.size(), 0u);
+  const size_t each = rest.positions.size() / axes.size();
+  for (size_t v = 0; v < rest.positions.size(); ++v) {
+    const auto& [a, b] = axes[v / each];
+    const double t =
+        std::clamp((rest.positions[v] - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+    EXPECT_NEAR((rest.positions[v] - (a + t * (b - a))).norm(), 0.04, 1e-6) << v;
+  }
+}
+
 TEST(GltfTree, RefusedWithoutWriting) {
   TempDir dir;
   TreeResultFile tree = MakeTreeResult(2, 6, 3, 1);

@@ -530,6 +530,18 @@ TEST(RobotTreeScenario, RunsTheExampleThroughTheFrontDoor) {
   }
 }
 
+// A smooth motion of every joint at time t in [0, 1]: q_j = a_j sin(pi t (1 + j mod 3)) within
+// the limits, a_j `slide` for a sliding joint and 0.4 for a turning one.
+Eigen::VectorXd SmoothMotion(const RobotTree& robot, double t, double slide) {
+  Eigen::VectorXd q(robot.joints());
+  for (int j = 0; j < robot.joints(); ++j) {
+    const double amplitude = robot.prismatic[j] ? slide : 0.4;
+    q[j] = std::clamp(amplitude * std::sin(M_PI * t * (1 + j % 3)), robot.joint_min[j],
+                      robot.joint_max[j]);
+  }
+  return q;
+}
+
 // A robot tree with sliding joints through the front door: a scenario whose two hands follow
 // where a smooth motion of every joint (the lift and the telescoping arm included) takes them, so
 // that every frame is reachable. Every frame reached, the rigid links' lengths kept, the sliding
@@ -546,15 +558,9 @@ TEST(RobotTreeScenario, RunsSlidingJointsThroughTheFrontDoor) {
   const int frames = 40;
   std::string paths[2];
   for (int f = 1; f <= frames; ++f) {
-    const double t = static_cast<double>(f) / frames;
-    Eigen::VectorXd q(robot.joints());
-    for (int j = 0; j < robot.joints(); ++j) {
-      const double amplitude = robot.prismatic[j] ? 0.08 : 0.4;
-      q[j] = std::clamp(amplitude * std::sin(M_PI * t * (1 + j % 3)), robot.joint_min[j],
-                        robot.joint_max[j]);
-    }
     Points tools, axes;
-    RobotTreeTools(robot, q, &tools, &axes);
+    RobotTreeTools(robot, SmoothMotion(robot, static_cast<double>(f) / frames, 0.08), &tools,
+                   &axes);
     for (int k = 0; k < 2; ++k) {
       paths[k] += std::string(f > 1 ? ", " : "") + "[" + std::to_string(tools(k, 0)) + ", " +
                   std::to_string(tools(k, 1)) + ", " + std::to_string(tools(k, 2)) + "]";
@@ -636,6 +642,43 @@ TEST(RobotTreeScenario, NamesEveryProblemByItsJsonPointer) {
       "targets": [{"link": "l_tool", "path": [[0, 0.97, 1.05]]}]})",
                                 read),
                std::system_error);
+}
+
+// examples/robot_lift.urdf is SlidingTwoArms (its comment aside), and the hands' paths of
+// examples/tree_robot_lift.json are where the forward kinematics put them under the motion
+// q_j(t) = clamp(a_j sin(pi t (1 + j mod 3))), a_j 0.1 for a sliding joint and 0.4 for a turning
+// one, t = f / 60 for frames 1 to 60 (printed to 6 decimals); the example runs through the front
+// door with every frame reached.
+TEST(RobotTreeScenario, TheLiftExampleIsTheSlidingRobotOnAReachablePath) {
+  const auto strip = [](std::string text) {
+    const size_t from = text.find("<!--"), to = text.find("-->");
+    if (from != std::string::npos && to != std::string::npos) text.erase(from, to + 3 - from);
+    return text;
+  };
+  const std::string urdf = test_util::SourceFileText("examples/robot_lift.urdf");
+  ASSERT_FALSE(urdf.empty());
+  EXPECT_EQ(strip(urdf), strip(test_util::SlidingTwoArms()));
+  const RobotTree robot = LiftRobot();
+  ScenarioReadOptions read;
+  read.robot = UrdfRobotScenarioOptions();
+  const AnyScenario s =
+      ReadScenarioFile(std::string(FLEXKIN_SOURCE_DIR) + "/examples/tree_robot_lift.json", read);
+  ASSERT_TRUE(s.valid()) << s.problems.front().Text();
+  ASSERT_TRUE(s.tree.has_value() && s.tree->robot);
+  ASSERT_EQ(s.tree->paths.size(), 2u);
+  const int frames = 60;
+  double worst = 0.0;
+  for (int f = 1; f <= frames; ++f) {
+    Points tools, axes;
+    RobotTreeTools(robot, SmoothMotion(robot, static_cast<double>(f) / frames, 0.1), &tools, &axes);
+    for (int k = 0; k < 2; ++k) {
+      ASSERT_EQ(s.tree->paths[k].rows(), frames);
+      worst = std::max(worst, (s.tree->paths[k].row(f - 1) - tools.row(k)).cwiseAbs().maxCoeff());
+    }
+  }
+  EXPECT_LE(worst, 5e-7);
+  const TreeRunResult r = RunTree(*s.tree);
+  EXPECT_EQ(r.failures(), 0) << r.BriefReport();
 }
 
 }  // namespace

@@ -118,7 +118,7 @@ RigAnimation PoseChain(const std::vector<Points>& frames) {
 
 namespace flexkin::gltf {
 
-TreeSkeleton MakeTreeSkeleton(const std::vector<int>& parents) {
+TreeSkeleton MakeTreeSkeleton(const std::vector<int>& parents, const std::vector<int>& sliding) {
   const int points = static_cast<int>(parents.size());
   const std::vector<std::vector<int>> children = TreeChildren(parents);
   const int root = TreeRoot(parents);
@@ -149,6 +149,16 @@ TreeSkeleton MakeTreeSkeleton(const std::vector<int>& parents) {
     s.toward.push_back(-1);
     s.names.push_back("tip_" + std::to_string(c));
   }
+  std::vector<char> slides(points, 0);
+  for (const int c : sliding) slides[c] = 1;
+  for (size_t k = 1; k < order.size(); ++k) {
+    const int c = order[k];
+    if (children[c].empty() || !slides[c]) continue;
+    s.parent.push_back(link_joint[c]);
+    s.head.push_back(c);
+    s.toward.push_back(-1);
+    s.names.push_back("slide_" + std::to_string(c));
+  }
   return s;
 }
 
@@ -174,9 +184,20 @@ RigAnimation PoseTree(const TreeSkeleton& skeleton, const std::vector<Points>& f
       head.row(j) = p.row(skeleton.head[j]);
       const int to = skeleton.toward[j];
       // A tip continues its link; the root of a lone point (no children) keeps +Y.
-      bone[j] = to >= 0 ? Vector3d((p.row(to) - p.row(skeleton.head[j])).transpose().normalized())
-                : j > 0 ? bone[skeleton.parent[j]]
-                        : Vector3d::UnitY();
+      if (to < 0) {
+        bone[j] = j > 0 ? bone[skeleton.parent[j]] : Vector3d::UnitY();
+        continue;
+      }
+      const auto direction = [&](const Points& q) {
+        return Vector3d((q.row(to) - q.row(skeleton.head[j])).transpose());
+      };
+      Vector3d d = direction(p);
+      if (d.squaredNorm() == 0.0 && f == 0) {
+        // A sliding link closed in the first frame: the direction it first opens in.
+        for (int g = 1; g < num_frames && d.squaredNorm() == 0.0; ++g) d = direction(frames[g]);
+        if (d.squaredNorm() == 0.0) d = j > 0 ? bone[skeleton.parent[j]] : Vector3d::UnitY();
+      }
+      if (d.squaredNorm() > 0.0) bone[j] = d.normalized();  // else the frame before's
     }
     root = (f == 0 ? SmallestRotation(Vector3d::UnitY(), bone[0])
                    : SmallestRotation(root_bone, bone[0]) * root)

@@ -47,14 +47,19 @@ struct TreeSkeleton {
   std::vector<int> toward;  // the point its +Y points to; -1 for a tip (and a lone root)
   std::vector<std::string> names;
 };
-// `parents`: a valid tree (ValidateTree).
-TreeSkeleton MakeTreeSkeleton(const std::vector<int>& parents);
+// `parents`: a valid tree (ValidateTree). `sliding`: the points whose link into them changes
+// length (a robot tree's prismatic joints); each that is not a leaf gets a joint "slide_<c>" on c
+// as a leaf gets its tip, a child of link_<c> with its orientation (the end that link's capsule
+// stretches to), after the tips in the same order.
+TreeSkeleton MakeTreeSkeleton(const std::vector<int>& parents,
+                              const std::vector<int>& sliding = {});
 
-// Poses the tree's skeleton for each of `frames` ((n+1) by 3, the tree's points; no link of
-// length 0), as PoseChain poses a chain: joint 0 turned from frame to frame by the smallest
-// rotation that turns its bone (toward the root's first child), each other joint from its parent
-// by the smallest rotation between their bones, translations from the float32 values of the
-// ancestors.
+// Poses the tree's skeleton for each of `frames` ((n+1) by 3, the tree's points; a link of
+// length 0 only where it slides: its bone keeps the direction of the frame before, or of the first
+// frame where it has one, or its parent's), as PoseChain poses a chain: joint 0 turned from frame
+// to frame by the smallest rotation that turns its bone (toward the root's first child), each other
+// joint from its parent by the smallest rotation between their bones, translations from the float32
+// values of the ancestors.
 RigAnimation PoseTree(const TreeSkeleton& skeleton, const std::vector<Points>& frames);
 
 }  // namespace flexkin::gltf

@@ -47,7 +47,9 @@ void CheckTreeGltfLimits(const TreeResultFile& tree, const gltf::TreeSkeleton& s
         }
       }
       const int parent = tree.parents[i];
-      if (parent >= 0 && p.row(i) == p.row(parent)) {
+      const bool slides =
+          std::find(tree.sliding.begin(), tree.sliding.end(), i) != tree.sliding.end();
+      if (parent >= 0 && !slides && p.row(i) == p.row(parent)) {
         throw InputError(PointField(f, i), "coincides with its parent, point " +
                                                std::to_string(parent) +
                                                "; a link needs a direction");
@@ -95,6 +97,11 @@ tinygltf::Value TreeExtras(const TreeResultFile& tree, const gltf::TreeSkeleton&
   for (const int h : skeleton.head) heads.emplace_back(h);
   info["parents"] = tinygltf::Value(std::move(parents));
   info["joint_points"] = tinygltf::Value(std::move(heads));
+  if (!tree.sliding.empty()) {
+    tinygltf::Value::Array sliding;
+    for (const int c : tree.sliding) sliding.emplace_back(c);
+    info["sliding"] = tinygltf::Value(std::move(sliding));
+  }
   if (!tree.name.empty()) info["scenario"] = tinygltf::Value(tree.name);
   tinygltf::Value::Object extras;
   extras["flexkin"] = tinygltf::Value(std::move(info));
@@ -131,34 +138,67 @@ void AddTreeMesh(const TreeResultFile& tree, const gltf::TreeSkeleton& skeleton,
                  gltf::BufferWriter* buffer, tinygltf::Model* model) {
   const Points& first = tree.frames.front();
   const size_t joints = skeleton.head.size();
+  // Each link's length in the bind pose: the first frame's; a sliding link's capsule is drawn as
+  // long as the link is longest, its far half skinned to the joint at its end (the link's tip or
+  // slide joint), whose bind pose is put there: the capsule stretches and shrinks with the link.
+  std::vector<double> length(joints, 0.0);
+  std::vector<int> end_joint(first.rows(), -1);
+  for (size_t j = 0; j < joints; ++j) {
+    if (skeleton.toward[j] < 0 && j > 0) end_joint[skeleton.head[j]] = static_cast<int>(j);
+  }
+  std::vector<char> slides(first.rows(), 0);
+  for (const int c : tree.sliding) slides[c] = 1;
   double total = 0.0;
   int links = 0;
   for (size_t j = 0; j < joints; ++j) {
     if (j == 0 || skeleton.toward[j] < 0) continue;
-    total += (first.row(skeleton.toward[j]) - first.row(skeleton.head[j])).norm();
-    ++links;
+    const int to = skeleton.toward[j], from = skeleton.head[j];
+    length[j] = (first.row(to) - first.row(from)).norm();
+    if (slides[to]) {
+      for (const Points& p : tree.frames)
+        length[j] = std::max(length[j], (p.row(to) - p.row(from)).norm());
+    }
+    total += length[j];
+    if (length[j] > 0.0) ++links;
+  }
+  // The bind pose of each sliding link's end joint: on the capsule's far end.
+  std::vector<Matrix3d> bind_rotation = bind.rotation;
+  std::vector<Vector3d> bind_position = bind.position;
+  for (size_t j = 1; j < joints; ++j) {
+    const int to = skeleton.toward[j];
+    if (to < 0 || !slides[to]) continue;
+    const int e = end_joint[to];
+    bind_rotation[e] = bind.rotation[j];
+    bind_position[e] = bind.position[j] + bind.rotation[j] * Vector3d(0.0, length[j], 0.0);
   }
   const double thickest = std::min(0.25 * total / links, 0.02 * total);
   gltf::TubeMesh mesh;
   for (size_t j = 1; j < joints; ++j) {
-    if (skeleton.toward[j] < 0) continue;
-    const double length = (first.row(skeleton.toward[j]) - first.row(skeleton.head[j])).norm();
+    // (A sliding link of length 0 in every frame, a joint that never moved off its lower limit,
+    // has nothing to draw.)
+    if (skeleton.toward[j] < 0 || length[j] == 0.0) continue;
     const double radius =
-        options.tube_radius > 0.0 ? options.tube_radius : std::min(thickest, 0.25 * length);
+        options.tube_radius > 0.0 ? options.tube_radius : std::min(thickest, 0.25 * length[j]);
     Eigen::VectorXd arc(2), radii(1);
-    arc << 0.0, length;
+    arc << 0.0, length[j];
     radii << radius;
     const gltf::TubeMesh capsule =
         gltf::MakeCapsuleTube(arc, radii, options.tube_sides, std::max(2, options.tube_sides / 4),
                               to_scene * bind.rotation[j]);
     const Vector3d offset = to_scene * bind.position[j];
     const uint32_t base = static_cast<uint32_t>(mesh.num_vertices());
+    const int far = slides[skeleton.toward[j]] ? end_joint[skeleton.toward[j]] : -1;
+    const Matrix3d to_link = (to_scene * bind.rotation[j]).inverse();
     for (int v = 0; v < capsule.num_vertices(); ++v) {
       for (int k = 0; k < 3; ++k) {
         mesh.positions.push_back(static_cast<float>(capsule.positions[3 * v + k] + offset[k]));
         mesh.normals.push_back(capsule.normals[3 * v + k]);
       }
-      mesh.joints.insert(mesh.joints.end(), {static_cast<uint16_t>(j), 0, 0, 0});
+      const Vector3d along =
+          to_link * Vector3d(capsule.positions[3 * v], capsule.positions[3 * v + 1],
+                             capsule.positions[3 * v + 2]);
+      const int joint = far >= 0 && along.y() > 0.5 * length[j] ? far : static_cast<int>(j);
+      mesh.joints.insert(mesh.joints.end(), {static_cast<uint16_t>(joint), 0, 0, 0});
       mesh.weights.insert(mesh.weights.end(), {1.0f, 0.0f, 0.0f, 0.0f});
     }
     for (const uint32_t i : capsule.indices) mesh.indices.push_back(base + i);
@@ -170,8 +210,8 @@ void AddTreeMesh(const TreeResultFile& tree, const gltf::TreeSkeleton& skeleton,
   std::vector<float> inverse_bind;
   for (size_t j = 0; j < joints; ++j) {
     Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-    m.topLeftCorner<3, 3>() = to_scene * bind.rotation[j];
-    m.topRightCorner<3, 1>() = to_scene * bind.position[j];
+    m.topLeftCorner<3, 3>() = to_scene * bind_rotation[j];
+    m.topRightCorner<3, 1>() = to_scene * bind_position[j];
     const Eigen::Matrix4d inverse = m.inverse();
     for (int c = 0; c < 4; ++c) {
       for (int r = 0; r < 4; ++r) inverse_bind.push_back(static_cast<float>(inverse(r, c)));
@@ -193,20 +233,8 @@ void WriteTreeGltf(const TreeResultFile& tree, const GltfOptions& options,
 
 void internal::WriteTreeGltf(const TreeResultFile& tree, const GltfOptions& options,
                              const std::string& path) {
-  if (!tree.sliding.empty()) {
-    // The skin's bones keep the first frame's lengths; a sliding link's does not.
-    throw InputError(Problem("sliding",
-                             "the tree has " + std::to_string(tree.sliding.size()) +
-                                 " sliding links (a robot tree's prismatic joints, point " +
-                                 std::to_string(tree.sliding.front()) +
-                                 " the first), whose lengths change; glTF export takes trees "
-                                 "whose links keep their lengths (its bones do); draw it, "
-                                 "animate it or view it instead",
-                             std::to_string(tree.sliding.size()) + " sliding links",
-                             "a tree without sliding links"));
-  }
   const bool binary = gltf::IsBinaryPath(path);
-  const gltf::TreeSkeleton skeleton = gltf::MakeTreeSkeleton(tree.parents);
+  const gltf::TreeSkeleton skeleton = gltf::MakeTreeSkeleton(tree.parents, tree.sliding);
   CheckTreeGltfLimits(tree, skeleton, options);
   const std::vector<float> times = TreeKeyframeTimes(tree.frames.size(), options.steps_per_second);
   const GltfUpAxis axis = gltf::ResolvedUpAxis(options.up_axis, tree.dim);
