@@ -24,6 +24,13 @@ std::string PointField(size_t f, Eigen::Index i) {
   return "frames[" + std::to_string(f) + "].points[" + std::to_string(i) + "]";
 }
 
+// Per point: 1 where the link into it slides (TreeResultFile::sliding).
+std::vector<char> SlidingMask(const TreeResultFile& tree) {
+  std::vector<char> slides(tree.parents.size(), 0);
+  for (const int c : tree.sliding) slides[c] = 1;
+  return slides;
+}
+
 // glTF's limits for a tree read and checked by ReadTreeResultFile: joints that 16-bit indices
 // address, float32 coordinates, keyframe times, and a direction for every link in every frame.
 void CheckTreeGltfLimits(const TreeResultFile& tree, const gltf::TreeSkeleton& skeleton,
@@ -35,6 +42,7 @@ void CheckTreeGltfLimits(const TreeResultFile& tree, const gltf::TreeSkeleton& s
                                     std::to_string(gltf::kMaxJoints - 1));
   }
   const double largest = 1e30 / options.scale;
+  const std::vector<char> slides = SlidingMask(tree);
   for (size_t f = 0; f < tree.frames.size(); ++f) {
     const Points& p = tree.frames[f];
     for (Eigen::Index i = 0; i < p.rows(); ++i) {
@@ -47,9 +55,7 @@ void CheckTreeGltfLimits(const TreeResultFile& tree, const gltf::TreeSkeleton& s
         }
       }
       const int parent = tree.parents[i];
-      const bool slides =
-          std::find(tree.sliding.begin(), tree.sliding.end(), i) != tree.sliding.end();
-      if (parent >= 0 && !slides && p.row(i) == p.row(parent)) {
+      if (parent >= 0 && !slides[i] && p.row(i) == p.row(parent)) {
         throw InputError(PointField(f, i), "coincides with its parent, point " +
                                                std::to_string(parent) +
                                                "; a link needs a direction");
@@ -146,8 +152,7 @@ void AddTreeMesh(const TreeResultFile& tree, const gltf::TreeSkeleton& skeleton,
   for (size_t j = 0; j < joints; ++j) {
     if (skeleton.toward[j] < 0 && j > 0) end_joint[skeleton.head[j]] = static_cast<int>(j);
   }
-  std::vector<char> slides(first.rows(), 0);
-  for (const int c : tree.sliding) slides[c] = 1;
+  const std::vector<char> slides = SlidingMask(tree);
   double total = 0.0;
   int links = 0;
   for (size_t j = 0; j < joints; ++j) {

@@ -969,13 +969,14 @@ void OverallContactStep(const Eigen::VectorXd& lengths, const Eigen::VectorXd& h
         // round a box's edge moves the chain behind it; the first model steps of half a link
         // then leave the lengths by a fifth of a link, and the iteration wanders inside): the
         // solve is tried again from the last sub-step's solution with only the head moved.
+        // (Solved in place: the next sub-step replaces that buffer.)
         iterations += sub.iterations;
-        Points retry = state->previous_solution;
+        Points& retry = state->previous_solution;
         retry.row(0) = target.transpose();
         ClearMultipliers(state);
         ContactSolver again(lengths, old, options, colliders, state);
         sub = again.Solve(&retry);
-        if (sub.converged()) *points = retry;
+        if (sub.converged()) points->swap(retry);
       }
     }
     iterations += sub.iterations;
