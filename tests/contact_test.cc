@@ -229,10 +229,15 @@ PostScene Post(int links) {
 // grazing them, clear of them, and with an end inside), each with thresholds at its clearance, a
 // few ulps and a hair either side of it, and far from it. Both sides of the boundary must occur.
 // (The test caught links deep in the ellipsoid where its computed distance is not convex: below.)
+// Each shape also with a margin, and a fifth of the links from a point of the surface nearly
+// along it, a hair in or out (the contact search's links: its head on the surface), which the
+// closed-form bound of SegmentClearanceBelow must answer as the search does. With a band (the
+// contact search's, a slack above the threshold), the answer is yes wherever the search's is,
+// and no wherever the clearance is at least the threshold plus the band.
 TEST(ContactTest, TheStoppedLinkTestAnswersAsTheFullSearch) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::vector<Collider> shapes(3);
+  std::vector<Collider> shapes(6);
   shapes[0].shape = ColliderShape::kEllipsoid;
   shapes[0].extents = Vector3d(0.3, 0.5, 0.2);
   shapes[1].shape = ColliderShape::kCylinder;
@@ -241,20 +246,31 @@ TEST(ContactTest, TheStoppedLinkTestAnswersAsTheFullSearch) {
   shapes[2].shape = ColliderShape::kBox;
   shapes[2].extents = Vector3d(0.2, 0.35, 0.15);
   shapes[2].margin = 0.01;
-  int below = 0, above = 0, checked = 0;
+  for (int k = 3; k < 6; ++k) shapes[k] = shapes[k - 3];
+  shapes[3].margin = 0.02;
+  shapes[4].margin = 0.03;
+  shapes[5].margin = 0.0;
+  int below = 0, above = 0, checked = 0, held_within_band = 0;
   for (Collider& c : shapes) {
     c.pose.translation() = Vector3d(0.1, -0.2, 0.05);
     c.pose.linear() = Eigen::AngleAxisd(0.7, Vector3d(1.0, 2.0, -0.5).normalized()).matrix();
     for (int k = 0; k < 1000; ++k) {
-      const Vector3d a = c.pose.translation() + 0.8 * Vector3d(u(rng), u(rng), u(rng));
-      const Vector3d b = a + (k % 4 == 0 ? 0.05 : 0.6) * Vector3d(u(rng), u(rng), u(rng));
+      Vector3d a = c.pose.translation() + 0.8 * Vector3d(u(rng), u(rng), u(rng));
+      Vector3d b = a + (k % 4 == 0 ? 0.05 : 0.6) * Vector3d(u(rng), u(rng), u(rng));
+      if (k % 5 == 1) {
+        const SurfaceQuery at = QuerySurface(c, a);
+        a = at.nearest;
+        const Vector3d along = at.normal.cross(Vector3d(u(rng), u(rng), u(rng))).normalized();
+        const double tilt = std::pow(10.0, -2.0 - 11.0 * (0.5 + 0.5 * u(rng)));
+        b = a + 0.05 * (along + (u(rng) < 0.0 ? -tilt : tilt) * at.normal).normalized();
+      }
       const double clearance = internal::SegmentClearance(c, a, b);
       // Deep inside an ellipsoid, near the disc in the plane of its two longer axes from which
       // two points of the surface are nearest (at least 0.08 deep here), its computed distance
       // (Eberly's root near its pole) is noisy at 1e-8 of the depth and not convex at that level,
       // so neither search is exact there; the contact search's thresholds are at the surface
       // (a link that deep is blocked at its first values). Links reaching that deep are left out.
-      if (c.shape == ColliderShape::kEllipsoid && clearance < -0.05) continue;
+      if (c.shape == ColliderShape::kEllipsoid && clearance + c.margin < -0.05) continue;
       const double ulp =
           4.0 * std::numeric_limits<double>::epsilon() * (1.0 + std::fabs(clearance));
       for (double offset : {0.0, -ulp,   ulp,   -1e-12, 1e-12, -1e-9, 1e-9, -0.1,  0.1,  -1.0,
@@ -266,12 +282,23 @@ TEST(ContactTest, TheStoppedLinkTestAnswersAsTheFullSearch) {
             << " threshold " << threshold << " a " << a.transpose() << " b " << b.transpose();
         (full ? below : above) += 1;
         ++checked;
+        const double band = 1e-13 * (b - a).norm();
+        const bool banded = internal::SegmentClearanceBelow(c, a, b, threshold, band);
+        if (full) ASSERT_TRUE(banded) << ColliderShapeName(c.shape) << " link " << k;
+        if (clearance >= threshold + band) {
+          ASSERT_FALSE(banded) << ColliderShapeName(c.shape) << " link " << k << " clearance "
+                               << clearance << " threshold " << threshold;
+        }
+        if (banded != full) ++held_within_band;
       }
     }
   }
-  EXPECT_GT(checked, 50000);
-  EXPECT_GT(below, 20000);
-  EXPECT_GT(above, 20000);
+  std::printf("with the band: %d of %d links held that the search lets through\n", held_within_band,
+              checked);
+  EXPECT_GT(held_within_band, 0);
+  EXPECT_GT(checked, 100000);
+  EXPECT_GT(below, 40000);
+  EXPECT_GT(above, 40000);
 }
 
 TEST(ContactTest, ALinkAlongACapsuleIsNoClearerThanItsEnds) {

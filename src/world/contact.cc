@@ -86,8 +86,9 @@ double ConvexMinimumAlong(const Collider& c, const Vector3d& a, const Vector3d& 
   const Eigen::Isometry3d to_local = c.pose.inverse(Eigen::Isometry);
   const auto f = [&](double t) { return SurfaceDistance(c, to_local, a + t * (b - a)); };
   const bool stop_early = std::isfinite(threshold);
-  const double f0 = f(0.0), f_end = f(1.0);
-  if (f0 < threshold) return f0;
+  const double f0 = f(0.0);
+  if (f0 < threshold || a == b) return f0;
+  const double f_end = f(1.0);
   if (f_end < threshold) return f_end;
   const double scale = (b - a).norm() + std::fabs(f0) + std::fabs(f_end) + std::fabs(threshold);
   const double margin = 1e-12 * scale;
@@ -175,12 +176,140 @@ double SegmentClearance(const Collider& c, const Vector3d& a, const Vector3d& b)
   return 0.0;
 }
 
+namespace {
+
+// Whether a link's least signed distance to an ellipsoid, a cylinder or a box, less its margin,
+// lies below `threshold`, where that is known without the search: 1 yes, 0 no, -1 not known.
+//
+// The shape's gauge rho is the factor by which it must grow to reach x (|x_i / a_i| for the
+// ellipsoid, max_i |x_i| / e_i for the box, the greater of the radial and the axial ratio for
+// the cylinder): K = {rho <= 1}, convex and symmetric about its centre, and the link in the
+// shape's frame scaled axis by axis (su, sv) is a segment along which rho is convex and closed
+// form. With r_in and r_out the radii of a ball about the centre within K and of one holding it,
+// the signed distance s of a point at gauge rho lies between (rho - 1) r_in and (rho - 1) r_out:
+// - outside (rho > 1): K plus a ball of r lies in (1 + r / r_in) K, and the point lies in K plus
+//   the ball of s, so rho <= 1 + s / r_in; and rho K = K + (rho - 1) K lies in K plus the ball
+//   of (rho - 1) r_out;
+// - inside: rho K plus the ball of (1 - rho) r_in lies in rho K + (1 - rho) K = K, and the
+//   boundary point x / rho on the ray from the centre is |x| (1 - rho) / rho <= (1 - rho) r_out
+//   away.
+// Both bounds grow with rho. So the link's least s is at most the upper bound at any point of it
+// (the least gauge, exact or a candidate) and at least the lower bound at its least gauge, which
+// is exact for the ellipsoid (a quadratic's minimum) and the box (the least of a piecewise linear
+// function: an end or where two of its six lines cross); for the cylinder only the upper bound
+// is used. `guard` covers the gauge's rounding (a few ulps of |su| + |sv|) in units of s.
+//
+// With `band` > 0 a link whose least s is certainly below threshold + band is answered yes (it
+// may be clear by less than the band); a no is still certain.
+int KnownBelow(const Collider& c, const Vector3d& a, const Vector3d& b, double threshold,
+               double band = 0.0) {
+  const Eigen::Matrix3d& rotation = c.pose.linear();
+  Vector3d scale;  // the gauge's axis by axis
+  double r_in = 0.0, r_out = 0.0;
+  switch (c.shape) {
+    case ColliderShape::kEllipsoid:
+      scale = c.extents.cwiseInverse();
+      r_in = c.extents.minCoeff();
+      r_out = c.extents.maxCoeff();
+      break;
+    case ColliderShape::kBox:
+      scale = c.extents.cwiseInverse();
+      r_in = c.extents.minCoeff();
+      r_out = c.extents.norm();
+      break;
+    case ColliderShape::kCylinder:
+      if (!(c.half_length > 0.0)) return -1;  // a flat disc: the search
+      scale = Vector3d(1.0 / c.radius, 1.0 / c.radius, 1.0 / c.half_length);
+      r_in = std::min(c.radius, c.half_length);
+      r_out = std::hypot(c.radius, c.half_length);
+      break;
+    default:
+      return -1;
+  }
+  const Vector3d su = (rotation.transpose() * (a - c.pose.translation())).cwiseProduct(scale);
+  const Vector3d sv = (rotation.transpose() * (b - a)).cwiseProduct(scale);
+  double rho = std::numeric_limits<double>::infinity(), at = 0.0;  // the least gauge, where
+  bool exact = true;
+  if (c.shape == ColliderShape::kEllipsoid) {
+    const double vv = sv.squaredNorm();
+    at = vv > 0.0 ? std::clamp(-su.dot(sv) / vv, 0.0, 1.0) : 0.0;
+    rho = (su + at * sv).norm();
+  } else if (c.shape == ColliderShape::kBox) {
+    const auto gauge = [&](double t) { return (su + t * sv).cwiseAbs().maxCoeff(); };
+    rho = gauge(0.0);
+    if (const double end = gauge(1.0); end < rho) rho = end, at = 1.0;
+    std::array<double, 6> offset, slope;
+    for (int i = 0; i < 3; ++i) {
+      offset[2 * i] = su[i], slope[2 * i] = sv[i];
+      offset[2 * i + 1] = -su[i], slope[2 * i + 1] = -sv[i];
+    }
+    for (int j = 0; j < 6; ++j) {
+      for (int k = j + 1; k < 6; ++k) {
+        if (slope[j] == slope[k]) continue;
+        const double t = (offset[k] - offset[j]) / (slope[j] - slope[k]);
+        if (t > 0.0 && t < 1.0) {
+          if (const double g = gauge(t); g < rho) rho = g, at = t;
+        }
+      }
+    }
+  } else {
+    // The greater of the radial ratio (the root of a quadratic) and the axial one (a line's
+    // absolute value): candidates at the ends, at each one's least and where they cross.
+    exact = false;
+    const auto gauge = [&](double t) {
+      const Vector3d x = su + t * sv;
+      return std::max(std::hypot(x.x(), x.y()), std::fabs(x.z()));
+    };
+    std::array<double, 6> candidates{0.0, 1.0, -1.0, -1.0, -1.0, -1.0};
+    const double vxy = sv.x() * sv.x() + sv.y() * sv.y();
+    const double uv = su.x() * sv.x() + su.y() * sv.y();
+    if (vxy > 0.0) candidates[2] = -uv / vxy;
+    if (sv.z() != 0.0) candidates[3] = -su.z() / sv.z();
+    // |xy|^2 = z^2: qa t^2 + qb t + qc = 0.
+    const double qa = vxy - sv.z() * sv.z(), qb = 2.0 * (uv - su.z() * sv.z());
+    const double qc = su.x() * su.x() + su.y() * su.y() - su.z() * su.z();
+    if (qa != 0.0) {
+      const double disc = qb * qb - 4.0 * qa * qc;
+      if (disc >= 0.0) {
+        const double q = -0.5 * (qb + std::copysign(std::sqrt(disc), qb));
+        candidates[4] = q / qa;
+        if (q != 0.0) candidates[5] = qc / q;
+      }
+    } else if (qb != 0.0) {
+      candidates[4] = -qc / qb;
+    }
+    for (double t : candidates) {
+      if (t >= 0.0 && t <= 1.0) {
+        if (const double g = gauge(t); g < rho) rho = g, at = t;
+      }
+    }
+  }
+  const double upper = rho >= 1.0 ? (rho - 1.0) * r_out : (rho - 1.0) * r_in;
+  const double lower = rho >= 1.0 ? (rho - 1.0) * r_in : (rho - 1.0) * r_out;
+  constexpr double kEps = std::numeric_limits<double>::epsilon();
+  const double guard =
+      8.0 * kEps * (r_out * (1.0 + su.norm() + sv.norm()) + c.margin + std::fabs(threshold));
+  if (upper - c.margin < threshold + band - guard) return 1;
+  if (exact && lower - c.margin > threshold + guard) return 0;
+  // Within the band, the distance of the point of least gauge, an upper bound of the least (the
+  // bisection's last steps, at the queries' rounding, where the bounds from the gauge are loose
+  // by r_out / r_in).
+  if (band > 0.0 && lower - c.margin < threshold + band &&
+      SurfaceDistance(c, c.pose.inverse(Eigen::Isometry), a + at * (b - a)) < threshold + band) {
+    return 1;
+  }
+  return -1;
+}
+
+}  // namespace
+
 bool SegmentClearanceBelow(const Collider& c, const Vector3d& a, const Vector3d& b,
-                           double threshold) {
+                           double threshold, double band) {
   switch (c.shape) {
     case ColliderShape::kEllipsoid:
     case ColliderShape::kCylinder:
     case ColliderShape::kBox:
+      if (const int known = KnownBelow(c, a, b, threshold, band); known >= 0) return known == 1;
       return ConvexMinimumAlong(c, a, b, threshold) < threshold;
     default:
       return SegmentClearance(c, a, b) < threshold;
@@ -320,9 +449,9 @@ class TailSearch {
       if (c.shape == ColliderShape::kMesh) rounds_ = std::numeric_limits<size_t>::max() - 1;
     }
     // The thread's buffer (ContactTail does not call itself): no allocation a contact step.
-    thread_local std::vector<double> allowed;
-    allowed.assign(colliders.size(), std::numeric_limits<double>::quiet_NaN());
-    allowed_ = &allowed;
+    thread_local std::vector<HeadAgainst> heads;
+    heads.assign(colliders.size(), HeadAgainst{});
+    heads_ = &heads;
   }
 
   Vector3d Tail(double theta, double psi) const { return head_ + length_ * dirs_.At(theta, psi); }
@@ -339,8 +468,24 @@ class TailSearch {
     // SegmentClearance's answer, from a golden-section search stopped where it is known for the
     // shapes that take one. Allowed is never above the slack's threshold, so a link within the
     // slack is clear whatever the head's own depth allows.
-    return SegmentClearanceBelow(c, head_, Tail(theta, psi),
-                                 Allowed(static_cast<size_t>(&c - colliders_.data())));
+    const size_t k = static_cast<size_t>(&c - colliders_.data());
+    const double allowed = Allowed(k);
+    if (c.shape == ColliderShape::kEllipsoid || c.shape == ColliderShape::kCylinder ||
+        c.shape == ColliderShape::kBox) {
+      // Without the search where the link leaves the collider from the head: the signed distance
+      // is convex along the link, and the head's normal (the outward normal at its nearest
+      // surface point) is a subgradient of it at the head, so where the link's direction has a
+      // positive component along it, the distance only grows from the head's own, which is not
+      // below `allowed`: the search's answer (its first value, the head's, is not below, and
+      // none after it is). The component must exceed the normal's rounding; a link near the
+      // tangent plane takes the search.
+      const HeadAgainst& head = (*heads_)[k];
+      if (head.distance >= allowed && head.normal.dot(dirs_.At(theta, psi)) > 1e-12) return false;
+    }
+    // A link within the slack above `allowed` may be held (the bisection's last steps, where
+    // only the search could tell, at the queries' rounding): the exit angle is then larger by
+    // at most what keeps the link that much clearer, and a link let through is still certain.
+    return SegmentClearanceBelow(c, head_, Tail(theta, psi), allowed, kContactSlack * length_);
   }
 
   // Mesh k's world-to-mesh transform (its pose's inverse), computed when first needed.
@@ -354,16 +499,19 @@ class TailSearch {
   // contact step left the head itself inside by a hair more, twice the head's depth, so that the
   // directions leading out of the collider are not held against the link. Computed when first
   // needed (a collider the link does not reach never needs it).
+  // The head's own distance and normal are kept for Blocks.
   double Allowed(size_t k) const {
-    double& allowed = (*allowed_)[k];
-    if (std::isnan(allowed)) {
+    HeadAgainst& head = (*heads_)[k];
+    if (std::isnan(head.allowed)) {
       const Collider& c = colliders_[k];
-      allowed = -kContactSlack * length_;
-      const double depth =
-          std::fmin(QuerySurface(c, head_).distance, SegmentClearance(c, head_, head_));
-      if (depth > -1e-9 * length_) allowed = std::fmin(allowed, 2.0 * depth);
+      head.allowed = -kContactSlack * length_;
+      const SurfaceQuery at = QuerySurface(c, head_);
+      head.distance = at.distance;
+      head.normal = at.normal;
+      const double depth = std::fmin(at.distance, SegmentClearance(c, head_, head_));
+      if (depth > -1e-9 * length_) head.allowed = std::fmin(head.allowed, 2.0 * depth);
     }
-    return allowed;
+    return head.allowed;
   }
 
   // The least angle theta along the half great circle psi at which no collider blocks the link
@@ -422,8 +570,15 @@ class TailSearch {
   const double length_;
   const std::vector<Collider>& colliders_;
   const Directions& dirs_;
-  size_t rounds_ = colliders_.size();       // each convex collider is passed at most once
-  std::vector<double>* allowed_ = nullptr;  // per collider: the least clearance a link may have
+  size_t rounds_ = colliders_.size();  // each convex collider is passed at most once
+  // Per collider: the least clearance a link may have (Allowed; NaN until computed), and the
+  // head's distance and outward normal there.
+  struct HeadAgainst {
+    double allowed = std::numeric_limits<double>::quiet_NaN();
+    double distance = 0.0;
+    Vector3d normal = Vector3d::Zero();
+  };
+  std::vector<HeadAgainst>* heads_ = nullptr;
   mutable std::vector<std::optional<Eigen::Isometry3d>> to_local_;  // per mesh: ToLocal
 };
 

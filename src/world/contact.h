@@ -43,9 +43,14 @@ double DistanceLowerBound(const Collider& collider, const Eigen::Vector3d& x);
 
 // Whether SegmentClearance(collider, a, b) < threshold; for an ellipsoid, a cylinder or a box
 // the same answer, from the same golden-section search, stopped where its answer is known (a
-// value below the threshold, or a lower bound of the convex function above it).
+// value below the threshold, or a lower bound of the convex function above it), where bounds of
+// the signed distance from the shape's gauge along the link (closed form) do not already tell.
+//
+// With `band` > 0 the answer may also be yes for a link whose clearance is below threshold +
+// band but not below the threshold (for an ellipsoid, a cylinder or a box: where the bounds
+// tell that, the search is not run); a no is always certain.
 bool SegmentClearanceBelow(const Collider& collider, const Eigen::Vector3d& a,
-                           const Eigen::Vector3d& b, double threshold);
+                           const Eigen::Vector3d& b, double threshold, double band = 0.0);
 
 // The smallest clearance of [a, b] over `colliders` (+inf for none).
 double SegmentClearance(const std::vector<Collider>& colliders, const Eigen::Vector3d& a,
