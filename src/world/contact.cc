@@ -196,8 +196,13 @@ namespace {
 // Both bounds grow with rho. So the link's least s is at most the upper bound at any point of it
 // (the least gauge, exact or a candidate) and at least the lower bound at its least gauge, which
 // is exact for the ellipsoid (a quadratic's minimum) and the box (the least of a piecewise linear
-// function: an end or where two of its six lines cross); for the cylinder only the upper bound
-// is used. `guard` covers the gauge's rounding (a few ulps of |su| + |sv|) in units of s.
+// function: an end or where two of its six lines cross) and for the cylinder: the greater of two
+// convex functions of t (the radial ratio, the root of a quadratic, and the axial one, a line's
+// absolute value) is least at an end, at the least of the one that is the greater there, or
+// where they cross, and each of these is a candidate. `guard` covers the gauge's rounding (a few
+// ulps of |su| + |sv|) in units of s; for the cylinder also a crossing's, whose root is well
+// conditioned where it is the least (the two slopes are of opposite signs there): its error in
+// the gauge is a few ulps of (|su| + |sv|)^2.
 //
 // With `band` > 0 a link whose least s is certainly below threshold + band is answered yes (it
 // may be clear by less than the band); a no is still certain.
@@ -229,7 +234,6 @@ int KnownBelow(const Collider& c, const Vector3d& a, const Vector3d& b, double t
   const Vector3d su = (rotation.transpose() * (a - c.pose.translation())).cwiseProduct(scale);
   const Vector3d sv = (rotation.transpose() * (b - a)).cwiseProduct(scale);
   double rho = std::numeric_limits<double>::infinity(), at = 0.0;  // the least gauge, where
-  bool exact = true;
   if (c.shape == ColliderShape::kEllipsoid) {
     const double vv = sv.squaredNorm();
     at = vv > 0.0 ? std::clamp(-su.dot(sv) / vv, 0.0, 1.0) : 0.0;
@@ -255,10 +259,9 @@ int KnownBelow(const Collider& c, const Vector3d& a, const Vector3d& b, double t
   } else {
     // The greater of the radial ratio (the root of a quadratic) and the axial one (a line's
     // absolute value): candidates at the ends, at each one's least and where they cross.
-    exact = false;
     const auto gauge = [&](double t) {
       const Vector3d x = su + t * sv;
-      return std::max(std::hypot(x.x(), x.y()), std::fabs(x.z()));
+      return std::max(std::sqrt(x.x() * x.x() + x.y() * x.y()), std::fabs(x.z()));
     };
     std::array<double, 6> candidates{0.0, 1.0, -1.0, -1.0, -1.0, -1.0};
     const double vxy = sv.x() * sv.x() + sv.y() * sv.y();
@@ -287,10 +290,12 @@ int KnownBelow(const Collider& c, const Vector3d& a, const Vector3d& b, double t
   const double upper = rho >= 1.0 ? (rho - 1.0) * r_out : (rho - 1.0) * r_in;
   const double lower = rho >= 1.0 ? (rho - 1.0) * r_in : (rho - 1.0) * r_out;
   constexpr double kEps = std::numeric_limits<double>::epsilon();
-  const double guard =
-      8.0 * kEps * (r_out * (1.0 + su.norm() + sv.norm()) + c.margin + std::fabs(threshold));
+  const double reach = 1.0 + su.norm() + sv.norm();
+  const double guard = 8.0 * kEps *
+                       (r_out * (c.shape == ColliderShape::kCylinder ? reach * reach : reach) +
+                        c.margin + std::fabs(threshold));
   if (upper - c.margin < threshold + band - guard) return 1;
-  if (exact && lower - c.margin > threshold + guard) return 0;
+  if (lower - c.margin > threshold + guard) return 0;
   // Within the band, the distance of the point of least gauge, an upper bound of the least (the
   // bisection's last steps, at the queries' rounding, where the bounds from the gauge are loose
   // by r_out / r_in).
