@@ -39,6 +39,12 @@ void ValidateLeaderSteps(const Points& steps, int dim) {
   }
 }
 
+// An upper bound of the path's length between running lengths `from` and `to` (to >= from),
+// with a margin for the rounding of the sums.
+inline double TravelUpper(double from, double to) {
+  return (to - from) * (1.0 + 1e-12) + 1e-14 * to;
+}
+
 // With colliders: the chain starts outside every one, and the leading end's path (straight
 // from the start through every target) never enters one.
 void CheckOutsideColliders(const Chain& chain, const Points& leader_steps,
@@ -49,6 +55,12 @@ void CheckOutsideColliders(const Chain& chain, const Points& leader_steps,
   };
   const double shortest = chain.lengths.minCoeff();
   const auto depth_text = [](double clearance) { return FormatNumber(-clearance); };
+  // travelled[s]: the length of the leading end's path over its first s moves.
+  std::vector<double> travelled(static_cast<size_t>(leader_steps.rows()) + 1, 0.0);
+  for (Eigen::Index s = 0; s < leader_steps.rows(); ++s) {
+    const Eigen::Vector3d from = at(s == 0 ? chain.points.row(0) : leader_steps.row(s - 1));
+    travelled[s + 1] = travelled[s] + (at(leader_steps.row(s)) - from).norm();
+  }
   for (size_t c = 0; c < colliders.size(); ++c) {
     std::string name =
         "colliders[" + std::to_string(c) + "] (" + ColliderShapeName(colliders[c].shape) + ")";
@@ -79,16 +91,25 @@ void CheckOutsideColliders(const Chain& chain, const Points& leader_steps,
       }
     }
     if (colliders[c].motion) continue;
-    Eigen::Vector3d from = at(chain.points.row(0));
-    for (Eigen::Index s = 0; s < leader_steps.rows(); ++s) {
-      const Eigen::Vector3d to = at(leader_steps.row(s));
-      // A move shorter than its start's distance from the collider (a lower bound of it) cannot
-      // enter it: measured exactly only where it comes nearer (the same verdicts, at a few
-      // operations a move over a long path).
-      if (internal::DistanceLowerBound(colliders[c], from) > (to - from).norm()) {
-        from = to;
+    // A stretch of the path shorter than its start's distance from the collider (a lower bound
+    // of it) cannot enter it: measured exactly only where it comes nearer (the same verdicts,
+    // with one bound and a binary search over the path's running length for many short moves).
+    const auto point = [&](Eigen::Index s) {  // the leading end before move s
+      return s == 0 ? at(chain.points.row(0)) : at(leader_steps.row(s - 1));
+    };
+    for (Eigen::Index s = 0; s < leader_steps.rows();) {
+      const Eigen::Vector3d from = point(s);
+      const double bound = internal::DistanceLowerBound(colliders[c], from);
+      // The moves s..e-1 travel travelled[e] - travelled[s] (within the rounding of the sums).
+      const double* first = travelled.data() + s;
+      const double* end = travelled.data() + travelled.size();
+      const double* last = std::upper_bound(
+          first + 1, end, bound, [&](double b, double t) { return !(TravelUpper(*first, t) < b); });
+      if (last - first > 1) {  // moves s..e-2 are clear
+        s += (last - first) - 1;
         continue;
       }
+      const Eigen::Vector3d to = at(leader_steps.row(s));
       const double clearance = internal::SegmentClearance(colliders[c], from, to);
       if (clearance < -internal::kContactSlack * shortest) {
         throw InputError("leader_steps[" + std::to_string(s) + "]",
@@ -96,7 +117,7 @@ void CheckOutsideColliders(const Chain& chain, const Points& leader_steps,
                              depth_text(clearance) +
                              " deep; the path must stay outside every collider");
       }
-      from = to;
+      ++s;
     }
   }
 }
@@ -360,10 +381,15 @@ RunResult RunOn(const Chain& chain, const Points& leader_steps, const RunOptions
     }
   };
 
-  if (pipeline && internal::Pipelined(options.method) && options.colliders.empty()) {
+  // Static colliders go through the pipeline with the per-link rules (the engines take their
+  // contact steps); moving ones, and the whole-chain rules with colliders, sub-step by sub-step.
+  const bool piped_colliders =
+      !AnyMoves(options.colliders) && internal::RuleRunsOn(options.method, internal::kSweepsEngine);
+  if (pipeline && internal::Pipelined(options.method) &&
+      (options.colliders.empty() || piped_colliders)) {
     const Stepper stepper = internal::MakeStepperUnchecked(options.method, chain);
-    internal::SweepPipeline pipeline(stepper, chain.points, leader_steps, substeps,
-                                     &result.metrics);
+    internal::SweepPipeline pipeline(stepper, chain.points, leader_steps, substeps, &result.metrics,
+                                     options.colliders);
     Eigen::VectorXd direction = first_direction;
     const auto on_frame = [&](int64_t done, const Points& points) {
       if (options.link_angles) {
@@ -373,6 +399,10 @@ RunResult RunOn(const Chain& chain, const Points& leader_steps, const RunOptions
     };
     if (options.progress) pipeline.after_chunk = report_progress;
     pipeline.Advance(num_steps, recorded, on_frame);
+    if (!options.colliders.empty()) {
+      result.contacts.contact_link_steps = pipeline.contacts().contact_link_steps;
+      result.contacts.least_clearance = pipeline.contacts().least_clearance;
+    }
   } else {
     ChainMover mover(chain, leader_steps, options, substeps, &result);
     MetricsAccumulator metrics(chain.lengths, num_steps, &result.metrics);

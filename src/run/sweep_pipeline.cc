@@ -75,6 +75,15 @@ SweepPipeline::SweepPipeline(const Stepper& stepper, const Points& start,
   }
 }
 
+SweepPipeline::SweepPipeline(const Stepper& stepper, const Points& start,
+                             const Points& leader_steps, int substeps, Metrics* metrics,
+                             const std::vector<Collider>& colliders)
+    : SweepPipeline(stepper, start, leader_steps, substeps, metrics) {
+  if (colliders.empty()) return;
+  contact_.colliders = &colliders;
+  trace_.contact = &contact_;
+}
+
 void SweepPipeline::AddSlots(int count) {
   while (static_cast<int>(slots_.size()) < count) {
     slots_.emplace_back(n_ + 1, dim_);

@@ -26,11 +26,22 @@ Eigen::VectorXd ArcLengthWeights(const Eigen::VectorXd& lengths);
 // Tractrix and follow-the-leader (the rules the engines have); and min_rotation and
 // min_joint_angle where the CPU has the whole-chain engine's kernel (WholeChainOnSimd,
 // sequential/whole_chain.h), which measures the metrics as the wavefront does.
+// With static colliders (a per-link rule only), each link's rule step is kept outside them in the
+// engines as ContactSweep keeps it: the one-pass loop's results are the sub-step by sub-step
+// run's bit for bit; the wavefront's are the free run's bit for bit where no link comes near a
+// collider, else the contact sweep's up to its exp's rounding as the contact steps amplify it
+// (docs/colliders.md, "On the SIMD engine").
 class SweepPipeline {
  public:
   // `start` is the chain's initial configuration; `metrics` (may be null) receives the metrics.
   SweepPipeline(const Stepper& stepper, const Points& start, const Points& leader_steps,
                 int substeps, Metrics* metrics);
+  // The same with static colliders (none: `colliders` empty), which must outlive the pipeline.
+  SweepPipeline(const Stepper& stepper, const Points& start, const Points& leader_steps,
+                int substeps, Metrics* metrics, const std::vector<Collider>& colliders);
+
+  // What the colliders did so far.
+  const ContactStats& contacts() const { return contact_.stats; }
 
   // Leader steps done.
   int64_t step() const { return step_; }
@@ -106,6 +117,7 @@ class SweepPipeline {
   std::vector<Points> slots_;
   std::array<double*, SweepTrace::kMaxSlots> slot_ptrs_;
   SweepTrace trace_;
+  SweepContact contact_;
   WholeChainWork whole_chain_work_;
   std::function<void(int64_t, const Points&)> on_frame_;
 };

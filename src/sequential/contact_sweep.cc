@@ -52,17 +52,10 @@ const std::vector<Collider>& NearColliders(const double* head, double total, dou
   return near->size() == colliders.size() ? colliders : *near;
 }
 
-// The colliders of one sweep with, for each, a ball that holds it (its pose's translation and
-// BoundingRadius; a radius < 0 for a half-space, which no ball holds): a link whose distance to
-// that ball, bounded from below by its midpoint's less half its length, leaves the link clear and
-// cannot lower the least clearance measured so far is not measured against the collider (the
-// same steps and the same report, bit for bit: see KeepOutside).
-struct SweepSet {
-  const std::vector<Collider>* colliders = nullptr;
-  std::vector<Eigen::Vector4d> balls;       // centre x, y, z and radius
-  std::vector<char> spheres;                // whether the collider is a sphere (its ball is itself)
-  std::vector<Eigen::Isometry3d> to_local;  // a mesh's world-to-mesh transform (its pose inverted)
-};
+// SweepSet (sweep.h): a link whose distance to a collider's ball, bounded from below by its
+// midpoint's less half its length, leaves the link clear and cannot lower the least clearance
+// measured so far is not measured against the collider (the same steps and the same report, bit
+// for bit: see KeepOutside).
 
 // Whether the link [a, b] is beyond mesh collider `c` (see BeyondBall) by the box that holds its
 // triangles (MeshSegmentLowerBound: tighter than the ball round a long or flat mesh), with a
@@ -136,18 +129,48 @@ bool KeepOutside(int i, const double* lead, const double* toward, double* tail, 
   const bool contact = clearance < -kContactSlack * length;
   if (contact) {
     Eigen::Vector3d x;
-    if (!ContactTail(Dim, head, In3d<Dim>(toward), length, colliders, &x)) {
+    if (!ContactTail(Dim, head, In3d<Dim>(toward), length, colliders, &x, &clearance)) {
       throw InputError("colliders", "leave no room for link " + std::to_string(i) +
                                         ": every position of point " + std::to_string(i) +
                                         " at its link's length from point " +
                                         std::to_string(i - 1) + " lies in a collider");
     }
     for (int k = 0; k < Dim; ++k) tail[k] = x[k];
-    clearance = SegmentClearance(colliders, head, x);
     ++stats->contact_link_steps;
   }
   stats->least_clearance = std::fmin(stats->least_clearance, clearance * inv_length);
   return contact;
+}
+
+// Fills `set` with the colliders sweeps whose points lie within `reach` of `head` may meet
+// (NearColliders), with their balls.
+template <int Dim>
+void FillSweepSet(const double* head, double reach, double longest,
+                  const std::vector<Collider>& all, const ContactStats& stats,
+                  std::vector<Collider>* near, SweepSet* set) {
+  set->colliders = &NearColliders<Dim>(head, reach, longest, all, stats, near);
+  set->balls.resize(set->colliders->size());
+  set->spheres.resize(set->colliders->size());
+  for (size_t k = 0; k < set->colliders->size(); ++k) {
+    const Collider& c = (*set->colliders)[k];
+    set->spheres[k] = c.shape == ColliderShape::kSphere;
+    if (c.shape == ColliderShape::kMesh) {
+      if (set->to_local.size() < set->colliders->size()) {
+        set->to_local.resize(set->colliders->size());
+      }
+      set->to_local[k] = c.pose.inverse(Eigen::Isometry);
+    }
+    set->balls[k] << c.pose.translation(),
+        c.shape == ColliderShape::kHalfSpace ? -1.0 : BoundingRadius(c);
+  }
+}
+
+// The chain's length (with a margin of 1e-12 of it for the rounding) and its longest link.
+inline void ChainReach(const double* lengths, int n, double* reach, double* longest) {
+  double total = 0.0;
+  *longest = 0.0;
+  for (int i = 0; i < n; ++i) total += lengths[i], *longest = std::fmax(*longest, lengths[i]);
+  *reach = total * (1.0 + 1e-12);
 }
 
 // The colliders a sweep from the new head `head` may meet (NearColliders over the chain's length),
@@ -155,23 +178,11 @@ bool KeepOutside(int i, const double* lead, const double* toward, double* tail, 
 template <int Dim>
 const SweepSet& SweepColliders(const double* head, const double* lengths, int n,
                                const std::vector<Collider>& all, const ContactStats& stats) {
-  double total = 0.0, longest = 0.0;
-  for (int i = 0; i < n; ++i) total += lengths[i], longest = std::fmax(longest, lengths[i]);
+  double reach, longest;
+  ChainReach(lengths, n, &reach, &longest);
   thread_local std::vector<Collider> near;
   thread_local SweepSet set;
-  set.colliders = &NearColliders<Dim>(head, total * (1.0 + 1e-12), longest, all, stats, &near);
-  set.balls.resize(set.colliders->size());
-  set.spheres.resize(set.colliders->size());
-  for (size_t k = 0; k < set.colliders->size(); ++k) {
-    const Collider& c = (*set.colliders)[k];
-    set.spheres[k] = c.shape == ColliderShape::kSphere;
-    if (c.shape == ColliderShape::kMesh) {
-      if (set.to_local.size() < set.colliders->size()) set.to_local.resize(set.colliders->size());
-      set.to_local[k] = c.pose.inverse(Eigen::Isometry);
-    }
-    set.balls[k] << c.pose.translation(),
-        c.shape == ColliderShape::kHalfSpace ? -1.0 : BoundingRadius(c);
-  }
+  FillSweepSet<Dim>(head, reach, longest, all, stats, &near, &set);
   return set;
 }
 
@@ -270,6 +281,25 @@ void MinJointAngleContactSweep(const double* head, const double* lengths, const 
 }
 
 }  // namespace
+
+void NearSweepSet(int dim, const double* head, double spread, const double* lengths, int n,
+                  SweepContact* contact) {
+  double reach, longest;
+  ChainReach(lengths, n, &reach, &longest);
+  reach += spread;
+  dim == 2 ? FillSweepSet<2>(head, reach, longest, *contact->colliders, contact->stats,
+                             &contact->near, &contact->set)
+           : FillSweepSet<3>(head, reach, longest, *contact->colliders, contact->stats,
+                             &contact->near, &contact->set);
+}
+
+bool KeepLinkOutside(int dim, int i, const double* lead, const double* toward, double* tail,
+                     double length, double inv_length, SweepContact* contact) {
+  return dim == 2 ? KeepOutside<2>(i, lead, toward, tail, length, inv_length, contact->set,
+                                   &contact->stats)
+                  : KeepOutside<3>(i, lead, toward, tail, length, inv_length, contact->set,
+                                   &contact->stats);
+}
 
 void ContactSweep(Method method, int dim, const double* head, const double* lengths,
                   const double* inv_lengths, int n, double* points,

@@ -54,6 +54,7 @@ template <class Rule, int Dim>
 void TracedSweeps(const double* heads, int64_t first, int64_t num_sweeps, const double* lengths,
                   const double* inv_lengths, int n, double* pts, internal::SweepTrace* trace) {
   const bool exact = trace->moved != nullptr;
+  internal::SweepContact* contact = trace->contact;
   for (int64_t s = first; s < num_sweeps; ++s) {
     const uint8_t flag = trace->flags[s];
     const bool check_lengths = !exact && (flag & internal::SweepTrace::kStepEnd);
@@ -62,6 +63,8 @@ void TracedSweeps(const double* heads, int64_t first, int64_t num_sweeps, const 
       lead_old[k] = pts[k];
       pts[k] = lead_new[k] = heads[s * Dim + k];
     }
+    // With colliders, the set ContactSweep takes for this sweep, and its steps.
+    if (contact != nullptr) internal::NearSweepSet(Dim, heads + s * Dim, 0.0, lengths, n, contact);
     double l2 = 0.0, l2w = 0.0, worst = trace->max_length_error;
     auto account = [&](int j, const double* before, const double* after) {
       const double moved = Distance<Dim>(after, before);
@@ -80,6 +83,10 @@ void TracedSweeps(const double* heads, int64_t first, int64_t num_sweeps, const 
       for (int k = 0; k < Dim; ++k) tail_old[k] = tail[k];
       internal::ApplyScalar<Rule, Dim>(lead_old, lead_new, tail, lengths[i - 1],
                                        inv_lengths[i - 1]);
+      if (contact != nullptr) {
+        internal::KeepLinkOutside(Dim, i, lead_new, tail_old, tail, lengths[i - 1],
+                                  inv_lengths[i - 1], contact);
+      }
       account(i, tail_old, tail);
       if (check_lengths) {
         const double error = std::fabs(Distance<Dim>(tail, lead_new) - lengths[i - 1]);

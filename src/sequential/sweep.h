@@ -27,6 +27,8 @@ void SweepsWavefront(Method method, int dim, const double* heads, int64_t num_sw
                      const double* lengths, const double* inv_lengths, int num_links,
                      double* points);
 
+struct SweepContact;
+
 // What a run observes of its sweeps (src/run/run.cc), filled in by the traced engines below in
 // the same pass that moves the chain.
 struct SweepTrace {
@@ -73,6 +75,9 @@ struct SweepTrace {
   double* const* slots = nullptr;
   void (*capture)(void* context, int64_t sweep, int slot) = nullptr;
   void* context = nullptr;
+  // Static colliders (a run's, through its sweep pipeline), or null: every link's rule step is
+  // then kept outside them as ContactSweep keeps it (SweepContact).
+  SweepContact* contact = nullptr;
 };
 
 // SweepsScalar and SweepsWavefront, observed: the same motion, bit for bit, plus `trace`.
@@ -95,6 +100,40 @@ struct ContactStats {
   // measured); at least -kContactSlack (world/contact.h).
   double least_clearance = std::numeric_limits<double>::infinity();
 };
+
+// The colliders a sweep, or a group of sweeps whose heads lie close together, may meet, with a
+// ball that holds each: its pose's translation and BoundingRadius (a radius < 0 for a half-space,
+// which no ball holds). contact_sweep.cc.
+struct SweepSet {
+  const std::vector<Collider>* colliders = nullptr;
+  std::vector<Eigen::Vector4d> balls;       // centre x, y, z and radius
+  std::vector<char> spheres;                // whether the collider is a sphere (its ball is itself)
+  std::vector<Eigen::Isometry3d> to_local;  // a mesh's world-to-mesh transform (its pose inverted)
+};
+
+// Static colliders in the traced engines (SweepTrace::contact): after each link's rule step the
+// link is kept outside them by ContactSweep's test and contact step (KeepLinkOutside), and what
+// they did is counted in `stats`. The wavefront skips the test for lanes whose link is beyond
+// every ball of `set` by a margin (the test would skip each collider: the same steps and report).
+struct SweepContact {
+  const std::vector<Collider>* colliders = nullptr;  // the run's
+  ContactStats stats;
+  SweepSet set;                // those near the sweeps at hand (NearSweepSet)
+  std::vector<Collider> near;  // set.colliders when some are left out
+};
+
+// Fills contact->set with the colliders that sweeps of a chain of `num_links` links may meet
+// whose heads lie within `spread` of `head` (ContactSweep's broad phase, with the chain's reach
+// grown by `spread`; for spread 0 the set ContactSweep takes for a sweep to `head`).
+void NearSweepSet(int dim, const double* head, double spread, const double* lengths, int num_links,
+                  SweepContact* contact);
+
+// Link i (1-based), its leading end `lead` placed and `tail` at its rule step: kept where the
+// link stays outside every collider of contact->set, else the contact step from `toward` (its
+// trailing end before the sweep), as ContactSweep does; counted in contact->stats. Returns
+// whether it met a collider; throws InputError when the colliders leave the link no room.
+bool KeepLinkOutside(int dim, int i, const double* lead, const double* toward, double* tail,
+                     double length, double inv_length, SweepContact* contact);
 
 // One sweep (the leading end to `head`) of a sequential rule (tractrix, ftl, min_rotation,
 // min_joint_angle) with colliders: each link's rule step, kept where the link stays outside every

@@ -15,6 +15,7 @@
 #include "sequential/link_rules.h"
 #include "sequential/rule_table.h"
 #include "sequential/sweep.h"
+#include "world/contact.h"
 
 namespace flexkin::internal {
 namespace {
@@ -81,6 +82,109 @@ inline __m512d SlideIn(__m512d a, __m512d b) {
 inline double First(__m512d v) { return _mm_cvtsd_f64(_mm512_castpd512_pd128(v)); }
 #endif
 
+// The links of a traced group's lanes `valid` ([a, b], of the given lengths) against the
+// colliders near them (SweepContact::set), as KeepOutside measures them. Returns the lanes that
+// take KeepOutside itself (KeepLinkOutside):
+//  - where every near collider is a sphere, those that enter one (their contact step); the
+//    others' clearances (a sphere's: the distance from its centre to the segment's nearest point
+//    less its radius, SegmentClearance's form) lower the least clearance here. A sphere a lane is
+//    beyond (the segment's squared distance to its centre exceeds the reach, as BeyondSphere has
+//    it) is not measured, as KeepOutside leaves it out;
+//  - else those within reach of some collider's ball (a sphere's exactly, another's by the link's
+//    midpoint, as BeyondBall), all of them for a half-space or before any clearance is measured.
+// The reach is KeepOutside's with a margin of 1e-8 instead of 1e-9, so a lane left out here is
+// one that test would leave out of every collider.
+template <class Arch, int Dim>
+[[gnu::always_inline]] inline xsimd::batch_bool<double, Arch> LanesToTest(
+    const xsimd::batch<double, Arch>* a, const xsimd::batch<double, Arch>* b,
+    const xsimd::batch<double, Arch>& length, const xsimd::batch<double, Arch>& neg_inv_length,
+    const xsimd::batch_bool<double, Arch>& valid, SweepContact* contact) {
+  using B = xsimd::batch<double, Arch>;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  constexpr double kMargin = 1.0 + 1e-8;
+  const SweepSet& set = contact->set;
+  const double least = contact->stats.least_clearance;
+  const bool measured = least < kInf;
+  const B floor = measured && least > 0.0 ? B(least) * length : B(0.0);
+  bool spheres_only = true;
+  for (char sphere : set.spheres) spheres_only = spheres_only && sphere;
+  if (!spheres_only && !measured) return valid;
+  auto near = B(0.0) != B(0.0);
+  B clear = B(kInf);
+  B ab[3], mid[3];
+  for (int k = 0; k < 3; ++k) {
+    ab[k] = k < Dim ? b[k] - a[k] : B(0.0);
+    mid[k] = k < Dim ? B(0.5) * (a[k] + b[k]) : B(0.0);
+  }
+  const B ab2 = xsimd::fma(ab[0], ab[0], xsimd::fma(ab[1], ab[1], ab[2] * ab[2]));
+  for (size_t c = 0; c < set.balls.size(); ++c) {
+    const Eigen::Vector4d& ball = set.balls[c];
+    if (ball[3] < 0.0) return valid;
+    if (set.spheres[c] && measured) {
+      // First by the link's midpoint (BeyondBall's bound, a few operations): a sphere every lane
+      // is beyond by it, the usual case, is beyond by the segment's own distance too.
+      const B far = (B(0.5) * length + B(ball[3]) + floor) * B(kMargin);
+      B m2 = B(0.0);
+      for (int k = 0; k < 3; ++k) {
+        const B m = mid[k] - B(ball[k]);
+        m2 = xsimd::fma(m, m, m2);
+      }
+      if (xsimd::all(!valid | (m2 > far * far))) continue;
+    }
+    if (set.spheres[c]) {
+      const B reach = (B(ball[3]) + floor) * B(kMargin);
+      B ac[3], ac2 = B(0.0), bc2 = B(0.0), along = B(0.0);
+      for (int k = 0; k < 3; ++k) {
+        ac[k] = k < Dim ? B(ball[k]) - a[k] : B(ball[k]);
+        const B bc = k < Dim ? B(ball[k]) - b[k] : B(ball[k]);
+        ac2 = xsimd::fma(ac[k], ac[k], ac2);
+        bc2 = xsimd::fma(bc, bc, bc2);
+        along = xsimd::fma(ac[k], ab[k], along);
+      }
+      // Inside the segment's span: d^2 |ab|^2 against reach^2 |ab|^2, as BeyondSphere.
+      const B across = xsimd::fms(ac2, ab2, along * along);
+      const auto inside = (along > B(0.0)) & (along < ab2);
+      const B end2 = xsimd::select(along <= B(0.0), ac2, bc2);
+      auto beyond = (inside & (across > reach * reach * ab2 * B(kMargin))) |
+                    (!inside & (end2 > reach * reach));
+      if (!measured) beyond = B(0.0) != B(0.0);
+      if (!spheres_only) {
+        near = near | !beyond;
+        continue;
+      }
+      const auto measure = valid & !beyond;
+      if (!xsimd::any(measure)) continue;
+      // SegmentClearance's sphere: the nearest point at t = clamp(ac.ab / ab^2, 0, 1).
+      const B t = xsimd::min(xsimd::max(along / ab2, B(0.0)), B(1.0));
+      B d2 = B(0.0);
+      for (int k = 0; k < 3; ++k) {
+        const B p = xsimd::fms(t, ab[k], ac[k]);  // a + t ab - centre
+        d2 = xsimd::fma(p, p, d2);
+      }
+      clear = xsimd::select(measure, xsimd::min(clear, xsimd::sqrt(d2) - B(ball[3])), clear);
+    } else {
+      const B reach = (B(0.5) * length + B(ball[3]) + floor) * B(kMargin);
+      B d2 = B(0.0);
+      for (int k = 0; k < 3; ++k) {
+        const B m = mid[k] - B(ball[k]);
+        d2 = xsimd::fma(m, m, d2);
+      }
+      near = near | !(d2 > reach * reach);
+    }
+  }
+  if (!spheres_only) return near & valid;
+  const auto enter = valid & (clear < B(-kContactSlack) * length);
+  const auto lower = valid & (clear < B(kInf)) & !enter;
+  if (xsimd::any(lower)) {
+    alignas(64) double relative[B::size];
+    xsimd::select(lower, clear * -neg_inv_length, B(kInf)).store_aligned(relative);
+    double low = contact->stats.least_clearance;
+    for (double r : relative) low = std::fmin(low, r);
+    contact->stats.least_clearance = low;
+  }
+  return enter;
+}
+
 // Lanes: with U registers of W lanes (G = U W lanes), a group of G consecutive sweeps
 // g..g+G-1 advances together; at iteration t, lane j (register j / W) works on point t-G+1+j for
 // sweep g+G-1-j. The point a lane reads is the one its neighbour lane (the previous sweep) wrote
@@ -95,7 +199,8 @@ inline double First(__m512d v) { return _mm_cvtsd_f64(_mm512_castpd512_pd128(v))
 // with the points), the length of its link after a sweep that ends a leader step, and copies its
 // point into a capture slot when its sweep is to be captured.
 // Starts at sweep `g` and returns the sweep it stopped at (g plus a multiple of G).
-template <class Arch, class Rule, int Dim, int U, bool Traced>
+// Contact (traced only): the run's static colliders (SweepTrace::contact), tested in the lanes.
+template <class Arch, class Rule, int Dim, int U, bool Traced, bool Contact>
 int64_t WavefrontGroups(const double* heads, int64_t g, int64_t num_sweeps, const double* lengths,
                         const double* inv_lengths, int n, double* points, SweepTrace* trace) {
   using B = xsimd::batch<double, Arch>;
@@ -125,6 +230,24 @@ int64_t WavefrontGroups(const double* heads, int64_t g, int64_t num_sweeps, cons
   const B last = B(static_cast<double>(n));
 
   for (; g + G <= num_sweeps; g += G) {
+    // Traced with colliders: those the group's sweeps may meet (their heads lie within `spread`
+    // of the first's).
+    [[maybe_unused]] SweepContact* contact = nullptr;
+    if constexpr (Contact) {
+      static_assert(Traced);
+      contact = trace->contact;
+      double spread2 = 0.0;
+      for (int s = 1; s < G; ++s) {
+        double d2 = 0.0;
+        for (int k = 0; k < Dim; ++k) {
+          const double d = heads[(g + s) * Dim + k] - heads[g * Dim + k];
+          d2 += d * d;
+        }
+        spread2 = std::fmax(spread2, d2);
+      }
+      NearSweepSet(Dim, heads + g * Dim, std::sqrt(spread2) * (1.0 + 1e-12), lengths, n, contact);
+      if (contact->set.colliders->empty()) contact = nullptr;
+    }
     B head[U][Dim], lead_old[U][Dim], lead_new[U][Dim], window[U][Dim];
     // Traced: per register, the lanes whose sweep ends a leader step, the running sums of the
     // sweeps' distances, the path-length window and the largest length error; the capture slot
@@ -210,6 +333,33 @@ int64_t WavefrontGroups(const double* heads, int64_t g, int64_t num_sweeps, cons
         }
         const auto is_head = index == B(0.0);
         for (int k = 0; k < Dim; ++k) tail[u][k] = xsimd::select(is_head, head[u][k], tail[u][k]);
+        if constexpr (Contact) {
+          if (contact != nullptr) {
+            // The links within reach of a collider: the contact sweep's test and contact step,
+            // lane by lane (window: the link's trailing end before the sweep).
+            const auto near = LanesToTest<Arch, Dim>(lead_new[u], tail[u], length, neg_inv_length,
+                                                     (index >= B(1.0)) & (index <= last), contact);
+            if (xsimd::any(near)) {
+              alignas(64) double ln[Dim][W], old[Dim][W], out[Dim][W], mask[W], len_j[W], inv_j[W];
+              for (int k = 0; k < Dim; ++k) {
+                lead_new[u][k].store_aligned(ln[k]);
+                window[u][k].store_aligned(old[k]);
+                tail[u][k].store_aligned(out[k]);
+              }
+              xsimd::select(near, B(1.0), B(0.0)).store_aligned(mask);
+              length.store_aligned(len_j);
+              neg_inv_length.store_aligned(inv_j);
+              for (int j = 0; j < W; ++j) {
+                if (mask[j] == 0.0) continue;
+                double a[Dim], c[Dim], x[Dim];
+                for (int k = 0; k < Dim; ++k) a[k] = ln[k][j], c[k] = old[k][j], x[k] = out[k][j];
+                KeepLinkOutside(Dim, first + j, a, c, x, len_j[j], -inv_j[j], contact);
+                for (int k = 0; k < Dim; ++k) out[k][j] = x[k];
+              }
+              for (int k = 0; k < Dim; ++k) tail[u][k] = B::load_aligned(out[k]);
+            }
+          }
+        }
         if constexpr (Traced) {
           // The distance the point moved (window: before the sweep, tail: after) and the length
           // of its link (lead_new: the point before it, after the sweep).
@@ -285,13 +435,27 @@ int64_t WavefrontGroups(const double* heads, int64_t g, int64_t num_sweeps, cons
 
 // Sweeps done by the engine (two registers per coordinate while at least 2 W sweeps are left,
 // then one); the caller finishes the fewer than W left with the one-pass loop.
+template <class Arch, class Rule, int Dim, bool Traced, bool Contact>
+int64_t WavefrontSweepsOf(const double* heads, int64_t num_sweeps, const double* lengths,
+                          const double* inv_lengths, int n, double* points, SweepTrace* trace) {
+  const int64_t done = WavefrontGroups<Arch, Rule, Dim, 2, Traced, Contact>(
+      heads, 0, num_sweeps, lengths, inv_lengths, n, points, trace);
+  return WavefrontGroups<Arch, Rule, Dim, 1, Traced, Contact>(heads, done, num_sweeps, lengths,
+                                                              inv_lengths, n, points, trace);
+}
+
+// The same, the lanes testing their links against the run's colliders where it has some.
 template <class Arch, class Rule, int Dim, bool Traced>
 int64_t WavefrontSweeps(const double* heads, int64_t num_sweeps, const double* lengths,
                         const double* inv_lengths, int n, double* points, SweepTrace* trace) {
-  const int64_t done = WavefrontGroups<Arch, Rule, Dim, 2, Traced>(heads, 0, num_sweeps, lengths,
-                                                                   inv_lengths, n, points, trace);
-  return WavefrontGroups<Arch, Rule, Dim, 1, Traced>(heads, done, num_sweeps, lengths, inv_lengths,
-                                                     n, points, trace);
+  if constexpr (Traced) {
+    if (trace->contact != nullptr) {
+      return WavefrontSweepsOf<Arch, Rule, Dim, true, true>(heads, num_sweeps, lengths, inv_lengths,
+                                                            n, points, trace);
+    }
+  }
+  return WavefrontSweepsOf<Arch, Rule, Dim, Traced, false>(heads, num_sweeps, lengths, inv_lengths,
+                                                           n, points, trace);
 }
 
 // Entry point of one instruction set: takes the rule from the table (rule_table.h) and picks the

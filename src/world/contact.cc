@@ -194,7 +194,7 @@ namespace {
 //   boundary point x / rho on the ray from the centre is |x| (1 - rho) / rho <= (1 - rho) r_out
 //   away.
 // Both bounds grow with rho. So the link's least s is at most the upper bound at any point of it
-// (the least gauge, exact or a candidate) and at least the lower bound at its least gauge, which
+// (at its least gauge, for one) and at least the lower bound at its least gauge, which
 // is exact for the ellipsoid (a quadratic's minimum) and the box (the least of a piecewise linear
 // function: an end or where two of its six lines cross) and for the cylinder: the greater of two
 // convex functions of t (the radial ratio, the root of a quadratic, and the axial one, a line's
@@ -677,7 +677,7 @@ bool SphereExit(int dim, const Collider& sphere, const Vector3d& head, const Vec
 }  // namespace
 
 bool ContactTail(int dim, const Vector3d& head, const Vector3d& tail, double length,
-                 const std::vector<Collider>& colliders, Vector3d* x) {
+                 const std::vector<Collider>& colliders, Vector3d* x, double* clearance) {
   Directions dirs;
   const Vector3d from_head = tail - head;
   const double distance = from_head.norm();
@@ -691,12 +691,35 @@ bool ContactTail(int dim, const Vector3d& head, const Vector3d& tail, double len
     dirs.e1 = dirs.d0.cross(helper).normalized();
     dirs.e2 = dirs.d0.cross(dirs.e1);
   }
-  const TailSearch search(head, length, colliders, dirs);
   // One sphere blocking the old direction, and its exit clear of the others: closed form.
   const Collider* only = nullptr;
   int blocking = 0;
-  for (const Collider& c : colliders) {
-    if (search.Blocks(c, 0.0, 0.0)) ++blocking, only = &c;
+  const bool spheres = std::all_of(colliders.begin(), colliders.end(), [](const Collider& c) {
+    return c.shape == ColliderShape::kSphere;
+  });
+  // Spheres within the link's reach from the head (with a margin for the rounding): the others
+  // block nothing, and a link from the head is clearer of them than of one it touches.
+  thread_local std::vector<const Collider*> within;
+  if (spheres) {
+    // TailSearch::Blocks for spheres, without its queries: the head's depth is its segment
+    // clearance at the head, |head - centre| - r (Allowed).
+    const Vector3d end = head + length * dirs.d0;
+    within.clear();
+    for (const Collider& c : colliders) {
+      const double reach = (c.radius + c.margin + length) * (1.0 + 1e-9);
+      if ((c.pose.translation() - head).squaredNorm() > reach * reach) continue;
+      within.push_back(&c);
+      const double depth = SegmentClearance(c, head, head);
+      double allowed = -kContactSlack * length;
+      if (depth > -1e-9 * length) allowed = std::fmin(allowed, 2.0 * depth);
+      if (SegmentClearance(c, head, end) < allowed) ++blocking, only = &c;
+    }
+  }
+  const TailSearch search(head, length, colliders, dirs);
+  if (!spheres) {
+    for (const Collider& c : colliders) {
+      if (search.Blocks(c, 0.0, 0.0)) ++blocking, only = &c;
+    }
   }
   if (blocking == 1 && only->shape == ColliderShape::kSphere) {
     // On the cone's boundary to the last bits; widened by a few ulps of the angle if rounding
@@ -704,8 +727,16 @@ bool ContactTail(int dim, const Vector3d& head, const Vector3d& tail, double len
     for (double widen : {0.0, 1e-15, 1e-14, 1e-13}) {
       Vector3d candidate;
       if (!SphereExit(dim, *only, head, dirs.d0, length, widen, &candidate)) break;
-      if (SegmentClearance(colliders, head, candidate) >= -kContactSlack * length) {
+      double least = std::numeric_limits<double>::infinity();
+      if (spheres) {
+        for (const Collider* c : within)
+          least = std::min(least, SegmentClearance(*c, head, candidate));
+      } else {
+        least = SegmentClearance(colliders, head, candidate);
+      }
+      if (least >= -kContactSlack * length) {
         *x = candidate;
+        if (clearance != nullptr) *clearance = least;
         return true;
       }
     }
@@ -738,6 +769,7 @@ bool ContactTail(int dim, const Vector3d& head, const Vector3d& tail, double len
   }
   if (!std::isfinite(best_theta)) return false;
   *x = search.Tail(best_theta, best_psi);
+  if (clearance != nullptr) *clearance = SegmentClearance(colliders, head, *x);
   return true;
 }
 

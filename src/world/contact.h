@@ -78,9 +78,11 @@ SegmentContact NearestOnSegment(const Collider& collider, const Eigen::Vector3d&
 // nearest to `tail` (the
 // least motion; direction = the unit direction from head to x, nearest in angle to that of tail).
 // In 2D (dim 2, z = 0) the directions are a circle, in 3D a sphere. Returns false if every
-// direction is blocked (the head is wedged between colliders), leaving *x alone.
+// direction is blocked (the head is wedged between colliders), leaving *x alone. `clearance`, if
+// given, receives SegmentClearance(colliders, head, *x).
 bool ContactTail(int dim, const Eigen::Vector3d& head, const Eigen::Vector3d& tail, double length,
-                 const std::vector<Collider>& colliders, Eigen::Vector3d* x);
+                 const std::vector<Collider>& colliders, Eigen::Vector3d* x,
+                 double* clearance = nullptr);
 
 // ContactTail leaves the tail where the link meets the collider to within its slack, or, from a
 // head inside by a hair (the last link's contact step), within twice the head's depth: along a
