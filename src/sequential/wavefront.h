@@ -117,8 +117,11 @@ template <class Arch, int Dim>
     mid[k] = k < Dim ? B(0.5) * (a[k] + b[k]) : B(0.0);
   }
   const B ab2 = xsimd::fma(ab[0], ab[0], xsimd::fma(ab[1], ab[1], ab[2] * ab[2]));
+  // The balls read as doubles: contact_sweep.cc filled them where Eigen aligns a Vector4d to 16
+  // bytes, and Eigen here (compiled for AVX) would take one to be aligned to 32.
+  const double* balls = reinterpret_cast<const double*>(set.balls.data());
   for (size_t c = 0; c < set.balls.size(); ++c) {
-    const Eigen::Vector4d& ball = set.balls[c];
+    const double* ball = balls + 4 * c;
     if (ball[3] < 0.0) return valid;
     if (set.spheres[c] && measured) {
       // First by the link's midpoint (BeyondBall's bound, a few operations): a sphere every lane
