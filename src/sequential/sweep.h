@@ -106,7 +106,9 @@ struct ContactStats {
 // which no ball holds). contact_sweep.cc.
 struct SweepSet {
   const std::vector<Collider>* colliders = nullptr;
-  std::vector<Eigen::Vector4d> balls;       // centre x, y, z and radius
+  // Centre x, y, z and radius. Filled where Eigen aligns a Vector4d to 16 bytes; the wavefront's
+  // translation units (AVX: Eigen assumes 32) read them as doubles, never as Vector4d.
+  std::vector<Eigen::Vector4d> balls;
   std::vector<char> spheres;                // whether the collider is a sphere (its ball is itself)
   std::vector<Eigen::Isometry3d> to_local;  // a mesh's world-to-mesh transform (its pose inverted)
 };
